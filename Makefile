@@ -1,0 +1,28 @@
+# Thin wrapper over CMake.  `make demo` and `make test` install missing
+# Debian packages first (scripts/deps.sh), then build and run.
+BUILD ?= build
+JOBS ?= $(shell nproc 2>/dev/null || echo 2)
+
+.PHONY: all test demo bench cross clean deps
+
+all: deps
+	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release
+	cmake --build $(BUILD) -j$(JOBS)
+
+deps:
+	@scripts/deps.sh
+
+test: all
+	cd $(BUILD) && ctest --output-on-failure -j$(JOBS)
+
+demo: all
+	scripts/demo.sh $(BUILD)
+
+bench: all
+	$(BUILD)/bench/ct_bench
+
+cross: deps
+	scripts/cross.sh $(BUILD)/cross
+
+clean:
+	rm -rf $(BUILD)

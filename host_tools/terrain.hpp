@@ -1,0 +1,71 @@
+// terrain.hpp -- host-side terrain model and package building (C++17).
+//
+// A Terrain is what a package is made from: 16-bit height codes on a square
+// grid plus the georeference.  build_package() computes the max-mipmap and
+// the directional PPT (apex + N sector angles per coarse cell) and returns
+// the package bytes in the format defined by lib/include/conetrace.h.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace ct_host {
+
+struct Georef {
+    // GDAL convention: post (i, j) centre = origin + (i + 1/2, j + 1/2) * posting.
+    double origin_e = 0.0, origin_n = 0.0;  // metres, top-left corner of pixel (0,0)
+    double posting_e = 30.0, posting_n = -30.0;  // metres; |e| == |n|
+    int epsg = 0;                                // 0 = unknown
+};
+
+struct Terrain {
+    int width = 0, height = 0;           // posts
+    std::vector<uint16_t> codes;         // row-major, width * height
+    std::vector<uint8_t> void_post;      // empty, or 1 where the post was nodata
+    Georef geo;
+    double height_offset_m = 0.0;        // h = offset + code * scale
+    double height_scale_m = 1.0;         // metres per LSB (> 0)
+
+    uint16_t at(int i, int j) const { return codes[(size_t)j * (size_t)width + (size_t)i]; }
+};
+
+enum class PptBuilder { Brute };
+
+struct BuildOptions {
+    int sectors = 24;      // N, 1..64
+    int reduce = 1;        // r, 1..8
+    int slices = 0;        // K > 0: apexes rounded up to K evenly spaced levels
+    int threads = 0;       // 0 = hardware concurrency
+    PptBuilder builder = PptBuilder::Brute;
+    // progress(done, total) called from the calling thread now and then
+    std::function<void(size_t, size_t)> progress;
+};
+
+struct BuildStats {
+    double seconds = 0.0;
+    size_t degenerate_cones = 0;   // (cell, sector) pairs with code 0
+    size_t cones = 0;              // (cell, sector) pairs
+};
+
+struct Error : std::runtime_error {
+    using std::runtime_error::runtime_error;
+};
+
+// Quantise metres to codes.  scale_m <= 0 chooses the finest power-of-two
+// fraction of a metre that fits the range (at most 1/16 m ... up to 2^k m).
+// NaN / nodata entries (valid[k] == 0) become void posts.
+Terrain terrain_from_heights(int width, int height, const std::vector<double> &h_m,
+                             const std::vector<uint8_t> &valid, const Georef &geo,
+                             double scale_m = 0.0);
+
+// The package bytes (header, heights, mipmap, apex, angles, voids, CRC).
+std::vector<uint8_t> build_package(const Terrain &t, const BuildOptions &opt,
+                                   BuildStats *stats = nullptr);
+
+// Georeference as the package stores it (integer nanometres).
+int64_t metres_to_nm(double m);
+
+}  // namespace ct_host

@@ -1,0 +1,315 @@
+/*
+ * conetrace.h -- the one public header of the conetrace flight library.
+ *
+ * Exact first hit of a ray on the bilinear surface of a terrain package
+ * (a DEM plus a directional parameter plane transform, Paglieroni 1997).
+ * C99, freestanding, integer-only, no heap, no recursion, every loop bounded.
+ *
+ * Frames and units (see README "Frames and formats"):
+ *   grid frame   x = column, y = row, in fine cells; post (i, j) sits at
+ *                (x, y) = (i, j); z is in height LSB (package code units).
+ *   map frame    the DEM's projected CRS in nanometres (int64): E east,
+ *                N north, h up.  Post (i, j) is at
+ *                E = origin_e + (i + 1/2) * posting_e,
+ *                N = origin_n + (j + 1/2) * posting_n  (GDAL convention),
+ *                h = height_offset + code * height_scale.
+ *
+ * Fixed-point formats (Q notation: Qm.n has n fractional bits):
+ *   ct_q16    int64 with 16 fractional bits.  Grid positions x, y (cells)
+ *             and z (LSB).  Inside a tile |x|,|y| < 2^15 cells and
+ *             z in [-2^16, 2^16] LSB, so values stay below 2^33; ray
+ *             origins may lie outside the tile up to CT_MAX_ORIGIN_Q16.
+ *   t (Q26)   the parameter of a *prepared* ray; position = o + t * d with
+ *             d normalised so that max(|dx|,|dy|,|dz|) is in
+ *             [2^25, 2^26].  Inside a tile t < 2^8, so t_q26 < 2^34.
+ * Overflow arguments for every product are written beside the code that
+ * forms it (lib/src/trace.c, lib/src/fixed.h).
+ *
+ * Status codes: every public function returns ct_status.  Negative values
+ * are errors (bad data or bad arguments); non-negative values are results.
+ * Programmer misuse (NULL pointers) also trips CT_ASSERT, which a build may
+ * override (define CT_ASSERT before including, or at compile time).
+ */
+#ifndef CONETRACE_H
+#define CONETRACE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ------------------------------------------------------------------------ */
+/* Status codes                                                              */
+
+typedef int32_t ct_status;
+
+enum {
+    /* results (>= 0) */
+    CT_OK = 0,
+    CT_HIT = 1,       /* first intersection found (hit fields valid)          */
+    CT_MISS = 2,      /* the ray leaves the tile (or never enters it)         */
+    CT_BELOW = 3,     /* the ray's first point in the tile is below the surface */
+    CT_HIT_VOID = 4,  /* first hit lies in a void (nodata) cell: position is on
+                         the filled floor, not on measured terrain             */
+
+    /* errors (< 0) */
+    CT_ERR_ARG = -1,        /* NULL pointer, bad enum, zero-length buffer       */
+    CT_ERR_TRUNCATED = -2,  /* buffer shorter than the header or total size     */
+    CT_ERR_MAGIC = -3,      /* not a conetrace package                          */
+    CT_ERR_VERSION = -4,    /* unsupported format version                       */
+    CT_ERR_HEADER = -5,     /* header size field wrong                          */
+    CT_ERR_CRC = -6,        /* CRC-32 mismatch                                  */
+    CT_ERR_DIMS = -7,       /* width/height outside [2, CT_MAX_POSTS]           */
+    CT_ERR_SECTORS = -8,    /* sector count outside [1, CT_MAX_SECTORS]         */
+    CT_ERR_REDUCE = -9,     /* reduction factor outside [1, CT_MAX_REDUCE]      */
+    CT_ERR_LEVELS = -10,    /* mipmap level count inconsistent with the size    */
+    CT_ERR_SIZE = -11,      /* a section size differs from the one implied      */
+    CT_ERR_OFFSET = -12,    /* a section lies outside the package, overlaps,
+                               or is not 8-byte aligned                         */
+    CT_ERR_RANGE = -13,     /* impossible value (hmin > hmax, codes outside)    */
+    CT_ERR_GEOREF = -14,    /* zero/non-square posting, non-positive scale      */
+    CT_ERR_FLAGS = -15,     /* unknown flag bits                                */
+    CT_ERR_RAY = -16,       /* zero direction or origin beyond CT_MAX_ORIGIN_Q16 */
+    CT_ERR_METHOD = -17,    /* unknown tracing method                           */
+    CT_ERR_INTERNAL = -18,  /* a loop reached its bound: a library bug          */
+    CT_ERR_VERIFY = -19     /* ct_package_verify: content breaks an invariant   */
+};
+
+/* ------------------------------------------------------------------------ */
+/* Limits                                                                    */
+
+#define CT_MAX_POSTS 32768        /* posts per side: x_q16 < 2^31            */
+#define CT_MAX_SECTORS 64
+#define CT_MAX_REDUCE 8
+#define CT_MAX_LEVELS 16          /* mipmap levels 1..15 stored               */
+#define CT_MAX_ORIGIN_Q16 ((int64_t)1 << 46) /* |origin| in q16, 2^30 cells   */
+#define CT_DIR_BITS 26            /* prepared direction: max |d| in [2^25, 2^26] */
+#define CT_T_FRAC_BITS 26         /* t_q26                                    */
+
+/* Worst-case loop iterations, published per method (DESIGN.md): every
+ * INCREMENTAL, CONE and DIRECTIONAL iteration leaves at least one fine
+ * cell, so iterations <= cells_x + cells_y + 1; HIERARCHICAL needs at most
+ * (levels + 2) iterations per fine cell left.  Exceeding a bound returns
+ * CT_ERR_INTERNAL.                                                          */
+#define CT_WCET_CELL_ITERS(cx, cy) ((uint32_t)(cx) + (uint32_t)(cy) + 2u)
+#define CT_WCET_HIER_ITERS(cx, cy, levels) \
+    (CT_WCET_CELL_ITERS(cx, cy) * ((uint32_t)(levels) + 2u))
+
+/* ------------------------------------------------------------------------ */
+/* Package format (little-endian; defined once here, written by host_tools) */
+
+#define CT_PKG_MAGIC "CTPK"
+#define CT_PKG_VERSION 1u
+#define CT_PKG_HEADER_SIZE 128u
+#define CT_PKG_ALIGN 8u
+#define CT_PKG_FLAG_VOIDS 1u     /* a void (nodata) cell bitmap is present   */
+
+/* Section indices in the header's section table.                           */
+enum {
+    CT_SEC_HEIGHTS = 0, /* W*H uint16 codes, row-major (row 0 first)          */
+    CT_SEC_MIPMAP = 1,  /* levels 1..L of max-mipmap, uint16, level by level  */
+    CT_SEC_APEX = 2,    /* Wc*Hc uint16 apex codes of the coarse cells        */
+    CT_SEC_ANGLES = 3,  /* P planes of Wc*Hc uint8 opening-angle codes;
+                           P = N for N == 1, else N + 1 (plane N = omni cone) */
+    CT_SEC_VOIDS = 4,   /* ceil(cx*cy/8) bytes, bit k = fine cell k is void   */
+    CT_SEC_COUNT = 5
+};
+
+/* Header byte offsets.  All multi-byte fields little-endian.
+ *   0  char[4] magic "CTPK"          4  u16 version        6  u16 header size
+ *   8  u32 total size (bytes)       12  u32 CRC-32 (IEEE, over the whole
+ *                                       package with these 4 bytes zero)
+ *  16  u16 width W (posts)          18  u16 height H (posts)
+ *  20  u8  reduce r                 21  u8  sectors N
+ *  22  u8  mipmap levels L          23  u8  flags
+ *  24  u16 hmin code                26  u16 hmax code
+ *  28  u32 slices K (informational, 0 = exact apexes)
+ *  32  i64 origin_e_nm              40  i64 origin_n_nm   (GDAL top-left corner)
+ *  48  i64 posting_e_nm             56  i64 posting_n_nm  (|e| == |n|)
+ *  64  i64 height_offset_nm         72  i64 height_scale_nm (> 0, per LSB)
+ *  80  u32 EPSG code (0 = unknown)  84  u32 reserved (0)
+ *  88  5 x { u32 offset, u32 size } section table (bytes from package start)
+ */
+#define CT_HDR_SECTION_TABLE 88u
+
+/* Sector convention: sector s covers the closed wedge of horizontal grid
+ * directions between boundary vectors b_s and b_{s+1}, b_k at grid azimuth
+ * 360 deg * k / N measured from +x (column, east) towards +y (row, south);
+ * on a north-up map that is clockwise from east.  b_k are integer vectors
+ * (|b| ~ 2^30) from ct_sector_boundary(); axes and diagonals are exact.
+ * The builder and the tracer use the very same integer wedge test.          */
+
+/* Opening angle codes: omega = code * 180 deg / 256 from the upward vertical,
+ * measured in the metric frame (height in metres vs distance in metres).
+ * Code 0 means "no cone" (degenerate).  The tracer uses
+ * cot_q16[code] = ceil(cot(omega) * posting / height_scale * 2^16), LSB per
+ * cell in Q16, rounded towards +infinity so the promised empty region only
+ * ever shrinks; |cot_q16| is limited to CT_COT_MAX_Q16 (larger positive
+ * values are treated as degenerate, larger negative ones clamped).          */
+#define CT_COT_MAX_Q16 ((int64_t)1 << 35)
+
+/* ------------------------------------------------------------------------ */
+/* Types                                                                     */
+
+typedef enum {
+    CT_METHOD_INCREMENTAL = 0, /* exact grid walk (Musgrave)                 */
+    CT_METHOD_HIERARCHICAL = 1,/* max-mipmap                                 */
+    CT_METHOD_CONE = 2,        /* one omnidirectional cone per coarse cell   */
+    CT_METHOD_DIRECTIONAL = 3, /* N sector cones per coarse cell             */
+    CT_METHOD_COUNT = 4
+} ct_method;
+
+/* An opened package: a zero-copy view of caller bytes plus derived tables.
+ * Transparent so it can live in static memory; fill it with ct_package_open.
+ * About 2.6 KB.                                                             */
+typedef struct {
+    const uint8_t *base;    /* the package bytes (not copied)                 */
+    uint32_t size;          /* total size in bytes                            */
+    uint32_t width, height; /* posts                                          */
+    uint32_t cells_x, cells_y;   /* fine cells = posts - 1                     */
+    uint32_t reduce, sectors;    /* r, N                                       */
+    uint32_t coarse_x, coarse_y; /* ceil(cells / r)                            */
+    uint32_t levels;             /* stored mipmap levels (1..L)                */
+    uint32_t planes;             /* angle planes (N or N + 1)                  */
+    uint32_t flags;
+    uint32_t slices;
+    uint32_t epsg;
+    int32_t hmin, hmax;          /* height code range                          */
+    int64_t origin_e_nm, origin_n_nm, posting_e_nm, posting_n_nm;
+    int64_t height_offset_nm, height_scale_nm;
+    const uint8_t *heights;      /* section pointers into base                 */
+    const uint8_t *mip[CT_MAX_LEVELS]; /* mip[l] for l = 1..levels             */
+    uint32_t mip_w[CT_MAX_LEVELS], mip_h[CT_MAX_LEVELS];
+    const uint8_t *apex;
+    const uint8_t *angles;
+    const uint8_t *voids;        /* NULL when no voids                         */
+    int32_t bound_x[CT_MAX_SECTORS + 1]; /* sector boundary vectors            */
+    int32_t bound_y[CT_MAX_SECTORS + 1];
+    int64_t cot_q16[256];        /* per angle code; see CT_COT_MAX_Q16         */
+    uint8_t cot_ok[256];         /* 0: code is degenerate for this package     */
+} ct_package;
+
+/* A ray as the caller gives it, grid frame.                                 */
+typedef struct {
+    int64_t x_q16, y_q16, z_q16; /* origin; |.| <= CT_MAX_ORIGIN_Q16           */
+    int64_t dx, dy, dz;          /* direction in the same units (cells, cells,
+                                    LSB), any common scale, not all zero,
+                                    |.| <= 2^62                                */
+} ct_ray;
+
+/* A ray clipped to the tile and quantised: the object the tracer is exact
+ * for.  Transparent so tests can trace the same ray independently.
+ * Position(t) = o + t * d, t >= 0; o lies in the tile's box.               */
+typedef struct {
+    int64_t ox, oy, oz;    /* Q16 origin (the entry point, rounded to Q16)    */
+    int32_t dx, dy, dz;    /* Q16 units per unit t; max |.| in [2^25, 2^26]   */
+    int32_t sector;        /* sector of (dx, dy); -1 for vertical rays        */
+    int64_t len_lo, len_hi;/* floor/ceil of sqrt(dx^2 + dy^2)                 */
+    int64_t tend_n, tend_d;/* t where the ray leaves the tile's box (> 0 den) */
+    ct_status start;       /* CT_OK, or CT_MISS/CT_BELOW/CT_HIT decided at prep */
+} ct_prepared;
+
+/* Result of a trace.                                                        */
+typedef struct {
+    int64_t x_q16, y_q16, z_q16; /* hit, grid frame (valid for CT_HIT*)        */
+    int64_t e_nm, n_nm, h_nm;    /* hit, map frame (valid for CT_HIT*)         */
+    int64_t t_q26;               /* parameter of the prepared ray at the hit   */
+    int32_t cell_x, cell_y;      /* fine cell holding the hit                  */
+    uint32_t steps;              /* advances (cells, blocks or cones)           */
+    uint32_t iters;              /* loop iterations (<= the WCET bound)         */
+} ct_hit;
+
+/* ------------------------------------------------------------------------ */
+/* Functions                                                                 */
+
+/* Validate bytes[0..len) as a package and fill *pkg (zero copy: bytes must
+ * outlive pkg).  Checks, in order: header, magic, version, header size,
+ * total size, CRC, dimensions, sectors, reduction, levels, flags, ranges,
+ * georeference, every section's offset, size and alignment.  A package that
+ * opens can never make any function read outside bytes[0..total).          */
+ct_status ct_package_open(ct_package *pkg, const uint8_t *bytes, size_t len);
+
+/* Deep content check, O(cells): mipmap levels are the max of their children,
+ * every apex is at least its coarse cell's tallest corner, hmin/hmax match
+ * the samples.  Returns CT_OK or CT_ERR_VERIFY.                             */
+ct_status ct_package_verify(const ct_package *pkg);
+
+/* Size in bytes of a package with these parameters (0 if out of limits).    */
+ct_status ct_package_size(uint32_t width, uint32_t height, uint32_t reduce,
+                          uint32_t sectors, uint32_t with_voids,
+                          uint32_t *out_size);
+
+/* Section layout (offset, size in bytes) for a package with these
+ * parameters; the writer and the reader share it.                          */
+ct_status ct_package_layout(uint32_t width, uint32_t height, uint32_t reduce,
+                            uint32_t sectors, uint32_t with_voids,
+                            uint32_t sec_off[CT_SEC_COUNT],
+                            uint32_t sec_size[CT_SEC_COUNT],
+                            uint32_t *levels, uint32_t *total);
+
+/* CRC-32 (IEEE 802.3, reflected 0xEDB88320), continuing from crc (start 0). */
+ct_status ct_crc32(uint32_t crc, const uint8_t *data, size_t len,
+                   uint32_t *out_crc);
+
+/* Sector boundary vector k (0..N) for N sectors; |b| ~ 2^30.                */
+ct_status ct_sector_boundary(uint32_t sectors, uint32_t k, int32_t *bx,
+                             int32_t *by);
+
+/* Sector holding grid direction (dx, dy) (|.| <= 2^30, not both zero): the
+ * lowest s whose closed wedge holds it, by the exact integer wedge test.   */
+ct_status ct_sector_of(const ct_package *pkg, int64_t dx, int64_t dy,
+                       uint32_t *out_sector);
+
+/* Same test for an explicit boundary set (used by the builder).             */
+ct_status ct_in_wedge(const int32_t *bound_x, const int32_t *bound_y,
+                      uint32_t sectors, uint32_t s, int64_t dx, int64_t dy,
+                      uint32_t *out_inside);
+
+/* cot table for angle codes given the georeference: out[code] in Q16 LSB per
+ * fine cell, rounded up; ok[code] = 0 where degenerate.                     */
+ct_status ct_cot_table(int64_t posting_nm, int64_t height_scale_nm,
+                       int64_t out_q16[256], uint8_t ok[256]);
+
+/* Clip and quantise a ray.  Returns CT_OK (traceable), CT_MISS (never enters
+ * the tile), CT_BELOW / CT_HIT (decided at its first point), or an error.   */
+ct_status ct_ray_prepare(const ct_package *pkg, const ct_ray *ray,
+                         ct_prepared *out);
+
+/* Trace a prepared ray.  Returns CT_HIT, CT_HIT_VOID, CT_MISS, CT_BELOW or an
+ * error; *hit is filled for every non-error result (steps, iters).         */
+ct_status ct_trace_prepared(const ct_package *pkg, const ct_prepared *ray,
+                            ct_method method, ct_hit *hit);
+
+/* ct_ray_prepare + ct_trace_prepared.                                       */
+ct_status ct_trace(const ct_package *pkg, const ct_ray *ray, ct_method method,
+                   ct_hit *hit);
+
+/* Grid (Q16) to map (nm) and back, exact integer scaling, rounded to
+ * nearest.  Map coordinates of the tile must stay within +-2^62 nm.         */
+ct_status ct_grid_to_map(const ct_package *pkg, int64_t x_q16, int64_t y_q16,
+                         int64_t z_q16, int64_t *e_nm, int64_t *n_nm,
+                         int64_t *h_nm);
+ct_status ct_map_to_grid(const ct_package *pkg, int64_t e_nm, int64_t n_nm,
+                         int64_t h_nm, int64_t *x_q16, int64_t *y_q16,
+                         int64_t *z_q16);
+
+/* A map-frame ray (origin in nm, direction in any common unit with
+ * |.| <= 2^40) as a grid-frame ct_ray.                                      */
+ct_status ct_ray_from_map(const ct_package *pkg, int64_t e_nm, int64_t n_nm,
+                          int64_t h_nm, int64_t de, int64_t dn, int64_t dh,
+                          ct_ray *out);
+
+/* Height of the bilinear surface at a grid point inside the tile, Q16,
+ * rounded up.                                                               */
+ct_status ct_surface_height(const ct_package *pkg, int64_t x_q16,
+                            int64_t y_q16, int64_t *z_q16);
+
+ct_status ct_status_name(ct_status s, const char **out);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* CONETRACE_H */

@@ -1,0 +1,1204 @@
+/*
+ * trace.c -- exact first hit of a prepared ray on the bilinear surface, by
+ * four methods that all share one exact cell test (so all four return
+ * bit-identical hits):
+ *   INCREMENTAL   grid walk over every fine cell (Musgrave)
+ *   HIERARCHICAL  max-mipmap block skipping
+ *   CONE          one omnidirectional cone per coarse cell
+ *   DIRECTIONAL   one cone per sector per coarse cell (Paglieroni 1997)
+ *
+ * Number formats (see conetrace.h):
+ *   positions  Q16 in int64; inside the tile box x, y < 2^31, z in
+ *              [(hmin-1)*2^16, (hmax+1)*2^16] so |z| < 2^33.
+ *   direction  int32, max component in [2^25, 2^26].
+ *   t          rational n/d, d in {1, |dx|, |dy|, |dz|, 2^26} <= 2^26;
+ *              the ray is inside the box for t <= tend < 2^8 (the dominant
+ *              axis moves >= 2^25 per unit t across a box of <= 2^33), so
+ *              0 <= n < 2^34.
+ * Every product below is annotated with its bound; all stay < 2^62 in
+ * int64 except the few marked "128-bit".
+ *
+ * Exactness: whether the ray meets the surface in a cell is decided with
+ * exact integer arithmetic (the sign of f = z_ray - S at cell faces in
+ * 64-bit; the interior minimum of the quadratic f in 128-bit).  Only the
+ * reported hit position is rounded: the root is computed to 2^-32 of the
+ * cell and the position reported at t_q26 = floor(t * 2^26).
+ */
+#include "conetrace.h"
+#include "fixed.h"
+
+#define ONE16 INT64_C(65536)
+#define T_ONE (INT64_C(1) << CT_T_FRAC_BITS)
+
+enum { FACE_X = 1, FACE_Y = 2, FACE_XY = 3 };
+
+typedef struct {
+    int64_t n, d; /* t = n / d, d > 0 */
+} rt;
+
+typedef struct {
+    rt t;      /* parameter at the exit point */
+    int face;  /* FACE_X, FACE_Y or FACE_XY (through a post) */
+    int32_t xf, yf; /* face coordinates (cells) */
+} cexit;
+
+typedef struct {
+    const ct_package *p;
+    const ct_prepared *r;
+    int32_t sx, sy;   /* signs of dx, dy */
+    int64_t adx, ady; /* |dx|, |dy| */
+    int32_t cx, cy;   /* fine cells */
+    rt tend;
+} ctx;
+
+static int sgn64(int64_t v) { return (v > 0) - (v < 0); }
+
+/* a < b for rationals: n <= 2^34, d <= 2^26 -> products < 2^60 */
+static int rt_lt(rt a, rt b) { return a.n * b.d < b.n * a.d; }
+
+/* z(t) in Q16, floored: n*dz < 2^34 * 2^26 = 2^60 */
+static int64_t z_at(const ctx *c, rt t)
+{
+    return c->r->oz + ct_floor_div(t.n * (int64_t)c->r->dz, t.d);
+}
+
+/* Fine-cell index along one axis at o + t*d (Q16), with the tie rule: a
+ * point exactly on a grid line belongs to the cell the ray moves into; with
+ * no motion along the axis, to the cell on its + side, clamped to the tile.
+ * num = o*den + n*d: o < 2^31 (or 2^47 at prep) ... callers bound it.      */
+static int32_t axis_cell(int64_t num, int64_t den16, int32_t s, int32_t ncell)
+{
+    int64_t k = ct_floor_div(num, den16);
+    if (k * den16 == num) {
+        if (s < 0) {
+            k -= 1;
+        } else if (s == 0 && k == ncell) {
+            k -= 1;
+        }
+    }
+    if (k < -1) {
+        k = -1;
+    }
+    if (k > ncell) {
+        k = ncell;
+    }
+    return (int32_t)k;
+}
+
+/* Cell holding the ray at t.  ox*d < 2^31 * 2^26, n*dx < 2^60. */
+static void locate(const ctx *c, rt t, int32_t *i, int32_t *j)
+{
+    *i = axis_cell(c->r->ox * t.d + t.n * (int64_t)c->r->dx, t.d * ONE16, c->sx, c->cx);
+    *j = axis_cell(c->r->oy * t.d + t.n * (int64_t)c->r->dy, t.d * ONE16, c->sy, c->cy);
+}
+
+static int inside(const ctx *c, int32_t i, int32_t j)
+{
+    return i >= 0 && j >= 0 && i < c->cx && j < c->cy;
+}
+
+/* Exit of fine cell (i, j).  (face*2^16 - o) < 2^31, times |d| <= 2^26:
+ * < 2^57. */
+static void cell_exit(const ctx *c, int32_t i, int32_t j, cexit *e)
+{
+    int64_t nx = 0, ny = 0;
+    e->xf = i + (c->sx > 0 ? 1 : 0);
+    e->yf = j + (c->sy > 0 ? 1 : 0);
+    if (c->sx != 0) {
+        nx = ((int64_t)e->xf * ONE16 - c->r->ox) * c->sx;
+    }
+    if (c->sy != 0) {
+        ny = ((int64_t)e->yf * ONE16 - c->r->oy) * c->sy;
+    }
+    if (c->sy == 0) {
+        e->face = FACE_X;
+    } else if (c->sx == 0) {
+        e->face = FACE_Y;
+    } else {
+        int64_t lx = nx * c->ady, ly = ny * c->adx;
+        e->face = lx < ly ? FACE_X : (ly < lx ? FACE_Y : FACE_XY);
+    }
+    if (e->face == FACE_Y) {
+        e->t.n = ny;
+        e->t.d = c->ady;
+    } else {
+        e->t.n = nx;
+        e->t.d = c->adx;
+    }
+}
+
+/* Canonical entry parameter of cell (i, j): the later of its entry faces,
+ * or 0 when the origin lies in it. */
+static rt cell_entry(const ctx *c, int32_t i, int32_t j)
+{
+    rt t = {0, 1};
+    if (c->sx != 0) {
+        int64_t xe = (int64_t)i + (c->sx < 0 ? 1 : 0);
+        rt tx;
+        tx.n = (xe * ONE16 - c->r->ox) * c->sx;
+        tx.d = c->adx;
+        if (rt_lt(t, tx)) {
+            t = tx;
+        }
+    }
+    if (c->sy != 0) {
+        int64_t ye = (int64_t)j + (c->sy < 0 ? 1 : 0);
+        rt ty;
+        ty.n = (ye * ONE16 - c->r->oy) * c->sy;
+        ty.d = c->ady;
+        if (rt_lt(t, ty)) {
+            t = ty;
+        }
+    }
+    return t;
+}
+
+typedef struct {
+    int32_t h00, h10, h01, h11, hmax;
+} posts4;
+
+static void load_posts(const ct_package *p, int32_t i, int32_t j, posts4 *q)
+{
+    const uint8_t *r0 = p->heights + 2u * ((size_t)(uint32_t)j * p->width + (uint32_t)i);
+    const uint8_t *r1 = r0 + 2u * p->width;
+    int32_t m;
+    q->h00 = (int32_t)ct_ld16(r0);
+    q->h10 = (int32_t)ct_ld16(r0 + 2);
+    q->h01 = (int32_t)ct_ld16(r1);
+    q->h11 = (int32_t)ct_ld16(r1 + 2);
+    m = q->h00 > q->h10 ? q->h00 : q->h10;
+    m = m > q->h01 ? m : q->h01;
+    q->hmax = m > q->h11 ? m : q->h11;
+}
+
+/* Sign of f = z_ray - S at the exit point, exact.  With d = e->t.d and
+ * n = e->t.n:  d*Z = oz*d + n*dz (< 2^58 + 2^60); h*2^16*d < 2^58;
+ * d*2^16*v in [0, 2^42] times |dh| < 2^16: < 2^58.  Sum < 2^62.        */
+static int exit_sign(const ctx *c, int32_t i, int32_t j, const cexit *e, const posts4 *q)
+{
+    int64_t d = e->t.d, n = e->t.n;
+    int64_t dz = c->r->oz * d + n * (int64_t)c->r->dz;
+    int64_t ha, hb, dw, val;
+    if (e->face == FACE_XY) {
+        int32_t h = (e->xf == i) ? (e->yf == j ? q->h00 : q->h01) : (e->yf == j ? q->h10 : q->h11);
+        return sgn64(dz - (int64_t)h * ONE16 * d);
+    }
+    if (e->face == FACE_X) {
+        ha = (e->xf == i) ? q->h00 : q->h10;
+        hb = (e->xf == i) ? q->h01 : q->h11;
+        dw = c->r->oy * d + n * (int64_t)c->r->dy - (int64_t)j * ONE16 * d;
+    } else {
+        ha = (e->yf == j) ? q->h00 : q->h01;
+        hb = (e->yf == j) ? q->h10 : q->h11;
+        dw = c->r->ox * d + n * (int64_t)c->r->dx - (int64_t)i * ONE16 * d;
+    }
+    val = (dz - ha * ONE16 * d) - (hb - ha) * dw;
+    return sgn64(val);
+}
+
+/* ------------------------------------------------------------------------ */
+/* The quadratic along the cell.  The primary axis p is the one with the
+ * larger |D| (x for |dx| >= |dy|); w in [0, 1] is the cell coordinate along
+ * p measured in the ray's direction (w = u for dx > 0, w = 1 - u for
+ * dx < 0), so w grows with t.  Posts are relabelled g[ip][iq] (ip along p,
+ * mirrored when the ray moves to -p), and the surface is
+ *     S = g00 + a w + b v + c w v      (v: cell coordinate across p).
+ * With d = |D_p|, L = the cell's w = 0 line, dps = d * t(L) = s*(L - o_p):
+ *     V0 = d*2^16 * v(L) = d*(o_q - k_q*2^16) + dps_q, dps_q = s*(L-o_p)*D_q
+ *     Z0 = d*2^16 * (z(L) - g00) = d*(o_z - g00*2^16) + s*(L-o_p)*D_z
+ *     d*2^16 * f(w) = A w^2 + B w + C,
+ *     C = Z0 - b*V0,  B = 2^16*(D_z - a*d - b*D_q) - c*V0,  A = -c*2^16*D_q
+ * Bounds (|D_q| <= |D_p| so v(L) in [-1, 2]; |a|,|b| < 2^16, |c| < 2^17):
+ * |V0| <= 2^43, |Z0| < 2^59.5, |C| < 2^60, |B| < 2^61, |A| < 2^59;
+ * B^2 - 4AC < 2^123 (128-bit).                                           */
+typedef struct {
+    int64_t A, B, C;
+    int p;       /* 0: x-major, 1: y-major */
+    int64_t d;   /* |D_p| */
+    int64_t dps; /* s * (L - o_p): d times t at the w = 0 line */
+} quad;
+
+static void make_quad(const ctx *c, int32_t i, int32_t j, const posts4 *q, quad *Q)
+{
+    int64_t op, oq, Dp, Dq, kq, L, g00, g10, g01, g11, a, b, cc, V0, Z0, s;
+    int32_t kp;
+    Q->p = (c->adx >= c->ady) ? 0 : 1;
+    if (Q->p == 0) {
+        op = c->r->ox;
+        oq = c->r->oy;
+        Dp = c->r->dx;
+        Dq = c->r->dy;
+        kp = i;
+        kq = j;
+        g00 = q->h00;
+        g10 = q->h10;
+        g01 = q->h01;
+        g11 = q->h11;
+    } else {
+        op = c->r->oy;
+        oq = c->r->ox;
+        Dp = c->r->dy;
+        Dq = c->r->dx;
+        kp = j;
+        kq = i;
+        g00 = q->h00;
+        g10 = q->h01;
+        g01 = q->h10;
+        g11 = q->h11;
+    }
+    s = Dp > 0 ? 1 : -1;
+    if (s < 0) {
+        /* mirror along p: w = 1 - (cell coordinate) */
+        int64_t t0 = g00, t1 = g01;
+        g00 = g10;
+        g01 = g11;
+        g10 = t0;
+        g11 = t1;
+        L = ((int64_t)kp + 1) * ONE16;
+    } else {
+        L = (int64_t)kp * ONE16;
+    }
+    a = g10 - g00;
+    b = g01 - g00;
+    cc = g11 - g10 - g01 + g00;
+    Q->d = ct_abs64(Dp);
+    Q->dps = s * (L - op); /* |L - o_p| < 2^31 */
+    /* d*(o_q - k_q 2^16): 2^26 * 2^31; s*(L - o_p)*D_q: 2^31 * 2^26 */
+    V0 = Q->d * (oq - kq * ONE16) + Q->dps * Dq;
+    /* d*(o_z - g00 2^16): 2^26 * 2^33; s*(L - o_p)*D_z: 2^31 * 2^26 */
+    Z0 = Q->d * (c->r->oz - g00 * ONE16) + Q->dps * (int64_t)c->r->dz;
+    Q->C = Z0 - b * V0;
+    Q->B = ONE16 * ((int64_t)c->r->dz - a * Q->d - b * Dq) - cc * V0;
+    Q->A = -cc * ONE16 * Dq;
+}
+
+/* w at parameter t as pn / pd (pd > 0): d*t - dps over 2^16:
+ * pn = n*d - e*dps (< 2^60 + 2^57), pd = e * 2^16 <= 2^42. */
+static void p_at(const ctx *c, const quad *Q, rt t, int64_t *pn, int64_t *pd)
+{
+    (void)c;
+    *pn = t.n * Q->d - t.d * Q->dps;
+    *pd = t.d * ONE16;
+}
+
+/* sign of dQ/dw at w = pn/pd: sign(B*pd + 2A*pn), 128-bit (< 2^104). */
+static int dq_sign(const quad *Q, int64_t pn, int64_t pd)
+{
+    ct_i128 v = ct_i128_add(ct_i128_mul(Q->B, pd), ct_i128_mul(2 * Q->A, pn));
+    return ct_i128_sign(v);
+}
+
+static ct_i128 disc(const quad *Q)
+{
+    /* B^2 < 2^122; 4AC < 2^121 */
+    return ct_i128_sub(ct_i128_mul(Q->B, Q->B), ct_i128_mul128_64(ct_i128_mul(Q->A, Q->C), 4));
+}
+
+/* Interior test: f > 0 at both ends of [tin, tout]; is there an interior
+ * minimum <= 0?  Needs A > 0, the vertex strictly inside, and B^2 >= 4AC. */
+static int interior_hit(const ctx *c, const quad *Q, rt tin, rt tout)
+{
+    int64_t pn, pd;
+    if (Q->A <= 0) {
+        return 0;
+    }
+    p_at(c, Q, tin, &pn, &pd);
+    if (dq_sign(Q, pn, pd) >= 0) {
+        return 0;
+    }
+    p_at(c, Q, tout, &pn, &pd);
+    if (dq_sign(Q, pn, pd) <= 0) {
+        return 0;
+    }
+    return ct_i128_sign(disc(Q)) >= 0;
+}
+
+/* First down-crossing root of the quadratic in [P(tin), P(tout)] and its
+ * t in Q26 (floored: the reported point never passes the true hit by more
+ * than one Q26 step).  Root r = (-B - sqrt(D)) / 2A = 2C / (-B + sqrt(D)),
+ * each form used where it does not cancel.                              */
+static int64_t root_t_q26(const ctx *c, const quad *Q, rt tin, rt tout)
+{
+    ct_i128 D = disc(Q);
+    int64_t sd, pq32, lo, hi, pn, pd;
+    ct_i128 num;
+    if (ct_i128_sign(D) < 0) {
+        D = ct_i128_from64(0); /* cannot happen for a decided hit */
+    }
+    sd = (int64_t)ct_i128_isqrt(D); /* < 2^61.5 */
+    if (Q->B < 0) {
+        int64_t den = -Q->B + sd; /* > 0, < 2^63 */
+        /* 2C * 2^32 < 2^93 */
+        pq32 = ct_i128_floor_div(ct_i128_shl(ct_i128_from64(2 * Q->C), 32), den);
+    } else if (Q->A != 0) {
+        /* (-B - sd) * 2^32 / 2A, A < 0 here: negate both */
+        ct_i128 nn = ct_i128_shl(ct_i128_from64(Q->B + sd), 32);
+        int64_t den = -2 * Q->A;
+        if (den < 0) {
+            nn = ct_i128_neg(nn);
+            den = -den;
+        }
+        pq32 = ct_i128_floor_div(nn, den);
+    } else {
+        pq32 = 0; /* f not decreasing: cannot happen for a decided hit */
+    }
+    /* clamp to the segment: lo = ceil(P(tin) 2^32), hi = floor(P(tout) 2^32) */
+    p_at(c, Q, tin, &pn, &pd);
+    lo = -ct_i128_floor_div(ct_i128_neg(ct_i128_shl(ct_i128_from64(pn), 32)), pd);
+    p_at(c, Q, tout, &pn, &pd);
+    hi = ct_i128_floor_div(ct_i128_shl(ct_i128_from64(pn), 32), pd);
+    if (pq32 < lo) {
+        pq32 = lo;
+    }
+    if (pq32 > hi) {
+        pq32 = hi;
+    }
+    /* d*t = dps + w*2^16, so t_q26 = floor((dps*2^32 + w_q32*2^16) / (d*2^6));
+     * dps*2^32 < 2^63: 128-bit. */
+    num = ct_i128_add(ct_i128_shl(ct_i128_from64(Q->dps), 32), ct_i128_shl(ct_i128_from64(pq32), 16));
+    {
+        int64_t t = ct_i128_floor_div(num, Q->d * 64);
+        return t < 0 ? 0 : t;
+    }
+}
+
+/* ------------------------------------------------------------------------ */
+
+static void fill_hit(const ctx *c, int64_t tq, int32_t i, int32_t j, ct_hit *h)
+{
+    const ct_prepared *r = c->r;
+    /* tq < 2^35, |d| <= 2^26: < 2^61 */
+    h->t_q26 = tq;
+    h->x_q16 = r->ox + ct_floor_div(tq * (int64_t)r->dx, T_ONE);
+    h->y_q16 = r->oy + ct_floor_div(tq * (int64_t)r->dy, T_ONE);
+    h->z_q16 = r->oz + ct_floor_div(tq * (int64_t)r->dz, T_ONE);
+    h->cell_x = i;
+    h->cell_y = j;
+    (void)ct_grid_to_map(c->p, h->x_q16, h->y_q16, h->z_q16, &h->e_nm, &h->n_nm, &h->h_nm);
+}
+
+static ct_status hit_status(const ct_package *p, int32_t i, int32_t j)
+{
+    if (p->voids != NULL) {
+        uint32_t k = (uint32_t)j * p->cells_x + (uint32_t)i;
+        if ((p->voids[k >> 3] >> (k & 7u)) & 1u) {
+            return CT_HIT_VOID;
+        }
+    }
+    return CT_HIT;
+}
+
+/* The exact cell test on [tin, exit]; f(tin) > 0 is known by the caller.
+ * Returns 1 and fills *h on a hit. */
+static int cell_test(const ctx *c, int32_t i, int32_t j, rt tin, const cexit *e, ct_hit *h)
+{
+    posts4 q;
+    int64_t zlim;
+    rt tlo;
+    load_posts(c->p, i, j, &q);
+    /* cheap reject: lowest ray point above the tallest corner.
+     * d*Z < 2^60 (see exit_sign), hmax*2^16*d < 2^58. */
+    tlo = c->r->dz <= 0 ? e->t : tin;
+    zlim = (int64_t)q.hmax * ONE16 * tlo.d;
+    if (c->r->oz * tlo.d + tlo.n * (int64_t)c->r->dz > zlim) {
+        return 0;
+    }
+    if (exit_sign(c, i, j, e, &q) > 0) {
+        int64_t cc = (int64_t)q.h11 - q.h10 - q.h01 + q.h00;
+        quad Q;
+        /* an interior minimum needs f convex: -c*dx*dy > 0 */
+        if (cc == 0 || (cc > 0) == ((c->sx * c->sy) > 0) || c->sx == 0 || c->sy == 0) {
+            return 0;
+        }
+        make_quad(c, i, j, &q, &Q);
+        if (!interior_hit(c, &Q, tin, e->t)) {
+            return 0;
+        }
+        fill_hit(c, root_t_q26(c, &Q, tin, e->t), i, j, h);
+        return 1;
+    }
+    {
+        quad Q;
+        make_quad(c, i, j, &q, &Q);
+        fill_hit(c, root_t_q26(c, &Q, tin, e->t), i, j, h);
+    }
+    return 1;
+}
+
+/* ------------------------------------------------------------------------ */
+/* Walkers.                                                                  */
+
+static void next_cell(const ctx *c, const cexit *e, int32_t *i, int32_t *j)
+{
+    if (e->face & FACE_X) {
+        *i += c->sx;
+    }
+    if (e->face & FACE_Y) {
+        *j += c->sy;
+    }
+}
+
+static ct_status walk_incremental(const ctx *c, ct_hit *h)
+{
+    int32_t i, j;
+    uint32_t it, bound = CT_WCET_CELL_ITERS(c->cx, c->cy);
+    rt tin = {0, 1};
+    cexit e;
+    locate(c, tin, &i, &j);
+    /* bound: each iteration leaves one fine cell */
+    for (it = 0u; it < bound; ++it) {
+        if (!inside(c, i, j)) {
+            h->iters = it;
+            return CT_MISS;
+        }
+        cell_exit(c, i, j, &e);
+        h->steps++;
+        if (cell_test(c, i, j, tin, &e, h)) {
+            h->iters = it + 1u;
+            return hit_status(c->p, i, j);
+        }
+        if (!rt_lt(e.t, c->tend)) {
+            h->iters = it + 1u;
+            return CT_MISS;
+        }
+        next_cell(c, &e, &i, &j);
+        tin = e.t;
+    }
+    return CT_ERR_INTERNAL;
+}
+
+static uint32_t mip_at(const ct_package *p, uint32_t l, int32_t bi, int32_t bj)
+{
+    return ct_ld16(p->mip[l] + 2u * ((size_t)(uint32_t)bj * p->mip_w[l] + (uint32_t)bi));
+}
+
+static ct_status walk_hierarchical(const ctx *c, ct_hit *h)
+{
+    const ct_package *p = c->p;
+    int32_t i, j;
+    uint32_t lvl = p->levels, it, bound = CT_WCET_HIER_ITERS(c->cx, c->cy, p->levels);
+    rt t = {0, 1};
+    cexit e;
+    locate(c, t, &i, &j);
+    /* bound: per fine cell left, at most levels descents + one advance */
+    for (it = 0u; it < bound; ++it) {
+        if (!inside(c, i, j)) {
+            h->iters = it;
+            return CT_MISS;
+        }
+        if (lvl == 0u) {
+            cell_exit(c, i, j, &e);
+            h->steps++;
+            if (cell_test(c, i, j, t, &e, h)) {
+                h->iters = it + 1u;
+                return hit_status(p, i, j);
+            }
+            if (!rt_lt(e.t, c->tend)) {
+                h->iters = it + 1u;
+                return CT_MISS;
+            }
+            next_cell(c, &e, &i, &j);
+            t = e.t;
+            lvl = p->levels > 0u ? 1u : 0u;
+        } else {
+            int32_t bi = i >> lvl, bj = j >> lvl, xf, yf;
+            int64_t bmax = (int64_t)mip_at(p, lvl, bi, bj), nx = 0, ny = 0;
+            rt tx;
+            int face;
+            /* block exit faces (cells); |face*2^16 - o| < 2^31 */
+            xf = c->sx > 0 ? ((bi + 1) << lvl) : (bi << lvl);
+            yf = c->sy > 0 ? ((bj + 1) << lvl) : (bj << lvl);
+            if (xf > c->cx) {
+                xf = c->cx;
+            }
+            if (yf > c->cy) {
+                yf = c->cy;
+            }
+            if (c->sx != 0) {
+                nx = ((int64_t)xf * ONE16 - c->r->ox) * c->sx;
+            }
+            if (c->sy != 0) {
+                ny = ((int64_t)yf * ONE16 - c->r->oy) * c->sy;
+            }
+            if (c->sy == 0) {
+                face = FACE_X;
+            } else if (c->sx == 0) {
+                face = FACE_Y;
+            } else {
+                int64_t lx = nx * c->ady, ly = ny * c->adx;
+                face = lx < ly ? FACE_X : (ly < lx ? FACE_Y : FACE_XY);
+            }
+            if (face == FACE_Y) {
+                tx.n = ny;
+                tx.d = c->ady;
+            } else {
+                tx.n = nx;
+                tx.d = c->adx;
+            }
+            {
+                rt tl = c->r->dz <= 0 ? tx : t;
+                if (c->r->oz * tl.d + tl.n * (int64_t)c->r->dz > bmax * ONE16 * tl.d) {
+                    /* skip the block: the ray is above its max all along */
+                    h->steps++;
+                    if (!rt_lt(tx, c->tend)) {
+                        h->iters = it + 1u;
+                        return CT_MISS;
+                    }
+                    if (face & FACE_X) {
+                        i = c->sx > 0 ? xf : xf - 1;
+                    } else {
+                        i = axis_cell(c->r->ox * tx.d + tx.n * (int64_t)c->r->dx, tx.d * ONE16, c->sx, c->cx);
+                    }
+                    if (face & FACE_Y) {
+                        j = c->sy > 0 ? yf : yf - 1;
+                    } else {
+                        j = axis_cell(c->r->oy * tx.d + tx.n * (int64_t)c->r->dy, tx.d * ONE16, c->sy, c->cy);
+                    }
+                    t = tx;
+                    if (lvl < p->levels) {
+                        lvl++;
+                    }
+                } else {
+                    lvl--;
+                }
+            }
+        }
+    }
+    return CT_ERR_INTERNAL;
+}
+
+static ct_status walk_cones(const ctx *c, uint32_t plane, ct_hit *h)
+{
+    const ct_package *p = c->p;
+    const ct_prepared *r = c->r;
+    const uint8_t *ang = p->angles + (size_t)plane * p->coarse_x * p->coarse_y;
+    int32_t i, j;
+    uint32_t it, bound = CT_WCET_CELL_ITERS(c->cx, c->cy);
+    rt t = {0, 1};   /* current point */
+    rt tin = {0, 1}; /* canonical entry of the current cell */
+    int tin_ok = 1;
+    cexit e;
+    locate(c, t, &i, &j);
+    /* bound: each iteration leaves at least one fine cell */
+    for (it = 0u; it < bound; ++it) {
+        uint32_t ci, cj, code;
+        size_t k;
+        if (!inside(c, i, j)) {
+            h->iters = it;
+            return CT_MISS;
+        }
+        cell_exit(c, i, j, &e);
+        h->steps++;
+        ci = (uint32_t)i / p->reduce;
+        cj = (uint32_t)j / p->reduce;
+        k = (size_t)cj * p->coarse_x + ci;
+        code = ang[k];
+        if (p->cot_ok[code]) {
+            int64_t a16 = (int64_t)ct_ld16(p->apex + 2u * k) * ONE16;
+            int64_t num = z_at(c, t) - a16; /* < 2^34 */
+            if (num > 0) {
+                int64_t cot = p->cot_q16[code];
+                int64_t len = cot >= 0 ? r->len_hi : r->len_lo;
+                /* len <= 2^26.5, |cot| <= 2^35: < 2^61.5 */
+                int64_t den = ct_ceil_div(len * cot, ONE16) - (int64_t)r->dz;
+                int64_t dt, tn;
+                if (den <= 0) {
+                    /* the ray never leaves the empty region: no hit ahead */
+                    h->iters = it + 1u;
+                    return CT_MISS;
+                }
+                dt = (num * T_ONE) / den; /* num*2^26 < 2^60 */
+                if (dt > (INT64_C(1) << 35)) {
+                    dt = INT64_C(1) << 35;
+                }
+                /* floor(t*2^26) + dt - 1 < the exact exit of the cone */
+                tn = ct_floor_div(t.n * T_ONE, t.d) + dt - 1;
+                /* tn < 2^36: tn * d < 2^62 */
+                if (tn * e.t.d > e.t.n * T_ONE) {
+                    rt tj;
+                    tj.n = tn;
+                    tj.d = T_ONE;
+                    if (!rt_lt(tj, c->tend)) {
+                        h->iters = it + 1u;
+                        return CT_MISS;
+                    }
+                    t = tj;
+                    locate(c, t, &i, &j);
+                    tin_ok = 0;
+                    continue;
+                }
+            }
+        }
+        /* exact cell step */
+        if (!tin_ok) {
+            tin = cell_entry(c, i, j);
+        }
+        if (cell_test(c, i, j, tin, &e, h)) {
+            h->iters = it + 1u;
+            return hit_status(p, i, j);
+        }
+        if (!rt_lt(e.t, c->tend)) {
+            h->iters = it + 1u;
+            return CT_MISS;
+        }
+        next_cell(c, &e, &i, &j);
+        t = e.t;
+        tin = e.t;
+        tin_ok = 1;
+    }
+    return CT_ERR_INTERNAL;
+}
+
+/* ------------------------------------------------------------------------ */
+
+/* Surface height at a Q16 point of cell (i, j), times 2^32 (exact):
+ * h00*2^32 + a*U*2^16 + b*V*2^16 + c*U*V with U, V in [0, 2^16]: < 2^50. */
+static int64_t surface_q32(const ct_package *p, int32_t i, int32_t j, int64_t x, int64_t y)
+{
+    posts4 q;
+    int64_t U = x - (int64_t)i * ONE16, V = y - (int64_t)j * ONE16;
+    int64_t a, b, cc;
+    load_posts(p, i, j, &q);
+    a = (int64_t)q.h10 - q.h00;
+    b = (int64_t)q.h01 - q.h00;
+    cc = (int64_t)q.h11 - q.h10 - q.h01 + q.h00;
+    return (int64_t)q.h00 * (ONE16 * ONE16) + a * U * ONE16 + b * V * ONE16 + cc * U * V;
+}
+
+ct_status ct_surface_height(const ct_package *p, int64_t x, int64_t y, int64_t *z)
+{
+    int32_t i, j;
+    int64_t s;
+    CT_ASSERT(p != NULL && z != NULL);
+    if (p == NULL || z == NULL) {
+        return CT_ERR_ARG;
+    }
+    if (x < 0 || y < 0 || x > (int64_t)p->cells_x * ONE16 || y > (int64_t)p->cells_y * ONE16) {
+        return CT_ERR_RANGE;
+    }
+    i = axis_cell(x, ONE16, 0, (int32_t)p->cells_x);
+    j = axis_cell(y, ONE16, 0, (int32_t)p->cells_y);
+    s = surface_q32(p, i, j, x, y);
+    *z = -ct_floor_div(-s, ONE16); /* ceil */
+    return CT_OK;
+}
+
+/* ------------------------------------------------------------------------ */
+/* Ray preparation.                                                          */
+
+typedef struct {
+    ct_i128 n;
+    int64_t d; /* > 0 */
+} bigrt;
+
+/* a < b for 128-bit rationals: |n| < 2^75, d <= 2^26: < 2^101 */
+static int bigrt_lt(const bigrt *a, const bigrt *b)
+{
+    return ct_i128_cmp(ct_i128_mul128_64(a->n, b->d), ct_i128_mul128_64(b->n, a->d)) < 0;
+}
+
+/* Round o + t*D to nearest on one axis: (o*d + n*D) / d.  128-bit. */
+static int64_t round_axis(int64_t o, int64_t D, const bigrt *t)
+{
+    ct_i128 num = ct_i128_add(ct_i128_mul(o, t->d), ct_i128_mul128_64(t->n, D));
+    /* floor((2 num + d) / 2d) */
+    num = ct_i128_add(ct_i128_shl(num, 1), ct_i128_from64(t->d));
+    return ct_i128_floor_div(num, 2 * t->d);
+}
+
+static int normalize_dir(const ct_ray *ray, int32_t out[3])
+{
+    int64_t v[3], m = 0;
+    int k, shift = 0;
+    v[0] = ray->dx;
+    v[1] = ray->dy;
+    v[2] = ray->dz;
+    /* bound: 3 components */
+    for (k = 0; k < 3; ++k) {
+        if (ct_abs64(v[k]) > (INT64_C(1) << 62)) {
+            return 0;
+        }
+        m = ct_max64(m, ct_abs64(v[k]));
+    }
+    if (m == 0) {
+        return 0;
+    }
+    /* bound: at most 62 halvings or 25 doublings */
+    while ((m >> shift) > (INT64_C(1) << CT_DIR_BITS)) {
+        shift++;
+    }
+    if (shift > 0) {
+        int64_t half = INT64_C(1) << (shift - 1);
+        for (k = 0; k < 3; ++k) {
+            int64_t a = ct_abs64(v[k]);
+            int64_t q = (a + half) >> shift; /* round half away from zero */
+            v[k] = v[k] < 0 ? -q : q;
+        }
+    } else {
+        while (m < (INT64_C(1) << (CT_DIR_BITS - 1))) {
+            m <<= 1;
+            for (k = 0; k < 3; ++k) {
+                v[k] *= 2;
+            }
+        }
+    }
+    for (k = 0; k < 3; ++k) {
+        out[k] = (int32_t)v[k];
+    }
+    return 1;
+}
+
+ct_status ct_ray_prepare(const ct_package *p, const ct_ray *ray, ct_prepared *out)
+{
+    int32_t D[3];
+    int64_t O[3], lo[3], hi[3];
+    bigrt tin, tout;
+    int k, has_out = 0;
+    CT_ASSERT(p != NULL && ray != NULL && out != NULL);
+    if (p == NULL || ray == NULL || out == NULL) {
+        return CT_ERR_ARG;
+    }
+    O[0] = ray->x_q16;
+    O[1] = ray->y_q16;
+    O[2] = ray->z_q16;
+    for (k = 0; k < 3; ++k) {
+        if (ct_abs64(O[k]) > CT_MAX_ORIGIN_Q16) {
+            return CT_ERR_RAY;
+        }
+    }
+    if (!normalize_dir(ray, D)) {
+        return CT_ERR_RAY;
+    }
+    lo[0] = 0;
+    hi[0] = (int64_t)p->cells_x * ONE16;
+    lo[1] = 0;
+    hi[1] = (int64_t)p->cells_y * ONE16;
+    lo[2] = INT64_MIN; /* no floor: a ray entering below the surface is BELOW */
+    hi[2] = ((int64_t)p->hmax + 1) * ONE16;
+    tin.n = ct_i128_from64(0);
+    tin.d = 1;
+    tout.n = ct_i128_from64(0);
+    tout.d = 1;
+    /* bound: 3 axes */
+    for (k = 0; k < 3; ++k) {
+        if (D[k] == 0) {
+            if (O[k] < lo[k] || O[k] > hi[k]) {
+                out->start = CT_MISS;
+                return CT_MISS;
+            }
+            continue;
+        }
+        {
+            bigrt a, b;
+            int64_t ad = ct_abs64(D[k]);
+            /* entry and exit along this axis: (bound - o) * sign / |d| */
+            if (D[k] > 0) {
+                a.n = lo[k] == INT64_MIN ? ct_i128_from64(-(INT64_C(1) << 50)) : ct_i128_from64(lo[k] - O[k]);
+                b.n = ct_i128_from64(hi[k] - O[k]);
+            } else {
+                a.n = ct_i128_from64(O[k] - hi[k]);
+                b.n = lo[k] == INT64_MIN ? ct_i128_from64(INT64_C(1) << 50) : ct_i128_from64(O[k] - lo[k]);
+            }
+            a.d = ad;
+            b.d = ad;
+            if (bigrt_lt(&tin, &a)) {
+                tin = a;
+            }
+            if (!has_out || bigrt_lt(&b, &tout)) {
+                tout = b;
+                has_out = 1;
+            }
+        }
+    }
+    if (has_out && bigrt_lt(&tout, &tin)) {
+        out->start = CT_MISS;
+        return CT_MISS;
+    }
+    if (ct_i128_sign(tin.n) > 0) {
+        for (k = 0; k < 3; ++k) {
+            O[k] = round_axis(O[k], D[k], &tin);
+        }
+        for (k = 0; k < 3; ++k) {
+            if (O[k] > hi[k]) {
+                O[k] = hi[k];
+            }
+            if (k < 2 && O[k] < lo[k]) {
+                O[k] = lo[k];
+            }
+        }
+    }
+    out->ox = O[0];
+    out->oy = O[1];
+    out->oz = O[2];
+    out->dx = D[0];
+    out->dy = D[1];
+    out->dz = D[2];
+    {
+        /* dx^2 + dy^2 <= 2^53 */
+        uint64_t l2 = (uint64_t)((int64_t)D[0] * D[0] + (int64_t)D[1] * D[1]);
+        uint64_t l = ct_isqrt64(l2);
+        out->len_lo = (int64_t)l;
+        out->len_hi = (int64_t)l + (l * l != l2 ? 1 : 0);
+    }
+    if (D[0] != 0 || D[1] != 0) {
+        uint32_t s;
+        ct_status st = ct_sector_of(p, D[0], D[1], &s);
+        if (st != CT_OK) {
+            return st;
+        }
+        out->sector = (int32_t)s;
+    } else {
+        out->sector = -1;
+    }
+    /* tend: leaving the box horizontally, through the top (rising) or
+     * below hmin - 1 (descending; never reached without a hit).          */
+    {
+        rt te = {INT64_C(1) << 40, 1}, c;
+        int64_t ztop = ((int64_t)p->hmax + 1) * ONE16, zbot = ((int64_t)p->hmin - 1) * ONE16;
+        if (D[0] != 0) {
+            c.n = D[0] > 0 ? hi[0] - O[0] : O[0];
+            c.d = ct_abs64(D[0]);
+            if (rt_lt(c, te)) {
+                te = c;
+            }
+        }
+        if (D[1] != 0) {
+            c.n = D[1] > 0 ? hi[1] - O[1] : O[1];
+            c.d = ct_abs64(D[1]);
+            if (rt_lt(c, te)) {
+                te = c;
+            }
+        }
+        if (D[2] > 0) {
+            c.n = ct_max64(ztop - O[2], 0);
+            c.d = D[2];
+            if (rt_lt(c, te)) {
+                te = c;
+            }
+        } else if (D[2] < 0 && O[2] > zbot) {
+            c.n = O[2] - zbot;
+            c.d = -(int64_t)D[2];
+            if (rt_lt(c, te)) {
+                te = c;
+            }
+        }
+        out->tend_n = te.n;
+        out->tend_d = te.d;
+    }
+    /* the first point: below, on, or above the surface (exact) */
+    {
+        int32_t i = axis_cell(O[0], ONE16, D[0] > 0 ? 1 : (D[0] < 0 ? -1 : 0), (int32_t)p->cells_x);
+        int32_t j = axis_cell(O[1], ONE16, D[1] > 0 ? 1 : (D[1] < 0 ? -1 : 0), (int32_t)p->cells_y);
+        int64_t s, f;
+        /* the first point is on the tile; use the cell it is in, clamped */
+        if (i < 0) {
+            i = 0;
+        }
+        if (j < 0) {
+            j = 0;
+        }
+        if (i >= (int32_t)p->cells_x) {
+            i = (int32_t)p->cells_x - 1;
+        }
+        if (j >= (int32_t)p->cells_y) {
+            j = (int32_t)p->cells_y - 1;
+        }
+        s = surface_q32(p, i, j, O[0], O[1]);
+        if (O[2] < -(INT64_C(1) << 46)) {
+            out->start = CT_BELOW;
+            return CT_BELOW;
+        }
+        f = O[2] * ONE16 - s; /* |oz| <= 2^46: < 2^62 */
+        if (f < 0) {
+            out->start = CT_BELOW;
+            return CT_BELOW;
+        }
+        if (f == 0) {
+            out->start = CT_HIT;
+            return CT_HIT;
+        }
+    }
+    out->start = CT_OK;
+    return CT_OK;
+}
+
+/* ------------------------------------------------------------------------ */
+
+static ct_status check_prepared(const ct_package *p, const ct_prepared *r)
+{
+    int64_t m = ct_max64(ct_abs64(r->dx), ct_max64(ct_abs64(r->dy), ct_abs64(r->dz)));
+    int64_t l2 = (int64_t)r->dx * r->dx + (int64_t)r->dy * r->dy;
+    if (m > (INT64_C(1) << CT_DIR_BITS) || m < (INT64_C(1) << (CT_DIR_BITS - 1))) {
+        return CT_ERR_RAY;
+    }
+    if (r->ox < 0 || r->oy < 0 || r->ox > (int64_t)p->cells_x * ONE16 ||
+        r->oy > (int64_t)p->cells_y * ONE16 || r->oz > ((int64_t)p->hmax + 1) * ONE16 ||
+        r->oz < -(INT64_C(1) << 46)) {
+        return CT_ERR_RAY;
+    }
+    if (r->len_lo < 0 || r->len_hi - r->len_lo < 0 || r->len_hi - r->len_lo > 1 ||
+        r->len_lo * r->len_lo > l2 || r->len_hi * r->len_hi < l2) {
+        return CT_ERR_RAY;
+    }
+    if (r->tend_d <= 0 || r->tend_d > (INT64_C(1) << CT_DIR_BITS) || r->tend_n < 0 ||
+        r->tend_n > (INT64_C(1) << 40)) {
+        return CT_ERR_RAY;
+    }
+    if (r->dx == 0 && r->dy == 0) {
+        if (r->sector != -1) {
+            return CT_ERR_RAY;
+        }
+    } else {
+        uint32_t in = 0u;
+        if (r->sector < 0 || (uint32_t)r->sector >= p->sectors ||
+            ct_in_wedge(p->bound_x, p->bound_y, p->sectors, (uint32_t)r->sector, r->dx, r->dy, &in) != CT_OK ||
+            !in) {
+            return CT_ERR_RAY;
+        }
+    }
+    return CT_OK;
+}
+
+ct_status ct_trace_prepared(const ct_package *p, const ct_prepared *r, ct_method m, ct_hit *h)
+{
+    ctx c;
+    ct_status st;
+    CT_ASSERT(p != NULL && r != NULL && h != NULL);
+    if (p == NULL || r == NULL || h == NULL) {
+        return CT_ERR_ARG;
+    }
+    if ((unsigned)m >= (unsigned)CT_METHOD_COUNT) {
+        return CT_ERR_METHOD;
+    }
+    h->steps = 0u;
+    h->iters = 0u;
+    h->x_q16 = h->y_q16 = h->z_q16 = 0;
+    h->e_nm = h->n_nm = h->h_nm = 0;
+    h->t_q26 = 0;
+    h->cell_x = h->cell_y = -1;
+    if (r->start == CT_MISS || r->start == CT_BELOW) {
+        return r->start;
+    }
+    st = check_prepared(p, r);
+    if (st != CT_OK) {
+        return st;
+    }
+    c.p = p;
+    c.r = r;
+    c.sx = sgn64(r->dx);
+    c.sy = sgn64(r->dy);
+    c.adx = ct_abs64(r->dx);
+    c.ady = ct_abs64(r->dy);
+    c.cx = (int32_t)p->cells_x;
+    c.cy = (int32_t)p->cells_y;
+    c.tend.n = r->tend_n;
+    c.tend.d = r->tend_d;
+    if (r->start == CT_HIT) {
+        int32_t i, j;
+        rt t0 = {0, 1};
+        locate(&c, t0, &i, &j);
+        i = i < 0 ? 0 : (i >= c.cx ? c.cx - 1 : i);
+        j = j < 0 ? 0 : (j >= c.cy ? c.cy - 1 : j);
+        fill_hit(&c, 0, i, j, h);
+        h->steps = 1u;
+        h->iters = 1u;
+        return hit_status(p, i, j);
+    }
+    if (r->start != CT_OK) {
+        return CT_ERR_RAY;
+    }
+    if (r->dx == 0 && r->dy == 0) {
+        /* vertical: f(0) > 0 was established at preparation */
+        int32_t i, j;
+        rt t0 = {0, 1};
+        int64_t s, tq;
+        h->steps = 1u;
+        h->iters = 1u;
+        if (r->dz > 0) {
+            return CT_MISS;
+        }
+        locate(&c, t0, &i, &j);
+        s = surface_q32(p, i, j, r->ox, r->oy);
+        /* t = (oz*2^16 - s) / (2^16 * |dz|) ; in Q26, floored:
+         * (oz*2^16 - s) < 2^50, * 2^26 / 2^16 = * 2^10: < 2^60 */
+        tq = ct_floor_div((r->oz * ONE16 - s) * 1024, -(int64_t)r->dz);
+        fill_hit(&c, tq, i, j, h);
+        /* report the exact surface height at a vertical hit */
+        h->z_q16 = -ct_floor_div(-s, ONE16);
+        (void)ct_grid_to_map(p, h->x_q16, h->y_q16, h->z_q16, &h->e_nm, &h->n_nm, &h->h_nm);
+        return hit_status(p, i, j);
+    }
+    switch (m) {
+    case CT_METHOD_INCREMENTAL:
+        return walk_incremental(&c, h);
+    case CT_METHOD_HIERARCHICAL:
+        return walk_hierarchical(&c, h);
+    case CT_METHOD_CONE:
+        return walk_cones(&c, p->sectors == 1u ? 0u : p->sectors, h);
+    case CT_METHOD_DIRECTIONAL:
+    default:
+        return walk_cones(&c, (uint32_t)r->sector, h);
+    }
+}
+
+ct_status ct_trace(const ct_package *p, const ct_ray *ray, ct_method m, ct_hit *h)
+{
+    ct_prepared r;
+    ct_status st;
+    CT_ASSERT(p != NULL && ray != NULL && h != NULL);
+    if (p == NULL || ray == NULL || h == NULL) {
+        return CT_ERR_ARG;
+    }
+    st = ct_ray_prepare(p, ray, &r);
+    if (st < 0) {
+        return st;
+    }
+    return ct_trace_prepared(p, &r, m, h);
+}
+
+/* ------------------------------------------------------------------------ */
+/* Map frame.                                                                */
+
+/* round(num / den) for den > 0, checking the quotient fits in |q| < 2^62. */
+static ct_status round_div(ct_i128 num, int64_t den, int64_t *q)
+{
+    ct_i128 lim = ct_i128_mul(INT64_C(1) << 62, den);
+    if (ct_i128_cmp(num, lim) >= 0 || ct_i128_cmp(num, ct_i128_neg(lim)) <= 0) {
+        return CT_ERR_RANGE;
+    }
+    /* floor((2 num + den) / 2 den); den <= 2^51 so 2 den fits */
+    *q = ct_i128_floor_div(ct_i128_add(ct_i128_shl(num, 1), ct_i128_from64(den)), 2 * den);
+    return CT_OK;
+}
+
+ct_status ct_grid_to_map(const ct_package *p, int64_t x, int64_t y, int64_t z,
+                         int64_t *e, int64_t *n, int64_t *hh)
+{
+    int64_t de, dn, dh;
+    ct_status st;
+    CT_ASSERT(p != NULL && e != NULL && n != NULL && hh != NULL);
+    if (p == NULL || e == NULL || n == NULL || hh == NULL) {
+        return CT_ERR_ARG;
+    }
+    if (ct_abs64(x) > (INT64_C(1) << 60) || ct_abs64(y) > (INT64_C(1) << 60) ||
+        ct_abs64(z) > (INT64_C(1) << 60)) {
+        return CT_ERR_RANGE;
+    }
+    /* (x + 2^15) * posting: < 2^61 * 2^50, 128-bit */
+    st = round_div(ct_i128_mul(x + 32768, p->posting_e_nm), ONE16, &de);
+    if (st != CT_OK) {
+        return st;
+    }
+    st = round_div(ct_i128_mul(y + 32768, p->posting_n_nm), ONE16, &dn);
+    if (st != CT_OK) {
+        return st;
+    }
+    st = round_div(ct_i128_mul(z, p->height_scale_nm), ONE16, &dh);
+    if (st != CT_OK) {
+        return st;
+    }
+    /* |origin| <= 2^61 and |delta| < 2^62: sums fit */
+    *e = p->origin_e_nm + de;
+    *n = p->origin_n_nm + dn;
+    *hh = p->height_offset_nm + dh;
+    return CT_OK;
+}
+
+ct_status ct_map_to_grid(const ct_package *p, int64_t e, int64_t n, int64_t hh,
+                         int64_t *x, int64_t *y, int64_t *z)
+{
+    ct_status st;
+    int64_t pe, pn;
+    ct_i128 ne, nn;
+    CT_ASSERT(p != NULL && x != NULL && y != NULL && z != NULL);
+    if (p == NULL || x == NULL || y == NULL || z == NULL) {
+        return CT_ERR_ARG;
+    }
+    if (ct_abs64(e) > (INT64_C(1) << 61) || ct_abs64(n) > (INT64_C(1) << 61) ||
+        ct_abs64(hh) > (INT64_C(1) << 61)) {
+        return CT_ERR_RANGE;
+    }
+    /* x = (e - e0) * 2^16 / pe - 2^15: |e - e0| < 2^62, * 2^16: 128-bit */
+    ne = ct_i128_shl(ct_i128_from64(e - p->origin_e_nm), 16);
+    nn = ct_i128_shl(ct_i128_from64(n - p->origin_n_nm), 16);
+    pe = p->posting_e_nm;
+    pn = p->posting_n_nm;
+    if (pe < 0) {
+        ne = ct_i128_neg(ne);
+        pe = -pe;
+    }
+    if (pn < 0) {
+        nn = ct_i128_neg(nn);
+        pn = -pn;
+    }
+    st = round_div(ct_i128_sub(ne, ct_i128_mul(32768, pe)), pe, x);
+    if (st != CT_OK) {
+        return st;
+    }
+    st = round_div(ct_i128_sub(nn, ct_i128_mul(32768, pn)), pn, y);
+    if (st != CT_OK) {
+        return st;
+    }
+    return round_div(ct_i128_shl(ct_i128_from64(hh - p->height_offset_nm), 16), p->height_scale_nm, z);
+}
+
+ct_status ct_ray_from_map(const ct_package *p, int64_t e, int64_t n, int64_t hh,
+                          int64_t de, int64_t dn, int64_t dh, ct_ray *out)
+{
+    ct_status st;
+    ct_i128 v[3];
+    int k, shift = 0;
+    CT_ASSERT(p != NULL && out != NULL);
+    if (p == NULL || out == NULL) {
+        return CT_ERR_ARG;
+    }
+    if (ct_abs64(de) > (INT64_C(1) << 40) || ct_abs64(dn) > (INT64_C(1) << 40) ||
+        ct_abs64(dh) > (INT64_C(1) << 40) || (de == 0 && dn == 0 && dh == 0)) {
+        return CT_ERR_RAY;
+    }
+    st = ct_map_to_grid(p, e, n, hh, &out->x_q16, &out->y_q16, &out->z_q16);
+    if (st != CT_OK) {
+        return CT_ERR_RAY;
+    }
+    /* grid direction ~ (de/pe, dn/pn, dh/scale) * |pe| * scale:
+     * (de*scale*sgn(pe), dn*scale*sgn(pn), dh*|pe|): < 2^40 * 2^50, 128-bit */
+    v[0] = ct_i128_mul(de, p->posting_e_nm < 0 ? -p->height_scale_nm : p->height_scale_nm);
+    v[1] = ct_i128_mul(dn, p->posting_n_nm < 0 ? -p->height_scale_nm : p->height_scale_nm);
+    v[2] = ct_i128_mul(dh, ct_abs64(p->posting_e_nm));
+    /* scale down to |.| <= 2^62. bound: < 40 halvings */
+    for (;;) {
+        int big = 0;
+        for (k = 0; k < 3; ++k) {
+            ct_i128 a = ct_i128_sign(v[k]) < 0 ? ct_i128_neg(v[k]) : v[k];
+            ct_i128 lim = ct_i128_shl(ct_i128_from64(INT64_C(1) << 61), 1 + (unsigned)shift);
+            if (ct_i128_cmp(a, lim) > 0) {
+                big = 1;
+            }
+        }
+        if (!big || shift >= 60) {
+            break;
+        }
+        shift++;
+    }
+    for (k = 0; k < 3; ++k) {
+        int64_t q;
+        if (shift == 0) {
+            q = ct_i128_to64(v[k]);
+        } else {
+            ct_i128 a = ct_i128_sign(v[k]) < 0 ? ct_i128_neg(v[k]) : v[k];
+            q = ct_i128_floor_div(ct_i128_add(a, ct_i128_shl(ct_i128_from64(1), (unsigned)shift - 1u)),
+                                  INT64_C(1) << shift);
+            if (ct_i128_sign(v[k]) < 0) {
+                q = -q;
+            }
+        }
+        if (k == 0) {
+            out->dx = q;
+        } else if (k == 1) {
+            out->dy = q;
+        } else {
+            out->dz = q;
+        }
+    }
+    return CT_OK;
+}
