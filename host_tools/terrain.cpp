@@ -1,2 +1,83 @@
-// placeholder, being written
+// terrain.cpp -- quantising metres to 16-bit codes.
 #include "terrain.hpp"
+
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+namespace ct_host {
+
+int64_t metres_to_nm(double m)
+{
+    if (!(std::fabs(m) < 4.0e9)) {
+        throw Error("value out of range for nanometre storage");
+    }
+    return (int64_t)std::llround(m * 1e9);
+}
+
+Terrain terrain_from_heights(int width, int height, const std::vector<double> &h_m,
+                             const std::vector<uint8_t> &valid, const Georef &geo, double scale_m)
+{
+    if (width < 2 || height < 2) {
+        throw Error("DEM must have at least 2x2 posts");
+    }
+    if (width > 32768 || height > 32768) {
+        std::ostringstream os;
+        os << "DEM of " << width << "x" << height << " posts exceeds the package limit of 32768 per side";
+        throw Error(os.str());
+    }
+    size_t n = (size_t)width * (size_t)height;
+    if (h_m.size() != n || (!valid.empty() && valid.size() != n)) {
+        throw Error("height array size does not match the dimensions");
+    }
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    size_t nvalid = 0;
+    for (size_t k = 0; k < n; ++k) {
+        bool ok = (valid.empty() || valid[k]) && std::isfinite(h_m[k]);
+        if (ok) {
+            lo = std::min(lo, h_m[k]);
+            hi = std::max(hi, h_m[k]);
+            nvalid++;
+        }
+    }
+    if (nvalid == 0) {
+        throw Error("every sample is nodata");
+    }
+    double range = hi - lo;
+    if (scale_m <= 0.0) {
+        // finest power-of-two LSB (at most 1/16 m) that keeps the range
+        // within 60000 codes
+        scale_m = 1.0 / 16.0;
+        while (range / scale_m > 60000.0) {
+            scale_m *= 2.0;
+        }
+    }
+    if (range / scale_m > 65535.0) {
+        std::ostringstream os;
+        os << "height range " << range << " m does not fit 16 bits at " << scale_m << " m per LSB";
+        throw Error(os.str());
+    }
+    Terrain t;
+    t.width = width;
+    t.height = height;
+    t.geo = geo;
+    t.height_offset_m = lo;
+    t.height_scale_m = scale_m;
+    t.codes.resize(n);
+    if (nvalid != n) {
+        t.void_post.assign(n, 0);
+    }
+    for (size_t k = 0; k < n; ++k) {
+        bool ok = (valid.empty() || valid[k]) && std::isfinite(h_m[k]);
+        if (!ok) {
+            t.codes[k] = 0; // voids are filled with the lowest height
+            t.void_post[k] = 1;
+            continue;
+        }
+        long c = std::lround((h_m[k] - lo) / scale_m);
+        t.codes[k] = (uint16_t)std::min(65535L, std::max(0L, c));
+    }
+    return t;
+}
+
+}  // namespace ct_host

@@ -163,6 +163,20 @@ int64_t ct_i128_floor_div(ct_i128 n, int64_t d)
     }
 }
 
+int64_t ct_i128_floor_div_sat(ct_i128 n, int64_t d)
+{
+    const int64_t lim = INT64_C(1) << 62;
+    ct_i128 cap = ct_i128_mul(lim, d);
+    CT_ASSERT(d > 0);
+    if (ct_i128_cmp(n, cap) >= 0) {
+        return lim;
+    }
+    if (ct_i128_cmp(n, ct_i128_neg(cap)) <= 0) {
+        return -lim;
+    }
+    return ct_i128_floor_div(n, d);
+}
+
 uint64_t ct_isqrt64(uint64_t n)
 {
     uint64_t res = 0u, bit = (uint64_t)1 << 62;

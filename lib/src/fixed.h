@@ -75,6 +75,8 @@ int ct_i128_cmp(ct_i128 a, ct_i128 b);      /* -1, 0, +1 */
 ct_i128 ct_i128_mul128_64(ct_i128 a, int64_t b);
 /* floor(n / d) for d > 0 and |quotient| < 2^63.                             */
 int64_t ct_i128_floor_div(ct_i128 n, int64_t d);
+/* floor(n / d) for d > 0, saturated to [-2^62, 2^62].                      */
+int64_t ct_i128_floor_div_sat(ct_i128 n, int64_t d);
 /* floor(sqrt(n)) for 0 <= n < 2^126.                                         */
 uint64_t ct_i128_isqrt(ct_i128 n);
 /* floor(sqrt(n)) for 64-bit n.                                               */

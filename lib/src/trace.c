@@ -313,51 +313,56 @@ static int interior_hit(const ctx *c, const quad *Q, rt tin, rt tout)
     return ct_i128_sign(disc(Q)) >= 0;
 }
 
-/* First down-crossing root of the quadratic in [P(tin), P(tout)] and its
+/* First down-crossing root of the quadratic in [w(tin), w(tout)] and its
  * t in Q26 (floored: the reported point never passes the true hit by more
- * than one Q26 step).  Root r = (-B - sqrt(D)) / 2A = 2C / (-B + sqrt(D)),
- * each form used where it does not cancel.                              */
+ * than one Q26 step).  Root w = (-B - sqrt(D)) / 2A = 2C / (-B + sqrt(D)),
+ * each form used where it does not cancel.  w is computed in Q60 (W_BITS):
+ * t = (dps + w 2^16) / d, so a steep ray (tiny d) still gets t to 2^-44.
+ * Scaling: |2C| 2^60 < 2^121 and |B + sd| 2^60 < 2^123 (128-bit), divisors
+ * -B + sd < 2^62.3 and 2|A| < 2^60; quotients saturate at +-2^62.        */
+#define W_BITS 60u
+
 static int64_t root_t_q26(const ctx *c, const quad *Q, rt tin, rt tout)
 {
     ct_i128 D = disc(Q);
-    int64_t sd, pq32, lo, hi, pn, pd;
+    int64_t sd, w, lo, hi, pn, pd;
     ct_i128 num;
+    (void)c;
     if (ct_i128_sign(D) < 0) {
         D = ct_i128_from64(0); /* cannot happen for a decided hit */
     }
     sd = (int64_t)ct_i128_isqrt(D); /* < 2^61.5 */
     if (Q->B < 0) {
-        int64_t den = -Q->B + sd; /* > 0, < 2^63 */
-        /* 2C * 2^32 < 2^93 */
-        pq32 = ct_i128_floor_div(ct_i128_shl(ct_i128_from64(2 * Q->C), 32), den);
+        w = ct_i128_floor_div_sat(ct_i128_shl(ct_i128_from64(2 * Q->C), W_BITS), -Q->B + sd);
     } else if (Q->A != 0) {
-        /* (-B - sd) * 2^32 / 2A, A < 0 here: negate both */
-        ct_i128 nn = ct_i128_shl(ct_i128_from64(Q->B + sd), 32);
+        /* (-B - sd) / 2A with A < 0 here: (B + sd) / (2|A|) */
+        ct_i128 nn = ct_i128_shl(ct_i128_from64(Q->B + sd), W_BITS);
         int64_t den = -2 * Q->A;
         if (den < 0) {
             nn = ct_i128_neg(nn);
             den = -den;
         }
-        pq32 = ct_i128_floor_div(nn, den);
+        w = ct_i128_floor_div_sat(nn, den);
     } else {
-        pq32 = 0; /* f not decreasing: cannot happen for a decided hit */
+        w = 0; /* f not decreasing: cannot happen for a decided hit */
     }
-    /* clamp to the segment: lo = ceil(P(tin) 2^32), hi = floor(P(tout) 2^32) */
+    /* clamp to the segment: lo = ceil(w(tin) 2^60), hi = floor(w(tout) 2^60);
+     * |pn| < 2^61: pn 2^60 < 2^121 */
     p_at(c, Q, tin, &pn, &pd);
-    lo = -ct_i128_floor_div(ct_i128_neg(ct_i128_shl(ct_i128_from64(pn), 32)), pd);
+    lo = -ct_i128_floor_div_sat(ct_i128_neg(ct_i128_shl(ct_i128_from64(pn), W_BITS)), pd);
     p_at(c, Q, tout, &pn, &pd);
-    hi = ct_i128_floor_div(ct_i128_shl(ct_i128_from64(pn), 32), pd);
-    if (pq32 < lo) {
-        pq32 = lo;
+    hi = ct_i128_floor_div_sat(ct_i128_shl(ct_i128_from64(pn), W_BITS), pd);
+    if (w < lo) {
+        w = lo;
     }
-    if (pq32 > hi) {
-        pq32 = hi;
+    if (w > hi) {
+        w = hi;
     }
-    /* d*t = dps + w*2^16, so t_q26 = floor((dps*2^32 + w_q32*2^16) / (d*2^6));
-     * dps*2^32 < 2^63: 128-bit. */
-    num = ct_i128_add(ct_i128_shl(ct_i128_from64(Q->dps), 32), ct_i128_shl(ct_i128_from64(pq32), 16));
+    /* d*t = dps + w*2^16, so t_q26 = floor((dps 2^60 + w 2^16) / (d 2^34));
+     * |dps| 2^60 < 2^91, w 2^16 < 2^77, d 2^34 <= 2^60. */
+    num = ct_i128_add(ct_i128_shl(ct_i128_from64(Q->dps), W_BITS), ct_i128_shl(ct_i128_from64(w), 16));
     {
-        int64_t t = ct_i128_floor_div(num, Q->d * 64);
+        int64_t t = ct_i128_floor_div_sat(num, Q->d << (W_BITS - CT_T_FRAC_BITS));
         return t < 0 ? 0 : t;
     }
 }
@@ -691,39 +696,37 @@ typedef struct {
     int64_t d; /* > 0 */
 } bigrt;
 
-/* a < b for 128-bit rationals: |n| < 2^75, d <= 2^26: < 2^101 */
+/* a < b for 128-bit rationals: |n| < 2^48, d <= 2^62: products < 2^110 */
 static int bigrt_lt(const bigrt *a, const bigrt *b)
 {
     return ct_i128_cmp(ct_i128_mul128_64(a->n, b->d), ct_i128_mul128_64(b->n, a->d)) < 0;
 }
 
-/* Round o + t*D to nearest on one axis: (o*d + n*D) / d.  128-bit. */
+/* Round o + t*D to nearest on one axis: (o*d + n*D) / d, 128-bit:
+ * |o| d < 2^46 2^62, |n D| < 2^48 2^62; quotient < 2^48. */
 static int64_t round_axis(int64_t o, int64_t D, const bigrt *t)
 {
     ct_i128 num = ct_i128_add(ct_i128_mul(o, t->d), ct_i128_mul128_64(t->n, D));
-    /* floor((2 num + d) / 2d) */
-    num = ct_i128_add(ct_i128_shl(num, 1), ct_i128_from64(t->d));
-    return ct_i128_floor_div(num, 2 * t->d);
+    int64_t q = ct_i128_floor_div(num, t->d);
+    ct_i128 rem = ct_i128_sub(num, ct_i128_mul(q, t->d)); /* 0 <= rem < d */
+    if (ct_i128_cmp(ct_i128_shl(rem, 1), ct_i128_from64(t->d)) >= 0) {
+        q += 1;
+    }
+    return q;
 }
 
-static int normalize_dir(const ct_ray *ray, int32_t out[3])
+/* Direction scaled so that max |component| is in [2^25, 2^26] (rounded to
+ * nearest; relative error of each component <= 2^-26 of the maximum).    */
+static void normalize_dir(const int64_t v0[3], int32_t out[3])
 {
     int64_t v[3], m = 0;
     int k, shift = 0;
-    v[0] = ray->dx;
-    v[1] = ray->dy;
-    v[2] = ray->dz;
     /* bound: 3 components */
     for (k = 0; k < 3; ++k) {
-        if (ct_abs64(v[k]) > (INT64_C(1) << 62)) {
-            return 0;
-        }
+        v[k] = v0[k];
         m = ct_max64(m, ct_abs64(v[k]));
     }
-    if (m == 0) {
-        return 0;
-    }
-    /* bound: at most 62 halvings or 25 doublings */
+    /* bound: at most 37 halvings or 25 doublings */
     while ((m >> shift) > (INT64_C(1) << CT_DIR_BITS)) {
         shift++;
     }
@@ -745,13 +748,12 @@ static int normalize_dir(const ct_ray *ray, int32_t out[3])
     for (k = 0; k < 3; ++k) {
         out[k] = (int32_t)v[k];
     }
-    return 1;
 }
 
 ct_status ct_ray_prepare(const ct_package *p, const ct_ray *ray, ct_prepared *out)
 {
     int32_t D[3];
-    int64_t O[3], lo[3], hi[3];
+    int64_t O[3], U[3], lo[3], hi[3];
     bigrt tin, tout;
     int k, has_out = 0;
     CT_ASSERT(p != NULL && ray != NULL && out != NULL);
@@ -761,50 +763,59 @@ ct_status ct_ray_prepare(const ct_package *p, const ct_ray *ray, ct_prepared *ou
     O[0] = ray->x_q16;
     O[1] = ray->y_q16;
     O[2] = ray->z_q16;
+    U[0] = ray->dx;
+    U[1] = ray->dy;
+    U[2] = ray->dz;
+    /* bound: 3 axes */
     for (k = 0; k < 3; ++k) {
-        if (ct_abs64(O[k]) > CT_MAX_ORIGIN_Q16) {
+        if (ct_abs64(O[k]) > CT_MAX_ORIGIN_Q16 || ct_abs64(U[k]) > (INT64_C(1) << 62)) {
             return CT_ERR_RAY;
         }
     }
-    if (!normalize_dir(ray, D)) {
+    if (U[0] == 0 && U[1] == 0 && U[2] == 0) {
         return CT_ERR_RAY;
     }
     lo[0] = 0;
     hi[0] = (int64_t)p->cells_x * ONE16;
     lo[1] = 0;
     hi[1] = (int64_t)p->cells_y * ONE16;
-    lo[2] = INT64_MIN; /* no floor: a ray entering below the surface is BELOW */
+    lo[2] = 0; /* unused: the box has no floor (a ray entering below the
+                  surface is BELOW) */
     hi[2] = ((int64_t)p->hmax + 1) * ONE16;
     tin.n = ct_i128_from64(0);
     tin.d = 1;
-    tout.n = ct_i128_from64(0);
-    tout.d = 1;
-    /* bound: 3 axes */
+    tout = tin;
+    /* Clip the caller's ray (unnormalised direction, exact 128-bit
+     * rationals) to the box.  bound: 3 axes */
     for (k = 0; k < 3; ++k) {
-        if (D[k] == 0) {
-            if (O[k] < lo[k] || O[k] > hi[k]) {
+        bigrt a, b;
+        int floorless = (k == 2);
+        if (U[k] == 0) {
+            if ((!floorless && O[k] < lo[k]) || O[k] > hi[k]) {
                 out->start = CT_MISS;
                 return CT_MISS;
             }
             continue;
         }
-        {
-            bigrt a, b;
-            int64_t ad = ct_abs64(D[k]);
-            /* entry and exit along this axis: (bound - o) * sign / |d| */
-            if (D[k] > 0) {
-                a.n = lo[k] == INT64_MIN ? ct_i128_from64(-(INT64_C(1) << 50)) : ct_i128_from64(lo[k] - O[k]);
-                b.n = ct_i128_from64(hi[k] - O[k]);
-            } else {
-                a.n = ct_i128_from64(O[k] - hi[k]);
-                b.n = lo[k] == INT64_MIN ? ct_i128_from64(INT64_C(1) << 50) : ct_i128_from64(O[k] - lo[k]);
-            }
-            a.d = ad;
-            b.d = ad;
-            if (bigrt_lt(&tin, &a)) {
+        a.d = b.d = ct_abs64(U[k]);
+        /* |bound - o| < 2^47 */
+        if (U[k] > 0) {
+            a.n = ct_i128_from64(lo[k] - O[k]);
+            b.n = ct_i128_from64(hi[k] - O[k]);
+            if (!floorless && bigrt_lt(&tin, &a)) {
                 tin = a;
             }
             if (!has_out || bigrt_lt(&b, &tout)) {
+                tout = b;
+                has_out = 1;
+            }
+        } else {
+            a.n = ct_i128_from64(O[k] - hi[k]);
+            b.n = ct_i128_from64(O[k] - lo[k]);
+            if (bigrt_lt(&tin, &a)) {
+                tin = a;
+            }
+            if (!floorless && (!has_out || bigrt_lt(&b, &tout))) {
                 tout = b;
                 has_out = 1;
             }
@@ -815,8 +826,9 @@ ct_status ct_ray_prepare(const ct_package *p, const ct_ray *ray, ct_prepared *ou
         return CT_MISS;
     }
     if (ct_i128_sign(tin.n) > 0) {
+        /* the entry point, rounded to Q16 and kept in the box */
         for (k = 0; k < 3; ++k) {
-            O[k] = round_axis(O[k], D[k], &tin);
+            O[k] = round_axis(O[k], U[k], &tin);
         }
         for (k = 0; k < 3; ++k) {
             if (O[k] > hi[k]) {
@@ -827,6 +839,7 @@ ct_status ct_ray_prepare(const ct_package *p, const ct_ray *ray, ct_prepared *ou
             }
         }
     }
+    normalize_dir(U, D);
     out->ox = O[0];
     out->oy = O[1];
     out->oz = O[2];
@@ -853,33 +866,30 @@ ct_status ct_ray_prepare(const ct_package *p, const ct_ray *ray, ct_prepared *ou
     /* tend: leaving the box horizontally, through the top (rising) or
      * below hmin - 1 (descending; never reached without a hit).          */
     {
-        rt te = {INT64_C(1) << 40, 1}, c;
+        /* candidates have n < 2^34 and d <= 2^26, so rt_lt cannot overflow;
+         * with no candidate (cannot happen: some axis moves) te stays 2^34 */
+        rt te = {INT64_C(1) << 34, 1}, c;
         int64_t ztop = ((int64_t)p->hmax + 1) * ONE16, zbot = ((int64_t)p->hmin - 1) * ONE16;
-        if (D[0] != 0) {
-            c.n = D[0] > 0 ? hi[0] - O[0] : O[0];
-            c.d = ct_abs64(D[0]);
-            if (rt_lt(c, te)) {
-                te = c;
+        int have = 0;
+        /* bound: 3 axes */
+        for (k = 0; k < 3; ++k) {
+            if (D[k] == 0) {
+                continue;
             }
-        }
-        if (D[1] != 0) {
-            c.n = D[1] > 0 ? hi[1] - O[1] : O[1];
-            c.d = ct_abs64(D[1]);
-            if (rt_lt(c, te)) {
-                te = c;
+            c.d = ct_abs64(D[k]);
+            if (k < 2) {
+                c.n = D[k] > 0 ? hi[k] - O[k] : O[k];
+            } else if (D[k] > 0) {
+                c.n = ct_max64(ztop - O[2], 0);
+            } else {
+                if (O[2] <= zbot) {
+                    continue;
+                }
+                c.n = O[2] - zbot;
             }
-        }
-        if (D[2] > 0) {
-            c.n = ct_max64(ztop - O[2], 0);
-            c.d = D[2];
-            if (rt_lt(c, te)) {
+            if (!have || rt_lt(c, te)) {
                 te = c;
-            }
-        } else if (D[2] < 0 && O[2] > zbot) {
-            c.n = O[2] - zbot;
-            c.d = -(int64_t)D[2];
-            if (rt_lt(c, te)) {
-                te = c;
+                have = 1;
             }
         }
         out->tend_n = te.n;
@@ -941,7 +951,7 @@ static ct_status check_prepared(const ct_package *p, const ct_prepared *r)
         return CT_ERR_RAY;
     }
     if (r->tend_d <= 0 || r->tend_d > (INT64_C(1) << CT_DIR_BITS) || r->tend_n < 0 ||
-        r->tend_n > (INT64_C(1) << 40)) {
+        r->tend_n > (INT64_C(1) << 34)) {
         return CT_ERR_RAY;
     }
     if (r->dx == 0 && r->dy == 0) {

@@ -1,0 +1,143 @@
+// host_io.cpp -- see host_io.hpp.
+#include "host_io.hpp"
+
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+#include <unistd.h>
+
+namespace ct_host {
+
+std::vector<uint8_t> read_file(const std::string &path)
+{
+    std::FILE *f = std::fopen(path.c_str(), "rb");
+    if (!f) throw Error(path + ": " + std::strerror(errno));
+    std::vector<uint8_t> b;
+    uint8_t buf[1 << 16];
+    size_t n;
+    while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) b.insert(b.end(), buf, buf + n);
+    bool bad = std::ferror(f);
+    std::fclose(f);
+    if (bad) throw Error(path + ": read error");
+    return b;
+}
+
+void write_file_atomic(const std::string &path, const std::vector<uint8_t> &bytes)
+{
+    std::string tmp = path + ".tmp." + std::to_string((long)getpid());
+    std::FILE *f = std::fopen(tmp.c_str(), "wb");
+    if (!f) throw Error(path + ": cannot write (" + std::strerror(errno) + ")");
+    bool ok = std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size();
+    ok = (std::fflush(f) == 0) && ok;
+    ok = (std::fclose(f) == 0) && ok;
+    if (!ok || std::rename(tmp.c_str(), path.c_str()) != 0) {
+        int e = errno;
+        std::remove(tmp.c_str());
+        throw Error(path + ": cannot write (" + std::strerror(e) + ")");
+    }
+}
+
+std::string status_name(ct_status s)
+{
+    const char *n = "unknown";
+    ct_status_name(s, &n);
+    return n;
+}
+
+std::vector<MapRay> read_rays_csv(const std::string &path)
+{
+    std::ifstream in(path);
+    if (!in) throw Error(path + ": " + std::strerror(errno));
+    std::string line;
+    if (!std::getline(in, line)) throw Error(path + ": empty file (expected a header E,N,h,dE,dN,dh)");
+    auto split = [](const std::string &s) {
+        std::vector<std::string> v;
+        std::string cur;
+        for (char ch : s) {
+            if (ch == ',') {
+                v.push_back(cur);
+                cur.clear();
+            } else if (ch != '\r' && ch != ' ' && ch != '\t') {
+                cur += ch;
+            }
+        }
+        v.push_back(cur);
+        return v;
+    };
+    std::vector<std::string> hdr = split(line);
+    const char *names[6] = {"E", "N", "h", "dE", "dN", "dh"};
+    int col[6];
+    for (int k = 0; k < 6; ++k) {
+        col[k] = -1;
+        for (size_t c = 0; c < hdr.size(); ++c)
+            if (hdr[c] == names[k]) col[k] = (int)c;
+        if (col[k] < 0) throw Error(path + ":1: header lacks column '" + names[k] + "' (need E,N,h,dE,dN,dh)");
+    }
+    std::vector<MapRay> rays;
+    int lineno = 1;
+    while (std::getline(in, line)) {
+        ++lineno;
+        if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+        std::vector<std::string> f = split(line);
+        double v[6];
+        for (int k = 0; k < 6; ++k) {
+            if ((size_t)col[k] >= f.size()) throw Error(path + ":" + std::to_string(lineno) + ": too few columns");
+            char *end = nullptr;
+            v[k] = std::strtod(f[col[k]].c_str(), &end);
+            if (f[col[k]].empty() || !end || *end || !std::isfinite(v[k]))
+                throw Error(path + ":" + std::to_string(lineno) + ": bad number '" + f[col[k]] + "' in column " + names[k]);
+        }
+        rays.push_back(MapRay{v[0], v[1], v[2], v[3], v[4], v[5]});
+    }
+    return rays;
+}
+
+ct_status map_ray_to_grid(const ct_package &p, const MapRay &r, ct_ray *out)
+{
+    double pe = p.posting_e_nm * 1e-9, pn = p.posting_n_nm * 1e-9;
+    double sc = p.height_scale_nm * 1e-9, off = p.height_offset_nm * 1e-9;
+    double e0 = p.origin_e_nm * 1e-9, n0 = p.origin_n_nm * 1e-9;
+    double x = (r.e - e0) / pe - 0.5, y = (r.n - n0) / pn - 0.5, z = (r.h - off) / sc;
+    double lim = (double)CT_MAX_ORIGIN_Q16 / 65536.0;
+    if (!(std::fabs(x) < lim && std::fabs(y) < lim && std::fabs(z) < lim)) return CT_ERR_RAY;
+    out->x_q16 = std::llround(x * 65536.0);
+    out->y_q16 = std::llround(y * 65536.0);
+    out->z_q16 = std::llround(z * 65536.0);
+    double d[3] = {r.de / pe, r.dn / pn, r.dh / sc};
+    double m = std::max(std::fabs(d[0]), std::max(std::fabs(d[1]), std::fabs(d[2])));
+    if (!(m > 0) || !std::isfinite(m)) return CT_ERR_RAY;
+    double s = 4503599627370496.0 / m; /* 2^52 */
+    out->dx = std::llround(d[0] * s);
+    out->dy = std::llround(d[1] * s);
+    out->dz = std::llround(d[2] * s);
+    return CT_OK;
+}
+
+Progress::Progress(std::string what) : what_(std::move(what)), t0_(std::chrono::steady_clock::now()) {}
+
+void Progress::update(size_t done, size_t total)
+{
+    double el = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0_).count();
+    if (el < 1.0 || total == 0 || !isatty(2)) {
+        if (el >= 1.0 && total && !isatty(2) && !shown_) {
+            std::fprintf(stderr, "%s ...\n", what_.c_str());
+            shown_ = true;
+        }
+        return;
+    }
+    shown_ = true;
+    int w = 30, k = (int)(w * done / total);
+    std::fprintf(stderr, "\r%s [%.*s%*s] %3d%% %.0f s", what_.c_str(), k, "##############################", w - k, "",
+                 (int)(100 * done / total), el);
+}
+
+void Progress::finish()
+{
+    if (shown_ && isatty(2)) std::fprintf(stderr, "\n");
+}
+
+}  // namespace ct_host

@@ -1,0 +1,46 @@
+// host_io.hpp -- files, CSV rays, progress, map <-> grid conversion (host).
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "conetrace.h"
+#include "terrain.hpp"
+
+namespace ct_host {
+
+// Whole-file read; throws Error("<path>: <reason>").
+std::vector<uint8_t> read_file(const std::string &path);
+// Write to "<path>.tmp.<pid>" then rename: never a partial output file.
+void write_file_atomic(const std::string &path, const std::vector<uint8_t> &bytes);
+
+std::string status_name(ct_status s);
+
+// A ray in the map frame (metres): origin (e, n, h), direction (de, dn, dh).
+struct MapRay {
+    double e, n, h, de, dn, dh;
+};
+// rays.csv: header naming E,N,h,dE,dN,dh (any order); throws Error with
+// "<path>:<line>: <reason>" on bad input.
+std::vector<MapRay> read_rays_csv(const std::string &path);
+
+// Map-frame ray (double metres) to a grid ray for the package: origin to
+// Q16 (rounded), direction scaled to |max| = 2^52.  CT_ERR_RAY if degenerate.
+ct_status map_ray_to_grid(const ct_package &p, const MapRay &r, ct_ray *out);
+
+// A progress bar on stderr, shown only once the work has taken > 1 s.
+class Progress {
+  public:
+    explicit Progress(std::string what);
+    void update(size_t done, size_t total);
+    void finish();
+
+  private:
+    std::string what_;
+    std::chrono::steady_clock::time_point t0_;
+    bool shown_ = false;
+};
+
+}  // namespace ct_host

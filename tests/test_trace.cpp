@@ -1,0 +1,210 @@
+// test_trace.cpp -- the tracer against an independent long-double reference
+// on many seeded rays per DEM, over ray families; all four methods must
+// return bit-identical results.
+//
+// Per DEM: CT_TEST_RAYS rays (default 100000) x 4 methods, scaled by
+// CT_TEST_SCALE; seed CT_TEST_SEED.  A result is "wrong" unless
+//  - status and position agree with the reference (position within
+//    POS_TOL_Q16 per axis), or
+//  - the disagreement is a tangency: the ray comes within EPS_LSB of the
+//    surface where the two disagree (the reference's own rounding), checked
+//    analytically by ref::min_clearance.
+// Wrong results must be zero.
+#include <cmath>
+#include <cstring>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "conetrace.h"
+#include "dem_cases.hpp"
+#include "harness.h"
+#include "reference.hpp"
+#include "terrain.hpp"
+
+namespace {
+
+constexpr double POS_TOL_Q16 = 2.5;   // stated bound: 2 Q16 units per axis (+ reference slack)
+constexpr double EPS_LSB = 1e-6;      // tangency band for disputes
+
+struct Stats {
+    long rays = 0, hits = 0, misses = 0, below = 0, tangent = 0, wrong = 0, prep_miss = 0;
+    double max_err_q16 = 0;
+    long steps[4] = {0, 0, 0, 0};
+    long iters[4] = {0, 0, 0, 0};
+};
+
+ref::Ray to_ref(const ct_prepared &p)
+{
+    ref::Ray r;
+    r.ox = (ref::ld)p.ox / 65536;
+    r.oy = (ref::ld)p.oy / 65536;
+    r.oz = (ref::ld)p.oz / 65536;
+    r.dx = (ref::ld)p.dx / 65536;
+    r.dy = (ref::ld)p.dy / 65536;
+    r.dz = (ref::ld)p.dz / 65536;
+    r.tend = (ref::ld)p.tend_n / (ref::ld)p.tend_d;
+    return r;
+}
+
+// Classify a disagreement; returns true when it is a tangency.
+bool tangent_ok(const ref::Dem &d, const ref::Ray &r, int ls, ref::ld tl, const ref::Hit &rh)
+{
+    const ref::ld e = EPS_LSB, dt = 1.0L / (1 << 25);
+    bool lhit = ls == CT_HIT || ls == CT_HIT_VOID;
+    if (ls == CT_BELOW || rh.status == ref::BELOW) {
+        return std::fabs((double)(r.oz - ref::surface(d, r.ox, r.oy))) <= EPS_LSB;
+    }
+    if (lhit && (rh.status != ref::HIT || tl < rh.t)) {
+        // the library stops earlier: it must be touching there
+        return ref::min_clearance(d, r, tl, tl + dt) <= e;
+    }
+    if (rh.status == ref::HIT && (!lhit || tl > rh.t)) {
+        // the library goes on past the reference's hit: that hit must be a graze
+        ref::ld upto = lhit ? tl : r.tend;
+        return ref::min_clearance(d, r, rh.t - dt, upto) >= -e;
+    }
+    return false;
+}
+
+void check_case(const dem_cases::Case &cs, long nrays, Stats *st, std::map<std::string, Stats> *fam)
+{
+    ct_package p;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_package_open(&p, cs.pkg.data(), cs.pkg.size()));
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_package_verify(&p));
+    ref::Dem d;
+    d.w = cs.t.width;
+    d.h = cs.t.height;
+    d.z.assign(cs.t.codes.begin(), cs.t.codes.end());
+    ct_rng rng;
+    ct_rng_seed(&rng, ct_test_seed() * 7919u + (uint64_t)cs.name.size() * 131u + cs.t.width);
+    int reported = 0;
+    for (long k = 0; k < nrays; ++k) {
+        dem_cases::Family f = (dem_cases::Family)(k % dem_cases::FAMILY_COUNT);
+        ct_ray ray = dem_cases::make_ray(cs.t, f, &rng);
+        ct_prepared pr;
+        ct_status ps = ct_ray_prepare(&p, &ray, &pr);
+        Stats &fs = (*fam)[dem_cases::family_name(f)];
+        st->rays++;
+        fs.rays++;
+        if (ps < 0) {
+            TEST_FAIL_MSG("%s: prepare failed %d for family %s", cs.name.c_str(), ps, dem_cases::family_name(f));
+        }
+        if (ps == CT_MISS) {
+            st->prep_miss++;
+            fs.prep_miss++;
+            TEST_ASSERT_MSG(!dem_cases::ray_crosses_box(cs.t, ray),
+                            "%s: prepare says MISS but the ray crosses the tile box (family %s, ray %ld: o=(%lld,%lld,%lld) "
+                            "d=(%lld,%lld,%lld))",
+                            cs.name.c_str(), dem_cases::family_name(f), k, (long long)ray.x_q16, (long long)ray.y_q16,
+                            (long long)ray.z_q16, (long long)ray.dx, (long long)ray.dy, (long long)ray.dz);
+            continue;
+        }
+        ct_hit h[4];
+        ct_status s[4];
+        for (int m = 0; m < 4; ++m) {
+            s[m] = ct_trace_prepared(&p, &pr, (ct_method)m, &h[m]);
+            TEST_ASSERT_MSG(s[m] >= 0, "%s: trace error %d (method %d, family %s, ray %ld)", cs.name.c_str(), s[m], m,
+                            dem_cases::family_name(f), k);
+            st->steps[m] += h[m].steps;
+            st->iters[m] += h[m].iters;
+            fs.steps[m] += h[m].steps;
+            fs.iters[m] += h[m].iters;
+        }
+        for (int m = 1; m < 4; ++m) {
+            bool same = s[m] == s[0];
+            if (same && (s[0] == CT_HIT || s[0] == CT_HIT_VOID))
+                same = h[m].x_q16 == h[0].x_q16 && h[m].y_q16 == h[0].y_q16 && h[m].z_q16 == h[0].z_q16 &&
+                       h[m].t_q26 == h[0].t_q26 && h[m].cell_x == h[0].cell_x && h[m].cell_y == h[0].cell_y;
+            TEST_ASSERT_MSG(same,
+                            "%s: method %d differs from incremental (family %s, ray %ld): status %d vs %d, "
+                            "x %lld vs %lld, y %lld vs %lld, z %lld vs %lld",
+                            cs.name.c_str(), m, dem_cases::family_name(f), k, s[m], s[0], (long long)h[m].x_q16,
+                            (long long)h[0].x_q16, (long long)h[m].y_q16, (long long)h[0].y_q16, (long long)h[m].z_q16,
+                            (long long)h[0].z_q16);
+        }
+        ref::Ray rr = to_ref(pr);
+        ref::Hit rh = ref::trace(d, rr);
+        bool lhit = s[0] == CT_HIT || s[0] == CT_HIT_VOID;
+        bool agree;
+        if (lhit && rh.status == ref::HIT) {
+            double ex = std::fabs((double)(h[0].x_q16 - rh.x * 65536));
+            double ey = std::fabs((double)(h[0].y_q16 - rh.y * 65536));
+            double ez = std::fabs((double)(h[0].z_q16 - rh.z * 65536));
+            double e = std::max(ex, std::max(ey, ez));
+            agree = e <= POS_TOL_Q16;
+            if (agree) st->max_err_q16 = std::max(st->max_err_q16, e);
+        } else {
+            agree = (s[0] == CT_MISS && rh.status == ref::MISS) || (s[0] == CT_BELOW && rh.status == ref::BELOW);
+        }
+        if (lhit) st->hits++;
+        if (s[0] == CT_MISS) st->misses++;
+        if (s[0] == CT_BELOW) st->below++;
+        if (agree) continue;
+        if (tangent_ok(d, rr, s[0], (ref::ld)h[0].t_q26 / (1 << 26), rh)) {
+            st->tangent++;
+            fs.tangent++;
+            continue;
+        }
+        st->wrong++;
+        fs.wrong++;
+        if (reported++ < 5) {
+            std::printf("  WRONG %s family %s ray %ld: lib status %d (%.6f, %.6f, %.6f) t=%.9f cell %d,%d; ref status %d "
+                        "(%.6Lf, %.6Lf, %.6Lf) t=%.9Lf cell %d,%d\n"
+                        "    prepared o=(%lld,%lld,%lld) d=(%d,%d,%d) tend=%lld/%lld\n",
+                        cs.name.c_str(), dem_cases::family_name(f), k, s[0], h[0].x_q16 / 65536.0, h[0].y_q16 / 65536.0,
+                        h[0].z_q16 / 65536.0, h[0].t_q26 / 67108864.0, h[0].cell_x, h[0].cell_y, rh.status, rh.x, rh.y,
+                        rh.z, rh.t, rh.ci, rh.cj, (long long)pr.ox, (long long)pr.oy, (long long)pr.oz, pr.dx, pr.dy,
+                        pr.dz, (long long)pr.tend_n, (long long)pr.tend_d);
+        }
+    }
+}
+
+long rays_per_dem()
+{
+    const char *s = getenv("CT_TEST_RAYS");
+    long n = s ? atol(s) : 100000;
+    return (long)(n * ct_test_scale());
+}
+
+void run_cases(const std::vector<dem_cases::Case> &cases)
+{
+    long n = rays_per_dem();
+    for (const auto &cs : cases) {
+        Stats st;
+        std::map<std::string, Stats> fam;
+        check_case(cs, n, &st, &fam);
+        if (ct_harness_g.current_failed) return;
+        std::printf("  %-22s N=%-2d r=%d: %ld rays, %ld hit, %ld miss, %ld below, %ld never enter; "
+                    "tangencies %ld, wrong %ld, max |err| %.2f q16; mean steps inc %.1f hier %.1f cone %.1f dir %.1f\n",
+                    cs.name.c_str(), cs.opt.sectors, cs.opt.reduce, st.rays, st.hits, st.misses, st.below, st.prep_miss,
+                    st.tangent, st.wrong, st.max_err_q16, (double)st.steps[0] / st.rays, (double)st.steps[1] / st.rays,
+                    (double)st.steps[2] / st.rays, (double)st.steps[3] / st.rays);
+        if (st.wrong) {
+            for (auto &kv : fam)
+                if (kv.second.wrong)
+                    std::printf("    family %-12s wrong %ld of %ld\n", kv.first.c_str(), kv.second.wrong, kv.second.rays);
+        }
+        TEST_ASSERT_MSG(st.wrong == 0, "%s: %ld wrong-surface results", cs.name.c_str(), st.wrong);
+        TEST_ASSERT_MSG(st.max_err_q16 <= POS_TOL_Q16, "position error above bound");
+    }
+}
+
+void test_adversarial_dems() { run_cases(dem_cases::adversarial_cases()); }
+
+void test_real_dem()
+{
+    std::vector<dem_cases::Case> cs = dem_cases::real_cases();
+    if (cs.empty()) TEST_SKIP("real fixture not available");
+    run_cases(cs);
+}
+
+}  // namespace
+
+int main()
+{
+    TEST_BEGIN("test_trace");
+    RUN_TEST(test_adversarial_dems);
+    RUN_TEST(test_real_dem);
+    return TEST_END();
+}
