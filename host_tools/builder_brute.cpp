@@ -491,14 +491,13 @@ std::vector<uint8_t> build_package(const Terrain &t, const BuildOptions &opt, Bu
         }
     };
     std::vector<std::thread> pool;
-    for (int k = 1; k < nthreads; ++k) pool.emplace_back(worker);
-    if (opt.progress && nthreads > 1) {
-        while (rows_done.load() < (size_t)hc && next_row.load() < hc) {
+    for (int k = 0; k < nthreads; ++k) pool.emplace_back(worker);
+    if (opt.progress) {
+        while (rows_done.load() < (size_t)hc) {
             opt.progress(rows_done.load(), (size_t)hc);
-            std::this_thread::sleep_for(std::chrono::milliseconds(200));
+            std::this_thread::sleep_for(std::chrono::milliseconds(100));
         }
     }
-    worker();
     for (auto &th : pool) th.join();
     if (opt.progress) opt.progress((size_t)hc, (size_t)hc);
 

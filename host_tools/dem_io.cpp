@@ -1,2 +1,651 @@
-// placeholder, being written
+// dem_io.cpp -- DEM rasters: pixels through OpenImageIO (read in the file's
+// native sample type, never rescaled), georeference through libtiff +
+// libgeotiff, GeoTIFF writing through libtiff + libgeotiff.
+//
+// Diagnostics: libtiff messages produced on our handles go to per-handle
+// handlers (libtiff >= 4.5, TIFFOpenOptions) and end up in the exception
+// text; warnings are dropped.  Process-wide handlers (TIFFSetErrorHandler /
+// TIFFSetWarningHandler) are installed once as a backstop for messages that
+// carry no handle: while one of our calls is active on the thread they are
+// captured, otherwise they are forwarded to whatever handler was installed
+// before ours (OpenImageIO installs its own silent ones too).
+
 #include "dem_io.hpp"
+
+#include <OpenImageIO/imageio.h>
+
+#include <geotiffio.h>
+#include <geovalues.h>
+#include <tiffio.h>
+#include <xtiffio.h>
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cfloat>
+#include <cmath>
+#include <cstdarg>
+#include <cstdio>
+#include <cstring>
+#include <limits>
+#include <memory>
+#include <mutex>
+#include <random>
+#include <sstream>
+#include <type_traits>
+
+namespace ct_host {
+namespace {
+
+// ---------------------------------------------------------------------------
+// message capture
+
+std::string vformat(const char *fmt, va_list ap)
+{
+    if (!fmt) return std::string();
+    char small[512];
+    va_list ap2;
+    va_copy(ap2, ap);
+    int n = std::vsnprintf(small, sizeof small, fmt, ap2);
+    va_end(ap2);
+    if (n < 0) return std::string(fmt);
+    if ((size_t)n < sizeof small) return std::string(small, (size_t)n);
+    std::string big((size_t)n + 1, '\0');
+    va_copy(ap2, ap);
+    std::vsnprintf(&big[0], big.size(), fmt, ap2);
+    va_end(ap2);
+    big.resize((size_t)n);
+    return big;
+}
+
+// Collapse a multi-line library message into one line.
+std::string one_line(std::string s)
+{
+    for (char &c : s)
+        if (c == '\n' || c == '\r') c = ' ';
+    while (!s.empty() && s.back() == ' ') s.pop_back();
+    size_t b = 0;
+    while (b < s.size() && s[b] == ' ') b++;
+    return s.substr(b);
+}
+
+struct MsgSink {
+    std::string errors;  // "module: message; module: message"
+    void add(const char *module, const char *fmt, va_list ap)
+    {
+        std::string m = one_line(vformat(fmt, ap));
+        if (module && *module) m = std::string(module) + ": " + m;
+        if (!errors.empty()) {
+            if (errors.size() > 600) return;  // enough detail already
+            errors += "; ";
+        }
+        errors += m;
+    }
+    std::string text(const char *fallback) const { return errors.empty() ? fallback : errors; }
+};
+
+thread_local MsgSink *t_sink = nullptr;
+
+struct SinkScope {
+    MsgSink *prev;
+    explicit SinkScope(MsgSink *s) : prev(t_sink) { t_sink = s; }
+    ~SinkScope() { t_sink = prev; }
+    SinkScope(const SinkScope &) = delete;
+    SinkScope &operator=(const SinkScope &) = delete;
+};
+
+TIFFErrorHandler g_prev_error_handler = nullptr;
+TIFFErrorHandler g_prev_warning_handler = nullptr;
+TIFFExtendProc g_prev_extender = nullptr;
+
+void global_tiff_error(const char *module, const char *fmt, va_list ap)
+{
+    if (t_sink)
+        t_sink->add(module, fmt, ap);
+    else if (g_prev_error_handler)
+        g_prev_error_handler(module, fmt, ap);
+}
+
+void global_tiff_warning(const char *module, const char *fmt, va_list ap)
+{
+    if (t_sink) return;  // our own warnings are dropped
+    if (g_prev_warning_handler) g_prev_warning_handler(module, fmt, ap);
+}
+
+#if TIFFLIB_VERSION >= 20221213  // libtiff 4.5.0: per-handle handlers
+int handle_tiff_error(TIFF *, void *user, const char *module, const char *fmt, va_list ap)
+{
+    static_cast<MsgSink *>(user)->add(module, fmt, ap);
+    return 1;  // handled: do not call the process-wide handlers
+}
+int handle_tiff_warning(TIFF *, void *, const char *, const char *, va_list) { return 1; }
+#define CT_HAVE_TIFF_OPEN_OPTIONS 1
+#endif
+
+// libgeotiff diagnostics: errors captured, warnings dropped.
+void geotiff_message(GTIF *gt, int level, const char *fmt, ...)
+{
+    if (level != LIBGEOTIFF_ERROR) return;
+    MsgSink *sink = gt ? static_cast<MsgSink *>(GTIFGetUserData(gt)) : nullptr;
+    if (!sink) sink = t_sink;
+    if (!sink) return;
+    va_list ap;
+    va_start(ap, fmt);
+    sink->add("libgeotiff", fmt, ap);
+    va_end(ap);
+}
+
+// ---------------------------------------------------------------------------
+// libtiff set-up: GeoTIFF tags (XTIFFInitialize), the GDAL_NODATA tag, and
+// the backstop handlers.
+
+constexpr uint32_t kTagGdalNodata = 42113;
+
+void gdal_tag_extender(TIFF *tif)
+{
+    static char name[] = "GDALNoDataValue";
+    static const TIFFFieldInfo info[] = {
+        {kTagGdalNodata, TIFF_VARIABLE, TIFF_VARIABLE, TIFF_ASCII, FIELD_CUSTOM, 1, 0, name},
+    };
+    TIFFMergeFieldInfo(tif, info, 1);
+    if (g_prev_extender) g_prev_extender(tif);
+}
+
+void tiff_init_once()
+{
+    static std::once_flag once;
+    std::call_once(once, [] {
+        XTIFFInitialize();  // registers the GeoTIFF tags (what XTIFFOpen does first)
+        g_prev_extender = TIFFSetTagExtender(gdal_tag_extender);
+        g_prev_error_handler = TIFFSetErrorHandler(global_tiff_error);
+        g_prev_warning_handler = TIFFSetWarningHandler(global_tiff_warning);
+    });
+}
+
+struct TiffCloser {
+    void operator()(TIFF *t) const
+    {
+        if (t) XTIFFClose(t);
+    }
+};
+using TiffPtr = std::unique_ptr<TIFF, TiffCloser>;
+
+struct GtifFreer {
+    void operator()(GTIF *g) const
+    {
+        if (g) GTIFFree(g);
+    }
+};
+using GtifPtr = std::unique_ptr<GTIF, GtifFreer>;
+
+// Open a TIFF with the GeoTIFF tags registered (equivalent to XTIFFOpen /
+// XTIFFFdOpen) and errors routed to `sink` (which must outlive the handle).
+TIFF *open_tiff(const std::string &name, const char *mode, MsgSink &sink, int fd = -1)
+{
+    tiff_init_once();
+#ifdef CT_HAVE_TIFF_OPEN_OPTIONS
+    TIFFOpenOptions *opts = TIFFOpenOptionsAlloc();
+    if (!opts) return nullptr;
+    TIFFOpenOptionsSetErrorHandlerExtR(opts, handle_tiff_error, &sink);
+    TIFFOpenOptionsSetWarningHandlerExtR(opts, handle_tiff_warning, nullptr);
+    TIFF *t = fd >= 0 ? TIFFFdOpenExt(fd, name.c_str(), mode, opts)
+                      : TIFFOpenExt(name.c_str(), mode, opts);
+    TIFFOpenOptionsFree(opts);
+    return t;
+#else
+    (void)sink;  // messages reach it through t_sink and the global handlers
+    return fd >= 0 ? XTIFFFdOpen(fd, name.c_str(), mode) : XTIFFOpen(name.c_str(), mode);
+#endif
+}
+
+// A double-array tag (ModelPixelScale, ModelTiepoint, ModelTransformation).
+std::vector<double> get_doubles(TIFF *tif, uint32_t tag)
+{
+    const TIFFField *f = TIFFFindField(tif, tag, TIFF_ANY);
+    if (!f || !TIFFFieldPassCount(f)) return {};
+    double *p = nullptr;
+    uint32_t n = 0;
+    int ok;
+    if (TIFFFieldReadCount(f) == TIFF_VARIABLE2) {
+        uint32_t c = 0;
+        ok = TIFFGetField(tif, tag, &c, &p);
+        n = c;
+    } else {
+        uint16_t c = 0;
+        ok = TIFFGetField(tif, tag, &c, &p);
+        n = c;
+    }
+    if (!ok || !p) return {};
+    return std::vector<double>(p, p + n);
+}
+
+std::string num(double v)
+{
+    std::ostringstream o;
+    o.precision(12);
+    o << v;
+    return o.str();
+}
+
+// ---------------------------------------------------------------------------
+// reading
+
+template <typename T>
+void convert_samples(const std::vector<unsigned char> &buf, size_t n, std::vector<double> &out)
+{
+    out.resize(n);
+    for (size_t k = 0; k < n; k++) {
+        T v;
+        std::memcpy(&v, buf.data() + k * sizeof(T), sizeof(T));
+        out[k] = (double)v;
+    }
+}
+
+void read_pixels(const std::string &path, DemRaster &r, bool &is_tiff)
+{
+    auto fail = [&](const std::string &why) { return Error(path + ": " + why); };
+
+    auto in = OIIO::ImageInput::open(path);
+    if (!in) {
+        std::string e = one_line(OIIO::geterror());
+        throw fail("cannot read image" + (e.empty() ? std::string() : ": " + e));
+    }
+    const OIIO::ImageSpec spec = in->spec();
+    is_tiff = std::strcmp(in->format_name(), "tiff") == 0;
+
+    if (spec.nchannels != 1)
+        throw fail("has " + std::to_string(spec.nchannels) +
+                   " channels; a single-channel (single-band) raster is required");
+    if (spec.depth > 1) throw fail("volume images are not supported");
+    if (spec.width <= 0 || spec.height <= 0) throw fail("empty image");
+
+    const OIIO::TypeDesc fmt = spec.format;
+    const char *name = nullptr;
+    switch (fmt.basetype) {
+    case OIIO::TypeDesc::INT8: name = "int8"; break;
+    case OIIO::TypeDesc::UINT8: name = "uint8"; break;
+    case OIIO::TypeDesc::INT16: name = "int16"; break;
+    case OIIO::TypeDesc::UINT16: name = "uint16"; break;
+    case OIIO::TypeDesc::INT32: name = "int32"; break;
+    case OIIO::TypeDesc::UINT32: name = "uint32"; break;
+    case OIIO::TypeDesc::FLOAT: name = "float32"; break;
+    case OIIO::TypeDesc::DOUBLE: name = "float64"; break;
+    default: break;
+    }
+    if (!name || fmt.aggregate != OIIO::TypeDesc::SCALAR || fmt.arraylen != 0)
+        throw fail(std::string("unsupported sample format '") + fmt.c_str() + "'");
+    // Sub-byte or odd bit depths (1/2/4/10/12-bit) are widened *and rescaled*
+    // by OIIO, which would corrupt heights.
+    int bits = spec.get_int_attribute("oiio:BitsPerSample", 0);
+    if (bits != 0 && bits != (int)(fmt.size() * 8))
+        throw fail("unsupported bit depth " + std::to_string(bits) + " (stored as " +
+                   fmt.c_str() + ")");
+
+    const size_t n = (size_t)spec.width * (size_t)spec.height;
+    if (n / (size_t)spec.width != (size_t)spec.height || n > ((size_t)1 << 34))
+        throw fail("image too large");
+    std::vector<unsigned char> buf(n * fmt.size());
+    // OIIO 2.4 can return true from read_image() although a strip failed to
+    // decode (the error is only recorded), so check has_error() as well.
+    const bool read_ok = in->read_image(0, 0, 0, 1, fmt, buf.data());
+    if (!read_ok || in->has_error()) {
+        std::string e = one_line(in->geterror());
+        throw fail("cannot read pixels" + (e.empty() ? std::string() : ": " + e));
+    }
+    in->close();
+
+    switch (fmt.basetype) {
+    case OIIO::TypeDesc::INT8: convert_samples<int8_t>(buf, n, r.h); break;
+    case OIIO::TypeDesc::UINT8: convert_samples<uint8_t>(buf, n, r.h); break;
+    case OIIO::TypeDesc::INT16: convert_samples<int16_t>(buf, n, r.h); break;
+    case OIIO::TypeDesc::UINT16: convert_samples<uint16_t>(buf, n, r.h); break;
+    case OIIO::TypeDesc::INT32: convert_samples<int32_t>(buf, n, r.h); break;
+    case OIIO::TypeDesc::UINT32: convert_samples<uint32_t>(buf, n, r.h); break;
+    case OIIO::TypeDesc::FLOAT: convert_samples<float>(buf, n, r.h); break;
+    default: convert_samples<double>(buf, n, r.h); break;
+    }
+    r.width = spec.width;
+    r.height = spec.height;
+    r.sample_type = name;
+}
+
+void read_georef(const std::string &path, DemRaster &r)
+{
+    auto fail = [&](const std::string &why) { return Error(path + ": " + why); };
+
+    MsgSink sink;
+    SinkScope scope(&sink);
+    TiffPtr tif(open_tiff(path, "r", sink));
+    if (!tif) throw fail("cannot open as TIFF: " + sink.text("unknown libtiff error"));
+
+    // GDAL_NODATA
+    char *nd = nullptr;
+    if (TIFFGetField(tif.get(), kTagGdalNodata, &nd) == 1 && nd) {
+        std::string s = one_line(nd);
+        char *end = nullptr;
+        errno = 0;
+        double v = std::strtod(s.c_str(), &end);
+        if (s.empty() || end == s.c_str() || *end != '\0')
+            throw fail("unparsable GDAL_NODATA value '" + s + "'");
+        r.has_nodata = true;
+        r.nodata = v;
+    }
+
+    std::vector<double> scale = get_doubles(tif.get(), TIFFTAG_GEOPIXELSCALE);
+    std::vector<double> ties = get_doubles(tif.get(), TIFFTAG_GEOTIEPOINTS);
+    std::vector<double> xform = get_doubles(tif.get(), TIFFTAG_GEOTRANSMATRIX);
+
+    GtifPtr gt(GTIFNewEx(tif.get(), geotiff_message, &sink));
+    if (!gt) throw fail("invalid GeoTIFF key directory: " + sink.text("GTIFNew failed"));
+
+    unsigned short v = 0;
+    int raster_type = RasterPixelIsArea;
+    if (GTIFKeyGetSHORT(gt.get(), GTRasterTypeGeoKey, &v, 0, 1) == 1) raster_type = v;
+    int epsg = 0;
+    if (GTIFKeyGetSHORT(gt.get(), ProjectedCSTypeGeoKey, &v, 0, 1) == 1 && v != 0 &&
+        v != KvUserDefined)
+        epsg = v;
+    else if (GTIFKeyGetSHORT(gt.get(), GeographicTypeGeoKey, &v, 0, 1) == 1 && v != 0 &&
+             v != KvUserDefined)
+        epsg = v;
+    r.geo.epsg = epsg;
+
+    double pe, pn, oe, on;
+    if (!scale.empty() || ties.size() >= 6) {
+        if (scale.size() < 2) {
+            if (xform.size() < 16)
+                throw fail("ModelTiepoint without ModelPixelScale (ground control points) "
+                           "is not supported");
+        } else if (ties.size() < 6) {
+            throw fail("ModelPixelScale without ModelTiepoint");
+        }
+    }
+    if (scale.size() >= 2 && ties.size() >= 6) {
+        const double sx = scale[0], sy = scale[1];
+        const double ti = ties[0], tj = ties[1], tx = ties[3], ty = ties[4];
+        pe = sx;
+        pn = -sy;
+        oe = tx - ti * sx;
+        on = ty + tj * sy;
+    } else if (xform.size() >= 16) {
+        const double a = xform[0], b = xform[1], d = xform[3];
+        const double e = xform[4], f = xform[5], h = xform[7];
+        const double mag = std::max(std::fabs(a), std::fabs(f));
+        if (std::fabs(b) > 1e-12 * mag || std::fabs(e) > 1e-12 * mag)
+            throw fail("rotated or sheared model transformation is not supported");
+        pe = a;
+        pn = f;
+        oe = d;
+        on = h;
+    } else {
+        r.has_georef = false;
+        return;
+    }
+    if (!(std::isfinite(pe) && std::isfinite(pn) && std::isfinite(oe) && std::isfinite(on)) ||
+        pe == 0.0 || pn == 0.0)
+        throw fail("invalid pixel scale or model transformation (" + num(pe) + ", " + num(pn) + ")");
+    const double ape = std::fabs(pe), apn = std::fabs(pn);
+    if (std::fabs(ape - apn) > 1e-9 * std::max(ape, apn))
+        throw fail("non-square posting (" + num(ape) + " x " + num(apn) + ")");
+    if (raster_type == RasterPixelIsPoint) {
+        // the model point is the centre of the referenced pixel
+        oe -= 0.5 * pe;
+        on -= 0.5 * pn;
+    }
+    r.has_georef = true;
+    r.geo.origin_e = oe;
+    r.geo.origin_n = on;
+    r.geo.posting_e = pe;
+    r.geo.posting_n = pn;
+}
+
+void mark_valid(DemRaster &r)
+{
+    bool can_match = false;
+    double cmp = 0.0;
+    if (r.has_nodata && !std::isnan(r.nodata)) {
+        const double nd = r.nodata;
+        const std::string &t = r.sample_type;
+        if (t == "float64") {
+            can_match = true;
+            cmp = nd;
+        } else if (t == "float32") {
+            // compare in the sample type, as GDAL does
+            if (std::isinf(nd) || std::fabs(nd) <= (double)FLT_MAX) {
+                can_match = true;
+                cmp = (double)(float)nd;
+            }
+        } else if (std::isfinite(nd) && nd == std::floor(nd)) {
+            double lo = 0, hi = 0;
+            if (t == "int8") lo = INT8_MIN, hi = INT8_MAX;
+            else if (t == "uint8") lo = 0, hi = UINT8_MAX;
+            else if (t == "int16") lo = INT16_MIN, hi = INT16_MAX;
+            else if (t == "uint16") lo = 0, hi = UINT16_MAX;
+            else if (t == "int32") lo = INT32_MIN, hi = INT32_MAX;
+            else if (t == "uint32") lo = 0, hi = UINT32_MAX;
+            can_match = nd >= lo && nd <= hi;
+            cmp = nd;
+        }
+    }
+    r.valid.assign(r.h.size(), 1);
+    for (size_t k = 0; k < r.h.size(); k++) {
+        const double v = r.h[k];
+        if (std::isnan(v) || (can_match && v == cmp)) r.valid[k] = 0;
+    }
+}
+
+// ---------------------------------------------------------------------------
+// writing
+
+struct TempFile {
+    std::string path;
+    bool armed = false;
+    ~TempFile()
+    {
+        if (armed) ::unlink(path.c_str());
+    }
+};
+
+std::string random_suffix()
+{
+    static std::mutex m;
+    static std::mt19937_64 rng{std::random_device{}() ^ ((uint64_t)::getpid() << 32)};
+    std::lock_guard<std::mutex> lock(m);
+    char s[17];
+    std::snprintf(s, sizeof s, "%08x", (unsigned)(rng() & 0xffffffffu));
+    return s;
+}
+
+template <typename T>
+void to_integer(const std::string &path, const std::vector<double> &values, bool has_nodata,
+                double nodata, const char *tname, std::vector<unsigned char> &out)
+{
+    const double lo = (double)std::numeric_limits<T>::min();
+    const double hi = (double)std::numeric_limits<T>::max();
+    if (has_nodata && !(std::isfinite(nodata) && nodata == std::floor(nodata) && nodata >= lo &&
+                        nodata <= hi))
+        throw Error(path + ": nodata value " + num(nodata) + " is not representable as " + tname);
+    out.resize(values.size() * sizeof(T));
+    for (size_t k = 0; k < values.size(); k++) {
+        double v = values[k];
+        if (std::isnan(v)) {
+            if (!has_nodata)
+                throw Error(path + ": NaN sample at index " + std::to_string(k) + " cannot be stored as " +
+                            tname + " without a nodata value");
+            v = nodata;
+        }
+        const double rv = std::round(v);  // nearest, halves away from zero
+        if (!(rv >= lo && rv <= hi))
+            throw Error(path + ": sample " + num(v) + " at index " + std::to_string(k) +
+                        " is out of range for " + tname);
+        const T t = (T)rv;
+        std::memcpy(out.data() + k * sizeof(T), &t, sizeof(T));
+    }
+}
+
+void to_float32(const std::string &path, const std::vector<double> &values,
+                std::vector<unsigned char> &out)
+{
+    out.resize(values.size() * sizeof(float));
+    for (size_t k = 0; k < values.size(); k++) {
+        const double v = values[k];
+        if (std::isfinite(v) && std::fabs(v) > (double)FLT_MAX)
+            throw Error(path + ": sample " + num(v) + " at index " + std::to_string(k) +
+                        " is out of range for float32");
+        const float f = (float)v;
+        std::memcpy(out.data() + k * sizeof(float), &f, sizeof(float));
+    }
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------
+
+DemRaster read_dem(const std::string &path)
+{
+    struct stat st;
+    if (::stat(path.c_str(), &st) != 0)
+        throw Error(path + ": cannot open: " + std::strerror(errno));
+    if (S_ISDIR(st.st_mode)) throw Error(path + ": cannot open: is a directory");
+    if (::access(path.c_str(), R_OK) != 0)
+        throw Error(path + ": cannot open: " + std::strerror(errno));
+
+    DemRaster r;
+    bool is_tiff = false;
+    read_pixels(path, r, is_tiff);
+    if (is_tiff) read_georef(path, r);
+    mark_valid(r);
+    return r;
+}
+
+void write_geotiff(const std::string &path, int width, int height,
+                   const std::vector<double> &values, SampleType type, const Georef &geo,
+                   bool has_nodata, double nodata)
+{
+    auto fail = [&](const std::string &why) { return Error(path + ": " + why); };
+
+    if (width <= 0 || height <= 0)
+        throw fail("invalid raster size " + std::to_string(width) + " x " + std::to_string(height));
+    if (values.size() != (size_t)width * (size_t)height)
+        throw fail("expected " + std::to_string((size_t)width * (size_t)height) + " samples, got " +
+                   std::to_string(values.size()));
+    if (!(geo.posting_e > 0.0 && geo.posting_n < 0.0 && std::isfinite(geo.posting_e) &&
+          std::isfinite(geo.posting_n)))
+        throw fail("only north-up rasters (posting_e > 0, posting_n < 0) can be written, got (" +
+                   num(geo.posting_e) + ", " + num(geo.posting_n) + ")");
+    if (!(std::isfinite(geo.origin_e) && std::isfinite(geo.origin_n)))
+        throw fail("non-finite origin");
+    if (geo.epsg < 0 || geo.epsg > 65535) throw fail("invalid EPSG code " + std::to_string(geo.epsg));
+
+    // Convert (and range-check) everything before touching the file system.
+    std::vector<unsigned char> data;
+    uint16_t bits = 0, sfmt = 0, predictor = PREDICTOR_HORIZONTAL;
+    switch (type) {
+    case SampleType::Int16:
+        to_integer<int16_t>(path, values, has_nodata, nodata, "int16", data);
+        bits = 16, sfmt = SAMPLEFORMAT_INT;
+        break;
+    case SampleType::UInt16:
+        to_integer<uint16_t>(path, values, has_nodata, nodata, "uint16", data);
+        bits = 16, sfmt = SAMPLEFORMAT_UINT;
+        break;
+    case SampleType::Float32:
+        to_float32(path, values, data);
+        bits = 32, sfmt = SAMPLEFORMAT_IEEEFP, predictor = PREDICTOR_FLOATINGPOINT;
+        break;
+    default: throw fail("unsupported sample type");
+    }
+    std::string nodata_text;
+    if (has_nodata) {
+        char b[64];
+        std::snprintf(b, sizeof b, "%.17g", nodata);
+        nodata_text = b;
+    }
+
+    tiff_init_once();
+    MsgSink sink;  // must outlive the TIFF handle
+    SinkScope scope(&sink);
+    TempFile tmp;
+    int fd = -1;
+    for (int attempt = 0; attempt < 100 && fd < 0; attempt++) {
+        tmp.path = path + ".tmp-" + random_suffix();
+        fd = ::open(tmp.path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+        if (fd < 0 && errno != EEXIST)
+            throw fail("cannot create temporary file '" + tmp.path + "': " + std::strerror(errno));
+    }
+    if (fd < 0) throw fail("cannot create a temporary file next to the output");
+    tmp.armed = true;
+
+    const bool big = data.size() > 0xE0000000ull;
+    TiffPtr tif(open_tiff(tmp.path, big ? "w8" : "w", sink, fd));
+    if (!tif) {
+        ::close(fd);
+        throw fail("cannot open for writing: " + sink.text("unknown libtiff error"));
+    }
+    TIFF *t = tif.get();
+    auto check = [&](bool ok, const char *what) {
+        if (!ok || !sink.errors.empty())
+            throw fail(std::string(what) + " failed" +
+                       (sink.errors.empty() ? std::string() : ": " + sink.errors));
+    };
+
+    const uint16_t compression =
+        TIFFIsCODECConfigured(COMPRESSION_ADOBE_DEFLATE) ? COMPRESSION_ADOBE_DEFLATE : COMPRESSION_NONE;
+    const size_t row_bytes = (size_t)width * (bits / 8);
+    const uint32_t rows_per_strip =
+        (uint32_t)std::max<size_t>(1, std::min<size_t>((size_t)height, 65536 / std::max<size_t>(1, row_bytes)));
+    bool ok = TIFFSetField(t, TIFFTAG_IMAGEWIDTH, (uint32_t)width) &&
+              TIFFSetField(t, TIFFTAG_IMAGELENGTH, (uint32_t)height) &&
+              TIFFSetField(t, TIFFTAG_SAMPLESPERPIXEL, (uint16_t)1) &&
+              TIFFSetField(t, TIFFTAG_BITSPERSAMPLE, bits) &&
+              TIFFSetField(t, TIFFTAG_SAMPLEFORMAT, sfmt) &&
+              TIFFSetField(t, TIFFTAG_PHOTOMETRIC, (uint16_t)PHOTOMETRIC_MINISBLACK) &&
+              TIFFSetField(t, TIFFTAG_PLANARCONFIG, (uint16_t)PLANARCONFIG_CONTIG) &&
+              TIFFSetField(t, TIFFTAG_COMPRESSION, compression) &&
+              TIFFSetField(t, TIFFTAG_ROWSPERSTRIP, rows_per_strip);
+    if (ok && compression != COMPRESSION_NONE) ok = TIFFSetField(t, TIFFTAG_PREDICTOR, predictor);
+    check(ok, "setting TIFF tags");
+
+    // Georeference: PixelIsArea tiepoint at the corner of pixel (0,0).
+    double pixel_scale[3] = {std::fabs(geo.posting_e), std::fabs(geo.posting_n), 0.0};
+    double tiepoint[6] = {0.0, 0.0, 0.0, geo.origin_e, geo.origin_n, 0.0};
+    ok = TIFFSetField(t, TIFFTAG_GEOPIXELSCALE, (uint16_t)3, pixel_scale) &&
+         TIFFSetField(t, TIFFTAG_GEOTIEPOINTS, (uint16_t)6, tiepoint);
+    if (ok && has_nodata) ok = TIFFSetField(t, kTagGdalNodata, nodata_text.c_str());
+    check(ok, "setting GeoTIFF tags");
+    {
+        GtifPtr gt(GTIFNewEx(t, geotiff_message, &sink));
+        check(gt != nullptr, "creating GeoTIFF keys");
+        ok = GTIFKeySet(gt.get(), GTModelTypeGeoKey, TYPE_SHORT, 1, (int)ModelTypeProjected) &&
+             GTIFKeySet(gt.get(), GTRasterTypeGeoKey, TYPE_SHORT, 1, (int)RasterPixelIsArea);
+        if (ok && geo.epsg != 0)
+            ok = GTIFKeySet(gt.get(), ProjectedCSTypeGeoKey, TYPE_SHORT, 1, geo.epsg);
+        else if (ok)
+            ok = GTIFKeySet(gt.get(), ProjLinearUnitsGeoKey, TYPE_SHORT, 1, (int)Linear_Meter);
+        check(ok, "setting GeoTIFF keys");
+        check(GTIFWriteKeys(gt.get()) != 0, "writing GeoTIFF keys");
+    }
+
+    for (uint32_t row = 0, strip = 0; row < (uint32_t)height; row += rows_per_strip, strip++) {
+        const uint32_t nrows = std::min<uint32_t>(rows_per_strip, (uint32_t)height - row);
+        const tmsize_t bytes = (tmsize_t)(nrows * row_bytes);
+        // libtiff may modify the buffer in place (predictor), so hand it a copy
+        std::vector<unsigned char> chunk(data.begin() + (ptrdiff_t)(row * row_bytes),
+                                         data.begin() + (ptrdiff_t)(row * row_bytes + (size_t)bytes));
+        check(TIFFWriteEncodedStrip(t, strip, chunk.data(), bytes) == bytes, "writing pixel data");
+    }
+    check(TIFFFlush(t) == 1, "writing TIFF directory");
+    if (::fsync(TIFFFileno(t)) != 0 && errno != EINVAL && errno != EROFS)
+        throw fail(std::string("fsync failed: ") + std::strerror(errno));
+    tif.reset();  // closes fd
+    check(true, "closing TIFF");
+
+    if (::rename(tmp.path.c_str(), path.c_str()) != 0)
+        throw fail("cannot rename '" + tmp.path + "' to the output: " + std::strerror(errno));
+    tmp.armed = false;
+}
+
+}  // namespace ct_host

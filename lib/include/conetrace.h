@@ -258,7 +258,8 @@ ct_status ct_sector_boundary(uint32_t sectors, uint32_t k, int32_t *bx,
                              int32_t *by);
 
 /* Sector holding grid direction (dx, dy) (|.| <= 2^30, not both zero): the
- * lowest s whose closed wedge holds it, by the exact integer wedge test.   */
+ * s with angle(b_s) <= angle(d) < angle(b_{s+1}) by an exact integer order,
+ * confirmed with the closed-wedge test ct_in_wedge (the builder's test).  */
 ct_status ct_sector_of(const ct_package *pkg, int64_t dx, int64_t dy,
                        uint32_t *out_sector);
 

@@ -386,7 +386,7 @@ static ct_status hit_status(const ct_package *p, int32_t i, int32_t j)
 {
     if (p->voids != NULL) {
         uint32_t k = (uint32_t)j * p->cells_x + (uint32_t)i;
-        if ((p->voids[k >> 3] >> (k & 7u)) & 1u) {
+        if (((uint32_t)p->voids[k >> 3] >> (k & 7u)) & 1u) {
             return CT_HIT_VOID;
         }
     }

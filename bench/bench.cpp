@@ -1,0 +1,229 @@
+// bench.cpp -- `make bench`: steps and time per ray, per ray family and
+// method, on the bundled real DEM used as a square 30 m grid (and on a
+// 2048x2048 mirror-tiled copy), with the incremental method as the baseline
+// ratio and (when built with Embree) Embree 3's rtcIntersect1 beside it.
+// Everything is measured in one run; nothing here is a pass/fail test.
+//
+// Options: --quick (fewer rays, no 2048 DEM), --rays N (per family),
+//          --no-2048.
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "conetrace.h"
+#include "dem_cases.hpp"
+#include "terrain.hpp"
+
+#ifdef CT_HAVE_EMBREE
+#include "embree_baseline.hpp"
+#endif
+
+namespace {
+
+using clk = std::chrono::steady_clock;
+
+struct FamilyRays {
+    std::string name;
+    std::vector<ct_ray> rays;
+};
+
+double elev_deg_rand(ct_rng *r, double lo, double hi) { return lo + (hi - lo) * ct_rng_unit(r); }
+
+// Ray families in the paper's spirit, in the metric frame of the terrain.
+std::vector<FamilyRays> make_families(const ct_host::Terrain &t, const ct_package &p, int n, uint64_t seed)
+{
+    ct_rng r;
+    ct_rng_seed(&r, seed);
+    double lo, hi;
+    dem_cases::minmax(t, &lo, &hi);
+    double cw = t.width - 1, ch = t.height - 1;
+    std::vector<FamilyRays> fam = {{"nadir", {}}, {"oblique30", {}}, {"grazing3", {}}, {"horizontal", {}},
+                                   {"paper_long", {}}};
+    auto start_above = [&](double x, double y, double el_deg, double az) {
+        double d[3];
+        dem_cases::metric_dir(t, az, el_deg * M_PI / 180, d);
+        if (el_deg <= -89.999) d[0] = d[1] = 0;
+        return dem_cases::to_ray(x, y, hi + 10, d);
+    };
+    for (int k = 0; k < n; ++k) {
+        double x = ct_rng_unit(&r) * cw, y = ct_rng_unit(&r) * ch, az = ct_rng_unit(&r) * 2 * M_PI;
+        fam[0].rays.push_back(start_above(x, y, -90 + elev_deg_rand(&r, 0, 0.0), az));
+        fam[1].rays.push_back(start_above(x, y, -30, az));
+        fam[2].rays.push_back(start_above(x, y, -3, az));
+        {
+            double d[3];
+            dem_cases::metric_dir(t, az, 0, d);
+            d[2] = 0;
+            double s = dem_cases::surf(t, x, y);
+            fam[3].rays.push_back(dem_cases::to_ray(x, y, s + ct_rng_unit(&r) * (hi - s), d));
+        }
+    }
+    // paper-like long rays: horizontal rays that need 400..600 incremental steps
+    int tries = 0;
+    while ((int)fam[4].rays.size() < n && tries < 400 * n) {
+        ++tries;
+        double x = ct_rng_unit(&r) * cw, y = ct_rng_unit(&r) * ch, az = ct_rng_unit(&r) * 2 * M_PI;
+        double d[3];
+        dem_cases::metric_dir(t, az, 0, d);
+        d[2] = 0;
+        double s = dem_cases::surf(t, x, y);
+        ct_ray ray = dem_cases::to_ray(x, y, s + 0.3 * (hi - s) * ct_rng_unit(&r), d);
+        ct_hit h;
+        ct_status st = ct_trace(&p, &ray, CT_METHOD_INCREMENTAL, &h);
+        if ((st == CT_HIT || st == CT_MISS) && h.steps >= 400 && h.steps <= 600) fam[4].rays.push_back(ray);
+    }
+    return fam;
+}
+
+struct Result {
+    double mean_steps = 0, median_steps = 0, ns = 0;
+    long hits = 0;
+};
+
+Result run(const ct_package &p, const std::vector<ct_ray> &rays, ct_method m, std::vector<ct_hit> *out)
+{
+    Result res;
+    std::vector<uint32_t> steps(rays.size());
+    out->resize(rays.size());
+    for (size_t k = 0; k < rays.size(); ++k) {
+        ct_status s = ct_trace(&p, &rays[k], m, &(*out)[k]);
+        steps[k] = (*out)[k].steps;
+        res.hits += (s == CT_HIT || s == CT_HIT_VOID);
+    }
+    double sum = 0;
+    for (uint32_t s : steps) sum += s;
+    res.mean_steps = rays.empty() ? 0 : sum / rays.size();
+    std::vector<uint32_t> sorted = steps;
+    std::sort(sorted.begin(), sorted.end());
+    res.median_steps = sorted.empty() ? 0 : sorted[sorted.size() / 2];
+    // time: best of 3 passes
+    double best = 1e30;
+    for (int rep = 0; rep < 3; ++rep) {
+        ct_hit h;
+        uint64_t sink = 0;
+        auto t0 = clk::now();
+        for (const ct_ray &ray : rays) {
+            ct_trace(&p, &ray, m, &h);
+            sink += (uint64_t)h.x_q16;
+        }
+        double ns = std::chrono::duration<double, std::nano>(clk::now() - t0).count() / std::max<size_t>(1, rays.size());
+        if (sink == 42) std::printf(" ");
+        best = std::min(best, ns);
+    }
+    res.ns = best;
+    return res;
+}
+
+#ifdef CT_HAVE_EMBREE
+double run_embree(const EmbreeTerrain &e, const std::vector<ct_ray> &rays, long *hits)
+{
+    std::vector<std::array<double, 6>> rr;
+    for (const ct_ray &r : rays) {
+        double m = std::max(std::fabs((double)r.dx), std::max(std::fabs((double)r.dy), std::fabs((double)r.dz)));
+        rr.push_back({r.x_q16 / 65536.0, r.y_q16 / 65536.0, r.z_q16 / 65536.0, r.dx / m, r.dy / m, r.dz / m});
+    }
+    double best = 1e30;
+    for (int rep = 0; rep < 3; ++rep) {
+        long h = 0;
+        double t;
+        auto t0 = clk::now();
+        for (const auto &q : rr) h += e.intersect(q.data(), q.data() + 3, 1e7, &t);
+        double ns = std::chrono::duration<double, std::nano>(clk::now() - t0).count() / std::max<size_t>(1, rr.size());
+        best = std::min(best, ns);
+        *hits = h;
+    }
+    return best;
+}
+#endif
+
+void bench_dem(const char *title, const ct_host::Terrain &t, int n, const std::vector<int> &reduces)
+{
+    std::printf("\n=== %s: %dx%d posts, 30 m grid, %.4g m per LSB ===\n", title, t.width, t.height, t.height_scale_m);
+    size_t dem_bytes = (size_t)t.width * t.height * 2;
+#ifdef CT_HAVE_EMBREE
+    EmbreeTerrain emb(t.codes.data(), t.width, t.height, 1.0);
+    std::printf("Embree 3 scene: %.1f MB (%.1fx the DEM), built in %.2f s\n", emb.memory_bytes() / 1e6,
+                (double)emb.memory_bytes() / dem_bytes, emb.build_seconds());
+#endif
+    for (int r : reduces) {
+        ct_host::BuildOptions o;
+        o.sectors = 24;
+        o.reduce = r;
+        ct_host::BuildStats bs;
+        std::vector<uint8_t> pkg = ct_host::build_package(t, o, &bs);
+        ct_package p;
+        if (ct_package_open(&p, pkg.data(), pkg.size()) != CT_OK) {
+            std::printf("package did not open\n");
+            return;
+        }
+        std::printf("\npackage N=24 r=%d: %zu bytes = %.2fx the 16-bit DEM (built in %.1f s, %.2f%% degenerate cones)\n", r,
+                    pkg.size(), (double)pkg.size() / dem_bytes, bs.seconds,
+                    100.0 * bs.degenerate_cones / std::max<size_t>(1, bs.cones));
+        auto fams = make_families(t, p, n, 2024);
+        std::printf("%-11s %6s | %-13s %9s %7s %9s %9s %9s\n", "family", "rays", "method", "steps", "median", "ns/ray",
+                    "x fewer", "x faster");
+        for (const auto &f : fams) {
+            if (f.rays.empty()) continue;
+            Result base;
+            std::vector<ct_hit> hs[4];
+            Result res[4];
+            for (int m = 0; m < 4; ++m) res[m] = run(p, f.rays, (ct_method)m, &hs[m]);
+            base = res[0];
+            const char *mn[4] = {"incremental", "hierarchical", "cone", "directional"};
+            for (int m = 0; m < 4; ++m) {
+                std::printf("%-11s %6zu | %-13s %9.1f %7.0f %9.0f %9.2f %9.2f\n", m == 0 ? f.name.c_str() : "",
+                            f.rays.size(), mn[m], res[m].mean_steps, res[m].median_steps, res[m].ns,
+                            base.mean_steps / std::max(1e-9, res[m].mean_steps), base.ns / res[m].ns);
+            }
+            std::printf("%-11s %6s   directional vs cone: %.2fx fewer steps\n", "", "",
+                        res[2].mean_steps / std::max(1e-9, res[3].mean_steps));
+#ifdef CT_HAVE_EMBREE
+            long eh = 0;
+            double ens = run_embree(emb, f.rays, &eh);
+            std::printf("%-11s %6s   embree %.0f ns/ray (%ld hits vs our %ld): directional/embree time = %.2f\n", "", "", ens,
+                        eh, res[3].hits, res[3].ns / ens);
+#endif
+        }
+    }
+}
+
+}  // namespace
+
+int main(int argc, char **argv)
+{
+    bool quick = false, big = true;
+    int n = 20000;
+    for (int k = 1; k < argc; ++k) {
+        if (!std::strcmp(argv[k], "--quick")) {
+            quick = true;
+            n = 2000;
+            big = false;
+        } else if (!std::strcmp(argv[k], "--rays") && k + 1 < argc) {
+            n = std::atoi(argv[++k]);
+        } else if (!std::strcmp(argv[k], "--no-2048")) {
+            big = false;
+        }
+    }
+    ct_host::Terrain t = dem_cases::real_terrain();
+    bench_dem("jacksboro_fault_dem (fixture)", t, n, {1, 3});
+    if (big && !quick) {
+        // mirror-tile the fixture to 2048 x 2048
+        ct_host::Terrain b = t;
+        b.width = b.height = 2048;
+        b.codes.resize((size_t)2048 * 2048);
+        for (int j = 0; j < 2048; ++j)
+            for (int i = 0; i < 2048; ++i) {
+                int pi = i % (2 * t.width), pj = j % (2 * t.height);
+                if (pi >= t.width) pi = 2 * t.width - 1 - pi;
+                if (pj >= t.height) pj = 2 * t.height - 1 - pj;
+                b.codes[(size_t)j * 2048 + i] = t.at(pi, pj);
+            }
+        bench_dem("jacksboro mirror-tiled", b, n, {3});
+    }
+    return 0;
+}

@@ -1,0 +1,261 @@
+/*
+ * test_fixed.c -- fixed-point helpers against independent references:
+ * 128-bit arithmetic against the compiler's __int128 (the library is built
+ * twice, native and CT_PORTABLE_INT128, and this test links each), integer
+ * square roots against long double, the cot table against long double cot,
+ * sector boundary vectors against cos/sin (exact on axes and diagonals),
+ * CRC-32 against the standard check value, sector selection against the
+ * closed-wedge test.  Hard-value tables plus seeded random cases.
+ */
+#include <math.h>
+
+#include "conetrace.h"
+#include "fixed.h"
+#include "harness.h"
+
+__extension__ typedef __int128 i128;
+
+static i128 to_n(ct_i128 a) { return (i128)(((unsigned __int128)a.hi << 64) | a.lo); }
+
+static ct_rng rng;
+
+static int64_t rand_bits(int bits)
+{
+    uint64_t v = ct_rng_u64(&rng);
+    int64_t x;
+    if (bits >= 63) {
+        x = (int64_t)(v >> 1);
+    } else {
+        x = (int64_t)(v & (((uint64_t)1 << bits) - 1));
+    }
+    return (ct_rng_u64(&rng) & 1) ? -x : x;
+}
+
+static void test_i128_hard_values(void)
+{
+    const int64_t hard[] = {0, 1, -1, 2, -2, INT64_MAX, INT64_MIN + 1, (int64_t)1 << 62, -((int64_t)1 << 62),
+                            ((int64_t)1 << 32) - 1, (int64_t)1 << 32, -((int64_t)1 << 32), 0x7fffffffll, -0x80000000ll};
+    size_t n = sizeof hard / sizeof hard[0], a, b;
+    for (a = 0; a < n; ++a) {
+        for (b = 0; b < n; ++b) {
+            ct_i128 p = ct_i128_mul(hard[a], hard[b]);
+            i128 e = (i128)hard[a] * hard[b];
+            TEST_ASSERT_MSG(to_n(p) == e, "mul %lld * %lld", (long long)hard[a], (long long)hard[b]);
+            TEST_ASSERT(to_n(ct_i128_add(ct_i128_from64(hard[a]), ct_i128_from64(hard[b]))) == (i128)hard[a] + hard[b]);
+            TEST_ASSERT(to_n(ct_i128_sub(ct_i128_from64(hard[a]), ct_i128_from64(hard[b]))) == (i128)hard[a] - hard[b]);
+            TEST_ASSERT(ct_i128_cmp(ct_i128_from64(hard[a]), ct_i128_from64(hard[b])) ==
+                        (hard[a] < hard[b] ? -1 : hard[a] > hard[b]));
+            if (hard[b] > 0) {
+                /* floor division, including negative numerators */
+                i128 q = (i128)hard[a] / hard[b];
+                if ((i128)hard[a] % hard[b] != 0 && hard[a] < 0) q -= 1;
+                TEST_ASSERT(ct_i128_floor_div(ct_i128_from64(hard[a]), hard[b]) == (int64_t)q);
+                TEST_ASSERT(ct_floor_div(hard[a], hard[b]) == (int64_t)q);
+            }
+        }
+    }
+    TEST_ASSERT(ct_i128_sign(ct_i128_from64(0)) == 0);
+    TEST_ASSERT(ct_i128_sign(ct_i128_from64(-5)) == -1);
+    TEST_ASSERT(ct_i128_sign(ct_i128_shl(ct_i128_from64(1), 63)) == 1);
+}
+
+static void test_i128_random(void)
+{
+    int k;
+    ct_rng_seed(&rng, ct_test_seed());
+    /* bound: fixed count */
+    for (k = 0; k < 200000; ++k) {
+        int64_t a = rand_bits((int)ct_rng_range(&rng, 1, 63)), b = rand_bits((int)ct_rng_range(&rng, 1, 63));
+        int64_t c = rand_bits((int)ct_rng_range(&rng, 1, 62));
+        ct_i128 p = ct_i128_mul(a, b);
+        i128 e = (i128)a * b;
+        unsigned sh = (unsigned)ct_rng_range(&rng, 0, 40);
+        TEST_ASSERT_MSG(to_n(p) == e, "mul %lld %lld", (long long)a, (long long)b);
+        TEST_ASSERT(to_n(ct_i128_neg(p)) == -e);
+        /* shl within range: a < 2^62 * 2^-sh */
+        {
+            int64_t s = a >> (sh + 1);
+            TEST_ASSERT(to_n(ct_i128_shl(ct_i128_from64(s), sh)) == (i128)s * ((i128)1 << sh));
+        }
+        /* mul128_64 with |a*b*c| < 2^126 */
+        {
+            int64_t a2 = a >> 32, b2 = b >> 2, c2 = c >> 2;
+            ct_i128 q = ct_i128_mul128_64(ct_i128_mul(a2, b2), c2);
+            TEST_ASSERT(to_n(q) == (i128)a2 * b2 * c2);
+        }
+        if (c > 0) {
+            /* floor(p / c) when it fits in 63 bits */
+            i128 q = e / c;
+            if (e % c != 0 && e < 0) q -= 1;
+            if (q < ((i128)1 << 62) && q > -((i128)1 << 62)) {
+                TEST_ASSERT_MSG(ct_i128_floor_div(p, c) == (int64_t)q, "floor_div");
+                TEST_ASSERT(ct_i128_floor_div_sat(p, c) == (int64_t)q);
+            } else {
+                TEST_ASSERT(ct_i128_floor_div_sat(p, c) == (q > 0 ? ((int64_t)1 << 62) : -((int64_t)1 << 62)));
+            }
+        }
+    }
+}
+
+static void test_isqrt(void)
+{
+    const uint64_t hard[] = {0, 1, 2, 3, 4, 15, 16, 17, 0xffffffffull, 0x100000000ull, 0xfffffffe00000001ull,
+                             0xffffffffffffffffull, (uint64_t)1 << 62, ((uint64_t)1 << 62) - 1};
+    size_t k;
+    for (k = 0; k < sizeof hard / sizeof hard[0]; ++k) {
+        uint64_t r = ct_isqrt64(hard[k]);
+        TEST_ASSERT_MSG((unsigned __int128)r * r <= hard[k] && (unsigned __int128)(r + 1) * (r + 1) > hard[k],
+                        "isqrt64(%llu) = %llu", (unsigned long long)hard[k], (unsigned long long)r);
+    }
+    ct_rng_seed(&rng, ct_test_seed() + 1);
+    for (k = 0; k < 100000; ++k) {
+        /* 128-bit: n < 2^126, including perfect squares and their neighbours */
+        unsigned bits = (unsigned)ct_rng_range(&rng, 1, 125);
+        unsigned __int128 n = ((unsigned __int128)ct_rng_u64(&rng) << 64) | ct_rng_u64(&rng);
+        uint64_t r;
+        ct_i128 v;
+        n &= (((unsigned __int128)1) << bits) - 1;
+        if (k % 3 == 0) {
+            uint64_t s = (uint64_t)(n >> (bits / 2 + 1)) & (((uint64_t)1 << 62) - 1);
+            n = (unsigned __int128)s * s + (unsigned __int128)(int)ct_rng_range(&rng, -1, 1);
+            if (n >> 126) continue;
+        }
+        v.hi = (uint64_t)(n >> 64);
+        v.lo = (uint64_t)n;
+        r = ct_i128_isqrt(v);
+        TEST_ASSERT_MSG((unsigned __int128)r * r <= n && ((unsigned __int128)r + 1) * ((unsigned __int128)r + 1) > n,
+                        "isqrt128 wrong at k=%d", (int)k);
+    }
+}
+
+static void test_cot_table(void)
+{
+    int k;
+    int64_t q16[256];
+    uint8_t ok[256];
+    for (k = 1; k < 256; ++k) {
+        long double ang = (long double)k * 3.14159265358979323846264338327950288L / 256.0L;
+        long double c = cosl(ang) / sinl(ang) * 4294967296.0L;
+        /* rounded up: entry >= exact, entry - exact < 1 (allow 1e-6 for long double) */
+        TEST_ASSERT_MSG((long double)ct_cot_q32[k] >= c - 1e-3L && (long double)ct_cot_q32[k] - c < 1.0L + 1e-3L,
+                        "cot_q32[%d] = %lld vs %.3Lf", k, (long long)ct_cot_q32[k], c);
+        if (k > 1) TEST_ASSERT(ct_cot_q32[k] < ct_cot_q32[k - 1]);
+    }
+    TEST_ASSERT(ct_cot_q32[128] == 0);
+    /* derived per-package table: 30 m posting, 0.0625 m per LSB */
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_cot_table(30000000000ll, 62500000ll, q16, ok));
+    TEST_ASSERT(!ok[0]);
+    for (k = 1; k < 256; ++k) {
+        long double ang = (long double)k * 3.14159265358979323846264338327950288L / 256.0L;
+        long double c = cosl(ang) / sinl(ang) * 30.0L / 0.0625L * 65536.0L;
+        if (!ok[k]) {
+            TEST_ASSERT(c > (long double)CT_COT_MAX_Q16 - 2);
+            continue;
+        }
+        TEST_ASSERT_MSG((long double)q16[k] >= c - 1e-2L && (long double)q16[k] - c < 2.0L, "cot_q16[%d]", k);
+        if (k > 1 && ok[k - 1]) TEST_ASSERT(q16[k] <= q16[k - 1]);
+    }
+    TEST_ASSERT_EQUAL_INT(CT_ERR_GEOREF, ct_cot_table(0, 1, q16, ok));
+    TEST_ASSERT_EQUAL_INT(CT_ERR_GEOREF, ct_cot_table(1, 0, q16, ok));
+}
+
+static void test_sector_boundaries(void)
+{
+    uint32_t n, k;
+    for (n = 1; n <= CT_MAX_SECTORS; ++n) {
+        for (k = 0; k <= n; ++k) {
+            int32_t x, y;
+            long double a = 2.0L * 3.14159265358979323846264338327950288L * k / n;
+            TEST_ASSERT_EQUAL_INT(CT_OK, ct_sector_boundary(n, k, &x, &y));
+            TEST_ASSERT_MSG(fabsl(x - cosl(a) * 1073741824.0L) < 4 && fabsl(y - sinl(a) * 1073741824.0L) < 4,
+                            "boundary %u/%u = (%d, %d)", k, n, x, y);
+            if ((8 * k) % n == 0) {
+                /* axes and diagonals: exact */
+                uint32_t o = (8 * k / n) % 8;
+                int32_t ax[8] = {1, 1, 0, -1, -1, -1, 0, 1}, ay[8] = {0, 1, 1, 1, 0, -1, -1, -1};
+                if (o % 2 == 0) {
+                    TEST_ASSERT(x == ax[o] * (1 << 30) && y == ay[o] * (1 << 30));
+                } else {
+                    TEST_ASSERT(x == ax[o] * 759250125 && y == ay[o] * 759250125);
+                }
+            }
+        }
+    }
+    {
+        int32_t bx, by;
+        TEST_ASSERT_EQUAL_INT(CT_ERR_SECTORS, ct_sector_boundary(0, 0, &bx, &by));
+        TEST_ASSERT_EQUAL_INT(CT_ERR_SECTORS, ct_sector_boundary(65, 0, &bx, &by));
+        TEST_ASSERT_EQUAL_INT(CT_ERR_SECTORS, ct_sector_boundary(8, 9, &bx, &by));
+    }
+}
+
+static void test_crc32(void)
+{
+    uint32_t c;
+    const uint8_t msg[] = "123456789";
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_crc32(0, msg, 9, &c));
+    TEST_ASSERT_EQUAL_UINT64(0xCBF43926u, c);
+    /* incremental == one shot */
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_crc32(0, msg, 4, &c));
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_crc32(c, msg + 4, 5, &c));
+    TEST_ASSERT_EQUAL_UINT64(0xCBF43926u, c);
+    TEST_ASSERT_EQUAL_INT(CT_ERR_ARG, ct_crc32(0, NULL, 3, &c));
+}
+
+/* ct_sector_of picks a sector whose closed wedge holds the direction, and
+ * the lowest such sector. */
+static void test_sector_of(void)
+{
+    static ct_package p; /* only sectors and boundaries are used */
+    uint32_t n, s, in, s2;
+    int k;
+    ct_rng_seed(&rng, ct_test_seed() + 2);
+    for (n = 1; n <= CT_MAX_SECTORS; ++n) {
+        p.sectors = n;
+        for (k = 0; k <= (int)n; ++k) ct_sector_boundary(n, (uint32_t)k, &p.bound_x[k], &p.bound_y[k]);
+        for (k = 0; k < 3000; ++k) {
+            int64_t dx, dy;
+            int kind = k % 4;
+            if (kind == 0) {
+                /* exactly on a boundary vector (scaled down exactly when possible) */
+                uint32_t b = (uint32_t)ct_rng_range(&rng, 0, n);
+                dx = p.bound_x[b];
+                dy = p.bound_y[b];
+            } else if (kind == 1) {
+                int64_t ax[8] = {1, 1, 0, -1, -1, -1, 0, 1}, ay[8] = {0, 1, 1, 1, 0, -1, -1, -1};
+                int o = (int)ct_rng_range(&rng, 0, 7);
+                int64_t m = ct_rng_range(&rng, 1, 1 << 26);
+                dx = ax[o] * m;
+                dy = ay[o] * m;
+            } else {
+                dx = ct_rng_range(&rng, -(1 << 26), 1 << 26);
+                dy = ct_rng_range(&rng, -(1 << 26), 1 << 26);
+                if (dx == 0 && dy == 0) dx = 1;
+            }
+            TEST_ASSERT_EQUAL_INT(CT_OK, ct_sector_of(&p, dx, dy, &s));
+            TEST_ASSERT(s < n);
+            TEST_ASSERT_EQUAL_INT(CT_OK, ct_in_wedge(p.bound_x, p.bound_y, n, s, dx, dy, &in));
+            TEST_ASSERT_MSG(in, "direction (%lld, %lld) not in its sector %u of %u", (long long)dx, (long long)dy, s, n);
+            /* no lower sector holds it -- except sector N-1 wrapping to 0 */
+            for (s2 = 0; s2 < s; ++s2) {
+                ct_in_wedge(p.bound_x, p.bound_y, n, s2, dx, dy, &in);
+                TEST_ASSERT_MSG(!in || (s2 == 0 && s == n - 1) || s2 + 1 == s,
+                                "lower sector %u of %u also holds (%lld,%lld), chosen %u", s2, n, (long long)dx,
+                                (long long)dy, s);
+            }
+        }
+    }
+}
+
+int main(void)
+{
+    TEST_BEGIN("test_fixed");
+    RUN_TEST(test_i128_hard_values);
+    RUN_TEST(test_i128_random);
+    RUN_TEST(test_isqrt);
+    RUN_TEST(test_cot_table);
+    RUN_TEST(test_sector_boundaries);
+    RUN_TEST(test_crc32);
+    RUN_TEST(test_sector_of);
+    return TEST_END();
+}
