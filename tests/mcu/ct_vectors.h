@@ -1,0 +1,86 @@
+/*
+ * ct_vectors.h -- layout of the host-generated test vectors that the MCU
+ * images (and the host replay) re-check bit for bit.
+ *
+ * The data file (ct_vectors.c in the build tree) is written at build time
+ * by tests/mcu/gen_vectors.cpp from the HOST build of the library (native
+ * __int128); the MCU program links the Cortex-M build (portable 128-bit
+ * code) and must reproduce every value exactly.  C99, no float.
+ */
+#ifndef CT_VECTORS_H
+#define CT_VECTORS_H
+
+#include <stdint.h>
+#include "conetrace.h"
+
+/* One ray, its preparation and its result under every method. */
+typedef struct {
+    ct_ray ray;
+    ct_status prep_status;
+    ct_prepared prep;                     /* zero-initialised before the call */
+    ct_status status[CT_METHOD_COUNT];
+    ct_hit hit[CT_METHOD_COUNT];          /* zero-initialised before the call */
+} ct_vec_case;
+
+/* Map-frame conversions of one grid point. */
+typedef struct {
+    int64_t x, y, z;                      /* grid input (Q16)                 */
+    ct_status g2m_status;
+    int64_t e, n, h;                      /* ct_grid_to_map                   */
+    ct_status m2g_status;
+    int64_t x2, y2, z2;                   /* ct_map_to_grid(e, n, h)          */
+    ct_status surf_status;
+    int64_t surf_z;                       /* ct_surface_height(x, y)          */
+    int64_t de, dn, dh;                   /* map direction                    */
+    ct_status rfm_status;
+    ct_ray rfm;                           /* ct_ray_from_map(e, n, h, de, dn, dh),
+                                             zero-initialised before the call */
+} ct_vec_point;
+
+typedef struct {
+    const char *name;
+    const uint8_t *bytes;                 /* 8-byte aligned package           */
+    uint32_t size;
+    uint32_t crc;                         /* CRC field of the header          */
+    uint32_t sectors, reduce, levels;
+    uint32_t cone_codes;                  /* non-zero angle codes (0 = none)  */
+    int64_t cot_q16[256];
+    uint8_t cot_ok[256];
+    int32_t bound_x[CT_MAX_SECTORS + 1], bound_y[CT_MAX_SECTORS + 1];
+    const ct_vec_case *cases;
+    uint32_t ncases;
+    const ct_vec_point *points;
+    uint32_t npoints;
+} ct_vec_package;
+
+/* Fixed-point (lib/src/fixed.h) checks: host native __int128 results. */
+typedef struct {
+    int64_t a, b;
+    uint64_t mul_hi, mul_lo;              /* ct_i128_mul(a, b)                */
+    int64_t div_d;                        /* divisor > 0                      */
+    int64_t div_q;                        /* ct_i128_floor_div(mul(a,b), d)   */
+    uint64_t isqrt;                       /* ct_i128_isqrt(|mul(a, b)|)       */
+    uint64_t isqrt64;                     /* ct_isqrt64((uint64_t)a)          */
+    int64_t m64;                          /* |m64| < 2^46                     */
+    uint64_t m_hi, m_lo;                  /* ct_i128_mul128_64(ct_i128_mul(
+                                             a / 2^24, b / 2^24), m64)        */
+} ct_vec_fixed;
+
+typedef struct {
+    uint32_t k, n;
+    int32_t cx, sy;                       /* ct_dir_of_fraction(k, n)         */
+} ct_vec_dir;
+
+typedef struct {
+    const ct_vec_package *packages;
+    uint32_t npackages;
+    const ct_vec_fixed *fixed;
+    uint32_t nfixed;
+    const ct_vec_dir *dirs;
+    uint32_t ndirs;
+    const char *generator;                /* "build_package" or "degenerate"  */
+} ct_vec_set;
+
+extern const ct_vec_set ct_vectors;
+
+#endif /* CT_VECTORS_H */

@@ -1,0 +1,747 @@
+// gen_vectors.cpp -- host generator of the MCU bit-identity vectors.
+//
+//   gen_vectors <out.c> [rays-per-package]
+//
+// Builds a small synthetic terrain, turns it into packages (N = 8, r = 2 and
+// N = 24, r = 1), traces a few hundred rays per package with every method
+// on the HOST build of the library (native __int128) and writes everything
+// -- package bytes, rays, prepared rays, every ct_hit field, map-frame
+// conversions, fixed-point results -- as a C99 data file (ct_vectors.h).
+// The MCU program re-computes all of it with the Cortex-M build and requires
+// bit-identical results.
+//
+// Package source: with CT_GEN_USE_BUILDER the packages come from
+// ct_host::build_package (real cones, so cone jumps run on the MCU).
+// Without it, the generator writes the package itself from the library's
+// layout (ct_package_layout, ct_crc32): exact mipmap, apex = tallest corner
+// of each coarse cell, every angle code 0 (degenerate cone, always valid).
+#include <cinttypes>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <exception>
+#include <string>
+#include <vector>
+
+#include "conetrace.h"
+extern "C" {
+#include "fixed.h"
+}
+#include "ct_vectors.h"
+
+#ifdef CT_GEN_USE_BUILDER
+#include "terrain.hpp"
+#endif
+
+namespace {
+
+const int64_t ONE16 = 65536;
+
+// ------------------------------------------------------------------ rng
+struct Rng {
+    uint64_t s;
+    explicit Rng(uint64_t seed) : s(seed * 0x9E3779B97F4A7C15ull + 0x1234567ull) {}
+    uint64_t u64()
+    {
+        uint64_t x = s;
+        x ^= x >> 12;
+        x ^= x << 25;
+        x ^= x >> 27;
+        s = x;
+        return x * 0x2545F4914F6CDD1Dull;
+    }
+    int64_t range(int64_t lo, int64_t hi) { return lo + (int64_t)(u64() % (uint64_t)(hi - lo + 1)); }
+    double unit() { return (double)(u64() >> 11) * (1.0 / 9007199254740992.0); }
+    double uni(double lo, double hi) { return lo + (hi - lo) * unit(); }
+    bool chance(int pct) { return range(0, 99) < pct; }
+};
+
+[[noreturn]] void die(const std::string &m)
+{
+    std::fprintf(stderr, "gen_vectors: %s\n", m.c_str());
+    std::exit(1);
+}
+
+// ------------------------------------------------------------------ terrain
+const int W = 33, H = 29;  // posts: 32 x 28 fine cells
+const double POSTING_M = 30.0, SCALE_M = 0.125, OFFSET_M = -100.0;
+const double ORIGIN_E_M = 500000.0, ORIGIN_N_M = 4200000.0;
+const int EPSG = 32633;
+
+struct Dem {
+    std::vector<uint16_t> codes;  // row-major
+    std::vector<uint8_t> void_post;
+    uint16_t at(int i, int j) const { return codes[(size_t)j * W + (size_t)i]; }
+};
+
+// Varied terrain: rolling hills, a sharp ridge, a pit, a flat plateau (exact
+// ties), a one-post spike, a cliff, a saddle, and a small nodata patch.
+Dem make_dem()
+{
+    Dem d;
+    d.codes.resize((size_t)W * H);
+    d.void_post.assign((size_t)W * H, 0);
+    for (int j = 0; j < H; ++j) {
+        for (int i = 0; i < W; ++i) {
+            double h = 220.0 + 45.0 * std::sin(i * 0.31) * std::cos(j * 0.23) + 12.0 * std::sin(i * 1.7 + j * 0.9);
+            h += 90.0 * std::exp(-std::pow((i - 2.0 * j / 3.0 - 6.0) / 1.6, 2));  // ridge
+            h -= 70.0 * std::exp(-((i - 24.0) * (i - 24.0) + (j - 20.0) * (j - 20.0)) / 10.0);  // pit
+            if (i >= 18 && i <= 23 && j >= 3 && j <= 8) {
+                h = 300.0;  // plateau: exactly flat
+            }
+            if (i >= 8 && i <= 12 && j >= 20) {
+                h += 80.0;  // cliff block
+            }
+            h += 0.02 * (i - 16) * (j - 14) * 3.0;  // saddle twist
+            if (i == 27 && j == 6) {
+                h = 520.0;  // spike
+            }
+            long c = std::lround((h - OFFSET_M) / SCALE_M);
+            if (c < 0 || c > 65535) {
+                die("terrain code out of range");
+            }
+            d.codes[(size_t)j * W + i] = (uint16_t)c;
+        }
+    }
+    // nodata patch: posts (3..4, 24..25); the fill is the floor of the patch
+    for (int j = 24; j <= 25; ++j) {
+        for (int i = 3; i <= 4; ++i) {
+            d.void_post[(size_t)j * W + i] = 1;
+            d.codes[(size_t)j * W + i] = d.at(2, 23);
+        }
+    }
+    return d;
+}
+
+// ------------------------------------------------------------------ package writer (fallback)
+void put16(std::vector<uint8_t> &b, size_t o, uint32_t v)
+{
+    b[o] = (uint8_t)v;
+    b[o + 1] = (uint8_t)(v >> 8);
+}
+void put32(std::vector<uint8_t> &b, size_t o, uint32_t v)
+{
+    for (int k = 0; k < 4; ++k) b[o + k] = (uint8_t)(v >> (8 * k));
+}
+void put64(std::vector<uint8_t> &b, size_t o, int64_t v)
+{
+    for (int k = 0; k < 8; ++k) b[o + k] = (uint8_t)((uint64_t)v >> (8 * k));
+}
+
+int64_t nm(double m) { return (int64_t)std::llround(m * 1e9); }
+
+std::vector<uint8_t> write_degenerate_package(const Dem &d, uint32_t n, uint32_t r)
+{
+    uint32_t so[CT_SEC_COUNT], ss[CT_SEC_COUNT], levels = 0, total = 0;
+    bool voids = false;
+    for (uint8_t v : d.void_post) voids = voids || v;
+    if (ct_package_layout(W, H, r, n, voids ? 1u : 0u, so, ss, &levels, &total) != CT_OK) {
+        die("ct_package_layout failed");
+    }
+    std::vector<uint8_t> b(total, 0);
+    const uint32_t cx = W - 1, cy = H - 1;
+    uint32_t hmin = 0xffff, hmax = 0;
+    for (uint16_t c : d.codes) {
+        hmin = c < hmin ? c : hmin;
+        hmax = c > hmax ? c : hmax;
+    }
+    // heights
+    for (size_t k = 0; k < d.codes.size(); ++k) put16(b, so[CT_SEC_HEIGHTS] + 2 * k, d.codes[k]);
+    // fine cell maxima
+    std::vector<uint32_t> cm((size_t)cx * cy);
+    for (uint32_t j = 0; j < cy; ++j)
+        for (uint32_t i = 0; i < cx; ++i) {
+            uint32_t m = d.at((int)i, (int)j);
+            m = std::max<uint32_t>(m, d.at((int)i + 1, (int)j));
+            m = std::max<uint32_t>(m, d.at((int)i, (int)j + 1));
+            m = std::max<uint32_t>(m, d.at((int)i + 1, (int)j + 1));
+            cm[(size_t)j * cx + i] = m;
+        }
+    // mipmap levels 1..L: each level is the max of the 2x2 children
+    {
+        std::vector<uint32_t> prev = cm;
+        uint32_t pw = cx, ph = cy;
+        size_t off = so[CT_SEC_MIPMAP];
+        for (uint32_t l = 1; l <= levels; ++l) {
+            uint32_t mw = (pw + 1) / 2, mh = (ph + 1) / 2;
+            std::vector<uint32_t> cur((size_t)mw * mh, 0);
+            for (uint32_t j = 0; j < mh; ++j)
+                for (uint32_t i = 0; i < mw; ++i) {
+                    uint32_t m = 0;
+                    for (uint32_t dj = 0; dj < 2; ++dj)
+                        for (uint32_t di = 0; di < 2; ++di) {
+                            uint32_t ci = 2 * i + di, cj = 2 * j + dj;
+                            if (ci < pw && cj < ph) m = std::max(m, prev[(size_t)cj * pw + ci]);
+                        }
+                    cur[(size_t)j * mw + i] = m;
+                    put16(b, off, m);
+                    off += 2;
+                }
+            prev.swap(cur);
+            pw = mw;
+            ph = mh;
+        }
+        if (off != (size_t)so[CT_SEC_MIPMAP] + ss[CT_SEC_MIPMAP]) die("mipmap size mismatch");
+    }
+    // apex = tallest corner of each coarse cell; all angle codes 0
+    const uint32_t wc = (cx + r - 1) / r, hc = (cy + r - 1) / r;
+    for (uint32_t j = 0; j < hc; ++j)
+        for (uint32_t i = 0; i < wc; ++i) {
+            uint32_t m = 0;
+            for (uint32_t fj = j * r; fj < (j + 1) * r && fj < cy; ++fj)
+                for (uint32_t fi = i * r; fi < (i + 1) * r && fi < cx; ++fi) m = std::max(m, cm[(size_t)fj * cx + fi]);
+            put16(b, so[CT_SEC_APEX] + 2 * ((size_t)j * wc + i), m);
+        }
+    // voids: a fine cell is void if any of its posts is
+    if (voids) {
+        for (uint32_t j = 0; j < cy; ++j)
+            for (uint32_t i = 0; i < cx; ++i) {
+                size_t p = (size_t)j * W + i;
+                if (d.void_post[p] || d.void_post[p + 1] || d.void_post[p + W] || d.void_post[p + W + 1]) {
+                    size_t k = (size_t)j * cx + i;
+                    b[so[CT_SEC_VOIDS] + k / 8] |= (uint8_t)(1u << (k % 8));
+                }
+            }
+    }
+    // header
+    std::memcpy(b.data(), CT_PKG_MAGIC, 4);
+    put16(b, 4, CT_PKG_VERSION);
+    put16(b, 6, CT_PKG_HEADER_SIZE);
+    put32(b, 8, total);
+    put16(b, 16, W);
+    put16(b, 18, H);
+    b[20] = (uint8_t)r;
+    b[21] = (uint8_t)n;
+    b[22] = (uint8_t)levels;
+    b[23] = voids ? CT_PKG_FLAG_VOIDS : 0;
+    put16(b, 24, hmin);
+    put16(b, 26, hmax);
+    put32(b, 28, 0);
+    put64(b, 32, nm(ORIGIN_E_M));
+    put64(b, 40, nm(ORIGIN_N_M));
+    put64(b, 48, nm(POSTING_M));
+    put64(b, 56, nm(-POSTING_M));
+    put64(b, 64, nm(OFFSET_M));
+    put64(b, 72, nm(SCALE_M));
+    put32(b, 80, EPSG);
+    put32(b, 84, 0);
+    for (uint32_t k = 0; k < CT_SEC_COUNT; ++k) {
+        put32(b, CT_HDR_SECTION_TABLE + 8 * k, so[k]);
+        put32(b, CT_HDR_SECTION_TABLE + 8 * k + 4, ss[k]);
+    }
+    uint32_t crc = 0;
+    ct_crc32(0, b.data(), b.size(), &crc);  // CRC field is still zero
+    put32(b, 12, crc);
+    return b;
+}
+
+#ifdef CT_GEN_USE_BUILDER
+std::vector<uint8_t> build_with_builder(const Dem &d, int n, int r)
+{
+    ct_host::Terrain t;
+    t.width = W;
+    t.height = H;
+    t.codes = d.codes;
+    t.void_post = d.void_post;
+    t.geo.origin_e = ORIGIN_E_M;
+    t.geo.origin_n = ORIGIN_N_M;
+    t.geo.posting_e = POSTING_M;
+    t.geo.posting_n = -POSTING_M;
+    t.geo.epsg = EPSG;
+    t.height_offset_m = OFFSET_M;
+    t.height_scale_m = SCALE_M;
+    ct_host::BuildOptions o;
+    o.sectors = n;
+    o.reduce = r;
+    o.threads = 1;
+    ct_host::BuildStats st;
+    std::vector<uint8_t> b = ct_host::build_package(t, o, &st);
+    std::fprintf(stderr, "gen_vectors: build_package N=%d r=%d: %zu bytes, %zu of %zu cones degenerate\n", n, r,
+                 b.size(), st.degenerate_cones, st.cones);
+    return b;
+}
+#endif
+
+// ------------------------------------------------------------------ rays
+struct Pkg {
+    std::string name;
+    std::vector<uint8_t> bytes;
+    ct_package p;
+    uint32_t cone_codes = 0;
+    std::vector<ct_vec_case> cases;
+    std::vector<ct_vec_point> points;
+};
+
+int64_t surface_q16(const ct_package &p, int64_t x, int64_t y)
+{
+    int64_t z = 0;
+    if (ct_surface_height(&p, x, y, &z) != CT_OK) die("ct_surface_height");
+    return z;
+}
+
+// direction from azimuth (rad, grid frame) and elevation (rad, metric)
+void dir_from_angles(const ct_package &p, double az, double el, double scale, ct_ray &r)
+{
+    double lsb_per_cell = (double)p.posting_e_nm / (double)p.height_scale_nm;
+    r.dx = (int64_t)std::llround(std::cos(az) * scale);
+    r.dy = (int64_t)std::llround(std::sin(az) * scale);
+    r.dz = (int64_t)std::llround(std::tan(el) * lsb_per_cell * scale);
+}
+
+ct_ray make_ray(Rng &g, const ct_package &p, int kind)
+{
+    const int64_t cx = p.cells_x, cy = p.cells_y;
+    const int64_t top = ((int64_t)p.hmax + 1) * ONE16;
+    ct_ray r{};
+    const double PI = 3.14159265358979323846;
+    switch (kind) {
+    case 0: {  // camera above the tile looking down
+        r.x_q16 = g.range(-5 * ONE16, (cx + 5) * ONE16);
+        r.y_q16 = g.range(-5 * ONE16, (cy + 5) * ONE16);
+        r.z_q16 = top + g.range(0, 2500 * ONE16);
+        dir_from_angles(p, g.uni(0, 2 * PI), -g.uni(2, 85) * PI / 180, g.uni(1e3, 1e9), r);
+        break;
+    }
+    case 1: {  // grazing from just above the surface
+        int64_t x = g.range(ONE16, (cx - 1) * ONE16), y = g.range(ONE16, (cy - 1) * ONE16);
+        r.x_q16 = x;
+        r.y_q16 = y;
+        r.z_q16 = surface_q16(p, x, y) + g.range(1, 64 * ONE16);
+        dir_from_angles(p, g.uni(0, 2 * PI), g.uni(-6, 1.5) * PI / 180, g.uni(1e4, 1e8), r);
+        break;
+    }
+    case 2: {  // from far outside, aimed exactly at a surface point
+        double a = g.uni(0, 2 * PI), dist = g.uni(40, 400);
+        int64_t tx = g.range(0, cx * ONE16), ty = g.range(0, cy * ONE16);
+        int64_t tz = surface_q16(p, tx, ty);
+        r.x_q16 = tx + (int64_t)std::llround(std::cos(a) * dist * ONE16);
+        r.y_q16 = ty + (int64_t)std::llround(std::sin(a) * dist * ONE16);
+        r.z_q16 = tz + (int64_t)std::llround(dist * g.uni(0.2, 600.0) * ONE16);
+        r.dx = tx - r.x_q16;
+        r.dy = ty - r.y_q16;
+        r.dz = tz - r.z_q16;
+        break;
+    }
+    case 3: {  // axis-aligned and exact diagonals, origins on grid lines / posts
+        int64_t s = g.range(1, 1 << 20);
+        int which = (int)g.range(0, 5);
+        r.x_q16 = g.range(0, cx) * ONE16 + (g.chance(50) ? 0 : g.range(0, ONE16 - 1));
+        r.y_q16 = g.range(0, cy) * ONE16 + (g.chance(50) ? 0 : g.range(0, ONE16 - 1));
+        r.z_q16 = surface_q16(p, std::min(r.x_q16, cx * ONE16), std::min(r.y_q16, cy * ONE16)) + g.range(1, 400 * ONE16);
+        int64_t sx = g.chance(50) ? 1 : -1, sy = g.chance(50) ? 1 : -1;
+        r.dx = which == 0 ? 0 : (which == 1 ? sx * s : sx * s);
+        r.dy = which == 0 ? sy * s : (which == 1 ? 0 : sy * s);
+        if (which >= 3) {  // off-diagonal small integer slopes
+            r.dx = sx * s * g.range(1, 3);
+            r.dy = sy * s * g.range(1, 3);
+        }
+        r.dz = -s * g.range(0, 300);
+        break;
+    }
+    case 4: {  // vertical, down and up, some on posts and lines
+        r.x_q16 = g.chance(40) ? g.range(0, cx) * ONE16 : g.range(0, cx * ONE16);
+        r.y_q16 = g.chance(40) ? g.range(0, cy) * ONE16 : g.range(0, cy * ONE16);
+        r.z_q16 = top + g.range(-ONE16, 500 * ONE16);
+        r.dz = g.chance(80) ? -g.range(1, INT64_C(1) << 40) : g.range(1, 1000);
+        if (g.chance(15)) {  // vertical outside the tile
+            r.x_q16 = -g.range(1, 1000);
+        }
+        break;
+    }
+    case 5: {  // starts below / exactly on the surface
+        int64_t x = g.range(0, cx) * ONE16, y = g.range(0, cy) * ONE16;
+        if (g.chance(50)) {
+            x += g.range(0, ONE16 - 1);
+            y += g.range(0, ONE16 - 1);
+            x = std::min(x, cx * ONE16);
+            y = std::min(y, cy * ONE16);
+        }
+        int64_t s = surface_q16(p, x, y);
+        r.x_q16 = x;
+        r.y_q16 = y;
+        r.z_q16 = g.chance(50) ? s : s - g.range(1, 50 * ONE16);
+        dir_from_angles(p, g.uni(0, 2 * PI), g.uni(-40, 40) * PI / 180, 1e6, r);
+        break;
+    }
+    case 6: {  // upward and level rays over the tile (misses)
+        r.x_q16 = g.range(-10 * ONE16, (cx + 10) * ONE16);
+        r.y_q16 = g.range(-10 * ONE16, (cy + 10) * ONE16);
+        r.z_q16 = top + g.range(-50 * ONE16, 50 * ONE16);
+        dir_from_angles(p, g.uni(0, 2 * PI), g.uni(0, 30) * PI / 180, 1e7, r);
+        break;
+    }
+    case 7: {  // extreme scales and invalid rays
+        int v = (int)g.range(0, 5);
+        r.x_q16 = g.range(0, cx * ONE16);
+        r.y_q16 = g.range(0, cy * ONE16);
+        r.z_q16 = top + g.range(0, 100 * ONE16);
+        if (v == 0) {  // huge direction
+            r.dx = g.range(-(INT64_C(1) << 62), INT64_C(1) << 62);
+            r.dy = g.range(-(INT64_C(1) << 62), INT64_C(1) << 62);
+            r.dz = -(INT64_C(1) << 62) + g.range(0, 1000);
+        } else if (v == 1) {  // tiny direction
+            r.dx = g.range(-1, 1);
+            r.dy = g.range(-1, 1);
+            r.dz = -1;
+        } else if (v == 2) {  // origin far away, near the limit
+            r.x_q16 = CT_MAX_ORIGIN_Q16 - g.range(0, 1000);
+            r.y_q16 = -CT_MAX_ORIGIN_Q16 + g.range(0, 1000);
+            r.z_q16 = CT_MAX_ORIGIN_Q16 / 2;
+            r.dx = -(INT64_C(1) << 50);
+            r.dy = INT64_C(1) << 50;
+            r.dz = -(INT64_C(1) << 46);
+        } else if (v == 3) {  // origin beyond the limit
+            r.x_q16 = CT_MAX_ORIGIN_Q16 + 1;
+            r.dx = -1;
+            r.dz = -1;
+        } else if (v == 4) {  // zero direction
+            r.dx = r.dy = r.dz = 0;
+        } else {  // direction beyond 2^62
+            r.dx = INT64_MAX;
+            r.dz = -1;
+        }
+        break;
+    }
+    case 8: {  // aimed exactly at posts, edge midpoints, plateau points
+        int64_t tx = g.range(0, cx) * ONE16, ty = g.range(0, cy) * ONE16;
+        if (g.chance(30)) tx += ONE16 / 2;
+        if (g.chance(30)) ty += ONE16 / 2;
+        if (g.chance(25)) {  // the plateau (flat, exact ties)
+            tx = g.range(18, 23) * ONE16 + g.range(0, 5) * (ONE16 / 4);
+            ty = g.range(3, 8) * ONE16;
+        }
+        tx = std::min(tx, cx * ONE16);
+        ty = std::min(ty, cy * ONE16);
+        int64_t tz = surface_q16(p, tx, ty);
+        int64_t ddx = g.range(-20, 20) * ONE16 / 4, ddy = g.range(-20, 20) * ONE16 / 4;
+        int64_t ddz = g.range(g.chance(20) ? 0 : 1, 3000) * ONE16;
+        r.x_q16 = tx - ddx;
+        r.y_q16 = ty - ddy;
+        r.z_q16 = tz + ddz;
+        r.dx = ddx;
+        r.dy = ddy;
+        r.dz = -ddz;
+        if (r.dx == 0 && r.dy == 0 && r.dz == 0) r.dz = -1;
+        break;
+    }
+    default: {  // long low rays across the whole tile
+        bool alongx = g.chance(50);
+        r.x_q16 = alongx ? -g.range(0, 3 * ONE16) : g.range(0, cx * ONE16);
+        r.y_q16 = alongx ? g.range(0, cy * ONE16) : (cy * ONE16 + g.range(0, 3 * ONE16));
+        r.z_q16 = ((int64_t)p.hmin + (p.hmax - p.hmin) / 2) * ONE16 + g.range(0, (p.hmax - p.hmin) / 2 * ONE16);
+        dir_from_angles(p, alongx ? g.uni(-0.6, 0.6) : g.uni(-PI / 2 - 0.6, -PI / 2 + 0.6), g.uni(-2, 0.2) * PI / 180,
+                        g.uni(1e5, 1e9), r);
+        break;
+    }
+    }
+    return r;
+}
+
+const int KIND_PCT[10] = {24, 14, 10, 10, 5, 6, 5, 6, 12, 8};  // sums to 100
+
+int pick_kind(Rng &g)
+{
+    int v = (int)g.range(0, 99), k = 0;
+    while (k < 9 && v >= KIND_PCT[k]) v -= KIND_PCT[k++];
+    return k;
+}
+
+ct_vec_case trace_case(const ct_package &p, const ct_ray &ray)
+{
+    ct_vec_case c;
+    std::memset(&c, 0, sizeof c);
+    c.ray = ray;
+    c.prep_status = ct_ray_prepare(&p, &ray, &c.prep);
+    for (int m = 0; m < CT_METHOD_COUNT; ++m) {
+        c.status[m] = ct_trace(&p, &ray, (ct_method)m, &c.hit[m]);
+        if (c.prep_status >= 0) {  // the prepared path must agree on the host already
+            ct_hit h2;
+            std::memset(&h2, 0, sizeof h2);
+            ct_status s2 = ct_trace_prepared(&p, &c.prep, (ct_method)m, &h2);
+            if (s2 != c.status[m] || h2.t_q26 != c.hit[m].t_q26 || h2.steps != c.hit[m].steps) {
+                die("host: ct_trace and ct_trace_prepared disagree");
+            }
+        }
+    }
+    return c;
+}
+
+ct_vec_point make_point(Rng &g, const ct_package &p, int k)
+{
+    ct_vec_point q;
+    std::memset(&q, 0, sizeof q);
+    const int64_t cx = p.cells_x, cy = p.cells_y;
+    if (k < 6) {  // posts and corners
+        q.x = (k & 1) ? cx * ONE16 : g.range(0, cx) * ONE16;
+        q.y = (k & 2) ? cy * ONE16 : g.range(0, cy) * ONE16;
+    } else if (k < 30) {
+        q.x = g.range(0, cx * ONE16);
+        q.y = g.range(0, cy * ONE16);
+    } else {  // outside the tile / far away
+        q.x = g.range(-(INT64_C(1) << 40), INT64_C(1) << 40);
+        q.y = g.range(-(INT64_C(1) << 40), INT64_C(1) << 40);
+    }
+    q.z = g.range(-(INT64_C(1) << 30), INT64_C(1) << 34);
+    q.g2m_status = ct_grid_to_map(&p, q.x, q.y, q.z, &q.e, &q.n, &q.h);
+    q.m2g_status = ct_map_to_grid(&p, q.e, q.n, q.h, &q.x2, &q.y2, &q.z2);
+    q.surf_status = ct_surface_height(&p, q.x, q.y, &q.surf_z);
+    q.de = g.range(-(INT64_C(1) << 40), INT64_C(1) << 40);
+    q.dn = g.range(-(INT64_C(1) << 40), INT64_C(1) << 40);
+    q.dh = -g.range(0, INT64_C(1) << 40);
+    if (k % 7 == 3) q.de = q.dn = 0;
+    if (k % 11 == 5) q.de = q.dn = q.dh = 0;  // invalid
+    q.rfm_status = ct_ray_from_map(&p, q.e, q.n, q.h, q.de, q.dn, q.dh, &q.rfm);
+    return q;
+}
+
+// ------------------------------------------------------------------ output
+std::string i64(int64_t v)
+{
+    char b[48];
+    if (v == INT64_MIN) return "(-INT64_C(9223372036854775807) - 1)";
+    std::snprintf(b, sizeof b, "INT64_C(%" PRId64 ")", v);
+    return b;
+}
+std::string u64(uint64_t v)
+{
+    char b[48];
+    std::snprintf(b, sizeof b, "UINT64_C(0x%016" PRIx64 ")", v);
+    return b;
+}
+std::string i32(int32_t v)
+{
+    char b[32];
+    if (v == INT32_MIN) return "(-2147483647 - 1)";
+    std::snprintf(b, sizeof b, "%" PRId32, v);
+    return b;
+}
+std::string u32(uint32_t v)
+{
+    char b[32];
+    std::snprintf(b, sizeof b, "%" PRIu32 "u", v);
+    return b;
+}
+
+std::string ray_init(const ct_ray &r)
+{
+    return "{" + i64(r.x_q16) + ", " + i64(r.y_q16) + ", " + i64(r.z_q16) + ", " + i64(r.dx) + ", " + i64(r.dy) + ", " +
+           i64(r.dz) + "}";
+}
+
+void emit_case(FILE *f, const ct_vec_case &c)
+{
+    const ct_prepared &p = c.prep;
+    std::fprintf(f, "  {.ray = %s,\n   .prep_status = %s,\n", ray_init(c.ray).c_str(), i32(c.prep_status).c_str());
+    std::fprintf(f,
+                 "   .prep = {.ox = %s, .oy = %s, .oz = %s, .dx = %s, .dy = %s, .dz = %s, .sector = %s,\n"
+                 "            .len_lo = %s, .len_hi = %s, .tend_n = %s, .tend_d = %s, .start = %s},\n",
+                 i64(p.ox).c_str(), i64(p.oy).c_str(), i64(p.oz).c_str(), i32(p.dx).c_str(), i32(p.dy).c_str(),
+                 i32(p.dz).c_str(), i32(p.sector).c_str(), i64(p.len_lo).c_str(), i64(p.len_hi).c_str(),
+                 i64(p.tend_n).c_str(), i64(p.tend_d).c_str(), i32(p.start).c_str());
+    std::fprintf(f, "   .status = {%s, %s, %s, %s},\n   .hit = {\n", i32(c.status[0]).c_str(), i32(c.status[1]).c_str(),
+                 i32(c.status[2]).c_str(), i32(c.status[3]).c_str());
+    for (int m = 0; m < CT_METHOD_COUNT; ++m) {
+        const ct_hit &h = c.hit[m];
+        std::fprintf(f,
+                     "    {.x_q16 = %s, .y_q16 = %s, .z_q16 = %s, .e_nm = %s, .n_nm = %s, .h_nm = %s,\n"
+                     "     .t_q26 = %s, .cell_x = %s, .cell_y = %s, .steps = %s, .iters = %s},\n",
+                     i64(h.x_q16).c_str(), i64(h.y_q16).c_str(), i64(h.z_q16).c_str(), i64(h.e_nm).c_str(),
+                     i64(h.n_nm).c_str(), i64(h.h_nm).c_str(), i64(h.t_q26).c_str(), i32(h.cell_x).c_str(),
+                     i32(h.cell_y).c_str(), u32(h.steps).c_str(), u32(h.iters).c_str());
+    }
+    std::fprintf(f, "  }},\n");
+}
+
+void emit_point(FILE *f, const ct_vec_point &q)
+{
+    std::fprintf(f,
+                 "  {%s, %s, %s,\n   %s, %s, %s, %s,\n   %s, %s, %s, %s,\n   %s, %s,\n   %s, %s, %s,\n   %s, %s},\n",
+                 i64(q.x).c_str(), i64(q.y).c_str(), i64(q.z).c_str(), i32(q.g2m_status).c_str(), i64(q.e).c_str(),
+                 i64(q.n).c_str(), i64(q.h).c_str(), i32(q.m2g_status).c_str(), i64(q.x2).c_str(), i64(q.y2).c_str(),
+                 i64(q.z2).c_str(), i32(q.surf_status).c_str(), i64(q.surf_z).c_str(), i64(q.de).c_str(),
+                 i64(q.dn).c_str(), i64(q.dh).c_str(), i32(q.rfm_status).c_str(), ray_init(q.rfm).c_str());
+}
+
+}  // namespace
+
+int main(int argc, char **argv)
+{
+    if (argc < 2) {
+        std::fprintf(stderr, "usage: gen_vectors <out.c> [rays-per-package]\n");
+        return 2;
+    }
+    const int nrays = argc > 2 ? std::atoi(argv[2]) : 300;
+    const Dem dem = make_dem();
+    struct Spec {
+        uint32_t n, r;
+    };
+    const Spec specs[] = {{8, 2}, {24, 1}};
+#ifdef CT_GEN_USE_BUILDER
+    std::string generator = "build_package";
+#else
+    std::string generator = "degenerate";
+#endif
+    std::vector<Pkg> pkgs;
+    Rng g(20240601u);
+    for (const Spec &s : specs) {
+        Pkg P;
+        char nm_[64];
+        ct_status st = CT_ERR_ARG;
+#ifdef CT_GEN_USE_BUILDER
+        // A builder that throws or writes a package the library rejects must
+        // not break the whole build: fall back to the degenerate package and
+        // say so in the vectors (mcu_vectors_host then fails, loudly).
+        try {
+            P.bytes = build_with_builder(dem, (int)s.n, (int)s.r);
+            st = ct_package_open(&P.p, P.bytes.data(), P.bytes.size());
+            if (st == CT_OK) st = ct_package_verify(&P.p);
+            if (st != CT_OK) {
+                std::fprintf(stderr, "gen_vectors: WARNING: build_package N=%u r=%u: package rejected (%d)\n", s.n,
+                             s.r, (int)st);
+            }
+        } catch (const std::exception &e) {
+            std::fprintf(stderr, "gen_vectors: WARNING: build_package N=%u r=%u threw: %s\n", s.n, s.r, e.what());
+        }
+        if (st != CT_OK) {
+            generator = "degenerate (FALLBACK: build_package failed)";
+        }
+        std::snprintf(nm_, sizeof nm_, "N%u_r%u_%s", s.n, s.r, st == CT_OK ? "build_package" : "degenerate_fallback");
+#else
+        std::snprintf(nm_, sizeof nm_, "N%u_r%u_degenerate", s.n, s.r);
+#endif
+        P.name = nm_;
+        if (st != CT_OK) {
+            P.bytes = write_degenerate_package(dem, s.n, s.r);
+            st = ct_package_open(&P.p, P.bytes.data(), P.bytes.size());
+            if (st != CT_OK) die("host ct_package_open failed: " + std::to_string(st));
+            st = ct_package_verify(&P.p);
+            if (st != CT_OK) die("host ct_package_verify failed: " + std::to_string(st));
+        }
+        {
+            const uint8_t *a = P.p.angles;
+            size_t na = (size_t)P.p.planes * P.p.coarse_x * P.p.coarse_y;
+            for (size_t k = 0; k < na; ++k) P.cone_codes += a[k] != 0;
+        }
+        int counts[8] = {0}, fewer_cone = 0, fewer_dir = 0;
+        for (int k = 0; k < nrays; ++k) {
+            ct_ray r = make_ray(g, P.p, pick_kind(g));
+            ct_vec_case c = trace_case(P.p, r);
+            P.cases.push_back(c);
+            int s0 = c.status[0];
+            counts[s0 < 0 ? 5 : (s0 > 4 ? 6 : s0)]++;
+            fewer_cone += c.hit[CT_METHOD_CONE].steps < c.hit[CT_METHOD_INCREMENTAL].steps;
+            fewer_dir += c.hit[CT_METHOD_DIRECTIONAL].steps < c.hit[CT_METHOD_INCREMENTAL].steps;
+            for (int m = 1; m < CT_METHOD_COUNT; ++m) {
+                if (c.status[m] != c.status[0] || c.hit[m].t_q26 != c.hit[0].t_q26) {
+                    std::fprintf(stderr, "gen_vectors: note: %s ray %d: method %d differs from incremental on host\n",
+                                 P.name.c_str(), k, m);
+                }
+            }
+        }
+        for (int k = 0; k < 40; ++k) P.points.push_back(make_point(g, P.p, k));
+        std::fprintf(stderr, "gen_vectors: %s: %zu bytes, %u non-zero angle codes, rays: %d hit, %d miss, %d below, "
+                     "%d hit_void, %d errors; cone jumps shortened %d (CONE) / %d (DIRECTIONAL) rays\n",
+                     P.name.c_str(), P.bytes.size(), P.cone_codes, counts[CT_HIT], counts[CT_MISS], counts[CT_BELOW],
+                     counts[CT_HIT_VOID], counts[5], fewer_cone, fewer_dir);
+        pkgs.push_back(std::move(P));
+    }
+
+    // fixed-point vectors (native __int128 on the host)
+    std::vector<ct_vec_fixed> fx;
+    std::vector<ct_vec_dir> dirs;
+    {
+        Rng h(77u);
+        for (int k = 0; k < 120; ++k) {
+            ct_vec_fixed v;
+            std::memset(&v, 0, sizeof v);
+            int ba = (int)h.range(0, 62), bb = (int)h.range(0, 62);
+            v.a = (int64_t)(h.u64() >> (63 - ba)) * (h.chance(50) ? -1 : 1);
+            v.b = (int64_t)(h.u64() >> (63 - bb)) * (h.chance(50) ? -1 : 1);
+            if (k == 0) { v.a = INT64_MAX; v.b = INT64_MAX; }
+            if (k == 1) { v.a = INT64_MAX; v.b = -INT64_MAX; }
+            if (k == 2) { v.a = 0; v.b = -5; }
+            if (k == 3) { v.a = -1; v.b = 1; }
+            ct_i128 p = ct_i128_mul(v.a, v.b);
+            v.mul_hi = p.hi;
+            v.mul_lo = p.lo;
+            // divisor with |quotient| < 2^62
+            __int128 pn = (__int128)(((unsigned __int128)p.hi << 64) | p.lo);
+            __int128 ap = pn < 0 ? -pn : pn;
+            // contract: d > 0 and |quotient| < 2^63
+            __int128 dmin = (ap >> 62) + 1;
+            if (dmin > (__int128)(INT64_C(1) << 62)) {
+                v.div_d = INT64_MAX;  // |p| < 2^126: quotient < 2^63
+            } else {
+                v.div_d = (int64_t)dmin + (int64_t)(h.u64() >> (1 + h.range(1, 62)));
+                if (k % 9 == 4) v.div_d = (int64_t)dmin;  // smallest allowed divisor
+            }
+            v.div_q = ct_i128_floor_div(p, v.div_d);
+            v.isqrt = ct_i128_isqrt(ct_i128_sign(p) < 0 ? ct_i128_neg(p) : p);
+            v.isqrt64 = ct_isqrt64((uint64_t)v.a);
+            v.m64 = h.range(-(INT64_C(1) << 46) + 1, (INT64_C(1) << 46) - 1);
+            ct_i128 m = ct_i128_mul128_64(ct_i128_mul(v.a / 16777216, v.b / 16777216), v.m64);
+            v.m_hi = m.hi;
+            v.m_lo = m.lo;
+            fx.push_back(v);
+        }
+        for (uint32_t n = 1; n <= CT_MAX_SECTORS; ++n) {
+            for (uint32_t k = 0; k <= n; k += (n > 16 ? 3 : 1)) {
+                ct_vec_dir d{k, n, 0, 0};
+                ct_dir_of_fraction(k, n, &d.cx, &d.sy);
+                dirs.push_back(d);
+            }
+        }
+    }
+
+    FILE *f = std::fopen(argv[1], "w");
+    if (!f) die(std::string("cannot write ") + argv[1]);
+    std::fprintf(f, "/* Generated by tests/mcu/gen_vectors.cpp -- do not edit. */\n#include \"ct_vectors.h\"\n\n");
+    for (size_t k = 0; k < pkgs.size(); ++k) {
+        const Pkg &P = pkgs[k];
+        std::fprintf(f, "static const union {\n    uint64_t align;\n    uint8_t b[%zu];\n} pkg%zu_bytes = {.b = {", P.bytes.size(), k);
+        for (size_t i = 0; i < P.bytes.size(); ++i) {
+            std::fprintf(f, "%s0x%02x,", (i % 16) ? " " : "\n    ", P.bytes[i]);
+        }
+        std::fprintf(f, "\n}};\n\nstatic const ct_vec_case pkg%zu_cases[%zu] = {\n", k, P.cases.size());
+        for (const ct_vec_case &c : P.cases) emit_case(f, c);
+        std::fprintf(f, "};\n\nstatic const ct_vec_point pkg%zu_points[%zu] = {\n", k, P.points.size());
+        for (const ct_vec_point &q : P.points) emit_point(f, q);
+        std::fprintf(f, "};\n\n");
+    }
+    std::fprintf(f, "static const ct_vec_package packages[%zu] = {\n", pkgs.size());
+    for (size_t k = 0; k < pkgs.size(); ++k) {
+        const Pkg &P = pkgs[k];
+        uint32_t crc = (uint32_t)P.bytes[12] | (uint32_t)P.bytes[13] << 8 | (uint32_t)P.bytes[14] << 16 |
+                       (uint32_t)P.bytes[15] << 24;
+        std::fprintf(f, "  {.name = \"%s\", .bytes = pkg%zu_bytes.b, .size = %zuu, .crc = 0x%08xu,\n", P.name.c_str(), k,
+                     P.bytes.size(), crc);
+        std::fprintf(f, "   .sectors = %uu, .reduce = %uu, .levels = %uu, .cone_codes = %uu,\n   .cot_q16 = {",
+                     P.p.sectors, P.p.reduce, P.p.levels, P.cone_codes);
+        for (int i = 0; i < 256; ++i) std::fprintf(f, "%s%s,", (i % 4) ? " " : "\n     ", i64(P.p.cot_q16[i]).c_str());
+        std::fprintf(f, "},\n   .cot_ok = {");
+        for (int i = 0; i < 256; ++i) std::fprintf(f, "%s%u,", (i % 32) ? "" : "\n     ", P.p.cot_ok[i]);
+        std::fprintf(f, "},\n   .bound_x = {");
+        for (int i = 0; i <= CT_MAX_SECTORS; ++i) std::fprintf(f, "%s%s,", (i % 8) ? " " : "\n     ", i32(P.p.bound_x[i]).c_str());
+        std::fprintf(f, "},\n   .bound_y = {");
+        for (int i = 0; i <= CT_MAX_SECTORS; ++i) std::fprintf(f, "%s%s,", (i % 8) ? " " : "\n     ", i32(P.p.bound_y[i]).c_str());
+        std::fprintf(f, "},\n   .cases = pkg%zu_cases, .ncases = %zuu, .points = pkg%zu_points, .npoints = %zuu},\n", k,
+                     P.cases.size(), k, P.points.size());
+    }
+    std::fprintf(f, "};\n\nstatic const ct_vec_fixed fixed[%zu] = {\n", fx.size());
+    for (const ct_vec_fixed &v : fx) {
+        std::fprintf(f, "  {%s, %s, %s, %s,\n   %s, %s, %s, %s,\n   %s, %s, %s},\n", i64(v.a).c_str(), i64(v.b).c_str(),
+                     u64(v.mul_hi).c_str(), u64(v.mul_lo).c_str(), i64(v.div_d).c_str(), i64(v.div_q).c_str(),
+                     u64(v.isqrt).c_str(), u64(v.isqrt64).c_str(), i64(v.m64).c_str(), u64(v.m_hi).c_str(),
+                     u64(v.m_lo).c_str());
+    }
+    std::fprintf(f, "};\n\nstatic const ct_vec_dir dirs[%zu] = {", dirs.size());
+    for (size_t i = 0; i < dirs.size(); ++i) {
+        std::fprintf(f, "%s{%uu, %uu, %s, %s},", (i % 3) ? " " : "\n  ", dirs[i].k, dirs[i].n, i32(dirs[i].cx).c_str(),
+                     i32(dirs[i].sy).c_str());
+    }
+    std::fprintf(f, "\n};\n\nconst ct_vec_set ct_vectors = {packages, %zuu, fixed, %zuu, dirs, %zuu, \"%s\"};\n",
+                 pkgs.size(), fx.size(), dirs.size(), generator.c_str());
+    if (std::fclose(f) != 0) die("write error");
+    return 0;
+}

@@ -1,0 +1,454 @@
+/*
+ * mcu_main.c -- bit-identity check of the flight library on a target.
+ *
+ * Re-computes every host-generated vector (ct_vectors.h) with the library
+ * build linked into this image: package open/verify and derived tables,
+ * CRC-32, ray preparation, all four tracing methods through ct_trace and
+ * ct_trace_prepared, map-frame conversions, surface heights and the
+ * fixed-point core.  Every field must be bit-identical.  Prints a summary
+ * and stops with pass/fail through the platform layer (semihosting on
+ * qemu).  C99, freestanding, no stdio, no float.
+ */
+#include <stddef.h>
+#include <stdint.h>
+
+#include "conetrace.h"
+#include "ct_vectors.h"
+#include "fixed.h"
+#include "mcu_platform.h"
+
+#ifndef CT_MCU_NAME
+#define CT_MCU_NAME "host"
+#endif
+
+#define MAX_REPORTS 12u
+
+static uint32_t g_checks, g_fail, g_reported;
+static const char *g_where = "";
+static uint32_t g_idx, g_method;
+
+/* ---- tiny formatting (no stdio) ----------------------------------------- */
+
+static char g_line[160];
+static uint32_t g_len;
+
+static void put_str(const char *s)
+{
+    while (*s != '\0' && g_len + 1u < sizeof g_line) {
+        g_line[g_len++] = *s++;
+    }
+    g_line[g_len] = '\0';
+}
+
+static void put_u64(uint64_t v)
+{
+    char buf[24];
+    uint32_t n = 0u;
+    do {
+        buf[n++] = (char)('0' + (int)(v % 10u));
+        v /= 10u;
+    } while (v != 0u && n < sizeof buf);
+    while (n > 0u && g_len + 1u < sizeof g_line) {
+        g_line[g_len++] = buf[--n];
+    }
+    g_line[g_len] = '\0';
+}
+
+static void put_i64(int64_t v)
+{
+    if (v < 0) {
+        put_str("-");
+        put_u64((uint64_t)0 - (uint64_t)v);
+    } else {
+        put_u64((uint64_t)v);
+    }
+}
+
+static void flush_line(void)
+{
+    put_str("\n");
+    ct_plat_puts(g_line);
+    g_len = 0u;
+    g_line[0] = '\0';
+}
+
+/* ---- comparisons ---------------------------------------------------------- */
+
+static void mismatch(const char *field, int64_t want, int64_t got)
+{
+    g_fail++;
+    if (g_reported < MAX_REPORTS) {
+        g_reported++;
+        put_str("MISMATCH ");
+        put_str(g_where);
+        put_str(" #");
+        put_u64(g_idx);
+        put_str(" method ");
+        put_u64(g_method);
+        put_str(" ");
+        put_str(field);
+        put_str(": host ");
+        put_i64(want);
+        put_str(" target ");
+        put_i64(got);
+        flush_line();
+    }
+}
+
+static void eq_i64(const char *field, int64_t want, int64_t got)
+{
+    g_checks++;
+    if (want != got) {
+        mismatch(field, want, got);
+    }
+}
+
+static void eq_u64(const char *field, uint64_t want, uint64_t got)
+{
+    g_checks++;
+    if (want != got) {
+        mismatch(field, (int64_t)want, (int64_t)got);
+    }
+}
+
+static void zero_bytes(void *p, size_t n)
+{
+    uint8_t *b = (uint8_t *)p;
+    size_t i;
+    for (i = 0u; i < n; ++i) {
+        b[i] = 0u;
+    }
+}
+
+static void eq_hit(const ct_hit *w, const ct_hit *g)
+{
+    eq_i64("x_q16", w->x_q16, g->x_q16);
+    eq_i64("y_q16", w->y_q16, g->y_q16);
+    eq_i64("z_q16", w->z_q16, g->z_q16);
+    eq_i64("e_nm", w->e_nm, g->e_nm);
+    eq_i64("n_nm", w->n_nm, g->n_nm);
+    eq_i64("h_nm", w->h_nm, g->h_nm);
+    eq_i64("t_q26", w->t_q26, g->t_q26);
+    eq_i64("cell_x", w->cell_x, g->cell_x);
+    eq_i64("cell_y", w->cell_y, g->cell_y);
+    eq_u64("steps", w->steps, g->steps);
+    eq_u64("iters", w->iters, g->iters);
+}
+
+static void eq_ray(const ct_ray *w, const ct_ray *g)
+{
+    eq_i64("ray.x_q16", w->x_q16, g->x_q16);
+    eq_i64("ray.y_q16", w->y_q16, g->y_q16);
+    eq_i64("ray.z_q16", w->z_q16, g->z_q16);
+    eq_i64("ray.dx", w->dx, g->dx);
+    eq_i64("ray.dy", w->dy, g->dy);
+    eq_i64("ray.dz", w->dz, g->dz);
+}
+
+static void eq_prep(const ct_prepared *w, const ct_prepared *g)
+{
+    eq_i64("prep.ox", w->ox, g->ox);
+    eq_i64("prep.oy", w->oy, g->oy);
+    eq_i64("prep.oz", w->oz, g->oz);
+    eq_i64("prep.dx", w->dx, g->dx);
+    eq_i64("prep.dy", w->dy, g->dy);
+    eq_i64("prep.dz", w->dz, g->dz);
+    eq_i64("prep.sector", w->sector, g->sector);
+    eq_i64("prep.len_lo", w->len_lo, g->len_lo);
+    eq_i64("prep.len_hi", w->len_hi, g->len_hi);
+    eq_i64("prep.tend_n", w->tend_n, g->tend_n);
+    eq_i64("prep.tend_d", w->tend_d, g->tend_d);
+    eq_i64("prep.start", w->start, g->start);
+}
+
+/* ---- stack measurement ---------------------------------------------------- */
+
+enum { ST_OPEN, ST_PREPARE, ST_TRACE, ST_TRACE_PREP, ST_COUNT };
+static const char *const st_names[ST_COUNT] = {"ct_package_open", "ct_ray_prepare", "ct_trace",
+                                               "ct_trace_prepared"};
+static unsigned st_max[ST_COUNT];
+
+static void st_note(int k)
+{
+    unsigned u = ct_plat_stack_used();
+    if (u > st_max[k]) {
+        st_max[k] = u;
+    }
+}
+
+/* ---- the checks ------------------------------------------------------------ */
+
+static ct_package g_pkg;                 /* ~2.6 KB: static, not on the stack */
+static union {
+    uint64_t align;
+    uint8_t b[128u * 1024u];
+} g_copy;                                /* RAM copy for corruption tests      */
+
+static uint32_t ld32(const uint8_t *p)
+{
+    return (uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) | ((uint32_t)p[3] << 24);
+}
+
+static void check_crc(void)
+{
+    static const uint8_t digits[9] = {'1', '2', '3', '4', '5', '6', '7', '8', '9'};
+    uint32_t c = 0u, c2 = 0u;
+    g_where = "crc";
+    g_idx = 0u;
+    g_method = 0u;
+    eq_i64("crc status", CT_OK, ct_crc32(0u, digits, sizeof digits, &c));
+    eq_u64("crc(123456789)", 0xCBF43926u, c);
+    /* continuation: crc(a || b) == crc(crc(a), b) */
+    (void)ct_crc32(0u, digits, 4u, &c2);
+    (void)ct_crc32(c2, digits + 4, 5u, &c2);
+    eq_u64("crc chained", c, c2);
+    eq_i64("crc null", CT_ERR_ARG, ct_crc32(0u, NULL, 1u, &c));
+}
+
+static void check_package(const ct_vec_package *vp, uint32_t *traces, uint32_t *hits)
+{
+    ct_status st;
+    uint32_t k, m, crc = 0u, size = 0u;
+    static const uint8_t zero4[4] = {0u, 0u, 0u, 0u};
+
+    g_where = vp->name;
+    g_idx = 0u;
+    g_method = 0u;
+    /* the stored CRC is the IEEE CRC of the package with its field zeroed */
+    (void)ct_crc32(0u, vp->bytes, 12u, &crc);
+    (void)ct_crc32(crc, zero4, 4u, &crc);
+    (void)ct_crc32(crc, vp->bytes + 16, vp->size - 16u, &crc);
+    eq_u64("package crc", vp->crc, crc);
+    eq_u64("header crc field", vp->crc, ld32(vp->bytes + 12));
+
+    ct_plat_stack_paint();
+    st = ct_package_open(&g_pkg, vp->bytes, vp->size);
+    st_note(ST_OPEN);
+    eq_i64("open", CT_OK, st);
+    if (st != CT_OK) {
+        return;
+    }
+    eq_i64("verify", CT_OK, ct_package_verify(&g_pkg));
+    eq_u64("sectors", vp->sectors, g_pkg.sectors);
+    eq_u64("reduce", vp->reduce, g_pkg.reduce);
+    eq_u64("levels", vp->levels, g_pkg.levels);
+    eq_i64("size status", CT_OK,
+           ct_package_size(g_pkg.width, g_pkg.height, g_pkg.reduce, g_pkg.sectors,
+                           g_pkg.voids != NULL ? 1u : 0u, &size));
+    eq_u64("package size", vp->size, size);
+    for (k = 0u; k < 256u; ++k) {
+        g_idx = k;
+        eq_i64("cot_q16", vp->cot_q16[k], g_pkg.cot_q16[k]);
+        eq_u64("cot_ok", vp->cot_ok[k], g_pkg.cot_ok[k]);
+    }
+    for (k = 0u; k <= CT_MAX_SECTORS; ++k) {
+        g_idx = k;
+        eq_i64("bound_x", vp->bound_x[k], g_pkg.bound_x[k]);
+        eq_i64("bound_y", vp->bound_y[k], g_pkg.bound_y[k]);
+    }
+
+    /* rays x methods */
+    for (k = 0u; k < vp->ncases; ++k) {
+        const ct_vec_case *c = &vp->cases[k];
+        ct_prepared prep;
+        g_idx = k;
+        g_method = 0u;
+        zero_bytes(&prep, sizeof prep);
+        ct_plat_stack_paint();
+        st = ct_ray_prepare(&g_pkg, &c->ray, &prep);
+        st_note(ST_PREPARE);
+        eq_i64("prep_status", c->prep_status, st);
+        eq_prep(&c->prep, &prep);
+        for (m = 0u; m < (uint32_t)CT_METHOD_COUNT; ++m) {
+            ct_hit h;
+            uint32_t before = g_fail;
+            g_method = m;
+            zero_bytes(&h, sizeof h);
+            ct_plat_stack_paint();
+            st = ct_trace(&g_pkg, &c->ray, (ct_method)m, &h);
+            st_note(ST_TRACE);
+            eq_i64("status", c->status[m], st);
+            eq_hit(&c->hit[m], &h);
+            if (c->prep_status >= 0) {
+                /* the same trace from the host's prepared ray */
+                zero_bytes(&h, sizeof h);
+                ct_plat_stack_paint();
+                st = ct_trace_prepared(&g_pkg, &c->prep, (ct_method)m, &h);
+                st_note(ST_TRACE_PREP);
+                eq_i64("prepared status", c->status[m], st);
+                eq_hit(&c->hit[m], &h);
+            }
+            if (g_fail == before) {
+                (*traces)++;
+            }
+            if (c->status[m] == CT_HIT || c->status[m] == CT_HIT_VOID) {
+                (*hits)++;
+            }
+        }
+    }
+
+    /* map frame, surface, rays from the map */
+    g_method = 0u;
+    for (k = 0u; k < vp->npoints; ++k) {
+        const ct_vec_point *q = &vp->points[k];
+        int64_t a = 0, b = 0, c = 0;
+        ct_ray r;
+        g_idx = k;
+        eq_i64("g2m status", q->g2m_status, ct_grid_to_map(&g_pkg, q->x, q->y, q->z, &a, &b, &c));
+        if (q->g2m_status == CT_OK) {
+            eq_i64("e", q->e, a);
+            eq_i64("n", q->n, b);
+            eq_i64("h", q->h, c);
+        }
+        a = b = c = 0;
+        eq_i64("m2g status", q->m2g_status, ct_map_to_grid(&g_pkg, q->e, q->n, q->h, &a, &b, &c));
+        if (q->m2g_status == CT_OK) {
+            eq_i64("x2", q->x2, a);
+            eq_i64("y2", q->y2, b);
+            eq_i64("z2", q->z2, c);
+        }
+        a = 0;
+        eq_i64("surface status", q->surf_status, ct_surface_height(&g_pkg, q->x, q->y, &a));
+        if (q->surf_status == CT_OK) {
+            eq_i64("surface z", q->surf_z, a);
+        }
+        zero_bytes(&r, sizeof r);
+        eq_i64("rfm status", q->rfm_status, ct_ray_from_map(&g_pkg, q->e, q->n, q->h, q->de, q->dn, q->dh, &r));
+        eq_ray(&q->rfm, &r);
+    }
+
+    /* corruption: a RAM copy with one flipped byte must fail its CRC, a
+     * short buffer must be reported truncated */
+    g_idx = 0u;
+    if (vp->size <= sizeof g_copy.b) {
+        ct_package tmp;
+        for (k = 0u; k < vp->size; ++k) {
+            g_copy.b[k] = vp->bytes[k];
+        }
+        eq_i64("copy opens", CT_OK, ct_package_open(&tmp, g_copy.b, vp->size));
+        g_copy.b[vp->size / 2u] ^= 0x10u;
+        eq_i64("corrupt", CT_ERR_CRC, ct_package_open(&tmp, g_copy.b, vp->size));
+        eq_i64("truncated", CT_ERR_TRUNCATED, ct_package_open(&tmp, g_copy.b, vp->size - 8u));
+    }
+}
+
+static void check_fixed(const ct_vec_set *vs)
+{
+    uint32_t k;
+    g_where = "fixed";
+    g_method = 0u;
+    for (k = 0u; k < vs->nfixed; ++k) {
+        const ct_vec_fixed *v = &vs->fixed[k];
+        ct_i128 p = ct_i128_mul(v->a, v->b), m;
+        g_idx = k;
+        eq_u64("mul.hi", v->mul_hi, p.hi);
+        eq_u64("mul.lo", v->mul_lo, p.lo);
+        eq_i64("floor_div", v->div_q, ct_i128_floor_div(p, v->div_d));
+        eq_u64("isqrt128", v->isqrt, ct_i128_isqrt(ct_i128_sign(p) < 0 ? ct_i128_neg(p) : p));
+        eq_u64("isqrt64", v->isqrt64, ct_isqrt64((uint64_t)v->a));
+        m = ct_i128_mul128_64(ct_i128_mul(v->a / 16777216, v->b / 16777216), v->m64);
+        eq_u64("mul128_64.hi", v->m_hi, m.hi);
+        eq_u64("mul128_64.lo", v->m_lo, m.lo);
+        /* algebra on the target itself: (p + p) - p == p, cmp, sign */
+        eq_i64("add/sub", 0, ct_i128_cmp(ct_i128_sub(ct_i128_add(p, p), p), p));
+        eq_i64("neg sign", -ct_i128_sign(p), ct_i128_sign(ct_i128_neg(p)));
+    }
+    g_where = "dir";
+    for (k = 0u; k < vs->ndirs; ++k) {
+        const ct_vec_dir *d = &vs->dirs[k];
+        int32_t cx = 0, sy = 0;
+        g_idx = k;
+        ct_dir_of_fraction(d->k, d->n, &cx, &sy);
+        eq_i64("cos", d->cx, cx);
+        eq_i64("sin", d->sy, sy);
+        cx = sy = 0;
+        eq_i64("boundary status", CT_OK, ct_sector_boundary(d->n, d->k, &cx, &sy));
+        eq_i64("boundary x", d->cx, cx);
+        eq_i64("boundary y", d->sy, sy);
+    }
+    g_where = "status names";
+    for (k = 0u; k < 26u; ++k) {
+        const char *name = NULL;
+        ct_status s = (ct_status)k - 20;
+        ct_status want = (s >= CT_ERR_VERIFY && s <= CT_HIT_VOID) ? CT_OK : CT_ERR_ARG;
+        g_idx = k;
+        eq_i64("status_name", want, ct_status_name(s, &name));
+        eq_i64("status_name set", 1, name != NULL);
+    }
+}
+
+int main(void)
+{
+    const ct_vec_set *vs = &ct_vectors;
+    uint32_t p, traces = 0u, hits = 0u, total = 0u;
+
+    put_str("mcu_vectors[" CT_MCU_NAME "]: generator ");
+    put_str(vs->generator);
+    flush_line();
+    check_crc();
+    check_fixed(vs);
+    for (p = 0u; p < vs->npackages; ++p) {
+        const ct_vec_package *vp = &vs->packages[p];
+        uint32_t t = 0u, h = 0u, before = g_fail;
+        check_package(vp, &t, &h);
+        total += vp->ncases * (uint32_t)CT_METHOD_COUNT;
+        traces += t;
+        hits += h;
+        put_str("  package ");
+        put_str(vp->name);
+        put_str(": ");
+        put_u64(vp->ncases);
+        put_str(" rays x 4 methods: ");
+        put_u64(t);
+        put_str("/");
+        put_u64(vp->ncases * (uint64_t)CT_METHOD_COUNT);
+        put_str(" identical (");
+        put_u64(h);
+        put_str(" hits, ");
+        put_u64(vp->cone_codes);
+        put_str(" cone codes), ");
+        put_u64(g_fail - before);
+        put_str(" mismatching fields");
+        flush_line();
+    }
+#ifdef CT_MCU_TARGET
+    for (p = 0u; p < (uint32_t)ST_COUNT; ++p) {
+        put_str("  measured stack ");
+        put_str(st_names[p]);
+        put_str(": ");
+        put_u64(st_max[p]);
+        put_str(" bytes");
+        flush_line();
+    }
+#else
+    (void)st_names;
+#endif
+#ifdef CT_MCU_EXPECT_BUILDER
+    /* the vectors must come from ct_host::build_package (real cones) */
+    {
+        const char *a = vs->generator, *b = "build_package";
+        while (*a != '\0' && *a == *b) {
+            ++a;
+            ++b;
+        }
+        if (*a != '\0' || *b != '\0') {
+            put_str("FAIL: vectors were not made by build_package: ");
+            put_str(vs->generator);
+            flush_line();
+            g_fail++;
+        }
+    }
+#endif
+    put_str("mcu_vectors[" CT_MCU_NAME "]: ");
+    put_str(g_fail == 0u && traces == total && total > 0u ? "PASS " : "FAIL ");
+    put_u64(traces);
+    put_str("/");
+    put_u64(total);
+    put_str(" traces bit-identical, ");
+    put_u64(g_checks);
+    put_str(" values checked, ");
+    put_u64(g_fail);
+    put_str(" mismatches");
+    flush_line();
+    return (g_fail == 0u && traces == total && total > 0u) ? 0 : 1;
+}
