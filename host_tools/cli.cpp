@@ -9,6 +9,7 @@
 // rays.csv: header, columns E,N,h,dE,dN,dh (map frame, metres).
 // hits.csv: header status,E,N,h,t,steps; one row per ray in input order;
 //           E,N,h,t are nan when nothing is hit.  t: hit = origin + t*d.
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -73,8 +74,10 @@ int to_int(const Args &a, const std::string &k, int def)
     auto it = a.opt.find(k);
     if (it == a.opt.end()) return def;
     char *end = nullptr;
+    errno = 0;
     long v = std::strtol(it->second.c_str(), &end, 10);
-    if (!end || *end) usage(k + " needs an integer, got '" + it->second + "'");
+    if (it->second.empty() || !end || *end || errno == ERANGE || v < -1000000 || v > 1000000)
+        usage(k + " needs an integer in range, got '" + it->second + "'");
     return (int)v;
 }
 
@@ -84,7 +87,8 @@ double to_double(const Args &a, const std::string &k, double def)
     if (it == a.opt.end()) return def;
     char *end = nullptr;
     double v = std::strtod(it->second.c_str(), &end);
-    if (!end || *end) usage(k + " needs a number, got '" + it->second + "'");
+    if (it->second.empty() || !end || *end || !std::isfinite(v) || v <= 0 || v > 1e6)
+        usage(k + " needs a positive number of metres (at most 1e6), got '" + it->second + "'");
     return v;
 }
 

@@ -515,7 +515,14 @@ DemRaster read_dem(const std::string &path)
 
     DemRaster r;
     bool is_tiff = false;
-    read_pixels(path, r, is_tiff);
+    try {
+        read_pixels(path, r, is_tiff);
+    } catch (const Error &) {
+        throw;
+    } catch (const std::exception &e) {
+        // OpenImageIO plugins can throw (e.g. a GIF disguised as .tif)
+        throw Error(path + ": cannot read image (" + e.what() + ")");
+    }
     if (is_tiff) read_georef(path, r);
     mark_valid(r);
     return r;

@@ -1,0 +1,821 @@
+// test_cli.cpp -- the `conetrace` command line tool, end to end.
+//
+// Runs the real binary (CT_CLI) through system() inside a fresh scratch
+// directory (mkdtemp under /tmp), capturing stdout, stderr and the exit
+// code, and checks: build + info on the bundled real DEM; trace with every
+// method against heights read independently from the fixture; the nodata
+// policy (void posts -> "voids yes", status hit_void; all-nodata is an
+// error); bad inputs (one "conetrace: " line naming the file, no output
+// and no leftover temporary); an existing output survives a failed run.
+//
+// CT_TEST_VERBOSE=1 prints every command and its stderr; CT_TEST_KEEP=1
+// keeps the scratch directory.  Independent invocations run a few at a
+// time (each start of the binary costs ~0.4 s of dynamic linking).
+
+#include "dem_io.hpp"
+#include "harness.h"
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <set>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#ifndef CT_CLI
+#error "CT_CLI must be defined (path of the conetrace binary)"
+#endif
+#ifndef CT_FIXTURES_DIR
+#error "CT_FIXTURES_DIR must be defined"
+#endif
+
+namespace fs = std::filesystem;
+using ct_host::Georef;
+using ct_host::SampleType;
+
+// ---------------------------------------------------------------------------
+// scratch directories, files, running the CLI
+
+static std::string g_root;  // mkdtemp directory; captures live directly in it
+static int g_dirs = 0;
+
+static bool verbose() { return getenv("CT_TEST_VERBOSE") != nullptr; }
+
+static std::string fixture_dem() { return std::string(CT_FIXTURES_DIR) + "/jacksboro_fault_dem.tif"; }
+
+// A fresh, empty working directory under g_root.
+static std::string new_dir(const char *tag)
+{
+    std::string d = g_root + "/" + std::to_string(++g_dirs) + "_" + tag;
+    fs::create_directory(d);
+    return d;
+}
+
+static std::string slurp(const std::string &path)
+{
+    std::ifstream in(path, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+static void spit(const std::string &path, const std::string &text)
+{
+    std::ofstream o(path, std::ios::binary | std::ios::trunc);
+    o << text;
+}
+
+static std::set<std::string> listing(const std::string &dir)
+{
+    std::set<std::string> s;
+    for (const auto &e : fs::directory_iterator(dir)) s.insert(e.path().filename().string());
+    return s;
+}
+
+static std::string join(const std::set<std::string> &s)
+{
+    std::string r;
+    for (const auto &x : s) r += (r.empty() ? "" : " ") + x;
+    return r.empty() ? "(empty)" : r;
+}
+
+static std::vector<std::string> lines_of(const std::string &text)
+{
+    std::vector<std::string> v;
+    std::istringstream in(text);
+    std::string l;
+    while (std::getline(in, l)) v.push_back(l);
+    return v;
+}
+
+static std::string quote(const std::string &s)
+{
+    std::string r = "'";
+    for (char c : s) r += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    return r + "'";
+}
+
+struct Run {
+    int code = -1;  // exit code; >= 128: killed by a signal
+    std::string out, err, cmd;
+    std::vector<std::string> err_lines;
+};
+
+// One invocation: `conetrace ARGS...` with `dir` as working directory.
+struct Job {
+    std::string dir;
+    std::vector<std::string> args;
+};
+
+static Run run_job(const Job &j, int slot)
+{
+    Run r;
+    std::string cmd = "cd " + quote(j.dir) + " && exec " + quote(CT_CLI);
+    r.cmd = "conetrace";
+    for (const auto &a : j.args) {
+        cmd += " " + quote(a);
+        r.cmd += " " + a;
+    }
+    // captures live in g_root itself, never in a checked directory
+    const std::string fo = g_root + "/stdout." + std::to_string(slot), fe = g_root + "/stderr." + std::to_string(slot);
+    cmd += " </dev/null >" + quote(fo) + " 2>" + quote(fe);
+    int st = std::system(cmd.c_str());
+    if (st == -1)
+        r.code = -1;
+    else if (WIFEXITED(st))
+        r.code = WEXITSTATUS(st);
+    else
+        r.code = 128 + (WIFSIGNALED(st) ? WTERMSIG(st) : 0);
+    r.out = slurp(fo);
+    r.err = slurp(fe);
+    r.err_lines = lines_of(r.err);
+    return r;
+}
+
+static void print_run(const Run &r)
+{
+    if (verbose()) printf("  $ %s  -> %d\n%s", r.cmd.c_str(), r.code, r.err.c_str());
+}
+
+static Run run_cli(const std::string &dir, const std::vector<std::string> &args)
+{
+    Run r = run_job(Job{dir, args}, 0);
+    print_run(r);
+    return r;
+}
+
+// Independent jobs (each in its own directory) run a few at a time: every
+// start of the binary costs ~0.4 s of dynamic linking (OpenImageIO).
+static std::vector<Run> run_all(const std::vector<Job> &jobs)
+{
+    std::vector<Run> runs(jobs.size());
+    std::atomic<size_t> next{0};
+    unsigned nt = std::max(2u, std::min(4u, std::thread::hardware_concurrency()));
+    std::vector<std::thread> pool;
+    for (unsigned w = 0; w < nt; ++w)
+        pool.emplace_back([&, w] {
+            for (size_t k; (k = next++) < jobs.size();) runs[k] = run_job(jobs[k], (int)w + 1);
+        });
+    for (auto &t : pool) t.join();
+    for (const Run &r : runs) print_run(r);
+    return runs;
+}
+
+static std::string first_err(const Run &r) { return r.err_lines.empty() ? "(no stderr)" : r.err_lines[0]; }
+
+static bool starts_with(const std::string &s, const std::string &p) { return s.compare(0, p.size(), p) == 0; }
+static bool contains(const std::string &s, const std::string &p) { return s.find(p) != std::string::npos; }
+
+// The value of an `info` line "key<spaces>value" ("" if absent).
+static std::string info_value(const std::string &text, const std::string &key)
+{
+    for (const std::string &l : lines_of(text)) {
+        if (!starts_with(l, key) || l.size() <= key.size() || l[key.size()] != ' ') continue;
+        size_t b = l.find_first_not_of(' ', key.size());
+        return b == std::string::npos ? std::string() : l.substr(b);
+    }
+    return std::string();
+}
+
+// A failed run: non-zero exit (no crash), nothing on stdout, first stderr
+// line "conetrace: ..." naming `name` and containing `needle`; exactly one
+// stderr line unless `usage` (usage text may follow); directory unchanged.
+// Returns "" or a description of what is wrong.
+static std::string check_failure(const Run &r, const std::string &dir, const std::set<std::string> &before,
+                                 const std::string &name, const std::string &needle = "", bool usage = false)
+{
+    std::string why;
+    if (r.code == 0) why += "exit code 0; ";
+    if (r.code < 0 || r.code >= 128) why += "crashed or killed (code " + std::to_string(r.code) + "); ";
+    if (!r.out.empty()) why += "stdout not empty: '" + r.out + "'; ";
+    if (r.err_lines.empty()) why += "nothing on stderr; ";
+    if (!usage && r.err_lines.size() != 1) why += std::to_string(r.err_lines.size()) + " stderr lines; ";
+    const std::string l = first_err(r);
+    if (!starts_with(l, "conetrace: ")) why += "stderr does not start with 'conetrace: '; ";
+    if (!name.empty() && !contains(l, name)) why += "message does not name '" + name + "'; ";
+    if (!needle.empty()) {  // "a|b": either will do
+        bool any = false;
+        for (size_t b = 0, e; b <= needle.size(); b = e + 1) {
+            e = std::min(needle.find('|', b), needle.size());
+            any = any || contains(l, needle.substr(b, e - b));
+        }
+        if (!any) why += "message lacks '" + needle + "'; ";
+    }
+    std::set<std::string> after = listing(dir);
+    if (after != before) why += "directory changed: before {" + join(before) + "}, after {" + join(after) + "}; ";
+    if (why.empty()) return why;
+    return "`" + r.cmd + "`: " + why + "stderr was: " + (r.err.empty() ? "(empty)" : r.err);
+}
+
+#define CHECK_FAILURE(...)                                                 \
+    do {                                                                   \
+        std::string why_ = check_failure(__VA_ARGS__);                     \
+        TEST_ASSERT_MSG(why_.empty(), "%s", why_.c_str());                 \
+    } while (0)
+
+// ---------------------------------------------------------------------------
+// the fixture (read independently with read_dem) and its package
+
+static const int kW = 403, kH = 344;
+static const double kOE = 195000.0, kON = 4071000.0, kPost = 30.0;
+
+static ct_host::DemRaster g_dem;
+static bool g_dem_ok = false;
+static std::string g_pkg;  // absolute path of the fixture package (built by test 1 or on demand)
+
+static double post_h(int i, int j) { return g_dem.h[(size_t)j * kW + (size_t)i]; }
+static double post_e(double i) { return kOE + (i + 0.5) * kPost; }
+static double post_n(double j) { return kON - (j + 0.5) * kPost; }
+
+// Bilinear surface of the fixture at map (e, n); false outside the post box.
+static bool surface(double e, double n, double *h)
+{
+    double x = (e - kOE) / kPost - 0.5, y = (kON - n) / kPost - 0.5;
+    if (!(x >= 0 && y >= 0 && x <= kW - 1 && y <= kH - 1)) return false;
+    int i = std::min((int)x, kW - 2), j = std::min((int)y, kH - 2);
+    double fx = x - i, fy = y - j;
+    *h = (1 - fy) * ((1 - fx) * post_h(i, j) + fx * post_h(i + 1, j)) +
+         fy * ((1 - fx) * post_h(i, j + 1) + fx * post_h(i + 1, j + 1));
+    return true;
+}
+
+static bool load_fixture()
+{
+    if (g_dem_ok) return true;
+    try {
+        g_dem = ct_host::read_dem(fixture_dem());
+        g_dem_ok = g_dem.width == kW && g_dem.height == kH;
+    } catch (const std::exception &e) {
+        printf("  read_dem(%s): %s\n", fixture_dem().c_str(), e.what());
+    }
+    return g_dem_ok;
+}
+
+// Build the fixture package once (sectors 8, reduce 2); "" on failure.
+static std::string fixture_package()
+{
+    if (!g_pkg.empty()) return g_pkg;
+    std::string d = new_dir("pkg");
+    Run r = run_cli(d, {"build", fixture_dem(), "-o", "X.ctp", "--sectors", "8", "--reduce", "2"});
+    if (r.code == 0 && fs::exists(d + "/X.ctp")) g_pkg = d + "/X.ctp";
+    else printf("  building the fixture package failed (%d): %s\n", r.code, r.err.c_str());
+    return g_pkg;
+}
+
+// ---------------------------------------------------------------------------
+// 1. build + info on the real DEM
+
+static void test_build_info_fixture(void)
+{
+    std::string d = new_dir("build");
+    Run r = run_cli(d, {"build", fixture_dem(), "-o", "X.ctp", "--sectors", "8", "--reduce", "2"});
+    TEST_ASSERT_MSG(r.code == 0, "build exited %d: %s", r.code, r.err.c_str());
+    std::vector<std::string> out = lines_of(r.out);
+    TEST_ASSERT_MSG(out.size() == 1, "build printed %zu lines on stdout, expected 1: '%s'", out.size(), r.out.c_str());
+    TEST_ASSERT_MSG(contains(out[0], "X.ctp"), "summary does not name the output: '%s'", out[0].c_str());
+    TEST_ASSERT_MSG(contains(out[0], "403x344"), "summary does not give the size: '%s'", out[0].c_str());
+    TEST_ASSERT_MSG(fs::is_regular_file(d + "/X.ctp"), "no X.ctp after build");
+    std::string pkg = slurp(d + "/X.ctp");
+    TEST_ASSERT_MSG(pkg.size() > 128 && pkg.compare(0, 4, "CTPK") == 0, "X.ctp is not a package (%zu bytes)", pkg.size());
+    std::set<std::string> files = listing(d);
+    TEST_ASSERT_MSG(files == std::set<std::string>{"X.ctp"}, "build left {%s}", join(files).c_str());
+    if (g_pkg.empty()) g_pkg = d + "/X.ctp";
+
+    Run i = run_cli(d, {"info", "X.ctp"});
+    TEST_ASSERT_MSG(i.code == 0, "info exited %d: %s", i.code, i.err.c_str());
+    const std::string &t = i.out;
+    TEST_ASSERT_MSG(info_value(t, "file") == "X.ctp", "info file: '%s'", info_value(t, "file").c_str());
+    TEST_ASSERT_MSG(starts_with(info_value(t, "posts"), "403 x 344"), "info posts: '%s'", info_value(t, "posts").c_str());
+    TEST_ASSERT_MSG(info_value(t, "sectors") == "8", "info sectors: '%s'", info_value(t, "sectors").c_str());
+    TEST_ASSERT_MSG(info_value(t, "reduce") == "2" || starts_with(info_value(t, "reduce"), "2 "), "info reduce: '%s'",
+                    info_value(t, "reduce").c_str());
+    TEST_ASSERT_MSG(info_value(t, "epsg") == "32617", "info epsg: '%s'", info_value(t, "epsg").c_str());
+    TEST_ASSERT_MSG(info_value(t, "voids") == "no", "info voids: '%s'", info_value(t, "voids").c_str());
+    TEST_ASSERT_MSG(contains(t, "\nverify        ok\n"), "info lacks 'verify        ok':\n%s", t.c_str());
+    // the origin and posting of fixtures/README.md
+    double oe = 0, on = 0;
+    TEST_ASSERT_MSG(std::sscanf(info_value(t, "origin").c_str(), "E %lf N %lf", &oe, &on) == 2, "info origin: '%s'",
+                    info_value(t, "origin").c_str());
+    TEST_ASSERT_DOUBLE_WITHIN(1e-6, kOE, oe);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-6, kON, on);
+    double pe = 0, pn = 0;
+    TEST_ASSERT_MSG(std::sscanf(info_value(t, "posting").c_str(), "%lf x %lf", &pe, &pn) == 2, "info posting: '%s'",
+                    info_value(t, "posting").c_str());
+    TEST_ASSERT_DOUBLE_WITHIN(1e-6, kPost, pe);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-6, -kPost, pn);
+    TEST_ASSERT_MSG(listing(d) == files, "info changed the directory: {%s}", join(listing(d)).c_str());
+}
+
+// ---------------------------------------------------------------------------
+// 2. trace
+
+struct TRay {
+    double e, n, h, de, dn, dh;
+    const char *kind;  // "nadir", "below", "miss", "hit", "any"
+    int pi, pj;        // nadir: the post under the ray
+};
+
+struct Row {
+    std::string status, e, n, h, t, steps;
+    double E = NAN, N = NAN, Hh = NAN, T = NAN;
+};
+
+static bool parse_hits(const std::string &text, std::vector<Row> *rows, std::string *why)
+{
+    std::vector<std::string> ls = lines_of(text);
+    if (ls.empty() || ls[0] != "status,E,N,h,t,steps") {
+        *why = "header is '" + (ls.empty() ? std::string("(none)") : ls[0]) + "'";
+        return false;
+    }
+    rows->clear();
+    for (size_t k = 1; k < ls.size(); ++k) {
+        std::vector<std::string> f;
+        std::string cur;
+        for (char c : ls[k]) {
+            if (c == ',') {
+                f.push_back(cur);
+                cur.clear();
+            } else {
+                cur += c;
+            }
+        }
+        f.push_back(cur);
+        if (f.size() != 6) {
+            *why = "line " + std::to_string(k + 1) + " has " + std::to_string(f.size()) + " fields: '" + ls[k] + "'";
+            return false;
+        }
+        Row r;
+        r.status = f[0], r.e = f[1], r.n = f[2], r.h = f[3], r.t = f[4], r.steps = f[5];
+        r.E = std::strtod(f[1].c_str(), nullptr);
+        r.N = std::strtod(f[2].c_str(), nullptr);
+        r.Hh = std::strtod(f[3].c_str(), nullptr);
+        r.T = std::strtod(f[4].c_str(), nullptr);
+        if (f[5].empty() || f[5].find_first_not_of("0123456789") != std::string::npos) {
+            *why = "line " + std::to_string(k + 1) + ": steps '" + f[5] + "' is not an unsigned integer";
+            return false;
+        }
+        rows->push_back(r);
+    }
+    return true;
+}
+
+static std::string fmt(double v)
+{
+    char b[64];
+    std::snprintf(b, sizeof b, "%.17g", v);
+    return b;
+}
+
+static std::vector<TRay> fixture_rays()
+{
+    std::vector<TRay> v;
+    auto nadir = [&](int i, int j, double dh) { v.push_back({post_e(i), post_n(j), 1500.0, 0, 0, dh, "nadir", i, j}); };
+    // the four corners (values of fixtures/README.md are checked separately)
+    nadir(0, 0, -1);
+    nadir(kW - 1, 0, -1);
+    nadir(0, kH - 1, -1);
+    nadir(kW - 1, kH - 1, -1);
+    // interior posts, the highest and the lowest post, and one with |d| != 1
+    int imax = 0, imin = 0;
+    for (size_t k = 0; k < g_dem.h.size(); ++k) {
+        if (g_dem.h[k] > g_dem.h[(size_t)imax]) imax = (int)k;
+        if (g_dem.h[k] < g_dem.h[(size_t)imin]) imin = (int)k;
+    }
+    nadir(100, 50, -1);
+    nadir(200, 171, -1);
+    nadir(37, 300, -1);
+    nadir(imax % kW, imax / kW, -1);
+    nadir(imin % kW, imin / kW, -1);
+    nadir(250, 100, -3);
+    // starts below the surface: just under a post; horizontal under the lowest terrain
+    v.push_back({post_e(120), post_n(120), post_h(120, 120) - 1.0, 0, 0, -1, "below", 0, 0});
+    v.push_back({post_e(150), post_n(200), 200.0, 1, 0.25, 0, "below", 0, 0});
+    // misses: outside heading away; horizontal overflight; rising into the sky
+    v.push_back({190000.0, 4066000.0, 800.0, -1, 0.2, -0.1, "miss", 0, 0});
+    v.push_back({194000.0, 4065000.0, 1200.0, 1, 0.3, 0, "miss", 0, 0});
+    v.push_back({post_e(200), post_n(170), 1100.0, 0.6, -0.7, 0.2, "miss", 0, 0});
+    // oblique rays that must hit: from high above the middle, and from outside
+    v.push_back({post_e(200), post_n(170), 1500.0, 0.6, -0.8, -0.5, "hit", 0, 0});
+    v.push_back({post_e(180), post_n(160), 1400.0, -0.3, 0.2, -1.0, "hit", 0, 0});
+    v.push_back({post_e(220), post_n(150), 1300.0, -0.5, -0.5, -0.3, "hit", 0, 0});
+    v.push_back({194000.0, 4066000.0, 1200.0, 1, 0.1, -0.08, "hit", 0, 0});
+    // a grazing ray: whatever it does, all methods must agree
+    v.push_back({195100.0, 4068000.0, 900.0, 1, -0.05, -0.02, "any", 0, 0});
+    return v;
+}
+
+static void write_rays(const std::string &path, const std::vector<TRay> &rays, bool reversed)
+{
+    std::string t = reversed ? "dh,dN,dE,h,N,E\n" : "E,N,h,dE,dN,dh\n";
+    for (const TRay &r : rays) {
+        if (reversed)
+            t += fmt(r.dh) + "," + fmt(r.dn) + "," + fmt(r.de) + "," + fmt(r.h) + "," + fmt(r.n) + "," + fmt(r.e) + "\n";
+        else
+            t += fmt(r.e) + "," + fmt(r.n) + "," + fmt(r.h) + "," + fmt(r.de) + "," + fmt(r.dn) + "," + fmt(r.dh) + "\n";
+    }
+    spit(path, t);
+}
+
+// Independent checks of one row against the ray; "" if fine.
+static std::string check_row(const TRay &ray, const Row &row)
+{
+    std::ostringstream w;
+    const std::string kind = ray.kind;
+    const bool hit = row.status == "hit";
+    if (kind == "below" || kind == "miss") {
+        if (row.status != kind) w << "status " << row.status << ", expected " << kind;
+        else if (row.e != "nan" || row.n != "nan" || row.h != "nan" || row.t != "nan")
+            w << "E,N,h,t are '" << row.e << "," << row.n << "," << row.h << "," << row.t << "', expected nan";
+        return w.str();
+    }
+    if (kind == "any" && !hit) {
+        if (row.status != "miss") w << "status " << row.status << ", expected hit or miss";
+        else if (row.e != "nan" || row.t != "nan") w << "a miss with E/t not nan";
+        return w.str();
+    }
+    if (!hit) {
+        w << "status " << row.status << ", expected hit";
+        return w.str();
+    }
+    if (!(std::isfinite(row.E) && std::isfinite(row.N) && std::isfinite(row.Hh) && std::isfinite(row.T)))
+        return "a hit with non-finite fields";
+    // hit = origin + t * d
+    const double pe = ray.e + row.T * ray.de, pn = ray.n + row.T * ray.dn, ph = ray.h + row.T * ray.dh;
+    if (!(row.T > 0) || std::fabs(pe - row.E) > 0.001 || std::fabs(pn - row.N) > 0.001 || std::fabs(ph - row.Hh) > 0.001)
+        w << "origin + t*d = (" << fmt(pe) << ", " << fmt(pn) << ", " << fmt(ph) << ") for t=" << row.t
+          << ", hit is (" << row.e << ", " << row.n << ", " << row.h << "); ";
+    if (kind == "nadir") {
+        double want = post_h(ray.pi, ray.pj);
+        if (std::fabs(row.Hh - want) > 0.01) w << "nadir over post (" << ray.pi << "," << ray.pj << ") hit h=" << row.h << ", post is " << want << "; ";
+        if (std::fabs(row.E - ray.e) > 0.001 || std::fabs(row.N - ray.n) > 0.001)
+            w << "nadir hit at (" << row.e << ", " << row.n << "), post centre (" << fmt(ray.e) << ", " << fmt(ray.n) << "); ";
+    }
+    // the hit lies on the bilinear surface of the fixture ...
+    double s = 0;
+    if (!surface(row.E, row.N, &s)) {
+        w << "hit (" << row.e << ", " << row.n << ") outside the post box; ";
+    } else if (std::fabs(s - row.Hh) > 0.05) {
+        w << "hit h=" << row.h << " but the surface there is " << fmt(s) << "; ";
+    }
+    // ... and is the first one: the ray stays above the surface before it
+    const double len = std::sqrt(ray.de * ray.de + ray.dn * ray.dn + ray.dh * ray.dh);
+    const int n = std::max(100, (int)(row.T * len / 2.0));
+    for (int k = 0; k < n; ++k) {
+        double t = row.T * k / n;
+        double hs = 0;
+        if (!surface(ray.e + t * ray.de, ray.n + t * ray.dn, &hs)) continue;
+        if (ray.h + t * ray.dh < hs - 0.05) {
+            w << "not the first hit: at t=" << fmt(t) << " the ray is at h=" << fmt(ray.h + t * ray.dh)
+              << ", below the surface " << fmt(hs) << "; ";
+            break;
+        }
+    }
+    return w.str();
+}
+
+static void test_trace_methods(void)
+{
+    TEST_ASSERT_MSG(load_fixture(), "cannot read the fixture DEM");
+    // fixtures/README.md's corner posts
+    TEST_ASSERT_DOUBLE_WITHIN(0, 483, post_h(0, 0));
+    TEST_ASSERT_DOUBLE_WITHIN(0, 444, post_h(kW - 1, 0));
+    TEST_ASSERT_DOUBLE_WITHIN(0, 545, post_h(0, kH - 1));
+    TEST_ASSERT_DOUBLE_WITHIN(0, 272, post_h(kW - 1, kH - 1));
+    const std::string pkg = fixture_package();
+    TEST_ASSERT_MSG(!pkg.empty(), "no fixture package");
+
+    std::string d = new_dir("trace");
+    const std::vector<TRay> rays = fixture_rays();
+    write_rays(d + "/rays.csv", rays, false);
+    write_rays(d + "/rays_rev.csv", rays, true);
+
+    // every method, the default, and the default on reordered columns; each
+    // writes its own hits file, so they run side by side
+    const char *methods[] = {"incremental", "hierarchical", "cone", "directional", nullptr};
+    std::vector<Job> jobs;
+    for (int m = 0; m < 5; ++m) {
+        std::string hits = std::string("hits_") + (methods[m] ? methods[m] : "default") + ".csv";
+        std::vector<std::string> args = {"trace", pkg, "--rays", "rays.csv", "-o", hits};
+        if (methods[m]) {
+            args.push_back("--method");
+            args.push_back(methods[m]);
+        }
+        jobs.push_back(Job{d, args});
+    }
+    jobs.push_back(Job{d, {"trace", pkg, "--rays", "rays_rev.csv", "-o", "hits_rev.csv"}});
+    std::vector<Run> runs = run_all(jobs);
+
+    std::vector<std::vector<Row>> all;
+    std::vector<std::string> texts;
+    for (int m = 0; m < 5; ++m) {
+        const char *mname = methods[m] ? methods[m] : "(default)";
+        const Run &r = runs[(size_t)m];
+        TEST_ASSERT_MSG(r.code == 0, "trace %s exited %d: %s", mname, r.code, r.err.c_str());
+        TEST_ASSERT_MSG(r.err.empty(), "trace %s wrote to stderr: %s", mname, r.err.c_str());
+        TEST_ASSERT_MSG(r.out.empty(), "trace %s wrote to stdout: %s", mname, r.out.c_str());
+        std::string text = slurp(d + "/" + jobs[(size_t)m].args[5]);
+        std::vector<Row> rows;
+        std::string why;
+        TEST_ASSERT_MSG(parse_hits(text, &rows, &why), "trace %s: hits.csv: %s", mname, why.c_str());
+        TEST_ASSERT_MSG(rows.size() == rays.size(), "trace %s: %zu rows for %zu rays", mname, rows.size(), rays.size());
+        for (size_t k = 0; k < rays.size(); ++k) {
+            std::string bad = check_row(rays[k], rows[k]);
+            TEST_ASSERT_MSG(bad.empty(), "trace %s, ray %zu (%s, %s,%s,%s dir %s,%s,%s): %s", mname, k + 1, rays[k].kind,
+                            fmt(rays[k].e).c_str(), fmt(rays[k].n).c_str(), fmt(rays[k].h).c_str(),
+                            fmt(rays[k].de).c_str(), fmt(rays[k].dn).c_str(), fmt(rays[k].dh).c_str(), bad.c_str());
+        }
+        all.push_back(rows);
+        texts.push_back(text);
+    }
+    // identical status, E, N, h, t for every method
+    for (size_t m = 1; m < all.size(); ++m)
+        for (size_t k = 0; k < rays.size(); ++k) {
+            const Row &a = all[0][k], &b = all[m][k];
+            TEST_ASSERT_MSG(a.status == b.status && a.e == b.e && a.n == b.n && a.h == b.h && a.t == b.t,
+                            "ray %zu: %s gives %s,%s,%s,%s,%s but %s gives %s,%s,%s,%s,%s", k + 1, methods[0],
+                            a.status.c_str(), a.e.c_str(), a.n.c_str(), a.h.c_str(), a.t.c_str(),
+                            methods[m] ? methods[m] : "(default)", b.status.c_str(), b.e.c_str(), b.n.c_str(),
+                            b.h.c_str(), b.t.c_str());
+        }
+    TEST_ASSERT_MSG(texts[4] == texts[3], "the default method's output differs from --method directional");
+
+    // columns in another order: the very same output
+    const Run &rr = runs[5];
+    TEST_ASSERT_MSG(rr.code == 0, "trace with reordered columns exited %d: %s", rr.code, rr.err.c_str());
+    std::string rev = slurp(d + "/hits_rev.csv");
+    TEST_ASSERT_MSG(rev == texts[4], "reordered columns give different hits:\n%s\nvs\n%s", rev.c_str(), texts[4].c_str());
+    std::set<std::string> files = listing(d), want = {"rays.csv", "rays_rev.csv", "hits_rev.csv"};
+    for (const Job &j : jobs) want.insert(j.args[5]);
+    TEST_ASSERT_MSG(files == want, "trace left {%s}", join(files).c_str());
+}
+
+// ---------------------------------------------------------------------------
+// 3. nodata policy
+
+static const int sW = 20, sH = 15;
+static const double sOE = 600000.0, sON = 4500000.0, sNodata = -9999.0;
+
+// multiples of 1/8 m: exact at the package's 1/16 m LSB
+static double small_h(int i, int j) { return 200.0 + 1.5 * i + 2.25 * j + 0.125 * ((i * j) % 7); }
+static bool small_void(int i, int j) { return i >= 6 && i <= 9 && j >= 5 && j <= 8; }
+
+static Georef small_geo(double posting_n = -30.0)
+{
+    Georef g;
+    g.origin_e = sOE;
+    g.origin_n = sON;
+    g.posting_e = 30.0;
+    g.posting_n = posting_n;
+    g.epsg = 32617;
+    return g;
+}
+
+// write_geotiff; "" or the error text
+static std::string write_small(const std::string &path, bool voids, bool all_nodata, double posting_n = -30.0)
+{
+    std::vector<double> v((size_t)sW * sH);
+    for (int j = 0; j < sH; ++j)
+        for (int i = 0; i < sW; ++i)
+            v[(size_t)j * sW + i] = all_nodata || (voids && small_void(i, j)) ? sNodata : small_h(i, j);
+    try {
+        ct_host::write_geotiff(path, sW, sH, v, SampleType::Float32, small_geo(posting_n), true, sNodata);
+    } catch (const std::exception &e) {
+        return e.what();
+    }
+    return "";
+}
+
+static void test_nodata_policy(void)
+{
+    std::string d = new_dir("nodata");
+    std::string w = write_small(d + "/void.tif", true, false);
+    TEST_ASSERT_MSG(w.empty(), "write_geotiff: %s", w.c_str());
+    Run b = run_cli(d, {"build", "void.tif", "-o", "void.ctp", "--sectors", "8", "--reduce", "2"});
+    TEST_ASSERT_MSG(b.code == 0, "build of a DEM with voids exited %d: %s", b.code, b.err.c_str());
+    TEST_ASSERT_MSG(lines_of(b.out).size() == 1 && contains(b.out, "void.ctp"), "build summary: '%s'", b.out.c_str());
+
+    // nadir over the middle of the void block (grid x 7.5, y 6.5: cell (7,6),
+    // all four corners void); nadir over a valid post far from the voids
+    const double ve = sOE + (7.5 + 0.5) * 30, vn = sON - (6.5 + 0.5) * 30;
+    const double ge = sOE + (17 + 0.5) * 30, gn = sON - (12 + 0.5) * 30;
+    spit(d + "/rays.csv", "E,N,h,dE,dN,dh\n" + fmt(ve) + "," + fmt(vn) + ",1000,0,0,-1\n" + fmt(ge) + "," + fmt(gn) +
+                              ",1000,0,0,-1\n");
+    // every post nodata: an error naming the file, no output
+    std::string d2 = new_dir("allnodata");
+    w = write_small(d2 + "/allnd.tif", false, true);
+    TEST_ASSERT_MSG(w.empty(), "write_geotiff: %s", w.c_str());
+    const std::set<std::string> before2 = listing(d2);
+
+    const char *methods[] = {"incremental", "hierarchical", "cone", "directional"};
+    std::vector<Job> jobs = {Job{d, {"info", "void.ctp"}}, Job{d2, {"build", "allnd.tif", "-o", "allnd.ctp"}}};
+    for (const char *m : methods)
+        jobs.push_back(Job{d, {"trace", "void.ctp", "--rays", "rays.csv", "--method", m, "-o", std::string("hits_") + m + ".csv"}});
+    std::vector<Run> runs = run_all(jobs);
+
+    const Run &i = runs[0];
+    TEST_ASSERT_MSG(i.code == 0, "info exited %d: %s", i.code, i.err.c_str());
+    TEST_ASSERT_MSG(contains(i.out, "\nvoids         yes\n"), "info lacks 'voids         yes':\n%s", i.out.c_str());
+    TEST_ASSERT_MSG(contains(i.out, "\nverify        ok\n"), "info lacks 'verify        ok':\n%s", i.out.c_str());
+    TEST_ASSERT_MSG(starts_with(info_value(i.out, "posts"), "20 x 15"), "info posts: '%s'", info_value(i.out, "posts").c_str());
+    TEST_ASSERT_MSG(info_value(i.out, "epsg") == "32617", "info epsg: '%s'", info_value(i.out, "epsg").c_str());
+
+    CHECK_FAILURE(runs[1], d2, before2, "allnd.tif");
+
+    for (size_t k = 0; k < 4; ++k) {
+        const char *m = methods[k];
+        const Run &t = runs[k + 2];
+        TEST_ASSERT_MSG(t.code == 0, "trace %s exited %d: %s", m, t.code, t.err.c_str());
+        std::vector<Row> rows;
+        std::string why;
+        TEST_ASSERT_MSG(parse_hits(slurp(d + "/hits_" + m + ".csv"), &rows, &why), "trace %s: %s", m, why.c_str());
+        TEST_ASSERT_MSG(rows.size() == 2, "trace %s: %zu rows", m, rows.size());
+        TEST_ASSERT_MSG(rows[0].status == "hit_void", "trace %s: nadir into the void block: status %s, expected hit_void",
+                        m, rows[0].status.c_str());
+        // the void floor is the lowest valid height (post (0,0) = 200 m)
+        TEST_ASSERT_MSG(std::fabs(rows[0].Hh - 200.0) <= 0.01, "trace %s: void floor at h=%s, expected 200 (lowest valid)",
+                        m, rows[0].h.c_str());
+        TEST_ASSERT_MSG(std::fabs(rows[0].E - ve) <= 0.001 && std::fabs(rows[0].N - vn) <= 0.001,
+                        "trace %s: void hit at %s,%s", m, rows[0].e.c_str(), rows[0].n.c_str());
+        TEST_ASSERT_MSG(rows[1].status == "hit", "trace %s: nadir over valid post (17,12): status %s", m,
+                        rows[1].status.c_str());
+        TEST_ASSERT_MSG(std::fabs(rows[1].Hh - small_h(17, 12)) <= 0.01, "trace %s: post (17,12) hit at h=%s, post is %g",
+                        m, rows[1].h.c_str(), small_h(17, 12));
+        TEST_ASSERT_MSG(std::fabs(rows[1].E - ge) <= 0.001 && std::fabs(rows[1].N - gn) <= 0.001,
+                        "trace %s: valid hit at %s,%s", m, rows[1].e.c_str(), rows[1].n.c_str());
+        TEST_ASSERT_MSG(std::fabs(rows[1].T - (1000.0 - small_h(17, 12))) <= 0.001, "trace %s: t=%s", m, rows[1].t.c_str());
+    }
+}
+
+// ---------------------------------------------------------------------------
+// 4. bad inputs: each case runs in its own empty directory (read-only inputs
+// come from a shared one), so "no output, no temporary" is a listing check.
+
+struct BadCase {
+    const char *tag;
+    std::vector<std::string> args;  // "@x" = the shared input file x
+    std::string name, needle;       // the message must contain name and needle ("a|b": a or b)
+    bool usage;                     // usage text may follow the first line
+    std::string rays;               // if set: written to rays.csv in the case directory
+};
+
+static void test_bad_inputs(void)
+{
+    std::string in = new_dir("inputs");
+    std::string w = write_small(in + "/ok.tif", false, false);
+    TEST_ASSERT_MSG(w.empty(), "write_geotiff: %s", w.c_str());
+    spit(in + "/garbage.tif", "this is not a TIFF file at all\n");
+    spit(in + "/gif.tif", "GIF89a not a tiff\n");
+    // write_geotiff writes ModelPixelScale (|posting_e|, |posting_n|) as given
+    w = write_small(in + "/nonsq.tif", false, false, -20.0);
+    TEST_ASSERT_MSG(w.empty(), "write_geotiff (non-square): %s", w.c_str());
+    const std::string pkg = fixture_package();
+    TEST_ASSERT_MSG(!pkg.empty(), "no fixture package");
+    std::string bytes = slurp(pkg);
+    TEST_ASSERT_MSG(bytes.size() > 4096, "fixture package too small (%zu)", bytes.size());
+    spit(in + "/trunc.ctp", bytes.substr(0, 100));
+    std::string flipped = bytes;
+    flipped[flipped.size() / 2] = (char)(flipped[flipped.size() / 2] ^ 0x10);
+    spit(in + "/flip.ctp", flipped);
+    const std::set<std::string> inputs = listing(in);
+
+    const std::string good = "E,N,h,dE,dN,dh\n195600,4068000,1500,0,0,-1\n";
+    const std::string fix = fixture_dem();
+    const std::vector<BadCase> cases = {
+        // DEM problems
+        {"missing", {"build", "missing.tif", "-o", "X.ctp"}, "missing.tif", "", false, ""},
+        {"garbage", {"build", "@garbage.tif", "-o", "X.ctp"}, "garbage.tif", "", false, ""},
+        // a .tif that starts like a GIF: OpenImageIO's GIF reader takes it
+        {"gif", {"build", "@gif.tif", "-o", "X.ctp"}, "gif.tif", "", false, ""},
+        {"nonsquare", {"build", "@nonsq.tif", "-o", "X.ctp"}, "nonsq.tif", "non-square", false, ""},
+        // output problems
+        {"nodir", {"build", "@ok.tif", "-o", "nodir/X.ctp"}, "nodir/X.ctp", "", false, ""},
+        {"outisdir", {"build", "@ok.tif", "-o", "adir"}, "adir", "", false, ""},
+        // damaged packages
+        {"trunc", {"info", "@trunc.ctp"}, "trunc.ctp", "", false, ""},
+        {"flip", {"info", "@flip.ctp"}, "flip.ctp", "err_crc", false, ""},
+        // bad rays.csv: file and line
+        {"nodh", {"trace", pkg, "--rays", "rays.csv", "-o", "hits.csv"}, "rays.csv:1:", "dh", false,
+         "E,N,h,dE,dN\n195600,4068000,1500,0,0\n"},
+        {"badnum", {"trace", pkg, "--rays", "rays.csv", "-o", "hits.csv"}, "rays.csv:3:", "15x0", false,
+         good + "195600,4068000,15x0,0,0,-1\n"},
+        // usage errors
+        {"method", {"trace", pkg, "--rays", "rays.csv", "--method", "bogus", "-o", "hits.csv"}, "", "bogus", true, good},
+        {"option", {"build", fix, "-o", "X.ctp", "--frobnicate", "1"}, "", "--frobnicate", true, ""},
+        {"sectors0", {"build", fix, "-o", "X.ctp", "--sectors", "0"}, "", "--sectors", true, ""},
+        {"sectors65", {"build", fix, "-o", "X.ctp", "--sectors", "65"}, "", "--sectors", true, ""},
+        {"reduce9", {"build", fix, "-o", "X.ctp", "--reduce", "9"}, "", "--reduce", true, ""},
+        // out-of-range option values must not be truncated or ignored
+        {"sectors2^32+8", {"build", "@ok.tif", "-o", "X.ctp", "--sectors", "4294967304"}, "", "--sectors", true, ""},
+        {"hscale_nan", {"build", "@ok.tif", "-o", "X.ctp", "--height-scale", "nan"}, "", "--height-scale|ok.tif", true, ""},
+        {"posting_nan", {"build", "@ok.tif", "-o", "X.ctp", "--posting", "nan"}, "", "--posting|ok.tif", true, ""},
+    };
+    std::vector<Job> jobs;
+    std::vector<std::string> dirs;
+    std::vector<std::set<std::string>> befores;
+    for (const BadCase &c : cases) {
+        std::string d = new_dir(c.tag);
+        if (!c.rays.empty()) spit(d + "/rays.csv", c.rays);
+        if (std::string(c.tag) == "outisdir") fs::create_directory(d + "/adir");
+        Job j{d, c.args};
+        for (auto &a : j.args)
+            if (!a.empty() && a[0] == '@') a = in + "/" + a.substr(1);
+        jobs.push_back(j);
+        dirs.push_back(d);
+        befores.push_back(listing(d));
+    }
+    std::vector<Run> runs = run_all(jobs);
+    // every case is checked; all failures are reported together
+    std::string bad;
+    int nbad = 0;
+    for (size_t k = 0; k < cases.size(); ++k) {
+        const BadCase &c = cases[k];
+        std::string why = check_failure(runs[k], dirs[k], befores[k], c.name, c.needle, c.usage);
+        if (!why.empty()) {
+            bad += "\n    case " + std::string(c.tag) + ": " + why;
+            nbad++;
+        }
+    }
+    TEST_ASSERT_MSG(bad.empty(), "%d of %zu bad-input cases wrong:%s", nbad, cases.size(), bad.c_str());
+    TEST_ASSERT_MSG(fs::is_empty(dirs[5] + "/adir"), "case outisdir: something was written into adir");
+    TEST_ASSERT_MSG(listing(in) == inputs, "the input directory changed: {%s}", join(listing(in)).c_str());
+}
+
+// ---------------------------------------------------------------------------
+// 5. an existing output survives a failed run
+
+static void test_failed_run_keeps_output(void)
+{
+    std::string in = new_dir("keep_inputs");
+    std::string w = write_small(in + "/allnd.tif", false, true);
+    TEST_ASSERT_MSG(w.empty(), "write_geotiff: %s", w.c_str());
+    spit(in + "/garbage.tif", std::string("II*\0\x08\0\0\0", 8) + "a truncated TIFF");
+    spit(in + "/rays.csv", "E,N,h,dE,dN,dh\n195600,4068000,1500,0,0,-1\n195600,4068000,nan,0,0,-1\n");
+    const std::string pkg = fixture_package();
+    TEST_ASSERT_MSG(!pkg.empty(), "no fixture package");
+
+    struct K {
+        std::vector<std::string> args;
+        std::string kept, name;
+    };
+    const std::vector<K> cases = {
+        {{"build", "missing.tif", "-o", "out.ctp"}, "out.ctp", "missing.tif"},
+        {{"build", in + "/garbage.tif", "-o", "out.ctp"}, "out.ctp", "garbage.tif"},
+        {{"build", in + "/allnd.tif", "-o", "out.ctp"}, "out.ctp", "allnd.tif"},
+        {{"build", fixture_dem(), "-o", "out.ctp", "--sectors", "65"}, "out.ctp", ""},
+        {{"trace", pkg, "--rays", in + "/rays.csv", "-o", "hits.csv"}, "hits.csv", "rays.csv:3:"},
+    };
+    std::vector<Job> jobs;
+    std::vector<std::set<std::string>> befores;
+    for (const K &c : cases) {
+        std::string d = new_dir("keep");
+        spit(d + "/" + c.kept, "keep");
+        jobs.push_back(Job{d, c.args});
+        befores.push_back(listing(d));
+    }
+    std::vector<Run> runs = run_all(jobs);
+    for (size_t k = 0; k < cases.size(); ++k) {
+        const Run &r = runs[k];
+        TEST_ASSERT_MSG(r.code != 0, "`%s` succeeded", r.cmd.c_str());
+        TEST_ASSERT_MSG(slurp(jobs[k].dir + "/" + cases[k].kept) == "keep", "`%s` damaged the existing %s", r.cmd.c_str(),
+                        cases[k].kept.c_str());
+        std::string why = check_failure(r, jobs[k].dir, befores[k], cases[k].name, "", cases[k].name.empty());
+        TEST_ASSERT_MSG(why.empty(), "%s", why.c_str());
+    }
+}
+
+// ---------------------------------------------------------------------------
+
+int main(void)
+{
+    TEST_BEGIN("test_cli");
+    char tmpl[] = "/tmp/ct_test_cli_XXXXXX";
+    if (!mkdtemp(tmpl)) {
+        printf("test_cli: mkdtemp failed\n");
+        return 1;
+    }
+    g_root = tmpl;
+    if (access(CT_CLI, X_OK) != 0) {
+        printf("test_cli: %s is not executable\n", CT_CLI);
+        return 1;
+    }
+    load_fixture();
+    RUN_TEST(test_build_info_fixture);
+    RUN_TEST(test_trace_methods);
+    RUN_TEST(test_nodata_policy);
+    RUN_TEST(test_bad_inputs);
+    RUN_TEST(test_failed_run_keeps_output);
+    int rc = TEST_END();
+    if (getenv("CT_TEST_KEEP"))
+        printf("scratch directory kept: %s\n", g_root.c_str());
+    else
+        fs::remove_all(g_root);
+    return rc;
+}
