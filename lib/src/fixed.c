@@ -4,126 +4,6 @@
  */
 #include "fixed.h"
 
-#if defined(__SIZEOF_INT128__) && !defined(CT_PORTABLE_INT128)
-#define CT_NATIVE_INT128 1
-__extension__ typedef __int128 ct_n128;
-__extension__ typedef unsigned __int128 ct_nu128;
-
-static ct_n128 to_n(ct_i128 a)
-{
-    ct_nu128 u = ((ct_nu128)a.hi << 64) | (ct_nu128)a.lo;
-    return (ct_n128)u;
-}
-static ct_i128 from_n(ct_n128 v)
-{
-    ct_i128 r;
-    ct_nu128 u = (ct_nu128)v;
-    r.hi = (uint64_t)(u >> 64);
-    r.lo = (uint64_t)u;
-    return r;
-}
-#endif
-
-ct_i128 ct_i128_from64(int64_t a)
-{
-    ct_i128 r;
-    r.lo = (uint64_t)a;
-    r.hi = a < 0 ? ~(uint64_t)0 : 0u;
-    return r;
-}
-
-int64_t ct_i128_to64(ct_i128 a) { return (int64_t)a.lo; }
-
-ct_i128 ct_i128_add(ct_i128 a, ct_i128 b)
-{
-    ct_i128 r;
-    r.lo = a.lo + b.lo;
-    r.hi = a.hi + b.hi + (r.lo < a.lo ? 1u : 0u);
-    return r;
-}
-
-ct_i128 ct_i128_neg(ct_i128 a)
-{
-    ct_i128 r;
-    r.lo = ~a.lo + 1u;
-    r.hi = ~a.hi + (r.lo == 0u ? 1u : 0u);
-    return r;
-}
-
-ct_i128 ct_i128_sub(ct_i128 a, ct_i128 b) { return ct_i128_add(a, ct_i128_neg(b)); }
-
-ct_i128 ct_i128_shl(ct_i128 a, unsigned n)
-{
-    ct_i128 r;
-    if (n == 0u) {
-        return a;
-    }
-    r.hi = (a.hi << n) | (a.lo >> (64u - n));
-    r.lo = a.lo << n;
-    return r;
-}
-
-int ct_i128_sign(ct_i128 a)
-{
-    if ((a.hi >> 63) != 0u) {
-        return -1;
-    }
-    return (a.hi | a.lo) != 0u ? 1 : 0;
-}
-
-int ct_i128_cmp(ct_i128 a, ct_i128 b) { return ct_i128_sign(ct_i128_sub(a, b)); }
-
-/* Unsigned 64 x 64 -> 128 from 32-bit halves. */
-static ct_i128 umul64(uint64_t a, uint64_t b)
-{
-    ct_i128 r;
-#ifdef CT_NATIVE_INT128
-    ct_nu128 p = (ct_nu128)a * (ct_nu128)b;
-    r.hi = (uint64_t)(p >> 64);
-    r.lo = (uint64_t)p;
-#else
-    uint64_t a0 = a & 0xffffffffu, a1 = a >> 32;
-    uint64_t b0 = b & 0xffffffffu, b1 = b >> 32;
-    uint64_t p00 = a0 * b0, p01 = a0 * b1, p10 = a1 * b0, p11 = a1 * b1;
-    uint64_t mid = (p00 >> 32) + (p01 & 0xffffffffu) + (p10 & 0xffffffffu);
-    r.lo = (p00 & 0xffffffffu) | (mid << 32);
-    r.hi = p11 + (p01 >> 32) + (p10 >> 32) + (mid >> 32);
-#endif
-    return r;
-}
-
-static uint64_t uabs64(int64_t a) { return a < 0 ? (uint64_t)0 - (uint64_t)a : (uint64_t)a; }
-
-ct_i128 ct_i128_mul(int64_t a, int64_t b)
-{
-    ct_i128 p = umul64(uabs64(a), uabs64(b));
-    return ((a < 0) != (b < 0)) ? ct_i128_neg(p) : p;
-}
-
-ct_i128 ct_i128_mul128_64(ct_i128 a, int64_t b)
-{
-#ifdef CT_NATIVE_INT128
-    return from_n(to_n(a) * (ct_n128)b);
-#else
-    int neg = 0;
-    ct_i128 ua = a, r, lo, hi;
-    uint64_t ub;
-    if (ct_i128_sign(a) < 0) {
-        ua = ct_i128_neg(a);
-        neg = 1;
-    }
-    if (b < 0) {
-        neg = !neg;
-    }
-    ub = uabs64(b);
-    lo = umul64(ua.lo, ub);
-    hi = umul64(ua.hi, ub); /* caller: |a*b| < 2^126, so hi.hi == 0 */
-    r.lo = lo.lo;
-    r.hi = lo.hi + hi.lo;
-    return neg ? ct_i128_neg(r) : r;
-#endif
-}
-
 /* Unsigned (hi:lo) / d with hi < d; returns the quotient, *rem the rest. */
 static uint64_t udiv128(uint64_t hi, uint64_t lo, uint64_t d, uint64_t *rem)
 {
@@ -152,6 +32,10 @@ int64_t ct_i128_floor_div(ct_i128 n, int64_t d)
 {
     uint64_t rem, q;
     CT_ASSERT(d > 0);
+    /* fast path: the numerator fits in 64 bits */
+    if (n.hi == ((n.lo >> 63) != 0u ? ~(uint64_t)0 : 0u) && n.lo != ((uint64_t)1 << 63)) {
+        return ct_floor_div((int64_t)n.lo, d);
+    }
     if (ct_i128_sign(n) >= 0) {
         q = udiv128(n.hi, n.lo, (uint64_t)d, &rem);
         return (int64_t)q;
@@ -180,6 +64,9 @@ int64_t ct_i128_floor_div_sat(ct_i128 n, int64_t d)
 uint64_t ct_isqrt64(uint64_t n)
 {
     uint64_t res = 0u, bit = (uint64_t)1 << 62;
+    if (n < 2u) {
+        return n;
+    }
     /* bound: 32 iterations (one result bit each) */
     while (bit > n) {
         bit >>= 2;
@@ -206,17 +93,24 @@ uint64_t ct_i128_isqrt(ct_i128 n)
     if (n.hi == 0u) {
         return ct_isqrt64(n.lo);
     }
-    /* Newton from above: x0 = 2^ceil(bits/2) >= sqrt(n); x <- (x + n/x)/2
-     * decreases monotonically to floor(sqrt(n)).  bound: 70 iterations
-     * (quadratic convergence needs < 10 from this start). */
+    /* Newton from above, started from the square root of the top bits:
+     * with n' = n >> 2s < 2^62, x0 = (isqrt(n') + 1) << s > sqrt(n), and
+     * x <- (x + n/x)/2 decreases monotonically to floor(sqrt(n)) (two or
+     * three steps from this start).  bound: 70 iterations.               */
     {
-        unsigned bits = 64u;
-        uint64_t h = n.hi;
-        while (h != 0u) {
+        unsigned bits = 64u, s;
+        uint64_t h = n.hi, top;
+        while (h != 0u) { /* bound: 64 */
             h >>= 1;
             bits++;
         }
-        x = (bits + 1u) / 2u >= 64u ? ~(uint64_t)0 : ((uint64_t)1 << ((bits + 1u) / 2u));
+        s = (bits - 61u) / 2u + 1u; /* 2s >= bits - 62, 2s < 64 + ... */
+        if (2u * s >= 64u) {
+            top = n.hi >> (2u * s - 64u);
+        } else {
+            top = (n.lo >> (2u * s)) | (n.hi << (64u - 2u * s));
+        }
+        x = (ct_isqrt64(top) + 1u) << s;
     }
     for (k = 0; k < 70; ++k) {
         uint64_t y;

@@ -63,16 +63,133 @@ static inline int64_t ct_ld64s(const uint8_t *p)
     return (int64_t)v;
 }
 
-ct_i128 ct_i128_from64(int64_t a);
-ct_i128 ct_i128_mul(int64_t a, int64_t b);
-ct_i128 ct_i128_add(ct_i128 a, ct_i128 b);
-ct_i128 ct_i128_sub(ct_i128 a, ct_i128 b);
-ct_i128 ct_i128_neg(ct_i128 a);
-ct_i128 ct_i128_shl(ct_i128 a, unsigned n); /* n < 64, no overflow by caller */
-int ct_i128_sign(ct_i128 a);                /* -1, 0, +1 */
-int ct_i128_cmp(ct_i128 a, ct_i128 b);      /* -1, 0, +1 */
-/* a * b with a 128-bit, b 64-bit; caller guarantees |a * b| < 2^126. */
-ct_i128 ct_i128_mul128_64(ct_i128 a, int64_t b);
+#if defined(__SIZEOF_INT128__) && !defined(CT_PORTABLE_INT128)
+#define CT_NATIVE_INT128 1
+__extension__ typedef __int128 ct_n128;
+__extension__ typedef unsigned __int128 ct_nu128;
+#endif
+
+/* Core 128-bit operations, inline: from64, to64 (caller knows it fits),
+ * add, neg, sub, shl (n < 64, no overflow by caller), sign and cmp (-1, 0,
+ * +1), mul (64 x 64), mul128_64 (caller guarantees |a * b| < 2^126).     */
+#ifdef CT_NATIVE_INT128
+
+static inline ct_n128 ct_to_n(ct_i128 a)
+{
+    ct_nu128 u = ((ct_nu128)a.hi << 64) | (ct_nu128)a.lo;
+    return (ct_n128)u;
+}
+static inline ct_i128 ct_from_n(ct_n128 v)
+{
+    ct_i128 r;
+    ct_nu128 u = (ct_nu128)v;
+    r.hi = (uint64_t)(u >> 64);
+    r.lo = (uint64_t)u;
+    return r;
+}
+#endif
+
+static inline ct_i128 ct_i128_from64(int64_t a)
+{
+    ct_i128 r;
+    r.lo = (uint64_t)a;
+    r.hi = a < 0 ? ~(uint64_t)0 : 0u;
+    return r;
+}
+
+static inline int64_t ct_i128_to64(ct_i128 a) { return (int64_t)a.lo; }
+
+static inline ct_i128 ct_i128_add(ct_i128 a, ct_i128 b)
+{
+    ct_i128 r;
+    r.lo = a.lo + b.lo;
+    r.hi = a.hi + b.hi + (r.lo < a.lo ? 1u : 0u);
+    return r;
+}
+
+static inline ct_i128 ct_i128_neg(ct_i128 a)
+{
+    ct_i128 r;
+    r.lo = ~a.lo + 1u;
+    r.hi = ~a.hi + (r.lo == 0u ? 1u : 0u);
+    return r;
+}
+
+static inline ct_i128 ct_i128_sub(ct_i128 a, ct_i128 b) { return ct_i128_add(a, ct_i128_neg(b)); }
+
+static inline ct_i128 ct_i128_shl(ct_i128 a, unsigned n)
+{
+    ct_i128 r;
+    if (n == 0u) {
+        return a;
+    }
+    r.hi = (a.hi << n) | (a.lo >> (64u - n));
+    r.lo = a.lo << n;
+    return r;
+}
+
+static inline int ct_i128_sign(ct_i128 a)
+{
+    if ((a.hi >> 63) != 0u) {
+        return -1;
+    }
+    return (a.hi | a.lo) != 0u ? 1 : 0;
+}
+
+static inline int ct_i128_cmp(ct_i128 a, ct_i128 b) { return ct_i128_sign(ct_i128_sub(a, b)); }
+
+/* Unsigned 64 x 64 -> 128 from 32-bit halves. */
+static inline ct_i128 ct_umul64(uint64_t a, uint64_t b)
+{
+    ct_i128 r;
+#ifdef CT_NATIVE_INT128
+    ct_nu128 p = (ct_nu128)a * (ct_nu128)b;
+    r.hi = (uint64_t)(p >> 64);
+    r.lo = (uint64_t)p;
+#else
+    uint64_t a0 = a & 0xffffffffu, a1 = a >> 32;
+    uint64_t b0 = b & 0xffffffffu, b1 = b >> 32;
+    uint64_t p00 = a0 * b0, p01 = a0 * b1, p10 = a1 * b0, p11 = a1 * b1;
+    uint64_t mid = (p00 >> 32) + (p01 & 0xffffffffu) + (p10 & 0xffffffffu);
+    r.lo = (p00 & 0xffffffffu) | (mid << 32);
+    r.hi = p11 + (p01 >> 32) + (p10 >> 32) + (mid >> 32);
+#endif
+    return r;
+}
+
+static inline uint64_t ct_uabs64(int64_t a) { return a < 0 ? (uint64_t)0 - (uint64_t)a : (uint64_t)a; }
+
+static inline ct_i128 ct_i128_mul(int64_t a, int64_t b)
+{
+    ct_i128 p = ct_umul64(ct_uabs64(a), ct_uabs64(b));
+    return ((a < 0) != (b < 0)) ? ct_i128_neg(p) : p;
+}
+
+static inline ct_i128 ct_i128_mul128_64(ct_i128 a, int64_t b)
+{
+#ifdef CT_NATIVE_INT128
+    return ct_from_n(ct_to_n(a) * (ct_n128)b);
+#else
+    int neg = 0;
+    ct_i128 ua = a, r, lo, hi;
+    uint64_t ub;
+    if (ct_i128_sign(a) < 0) {
+        ua = ct_i128_neg(a);
+        neg = 1;
+    }
+    if (b < 0) {
+        neg = !neg;
+    }
+    ub = ct_uabs64(b);
+    lo = ct_umul64(ua.lo, ub);
+    hi = ct_umul64(ua.hi, ub); /* caller: |a*b| < 2^126, so hi.hi == 0 */
+    r.lo = lo.lo;
+    r.hi = lo.hi + hi.lo;
+    return neg ? ct_i128_neg(r) : r;
+#endif
+}
+
+
 /* floor(n / d) for d > 0 and |quotient| < 2^63.                             */
 int64_t ct_i128_floor_div(ct_i128 n, int64_t d);
 /* floor(n / d) for d > 0, saturated to [-2^62, 2^62].                      */
@@ -81,8 +198,6 @@ int64_t ct_i128_floor_div_sat(ct_i128 n, int64_t d);
 uint64_t ct_i128_isqrt(ct_i128 n);
 /* floor(sqrt(n)) for 64-bit n.                                               */
 uint64_t ct_isqrt64(uint64_t n);
-/* low 64 bits as a signed value (caller knows it fits).                     */
-int64_t ct_i128_to64(ct_i128 a);
 
 /* Integer cos/sin of 2*pi*k/n in units of 2^30 (|error| < 2^-28 of full
  * scale); exact on axes and diagonals and symmetric, deterministic.       */

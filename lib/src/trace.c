@@ -53,14 +53,15 @@ typedef struct {
 
 static int sgn64(int64_t v) { return (v > 0) - (v < 0); }
 
+/* floor(a / 2^n) without relying on the implementation-defined right shift
+ * of negative values. */
+static int64_t floor_shr(int64_t a, unsigned n)
+{
+    return a >= 0 ? a >> n : -(int64_t)(((uint64_t)(-a) + (((uint64_t)1 << n) - 1u)) >> n);
+}
+
 /* a < b for rationals: n <= 2^34, d <= 2^26 -> products < 2^60 */
 static int rt_lt(rt a, rt b) { return a.n * b.d < b.n * a.d; }
-
-/* z(t) in Q16, floored: n*dz < 2^34 * 2^26 = 2^60 */
-static int64_t z_at(const ctx *c, rt t)
-{
-    return c->r->oz + ct_floor_div(t.n * (int64_t)c->r->dz, t.d);
-}
 
 /* Fine-cell index along one axis at o + t*d (Q16), with the tie rule: a
  * point exactly on a grid line belongs to the cell the ray moves into; with
@@ -86,8 +87,33 @@ static int32_t axis_cell(int64_t num, int64_t den16, int32_t s, int32_t ncell)
 }
 
 /* Cell holding the ray at t.  ox*d < 2^31 * 2^26, n*dx < 2^60. */
+/* Cell index for a Q26 t (den 2^42): shifts instead of divisions. */
+static int32_t axis_cell_q26(int64_t num, int32_t s, int32_t ncell)
+{
+    int64_t k = floor_shr(num, 16u + CT_T_FRAC_BITS);
+    if ((num & ((INT64_C(1) << (16 + CT_T_FRAC_BITS)) - 1)) == 0) {
+        if (s < 0) {
+            k -= 1;
+        } else if (s == 0 && k == ncell) {
+            k -= 1;
+        }
+    }
+    if (k < -1) {
+        k = -1;
+    }
+    if (k > ncell) {
+        k = ncell;
+    }
+    return (int32_t)k;
+}
+
 static void locate(const ctx *c, rt t, int32_t *i, int32_t *j)
 {
+    if (t.d == T_ONE) {
+        *i = axis_cell_q26(c->r->ox * T_ONE + t.n * (int64_t)c->r->dx, c->sx, c->cx);
+        *j = axis_cell_q26(c->r->oy * T_ONE + t.n * (int64_t)c->r->dy, c->sy, c->cy);
+        return;
+    }
     *i = axis_cell(c->r->ox * t.d + t.n * (int64_t)c->r->dx, t.d * ONE16, c->sx, c->cx);
     *j = axis_cell(c->r->oy * t.d + t.n * (int64_t)c->r->dy, t.d * ONE16, c->sy, c->cy);
 }
@@ -600,7 +626,12 @@ static ct_status walk_cones(const ctx *c, uint32_t plane, ct_hit *h)
         code = ang[k];
         if (p->cot_ok[code]) {
             int64_t a16 = (int64_t)ct_ld16(p->apex + 2u * k) * ONE16;
-            int64_t num = z_at(c, t) - a16; /* < 2^34 */
+            /* T = floor(t 2^26), and a lower bound of z(t) from a Q26 point
+             * (z at T for a rising ray, at T + 1 for a descending one unless
+             * t is exactly T / 2^26): t.n 2^26 < 2^60. */
+            int64_t T = t.d == T_ONE ? t.n : ct_floor_div(t.n * T_ONE, t.d);
+            int64_t Tz = (t.d != T_ONE && r->dz < 0) ? T + 1 : T;
+            int64_t num = r->oz + floor_shr(Tz * (int64_t)r->dz, CT_T_FRAC_BITS) - a16; /* < 2^34 */
             if (num > 0) {
                 int64_t cot = p->cot_q16[code];
                 int64_t len = cot >= 0 ? r->len_hi : r->len_lo;
@@ -616,8 +647,8 @@ static ct_status walk_cones(const ctx *c, uint32_t plane, ct_hit *h)
                 if (dt > (INT64_C(1) << 35)) {
                     dt = INT64_C(1) << 35;
                 }
-                /* floor(t*2^26) + dt - 1 < the exact exit of the cone */
-                tn = ct_floor_div(t.n * T_ONE, t.d) + dt - 1;
+                /* T + dt - 1 < 2^26 times the exact exit of the cone */
+                tn = T + dt - 1;
                 /* tn < 2^36: tn * d < 2^62 */
                 if (tn * e.t.d > e.t.n * T_ONE) {
                     rt tj;
@@ -1081,11 +1112,23 @@ static ct_status round_div(ct_i128 num, int64_t den, int64_t *q)
     return CT_OK;
 }
 
+/* round(v / 2^16) for a 128-bit v, checking |result| < 2^62. */
+static ct_status round_shr16(ct_i128 v, int64_t *q)
+{
+    ct_i128 r = ct_i128_add(v, ct_i128_from64(32768));
+    int64_t hi = (int64_t)r.hi;
+    /* r >> 16 fits in 62 bits iff the top 66 bits of r are all equal */
+    if (hi >= (INT64_C(1) << 13) || hi < -(INT64_C(1) << 13)) {
+        return CT_ERR_RANGE;
+    }
+    *q = (int64_t)((r.hi << 48) | (r.lo >> 16));
+    return CT_OK;
+}
+
 ct_status ct_grid_to_map(const ct_package *p, int64_t x, int64_t y, int64_t z,
                          int64_t *e, int64_t *n, int64_t *hh)
 {
     int64_t de, dn, dh;
-    ct_status st;
     CT_ASSERT(p != NULL && e != NULL && n != NULL && hh != NULL);
     if (p == NULL || e == NULL || n == NULL || hh == NULL) {
         return CT_ERR_ARG;
@@ -1094,18 +1137,11 @@ ct_status ct_grid_to_map(const ct_package *p, int64_t x, int64_t y, int64_t z,
         ct_abs64(z) > (INT64_C(1) << 60)) {
         return CT_ERR_RANGE;
     }
-    /* (x + 2^15) * posting: < 2^61 * 2^50, 128-bit */
-    st = round_div(ct_i128_mul(x + 32768, p->posting_e_nm), ONE16, &de);
-    if (st != CT_OK) {
-        return st;
-    }
-    st = round_div(ct_i128_mul(y + 32768, p->posting_n_nm), ONE16, &dn);
-    if (st != CT_OK) {
-        return st;
-    }
-    st = round_div(ct_i128_mul(z, p->height_scale_nm), ONE16, &dh);
-    if (st != CT_OK) {
-        return st;
+    /* (x + 2^15) * posting / 2^16 rounded: < 2^61 * 2^50, 128-bit */
+    if (round_shr16(ct_i128_mul(x + 32768, p->posting_e_nm), &de) != CT_OK ||
+        round_shr16(ct_i128_mul(y + 32768, p->posting_n_nm), &dn) != CT_OK ||
+        round_shr16(ct_i128_mul(z, p->height_scale_nm), &dh) != CT_OK) {
+        return CT_ERR_RANGE;
     }
     /* |origin| <= 2^61 and |delta| < 2^62: sums fit */
     *e = p->origin_e_nm + de;
