@@ -243,20 +243,25 @@ int cmd_demo(int argc, char **argv)
         {"nadir", {e0 + 0.41 * w, n0 - 0.37 * hgt, top + 500, 0, 0, -1}},
         {"oblique 30 deg", {e0 + 0.05 * w, n0 - 0.5 * hgt, top, 0.866, -0.05, -0.5}},
         {"grazing 2 deg", {e0 + 0.02 * w, n0 - 0.3 * hgt, t.height_offset_m + 0.6 * 65535 * t.height_scale_m, 0.9994, -0.3, -0.0349}},
-        {"horizontal", {e0, n0 - 0.5 * hgt, t.height_offset_m + 0.5 * (bs.cones ? 1 : 0) * 0 + 0.0, 1, 0.02, 0}},
+        {"horizontal", {e0, n0 - 0.5 * hgt, 0, 1, 0.02, 0}},
         {"rising 5 deg", {e0 + 0.5 * w, n0 - 0.5 * hgt, t.height_offset_m + 1.0, 0.7, 0.7, 0.087}},
     };
-    // horizontal: at the mean of min and max terrain height
+    // heights relative to the terrain: the horizontal and rising rays start
+    // a few metres above the ground below them
     {
         uint16_t lo = 65535, hi = 0;
         for (uint16_t c : t.codes) {
             lo = std::min(lo, c);
             hi = std::max(hi, c);
         }
-        demos[3].r.h = t.height_offset_m + (0.5 * (lo + hi)) * t.height_scale_m;
+        auto ground = [&](double fx, double fy) {
+            int i = (int)std::lround(fx * (t.width - 1)), j = (int)std::lround(fy * (t.height - 1));
+            return t.height_offset_m + t.at(i, j) * t.height_scale_m;
+        };
         demos[1].r.h = t.height_offset_m + hi * t.height_scale_m + 300;
         demos[2].r.h = t.height_offset_m + (lo + 0.8 * (hi - lo)) * t.height_scale_m;
-        demos[4].r.h = t.height_offset_m + (lo + 0.3 * (hi - lo)) * t.height_scale_m;
+        demos[3].r.h = std::max(t.height_offset_m + (lo + 0.75 * (hi - lo)) * t.height_scale_m, ground(0.0, 0.5) + 5.0);
+        demos[4].r.h = ground(0.5, 0.5) + 5.0;
     }
     const char *mnames[4] = {"incremental", "hierarchical", "cone", "directional"};
     std::printf("%-16s %-7s %14s %14s %10s | %11s %12s %5s %11s\n", "ray", "status", "E (m)", "N (m)", "h (m)",

@@ -857,6 +857,17 @@ ct_status ct_ray_prepare(const ct_package *p, const ct_ray *ray, ct_prepared *ou
         return CT_MISS;
     }
     if (ct_i128_sign(tin.n) > 0) {
+        /* The box has no floor: a ray may enter through a side face far
+         * below the terrain (z unbounded below).  Below -2^46 it is BELOW
+         * (every surface is >= 0) and its z would not fit the rounding:
+         * (oz + 2^46) * d + n * U_z < 0, with |oz + 2^46| <= 2^47,
+         * d <= 2^62, n < 2^48: 128-bit.                                    */
+        ct_i128 zq = ct_i128_add(ct_i128_mul(O[2] + CT_MAX_ORIGIN_Q16, tin.d),
+                                 ct_i128_mul128_64(tin.n, U[2]));
+        if (ct_i128_sign(zq) < 0) {
+            out->start = CT_BELOW;
+            return CT_BELOW;
+        }
         /* the entry point, rounded to Q16 and kept in the box */
         for (k = 0; k < 3; ++k) {
             O[k] = round_axis(O[k], U[k], &tin);
