@@ -10,9 +10,14 @@
 // per fine cell) by three valid pieces:
 //  near   for q with rho <= K_NEAR: S(q) - a <= S(q) - S(p*) <= rho * (max
 //         directional slope of the bilinear patches met on the segment
-//         p* -> q, all of which lie in cells within K_NEAR of F in W_s);
+//         p* -> q, all of which lie in cells within K_NEAR of F in W_s and
+//         outside F: p* being the point of F nearest to q, no point of the
+//         segment lies in F's interior);
 //  far    for q with rho > K_NEAR in a cell Q higher than a:
-//         (hmax(Q) - a) / max(K_NEAR, dist_s(F, Q));
+//         (hmax(Q) - a) / max(K_NEAR, dist_s(F, Q)), and where that bound
+//         could be the maximum, the same over Q's sub-squares down to 1/8
+//         cell (the patch's maximum over a square is at a corner), which
+//         shrinks the column over-estimate from ~1/d to ~1/(8d);
 //  below  for cells not higher than a: (hmax(Q) - a) / far_s(F, Q) <= 0.
 // Cells whose intersection with F (+) W_s has zero area are skipped: their
 // points in the region are limits of points of neighbouring cells that do
@@ -37,7 +42,7 @@
 namespace ct_host {
 namespace {
 
-constexpr double K_NEAR = 1.0;          // cells
+constexpr double K_NEAR = 1.0;          // cells          // cells
 constexpr double INF = std::numeric_limits<double>::infinity();
 constexpr size_t BELOW_POP_CAP = 4096;  // effort cap for negative cones
 constexpr double GEOM_EPS = 1e-9;       // cells: slab expansion
@@ -254,6 +259,32 @@ Rect block_rect(const Ctx &c, int l, int bi, int bj, int fx0, int fx1, int fy0, 
     return Rect{bx0 - fx1, bx1 - fx0, by0 - fy1, by1 - fy0};
 }
 
+// Far term of a sub-square at depth k >= 1: fine cell (i >> k, j >> k),
+// the square [i, i+1] x [j, j+1] / 2^k in fine-cell units.  The bilinear
+// patch is linear along each axis, so its maximum over the square is the
+// largest of the patch at the square's four corners (dyadic: exact in
+// double).  Distances in units of 2^-k cells, exact wedge tests.
+constexpr int SUB_DEPTH = 3;  // refine far cells down to 1/8 cell
+double sub_term(const Ctx &c, int s, double a, int k, int64_t i, int64_t j, int fx0, int fx1, int fy0, int fy1)
+{
+    const Terrain &t = *c.t;
+    int ci = (int)(i >> k), cj = (int)(j >> k);
+    double h00 = t.at(ci, cj), h10 = t.at(ci + 1, cj), h01 = t.at(ci, cj + 1), h11 = t.at(ci + 1, cj + 1);
+    double sc = 1.0 / (double)(1 << k), hm = -INF;
+    double u0 = (double)(i - ((int64_t)ci << k)) * sc, v0 = (double)(j - ((int64_t)cj << k)) * sc;
+    for (int dv = 0; dv < 2; ++dv)
+        for (int du = 0; du < 2; ++du) {
+            double u = u0 + du * sc, v = v0 + dv * sc;
+            hm = std::max(hm, h00 * (1 - u) * (1 - v) + h10 * u * (1 - v) + h01 * (1 - u) * v + h11 * u * v);
+        }
+    if (hm <= a) return -INF;
+    Rect rr{i - ((int64_t)fx1 << k), i + 1 - ((int64_t)fx0 << k), j - ((int64_t)fy1 << k), j + 1 - ((int64_t)fy0 << k)};
+    if (!overlaps(c.wedge, s, rr)) return -INF;
+    double d = dist_min(c.wedge, s, rr) * sc;
+    if (d == INF) return -INF;
+    return (hm - a) / std::max(K_NEAR, d);
+}
+
 // Needed cot (LSB per fine cell) for coarse cell (ci, cj), sector s, apex a.
 // seed: a fine cell index likely to be the maximiser (or -1); updated.
 double needed_cot(const Ctx &c, int ci, int cj, int s, int a, long *seed)
@@ -263,6 +294,10 @@ double needed_cot(const Ctx &c, int ci, int cj, int s, int a, long *seed)
     // near term
     for (int j = std::max(0, fy0 - 2); j < std::min(c.cy, fy1 + 2); ++j)
         for (int i = std::max(0, fx0 - 2); i < std::min(c.cx, fx1 + 2); ++i) {
+            // F's own cells: a segment from the nearest point p* of F to a
+            // point q outside F never runs through F's interior (a point of
+            // F nearer to q would lie on it), so F's slopes do not count.
+            if (i >= fx0 && i < fx1 && j >= fy0 && j < fy1) continue;
             Rect rr = block_rect(c, 0, i, j, fx0, fx1, fy0, fy1);
             if (!overlaps(c.wedge, s, rr)) continue;
             if (dist_min(c.wedge, s, rr) > K_NEAR) continue;
@@ -287,7 +322,18 @@ double needed_cot(const Ctx &c, int ci, int cj, int s, int a, long *seed)
     // seed with the previous maximiser (an exact term is a valid lower bound)
     if (*seed >= 0) {
         bool ok;
-        double v = leaf_term((int)(*seed % c.cx), (int)(*seed / c.cx), &ok);
+        int si = (int)(*seed % c.cx), sj = (int)(*seed / c.cx);
+        double v = leaf_term(si, sj, &ok);
+        if (ok && v > 0.0) {
+            // the seed cell's refined far term: every sub-square at full depth
+            double vr = -INF;
+            const int n = 1 << SUB_DEPTH;
+            for (int b = 0; b < n; ++b)
+                for (int q = 0; q < n; ++q)
+                    vr = std::max(vr, sub_term(c, s, a, SUB_DEPTH, ((int64_t)si << SUB_DEPTH) + q,
+                                               ((int64_t)sj << SUB_DEPTH) + b, fx0, fx1, fy0, fy1));
+            v = vr;
+        }
         if (ok) best = std::max(best, v);
     }
     // phase 1: cells higher than the apex
@@ -298,11 +344,20 @@ double needed_cot(const Ctx &c, int ci, int cj, int s, int a, long *seed)
         Node nd = pq.top();
         if (nd.bound <= best) break;
         pq.pop();
-        if (nd.l == 0) {
-            if (nd.bound > best) {
+        if (nd.l <= 0) {
+            // a fine cell (l = 0) or a sub-square at depth -l: refine
+            int k = -nd.l;
+            if (k == SUB_DEPTH) {
                 best = nd.bound;
-                *seed = (long)nd.j * c.cx + nd.i;
+                *seed = (long)(nd.j >> k) * c.cx + (nd.i >> k);
+                continue;
             }
+            for (int dj = 0; dj < 2; ++dj)
+                for (int di = 0; di < 2; ++di) {
+                    int64_t si = (int64_t)nd.i * 2 + di, sj = (int64_t)nd.j * 2 + dj;
+                    double bound = sub_term(c, s, a, k + 1, si, sj, fx0, fx1, fy0, fy1);
+                    if (bound > best) pq.push(Node{bound, -(k + 1), (int)si, (int)sj});
+                }
             continue;
         }
         int l = nd.l - 1;

@@ -264,7 +264,9 @@ struct Checker {
     // that meet (box intersected with the reachable region) with positive
     // area (a segment p*-q running along an edge has the same derivative on
     // both sides).  grad S is affine per cell: extremes at sub-box corners.
-    ld max_slope(int s, const Poly &reach, ld x0, ld x1, ld y0, ld y1) const
+    // Largest slope in the wedge's directions over the cells meeting the
+    // window and the reach, except F's own cells [fx0,fx1) x [fy0,fy1).
+    ld max_slope(int s, const Poly &reach, ld x0, ld x1, ld y0, ld y1, int fx0, int fx1, int fy0, int fy1) const
     {
         int cx = t->width - 1, cy = t->height - 1;
         x0 = std::max<ld>(0, x0);
@@ -274,6 +276,7 @@ struct Checker {
         ld best = -INFINITY;
         for (int j = std::max(0, (int)std::floor(y0)); j < cy && j <= (int)std::floor(y1); ++j)
             for (int i = std::max(0, (int)std::floor(x0)); i < cx && i <= (int)std::floor(x1); ++i) {
+                if (i >= fx0 && i < fx1 && j >= fy0 && j < fy1) continue;
                 ld bx0 = std::max<ld>(x0, i), bx1 = std::min<ld>(x1, i + 1), by0 = std::max<ld>(y0, j),
                    by1 = std::min<ld>(y1, j + 1);
                 if (bx1 <= bx0 || by1 <= by0) continue;
@@ -315,7 +318,9 @@ struct Checker {
         // Mean value bound: with p* in F the nearest wedge point of q,
         // S(q) - a <= S(q) - S(p*) <= rho(q) * G, G the largest slope in the
         // wedge's directions where the segment p*-q runs: within
-        // max_q rho(q) of R (rho is convex, so its max is at a vertex of pr).
+        // max_q rho(q) of R (rho is convex, so its max is at a vertex of pr),
+        // and outside F: p* is the point of F nearest to q in the wedge, so
+        // no other point of the segment lies in F (it would be nearer).
         ld rh = 0;
         bool rh_ok = true;
         for (P2 v : pr) {
@@ -325,7 +330,8 @@ struct Checker {
         }
         if (rh_ok) {
             rh = rh * (1 + 1e-12L) + 1e-12L;
-            if (max_slope(s, reach, x0 - rh, x1 + rh, y0 - rh, y1 + rh) <= cot) return;
+            if (max_slope(s, reach, x0 - rh, x1 + rh, y0 - rh, y1 + rh, (int)fx0, (int)fx1, (int)fy0, (int)fy1) <= cot)
+                return;
         }
         // samples: the reachable polygon's vertices and R's centre
         std::vector<P2> samples(pr.begin(), pr.end());
