@@ -28,6 +28,7 @@ struct Ray {
     ld ox, oy, oz;  // cells, cells, LSB
     ld dx, dy, dz;  // per unit t
     ld tend;        // the ray ends here (tile box exit)
+    ld kz = 0;      // bent rays: z(t) = oz + t dz + kz t^2 (LSB per t^2)
 };
 
 enum { MISS = 0, HIT = 1, BELOW = 2 };
@@ -45,7 +46,7 @@ inline ld f_cell(const Dem &d, int i, int j, const Ray &r, ld t)
     ld u = r.ox + t * r.dx - i, v = r.oy + t * r.dy - j;
     ld h00 = d.at(i, j), h10 = d.at(i + 1, j), h01 = d.at(i, j + 1), h11 = d.at(i + 1, j + 1);
     ld s = h00 + (h10 - h00) * u + (h01 - h00) * v + (h11 - h10 - h01 + h00) * u * v;
-    return r.oz + t * r.dz - s;
+    return r.oz + t * r.dz + r.kz * t * t - s;
 }
 
 // Surface height at (x, y) inside the tile.
@@ -83,7 +84,7 @@ inline ld first_root(const Dem &d, int i, int j, const Ray &r, ld t0, ld t1)
     ld a = h10 - h00, b = h01 - h00, c = h11 - h10 - h01 + h00;
     ld u0 = r.ox - i, v0 = r.oy - j;
     // f(t) = A t^2 + B t + C
-    ld A = -c * r.dx * r.dy;
+    ld A = -c * r.dx * r.dy + r.kz;
     ld B = r.dz - a * r.dx - b * r.dy - c * (u0 * r.dy + v0 * r.dx);
     ld C = r.oz - h00 - a * u0 - b * v0 - c * u0 * v0;
     auto f = [&](ld t) { return (A * t + B) * t + C; };
@@ -195,7 +196,7 @@ inline Hit trace(const Dem &d, const Ray &r)
         h.t = best;
         h.x = r.ox + best * r.dx;
         h.y = r.oy + best * r.dy;
-        h.z = r.oz + best * r.dz;
+        h.z = r.oz + best * r.dz + r.kz * best * best;
         h.ci = bi;
         h.cj = bj;
     }
@@ -230,7 +231,7 @@ inline ld min_clearance(const Dem &d, const Ray &r, ld ta, ld tb)
             m = std::min(m, f_cell(d, i, j, r, t1));
             ld h00 = d.at(i, j), h10 = d.at(i + 1, j), h01 = d.at(i, j + 1), h11 = d.at(i + 1, j + 1);
             ld c = h11 - h10 - h01 + h00;
-            ld A = -c * r.dx * r.dy;
+            ld A = -c * r.dx * r.dy + r.kz;
             if (A > 0) {
                 ld a = h10 - h00, b = h01 - h00, u0 = r.ox - i, v0 = r.oy - j;
                 ld B = r.dz - a * r.dx - b * r.dy - c * (u0 * r.dy + v0 * r.dx);

@@ -307,6 +307,45 @@ ct_status ct_ray_from_map(const ct_package *pkg, int64_t e_nm, int64_t n_nm,
 ct_status ct_surface_height(const ct_package *pkg, int64_t x_q16,
                             int64_t y_q16, int64_t *z_q16);
 
+/* Like ct_ray_prepare, but the ray is the segment from its origin to
+ * origin + direction (t <= 1 in the caller's parameter): the prepared ray's
+ * tend is also at most the segment's end.  A walk may still report a hit in
+ * the segment's last cell beyond tend; ct_trace_bent discards those.       */
+ct_status ct_ray_prepare_segment(const ct_package *pkg, const ct_ray *ray,
+                                 ct_prepared *out);
+
+/* ------------------------------------------------------------------------ */
+/* Bent rays: earth curvature and atmospheric refraction (lib/src/bend.c).   */
+
+/* Model: over a projected-grid DEM, a ray from an observer gains height
+ * above the datum of  c * rho^2 / (2 R)  at horizontal range rho from its
+ * origin, c = (curvature ? 1 : 0) - (refraction ? k : 0), k the refraction
+ * coefficient (~0.13), R the earth radius.  The library traces the polyline
+ * with vertices on that curve (rounded to Q16) every Delta of horizontal
+ * range, Delta = sqrt(8 * chord * R / |c|), so the polyline stays within
+ * chord_nm (+ 1 Q16 unit of vertex rounding) of the curve; each segment is
+ * traced exactly (ct_ray_prepare_segment), so the result is the exact first
+ * hit of the polyline.  The observer must be within 2^52 nm (4500 km)
+ * horizontally of every point of the tile.                                 */
+typedef struct {
+    int32_t coeff_q16; /* c in Q16, |c| <= 4 * 2^16; 0 = straight ray       */
+    int64_t radius_nm; /* R in nm, [2^40, 2^54] (1.1 km .. 18,000 km)        */
+    int64_t chord_nm;  /* largest polyline deviation, [2^10, 2^50] nm       */
+} ct_bend;
+
+#define CT_BEND_MAX_SEGMENTS 65536u
+/* Worst-case iterations of a bent trace: every segment's walk leaves a new
+ * fine cell per iteration except at most twice per segment (its first and
+ * last cell are shared with its neighbours).                               */
+#define CT_WCET_BENT_ITERS(cx, cy, segments) \
+    (CT_WCET_CELL_ITERS(cx, cy) + 2u * (uint32_t)(segments))
+
+/* Trace ray (its origin is the observer) bent by *bend.  Returns as
+ * ct_trace; hit->t_q26 is the parameter on the segment holding the hit,
+ * hit->steps and hit->iters are summed over segments.                      */
+ct_status ct_trace_bent(const ct_package *pkg, const ct_ray *ray,
+                        const ct_bend *bend, ct_method method, ct_hit *hit);
+
 ct_status ct_status_name(ct_status s, const char **out);
 
 #ifdef __cplusplus

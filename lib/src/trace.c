@@ -781,7 +781,9 @@ static void normalize_dir(const int64_t v0[3], int32_t out[3])
     }
 }
 
-ct_status ct_ray_prepare(const ct_package *p, const ct_ray *ray, ct_prepared *out)
+/* seg != 0: the ray ends at origin + direction (t <= 1 in the caller's
+ * parameter) as well as at the box. */
+static ct_status prepare_impl(const ct_package *p, const ct_ray *ray, int seg, ct_prepared *out)
 {
     int32_t D[3];
     int64_t O[3], U[3], lo[3], hi[3];
@@ -850,6 +852,15 @@ ct_status ct_ray_prepare(const ct_package *p, const ct_ray *ray, ct_prepared *ou
                 tout = b;
                 has_out = 1;
             }
+        }
+    }
+    if (seg) {
+        bigrt one;
+        one.n = ct_i128_from64(1);
+        one.d = 1;
+        if (!has_out || bigrt_lt(&one, &tout)) {
+            tout = one;
+            has_out = 1;
         }
     }
     if (has_out && bigrt_lt(&tout, &tin)) {
@@ -934,6 +945,32 @@ ct_status ct_ray_prepare(const ct_package *p, const ct_ray *ray, ct_prepared *ou
                 have = 1;
             }
         }
+        if (seg) {
+            /* the segment's end: where the prepared ray reaches the end
+             * point's coordinate on its dominant axis m.  The end is
+             * origin + U: |origin| <= 2^46, |U| <= 2^62, so the sum fits;
+             * the entry |O[m]| <= 2^47, so the difference fits.  Beyond
+             * 2^34 the box exit above is nearer anyway (box < 2^34).    */
+            int m = 0;
+            int64_t e, num;
+            for (k = 1; k < 3; ++k) { /* bound: 2 axes */
+                if (ct_abs64(D[k]) > ct_abs64(D[m])) {
+                    m = k;
+                }
+            }
+            e = (m == 0 ? ray->x_q16 : (m == 1 ? ray->y_q16 : ray->z_q16)) + U[m];
+            num = (e - O[m]) * (D[m] > 0 ? 1 : -1);
+            if (num < 0) {
+                num = 0;
+            }
+            if (num < (INT64_C(1) << 34)) {
+                c.n = num;
+                c.d = ct_abs64(D[m]);
+                if (rt_lt(c, te)) {
+                    te = c;
+                }
+            }
+        }
         out->tend_n = te.n;
         out->tend_d = te.d;
     }
@@ -972,6 +1009,16 @@ ct_status ct_ray_prepare(const ct_package *p, const ct_ray *ray, ct_prepared *ou
     }
     out->start = CT_OK;
     return CT_OK;
+}
+
+ct_status ct_ray_prepare(const ct_package *p, const ct_ray *ray, ct_prepared *out)
+{
+    return prepare_impl(p, ray, 0, out);
+}
+
+ct_status ct_ray_prepare_segment(const ct_package *p, const ct_ray *ray, ct_prepared *out)
+{
+    return prepare_impl(p, ray, 1, out);
 }
 
 /* ------------------------------------------------------------------------ */

@@ -1,0 +1,289 @@
+/*
+ * bend.c -- rays bent by earth curvature and atmospheric refraction.
+ *
+ * The curve: P(s) = O + (s / L) * U + (0, 0, drop(s)), s >= 0 the
+ * horizontal range from the observer O in Q16 fine cells, U the caller's
+ * direction reduced to |U| <= 2^30 per component, L = floor(sqrt(Ux^2 +
+ * Uy^2)) (so the horizontal range is s up to a relative 2^-30), and
+ *     drop(s) = c * rho^2 / (2 R)   converted to Q16 height LSB,
+ *     rho = s * posting / 2^16      (nm).
+ * Vertices at s_k = k * Delta, rounded to Q16; each chord is traced exactly
+ * as a segment.  A parabola with second derivative q deviates from its chord
+ * over a length Delta by at most q Delta^2 / 8, so Delta = sqrt(8 eps R / |c|)
+ * keeps the polyline within eps of the curve (plus vertex rounding).
+ *
+ * Formats and bounds (all integers):
+ *   s, Delta      int64 Q16 cells; |s| < 2^52 nm / posting * 2^16 < 2^63.
+ *   rho           int64 nm, checked < 2^52.
+ *   drop          c * rho^2 < 2^18 * 2^104 = 2^122 (128-bit), divided by
+ *                 2R (< 2^55) and by the height scale, saturated at 2^62.
+ *   vertex        O + s * U / L: s * U < 2^63 * 2^30 (128-bit), / L.
+ */
+#include "conetrace.h"
+#include "fixed.h"
+
+#define ONE16 INT64_C(65536)
+#define RHO_MAX_NM (INT64_C(1) << 52)
+#define DIR_MAX (INT64_C(1) << 30)
+
+typedef struct {
+    int64_t x, y, z;
+} v3;
+
+typedef struct {
+    const ct_package *p;
+    int64_t ox, oy, oz;    /* observer, Q16 */
+    int64_t ux, uy, uz;    /* reduced direction, |.| <= 2^30 */
+    int64_t L;             /* floor(|(ux, uy)|) >= 1 */
+    int64_t coeff;         /* c, Q16 */
+    int64_t radius;        /* nm */
+    int64_t posting;       /* |posting|, nm */
+} bent;
+
+/* round(a / b), b > 0, 128-bit numerator, saturated to +-2^62 */
+static int64_t round_div128(ct_i128 a, int64_t b)
+{
+    ct_i128 twice = ct_i128_add(ct_i128_shl(a, 1), ct_i128_from64(b));
+    /* floor((2a + b) / 2b); b < 2^62 so 2b fits */
+    return ct_i128_floor_div_sat(twice, 2 * b);
+}
+
+/* The vertex at range s (Q16 cells, s >= 0).  Returns CT_ERR_RANGE when
+ * the range exceeds RHO_MAX_NM. */
+static ct_status vertex(const bent *b, int64_t s, v3 *v)
+{
+    ct_i128 rho2;
+    int64_t rho, drop;
+    /* rho = s * posting / 2^16: s < 2^63, posting < 2^62 -> 128-bit */
+    rho = ct_i128_floor_div_sat(ct_i128_mul(s, b->posting), ONE16);
+    if (rho >= RHO_MAX_NM) {
+        return CT_ERR_RANGE;
+    }
+    /* c * rho^2: |c| <= 2^18, rho^2 < 2^104 -> < 2^122 */
+    rho2 = ct_umul64((uint64_t)rho, (uint64_t)rho);
+    {
+        ct_i128 num = ct_i128_mul128_64(rho2, b->coeff);
+        /* drop_q16 = c_q16 / 2^16 * rho^2 / (2R) * 2^16 / scale
+         *          = c_q16 * rho^2 / (2 R scale): divide by 2R, then scale */
+        int64_t q1 = ct_i128_floor_div_sat(num, 2 * b->radius);
+        drop = ct_floor_div(q1, b->p->height_scale_nm);
+    }
+    /* s * U / L: |s| < 2^63, |U| <= 2^30: 128-bit; quotients < 2^63 / 1 are
+     * saturated at 2^62 (far outside the box: the segment clip rejects) */
+    v->x = b->ox + round_div128(ct_i128_mul(s, b->ux), b->L);
+    v->y = b->oy + round_div128(ct_i128_mul(s, b->uy), b->L);
+    v->z = b->oz + round_div128(ct_i128_mul(s, b->uz), b->L);
+    /* keep z within +-2^62 */
+    if (drop > 0 && v->z > (INT64_C(1) << 62) - drop) {
+        v->z = INT64_C(1) << 62;
+    } else if (drop < 0 && v->z < -(INT64_C(1) << 62) - drop) {
+        v->z = -(INT64_C(1) << 62);
+    } else {
+        v->z += drop;
+    }
+    return CT_OK;
+}
+
+/* Range interval [s0, s1] (Q16 cells) where the horizontal path is inside
+ * the tile's closed box; 0 when it never is.  Along x: ox + s ux / L in
+ * [0, W]: s in [(0 - ox) L / ux, (W - ox) L / ux] (sorted).  Floors and
+ * ceilings widen the interval (more segments, never a missed piece). */
+static int range_in_box(const bent *b, int64_t *s0, int64_t *s1)
+{
+    int64_t lo = 0, hi = INT64_C(1) << 62;
+    const int64_t o[2] = {b->ox, b->oy}, u[2] = {b->ux, b->uy};
+    const int64_t top[2] = {(int64_t)b->p->cells_x * ONE16, (int64_t)b->p->cells_y * ONE16};
+    int k;
+    for (k = 0; k < 2; ++k) { /* bound: 2 axes */
+        if (u[k] == 0) {
+            if (o[k] < 0 || o[k] > top[k]) {
+                return 0;
+            }
+            continue;
+        }
+        {
+            /* (edge - o) * L: |edge - o| < 2^48, L < 2^31: < 2^79 */
+            int64_t a = u[k] > 0 ? 0 : top[k], e = u[k] > 0 ? top[k] : 0;
+            int64_t au = ct_abs64(u[k]);
+            ct_i128 na = ct_i128_mul((a - o[k]) * (u[k] > 0 ? 1 : -1), b->L);
+            ct_i128 ne = ct_i128_mul((e - o[k]) * (u[k] > 0 ? 1 : -1), b->L);
+            int64_t sa = ct_i128_floor_div_sat(na, au);
+            int64_t se = -ct_i128_floor_div_sat(ct_i128_neg(ne), au);
+            lo = ct_max64(lo, sa);
+            hi = ct_min64(hi, se);
+        }
+    }
+    if (hi < lo) {
+        return 0;
+    }
+    *s0 = lo;
+    *s1 = hi;
+    return 1;
+}
+
+ct_status ct_trace_bent(const ct_package *p, const ct_ray *ray, const ct_bend *bd, ct_method m,
+                        ct_hit *h)
+{
+    bent b;
+    int64_t s0, s1, delta, k0, k1, k;
+    int entered = 0;
+    uint32_t steps = 0u, iters = 0u;
+    v3 va, vb;
+    ct_status st;
+    CT_ASSERT(p != NULL && ray != NULL && bd != NULL && h != NULL);
+    if (p == NULL || ray == NULL || bd == NULL || h == NULL) {
+        return CT_ERR_ARG;
+    }
+    if (bd->coeff_q16 < -(4 * 65536) || bd->coeff_q16 > 4 * 65536 || bd->radius_nm < (INT64_C(1) << 40) ||
+        bd->radius_nm > (INT64_C(1) << 54) || bd->chord_nm < (INT64_C(1) << 10) ||
+        bd->chord_nm > (INT64_C(1) << 50)) {
+        return CT_ERR_ARG;
+    }
+    if (bd->coeff_q16 == 0 || (ray->dx == 0 && ray->dy == 0)) {
+        return ct_trace(p, ray, m, h);
+    }
+    if ((uint32_t)m >= (uint32_t)CT_METHOD_COUNT) {
+        return CT_ERR_METHOD;
+    }
+    if (ct_abs64(ray->x_q16) > CT_MAX_ORIGIN_Q16 || ct_abs64(ray->y_q16) > CT_MAX_ORIGIN_Q16 ||
+        ct_abs64(ray->z_q16) > CT_MAX_ORIGIN_Q16 || ct_abs64(ray->dx) > (INT64_C(1) << 62) ||
+        ct_abs64(ray->dy) > (INT64_C(1) << 62) || ct_abs64(ray->dz) > (INT64_C(1) << 62)) {
+        return CT_ERR_RAY;
+    }
+    b.p = p;
+    b.ox = ray->x_q16;
+    b.oy = ray->y_q16;
+    b.oz = ray->z_q16;
+    b.ux = ray->dx;
+    b.uy = ray->dy;
+    b.uz = ray->dz;
+    {
+        /* reduce to |U| <= 2^30, rounding. bound: 32 halvings */
+        int64_t mx = ct_max64(ct_abs64(b.ux), ct_max64(ct_abs64(b.uy), ct_abs64(b.uz)));
+        unsigned sh = 0u;
+        while ((mx >> sh) > DIR_MAX) {
+            sh++;
+        }
+        if (sh > 0u) {
+            int64_t half = INT64_C(1) << (sh - 1u);
+            b.ux = b.ux >= 0 ? (b.ux + half) >> sh : -((-b.ux + half) >> sh);
+            b.uy = b.uy >= 0 ? (b.uy + half) >> sh : -((-b.uy + half) >> sh);
+            b.uz = b.uz >= 0 ? (b.uz + half) >> sh : -((-b.uz + half) >> sh);
+        }
+    }
+    if (b.ux == 0 && b.uy == 0) {
+        /* horizontal part below 2^-31 of the ray: no bending over the tile */
+        return ct_trace(p, ray, m, h);
+    }
+    /* ux^2 + uy^2 <= 2^61 */
+    b.L = (int64_t)ct_isqrt64((uint64_t)(b.ux * b.ux + b.uy * b.uy));
+    b.coeff = bd->coeff_q16;
+    b.radius = bd->radius_nm;
+    b.posting = ct_abs64(p->posting_e_nm);
+    h->steps = h->iters = 0u;
+    if (!range_in_box(&b, &s0, &s1)) {
+        h->x_q16 = h->y_q16 = h->z_q16 = 0;
+        h->cell_x = h->cell_y = -1;
+        return CT_MISS;
+    }
+    {
+        /* Delta in nm: sqrt(8 eps R 2^16 / |c|): eps R < 2^104, * 2^19 <
+         * 2^123; then Q16 cells: * 2^16 / posting (< 2^62: saturated) */
+        ct_i128 num = ct_i128_shl(ct_umul64((uint64_t)bd->chord_nm, (uint64_t)bd->radius_nm), 19);
+        int64_t q = ct_i128_floor_div_sat(num, ct_abs64(b.coeff));
+        uint64_t dn = ct_i128_isqrt(ct_i128_from64(q));
+        delta = ct_i128_floor_div_sat(ct_i128_shl(ct_i128_from64((int64_t)dn), 16), b.posting);
+        if (delta < 1024) {
+            return CT_ERR_ARG; /* chord too small for this posting */
+        }
+    }
+    k0 = s0 / delta;
+    k1 = s1 / delta + 1;
+    if (k1 - k0 > (int64_t)CT_BEND_MAX_SEGMENTS) {
+        return CT_ERR_RANGE;
+    }
+    st = vertex(&b, k0 * delta, &va);
+    if (st != CT_OK) {
+        return st;
+    }
+    /* bound: k1 - k0 <= CT_BEND_MAX_SEGMENTS segments */
+    for (k = k0; k < k1; ++k) {
+        ct_ray seg;
+        ct_prepared pr;
+        ct_hit sh;
+        int64_t ztop = ((int64_t)p->hmax + 1) * ONE16;
+        st = vertex(&b, (k + 1) * delta, &vb);
+        if (st != CT_OK) {
+            return st;
+        }
+        /* convex and rising above the box: it never comes back */
+        if (b.coeff > 0 && va.z > ztop && vb.z >= va.z) {
+            break;
+        }
+        seg.x_q16 = va.x;
+        seg.y_q16 = va.y;
+        seg.z_q16 = va.z;
+        seg.dx = vb.x - va.x;
+        seg.dy = vb.y - va.y;
+        seg.dz = vb.z - va.z;
+        va = vb;
+        if (ct_abs64(seg.x_q16) > CT_MAX_ORIGIN_Q16 || ct_abs64(seg.y_q16) > CT_MAX_ORIGIN_Q16 ||
+            ct_abs64(seg.z_q16) > CT_MAX_ORIGIN_Q16) {
+            /* a vertex beyond the library's origin range: only possible
+             * far above or below the tile */
+            if (seg.z_q16 < 0 && entered == 0) {
+                return CT_BELOW;
+            }
+            continue;
+        }
+        if (seg.dx == 0 && seg.dy == 0 && seg.dz == 0) {
+            continue;
+        }
+        st = ct_ray_prepare_segment(p, &seg, &pr);
+        if (st < 0) {
+            return st;
+        }
+        if (st == CT_MISS) {
+            continue;
+        }
+        if (st == CT_BELOW) {
+            if (!entered) {
+                h->steps = steps;
+                h->iters = iters;
+                return CT_BELOW;
+            }
+            /* the polyline crossed the surface within the vertex rounding
+             * between the previous segment's end and this start */
+            pr.start = CT_HIT;
+        }
+        entered = 1;
+        st = ct_trace_prepared(p, &pr, m, &sh);
+        if (st < 0) {
+            return st;
+        }
+        steps += sh.steps;
+        iters += sh.iters;
+        if (st == CT_HIT || st == CT_HIT_VOID) {
+            /* a hit in the last cell beyond the segment's end belongs to
+             * the extension of the chord, not to the polyline.
+             * t_q26 < 2^35, tend_d <= 2^26: < 2^61; tend_n < 2^34: 2^60 */
+            if (sh.t_q26 * pr.tend_d > pr.tend_n * (INT64_C(1) << CT_T_FRAC_BITS)) {
+                continue;
+            }
+            *h = sh;
+            h->steps = steps;
+            h->iters = iters;
+            return st;
+        }
+        if (st == CT_BELOW) {
+            h->steps = steps;
+            h->iters = iters;
+            return CT_BELOW;
+        }
+    }
+    h->steps = steps;
+    h->iters = iters;
+    h->x_q16 = h->y_q16 = h->z_q16 = 0;
+    h->cell_x = h->cell_y = -1;
+    return CT_MISS;
+}

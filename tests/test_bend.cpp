@@ -1,0 +1,233 @@
+// test_bend.cpp -- rays bent by earth curvature and refraction
+// (ct_trace_bent) against the long-double reference tracing the exact
+// parabola z(t) = oz + t dz + kz t^2 cell by cell.
+//
+// The library traces a polyline within delta of the curve (chord error plus
+// vertex rounding), so its hit is checked by a sandwich: the curve lowered by
+// delta must hit no later, the curve raised by delta no earlier (lowering a
+// ray can only bring its first hit forward).  Statuses must agree with the
+// same sandwich, the four methods must agree bit for bit, and the bending
+// must matter (hits differ from the straight ray's).
+#include <cmath>
+#include <vector>
+
+#include "conetrace.h"
+#include "dem_cases.hpp"
+#include "harness.h"
+#include "reference.hpp"
+
+namespace {
+
+typedef long double ld;
+
+struct Scene {
+    const char *name;
+    double coeff;      // c
+    double radius_m;   // R
+    double chord_m;    // polyline tolerance
+};
+
+struct Counts {
+    long rays = 0, hits = 0, miss = 0, below = 0, differ_from_straight = 0, bad = 0;
+    ld worst_lead = 0;
+};
+
+// Reference hit parameter (t of the caller's ray) of the curve shifted by dz0
+// LSB, +inf for a miss, -1 for BELOW.  The reference starts where the path
+// enters the tile (re-expanding the parabola there).
+ld ref_t(const ref::Dem &d, ld ox, ld oy, ld oz, ld dx, ld dy, ld dz, ld kz, ld dz0)
+{
+    const ld W = d.w - 1, H = d.h - 1;
+    ld lo = 0, hi = INFINITY;
+    auto axis = [&](ld o, ld u, ld top) {
+        if (u == 0) return o >= 0 && o <= top;
+        ld a = (0 - o) / u, b = (top - o) / u;
+        if (a > b) std::swap(a, b);
+        lo = std::max(lo, a);
+        hi = std::min(hi, b);
+        return true;
+    };
+    if (!axis(ox, dx, W) || !axis(oy, dy, H) || hi < lo) return INFINITY;
+    ref::Ray r;
+    // the entry point, kept on the tile against rounding (so the
+    // reference's start-point test applies to it)
+    r.ox = std::min(W, std::max<ld>(0, ox + lo * dx));
+    r.oy = std::min(H, std::max<ld>(0, oy + lo * dy));
+    r.oz = oz + dz0 + lo * dz + kz * lo * lo;
+    r.dx = dx;
+    r.dy = dy;
+    r.dz = dz + 2 * kz * lo;
+    r.kz = kz;
+    r.tend = hi - lo;
+    ref::Hit h = ref::trace(d, r);
+    if (h.status == ref::BELOW) return -1;
+    if (h.status != ref::HIT) return INFINITY;
+    return lo + h.t;
+}
+
+void run_scene(const dem_cases::Case &cs, const Scene &sc, long nrays, Counts *cnt)
+{
+    ct_package p;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_package_open(&p, cs.pkg.data(), cs.pkg.size()));
+    ref::Dem d;
+    d.w = cs.t.width;
+    d.h = cs.t.height;
+    d.z.assign(cs.t.codes.begin(), cs.t.codes.end());
+    double lo, hi;
+    dem_cases::minmax(cs.t, &lo, &hi);
+    const ld posting = (ld)std::fabs(cs.t.geo.posting_e), scale = (ld)cs.t.height_scale_m;
+    ct_bend bd;
+    bd.coeff_q16 = (int32_t)std::lround(sc.coeff * 65536);
+    bd.radius_nm = (int64_t)std::llround(sc.radius_m * 1e9);
+    bd.chord_nm = (int64_t)std::llround(sc.chord_m * 1e9);
+    const ld c = (ld)bd.coeff_q16 / 65536, R = (ld)bd.radius_nm * 1e-9L;
+    // largest slope (LSB per cell) for the horizontal part of the delta
+    ld slope = 0;
+    for (int j = 0; j + 1 < d.h; ++j)
+        for (int i = 0; i + 1 < d.w; ++i)
+            slope = std::max(slope, (ld)std::abs(d.at(i + 1, j) - d.at(i, j)) + std::abs(d.at(i, j + 1) - d.at(i, j)));
+    const ld delta = sc.chord_m / scale * 1.001L + (3 + 3 * slope) / 65536.0L + 1e-6L;
+    ct_rng rng;
+    ct_rng_seed(&rng, ct_test_seed() * 31 + (uint64_t)(sc.radius_m / 1000) + (uint64_t)cs.t.width);
+    const double cw = cs.t.width - 1, ch = cs.t.height - 1;
+    for (long n = 0; n < nrays; ++n) {
+        // a target near the terrain, an observer up to 1.5 tile widths back
+        // along a line of sight at elevation angle el; a few rising rays
+        // from just above the ground
+        double tx = ct_rng_unit(&rng) * cw, ty = ct_rng_unit(&rng) * ch;
+        double tz = dem_cases::surf(cs.t, tx, ty) + ct_rng_unit(&rng) * 0.5 * (hi - lo);
+        double el = (0.1 + 20 * std::pow(ct_rng_unit(&rng), 2)) * M_PI / 180;
+        double az = ct_rng_unit(&rng) * 2 * M_PI, D = ct_rng_unit(&rng) * 1.5 * std::max(cw, ch);
+        double x = tx - D * std::cos(az), y = ty - D * std::sin(az);
+        double zm = tz + D * std::fabs(cs.t.geo.posting_e) * std::tan(el) / cs.t.height_scale_m;
+        if (n % 7 == 0) {
+            x = tx;
+            y = ty;
+            zm = dem_cases::surf(cs.t, tx, ty) + 5 / cs.t.height_scale_m;
+            el = -0.005 * ct_rng_unit(&rng);
+        }
+        double dv[3];
+        dem_cases::metric_dir(cs.t, az, -el, dv);
+        ct_ray ray = dem_cases::to_ray(x, y, zm, dv);
+        ct_hit h[4];
+        ct_status st[4];
+        for (int m = 0; m < 4; ++m) st[m] = ct_trace_bent(&p, &ray, &bd, (ct_method)m, &h[m]);
+        cnt->rays++;
+        for (int m = 1; m < 4; ++m)
+            if (st[m] != st[0] || ((st[0] == CT_HIT || st[0] == CT_HIT_VOID) &&
+                                   (h[m].x_q16 != h[0].x_q16 || h[m].y_q16 != h[0].y_q16 || h[m].z_q16 != h[0].z_q16)))
+                TEST_FAIL_MSG("%s/%s ray %ld: method %d disagrees with incremental", cs.name.c_str(), sc.name, n, m);
+        TEST_ASSERT(st[0] >= 0);
+        // the reference curve, in the caller's parameter
+        ld ox = (ld)ray.x_q16 / 65536, oy = (ld)ray.y_q16 / 65536, oz = (ld)ray.z_q16 / 65536;
+        ld dx = (ld)ray.dx / 65536, dy = (ld)ray.dy / 65536, dz = (ld)ray.dz / 65536;
+        ld hm = std::sqrt(dx * dx + dy * dy) * posting;  // metres per unit t
+        ld kz = c * hm * hm / (2 * R) / scale;
+        ld t_dn = ref_t(d, ox, oy, oz, dx, dy, dz, kz, -delta);
+        ld t_up = ref_t(d, ox, oy, oz, dx, dy, dz, kz, +delta);
+        ld slack = 3.0L / 65536 / std::sqrt(dx * dx + dy * dy);
+        bool ok = true;
+        if (st[0] == CT_HIT || st[0] == CT_HIT_VOID) {
+            cnt->hits++;
+            ld hx = (ld)h[0].x_q16 / 65536, hy = (ld)h[0].y_q16 / 65536;
+            ld tl = ((hx - ox) * dx + (hy - oy) * dy) / (dx * dx + dy * dy);
+            // the lowered curve hits no later (or starts below); the raised
+            // one hits no earlier
+            ok = (t_dn == -1 || t_dn <= tl + slack) && (t_up == INFINITY || t_up >= tl - slack);
+            // the hit lies on the curve within delta (vertically)
+            ld zc = oz + tl * dz + kz * tl * tl, zl = (ld)h[0].z_q16 / 65536;
+            ld lead = std::fabs(zl - zc);
+            cnt->worst_lead = std::max(cnt->worst_lead, lead);
+            if (lead > delta + std::fabs(dz) * slack) ok = false;
+            ct_hit hs;
+            ct_status ss = ct_trace(&p, &ray, CT_METHOD_DIRECTIONAL, &hs);
+            if (ss != st[0] || std::llabs(hs.x_q16 - h[0].x_q16) + std::llabs(hs.y_q16 - h[0].y_q16) > 65536)
+                cnt->differ_from_straight++;
+        } else if (st[0] == CT_MISS) {
+            cnt->miss++;
+            ok = t_up == INFINITY;  // the raised curve must miss too
+        } else if (st[0] == CT_BELOW) {
+            cnt->below++;
+            ok = t_dn == -1;  // the lowered curve starts below as well
+        }
+        if (!ok) {
+            cnt->bad++;
+            if (cnt->bad <= 5)
+                printf("  BAD %s/%s ray %ld: status %d, ref t(down) %.6Lg t(up) %.6Lg (ray %lld %lld %lld / %lld %lld "
+                       "%lld)\n",
+                       cs.name.c_str(), sc.name, n, (int)st[0], t_dn, t_up, (long long)ray.x_q16, (long long)ray.y_q16,
+                       (long long)ray.z_q16, (long long)ray.dx, (long long)ray.dy, (long long)ray.dz);
+        }
+    }
+}
+
+const Scene kScenes[] = {
+    {"earth k=0.13", 0.87, 6371000.0, 0.001},
+    {"earth curvature only", 1.0, 6371000.0, 0.005},
+    {"exaggerated R=40km", 1.0, 40000.0, 0.001},
+    {"exaggerated refraction only", -0.5, 40000.0, 0.002},
+};
+
+void test_bent_vs_reference()
+{
+    std::vector<dem_cases::Case> cases;
+    cases.push_back(dem_cases::make_case("jacksboro r3", dem_cases::real_terrain(), 24, 3));
+    {
+        int w = 97, h = 83;
+        cases.push_back(dem_cases::make_case("smooth", dem_cases::make_terrain(w, h, dem_cases::smooth(w, h, 17, 100, 9000), 0.125), 16, 2));
+    }
+    long per = (long)(2000 * ct_test_scale());
+    for (const auto &cs : cases)
+        for (const Scene &sc : kScenes) {
+            Counts cnt;
+            run_scene(cs, sc, per, &cnt);
+            printf("  %-13s %-28s %ld rays: %ld hit, %ld miss, %ld below; %ld differ from the straight ray; "
+                   "worst |z - curve| %.4Lf LSB; bad %ld\n",
+                   cs.name.c_str(), sc.name, cnt.rays, cnt.hits, cnt.miss, cnt.below, cnt.differ_from_straight,
+                   cnt.worst_lead, cnt.bad);
+            TEST_ASSERT(cnt.bad == 0);
+            TEST_ASSERT(cnt.hits > cnt.rays / (sc.radius_m < 1e6 ? 10 : 3));  // strong bending lifts many over the tile
+            if (sc.radius_m < 1e6) TEST_ASSERT(cnt.differ_from_straight > cnt.hits / 4);  // the effect is real
+        }
+}
+
+void test_bent_arguments()
+{
+    auto cs = dem_cases::make_case("flat", dem_cases::make_terrain(9, 9, std::vector<uint16_t>(81, 100)), 4, 1);
+    ct_package p;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_package_open(&p, cs.pkg.data(), cs.pkg.size()));
+    ct_ray ray = {0, 0, 200 << 16, 1 << 20, 1 << 20, -(250 << 16)};
+    ct_bend bd = {57016, INT64_C(6371000000000000), 1000000};
+    ct_hit h;
+    TEST_ASSERT(ct_trace_bent(&p, &ray, &bd, CT_METHOD_DIRECTIONAL, &h) == CT_HIT);
+    TEST_ASSERT_EQUAL_INT(CT_ERR_ARG, ct_trace_bent(nullptr, &ray, &bd, CT_METHOD_DIRECTIONAL, &h));
+    ct_bend b2 = bd;
+    b2.radius_nm = 1000;
+    TEST_ASSERT_EQUAL_INT(CT_ERR_ARG, ct_trace_bent(&p, &ray, &b2, CT_METHOD_DIRECTIONAL, &h));
+    b2 = bd;
+    b2.chord_nm = 0;
+    TEST_ASSERT_EQUAL_INT(CT_ERR_ARG, ct_trace_bent(&p, &ray, &b2, CT_METHOD_DIRECTIONAL, &h));
+    b2 = bd;
+    b2.coeff_q16 = 5 << 16;
+    TEST_ASSERT_EQUAL_INT(CT_ERR_ARG, ct_trace_bent(&p, &ray, &b2, CT_METHOD_DIRECTIONAL, &h));
+    TEST_ASSERT_EQUAL_INT(CT_ERR_METHOD, ct_trace_bent(&p, &ray, &bd, (ct_method)7, &h));
+    // c = 0 and vertical rays are the straight trace
+    b2 = bd;
+    b2.coeff_q16 = 0;
+    ct_hit hs;
+    TEST_ASSERT_EQUAL_INT(ct_trace(&p, &ray, CT_METHOD_CONE, &hs), ct_trace_bent(&p, &ray, &b2, CT_METHOD_CONE, &h));
+    TEST_ASSERT(h.x_q16 == hs.x_q16 && h.z_q16 == hs.z_q16);
+    ct_ray v = {3 << 16, 3 << 16, 500 << 16, 0, 0, -1};
+    TEST_ASSERT_EQUAL_INT(ct_trace(&p, &v, CT_METHOD_CONE, &hs), ct_trace_bent(&p, &v, &bd, CT_METHOD_CONE, &h));
+    TEST_ASSERT(h.z_q16 == hs.z_q16);
+}
+
+}  // namespace
+
+int main()
+{
+    TEST_BEGIN("test_bend");
+    RUN_TEST(test_bent_arguments);
+    RUN_TEST(test_bent_vs_reference);
+    return TEST_END();
+}
