@@ -25,6 +25,7 @@
 
 #include "conetrace.h"
 #include "dem_io.hpp"
+#include "emit_c.hpp"
 #include "host_io.hpp"
 #include "terrain.hpp"
 
@@ -38,6 +39,7 @@ namespace {
     std::fprintf(stderr,
                  "usage: conetrace build DEM -o OUT.ctp [--sectors N] [--reduce r] [--slices K]\n"
                  "                       [--height-scale M] [--posting M] [--threads T]\n"
+                 "                       [--emit-c NAME]\n"
                  "       conetrace info PKG\n"
                  "       conetrace trace PKG --rays rays.csv [--method M] -o hits.csv\n"
                  "       conetrace demo DEM\n"
@@ -123,7 +125,8 @@ Terrain load_terrain(const std::string &path, double posting, double hscale)
 
 int cmd_build(int argc, char **argv)
 {
-    Args a = parse(argc, argv, 2, {"-o", "--sectors", "--reduce", "--slices", "--height-scale", "--posting", "--threads"});
+    Args a = parse(argc, argv, 2,
+                   {"-o", "--sectors", "--reduce", "--slices", "--height-scale", "--posting", "--threads", "--emit-c"});
     if (a.pos.size() != 1) usage("build needs exactly one DEM file");
     if (!a.opt.count("-o")) usage("build needs -o OUT.ctp");
     BuildOptions o;
@@ -135,6 +138,8 @@ int cmd_build(int argc, char **argv)
     if (o.reduce < 1 || o.reduce > 8) usage("--reduce must be in 1..8");
     if (o.slices < 0) usage("--slices must be >= 0");
     const std::string out = a.opt["-o"];
+    if (a.opt.count("--emit-c") && !is_c_identifier(a.opt["--emit-c"]))
+        usage("--emit-c " + a.opt["--emit-c"] + ": not a C identifier (letters, digits, _; at most 31)");
     auto t0 = std::chrono::steady_clock::now();
     Terrain t = load_terrain(a.pos[0], to_double(a, "--posting", 0), to_double(a, "--height-scale", 0));
     Progress bar("building cones");
@@ -143,6 +148,14 @@ int cmd_build(int argc, char **argv)
     std::vector<uint8_t> pkg = build_package(t, o, &st);
     bar.finish();
     write_file_atomic(out, pkg);
+    if (a.opt.count("--emit-c")) {
+        try {
+            emit_c_array(out, a.opt["--emit-c"], pkg);
+        } catch (...) {
+            std::remove(out.c_str());  // all outputs or none
+            throw;
+        }
+    }
     double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     size_t dem_bytes = (size_t)t.width * t.height * 2;
     std::printf("%s: %dx%d posts, %d sectors, r=%d, package %zu bytes (%.2fx the 16-bit DEM), "
