@@ -43,6 +43,7 @@ namespace {
                  "       conetrace info PKG\n"
                  "       conetrace trace PKG --rays rays.csv [--method M] -o hits.csv\n"
                  "       conetrace demo DEM\n"
+                 "       conetrace geoloc PKG --camera C.cameramodel --pixels px.csv [--method M] -o g.csv\n"
                  "methods: incremental, hierarchical, cone, directional (default)\n");
     std::exit(2);
 }
@@ -303,6 +304,8 @@ int cmd_demo(int argc, char **argv)
 
 }  // namespace
 
+int cmd_geoloc(int argc, char **argv);  // cmd_geoloc.cpp
+
 int main(int argc, char **argv)
 {
     if (argc < 2) usage("missing command");
@@ -312,6 +315,7 @@ int main(int argc, char **argv)
         if (cmd == "info") return cmd_info(argc, argv);
         if (cmd == "trace") return cmd_trace(argc, argv);
         if (cmd == "demo") return cmd_demo(argc, argv);
+        if (cmd == "geoloc") return cmd_geoloc(argc, argv);
         if (cmd == "-h" || cmd == "--help" || cmd == "help") usage("help");
         usage("unknown command '" + cmd + "'");
     } catch (const std::exception &e) {

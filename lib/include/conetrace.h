@@ -348,6 +348,174 @@ ct_status ct_trace_bent(const ct_package *pkg, const ct_ray *ray,
 
 ct_status ct_status_name(ct_status s, const char **out);
 
+/* ======================================================================== */
+/* Camera and geolocation (lib/src/camera.c, lib/src/geoloc.c)              */
+/*                                                                          */
+/* pixel --lens--> unit ray in the camera frame --pose--> map-frame ray     */
+/*       --ct_trace--> first hit (E, N, h in nm).                           */
+/*                                                                          */
+/* Conventions are mrcal's: camera frame x right, y down, z forward (the    */
+/* optical axis); pixel (0, 0) is the centre of the top-left pixel; lens    */
+/* parameters as mrcal orders them (fx, fy, cx, cy, then OpenCV's k1 k2 p1  */
+/* p2 [k3 [k4 k5 k6]]).  A .cameramodel's extrinsics rt_cam_ref map         */
+/* reference-frame (here: map-frame) points into the camera frame; the      */
+/* library takes the inverse pose, R_map_cam and the camera centre in nm.   */
+/* The conversion rt_cam_ref -> (R_map_cam, centre) runs on the host in     */
+/* long double (host_tools/camera_host.cpp, ct_host::pose_from_rt).         */
+/*                                                                          */
+/* Fixed-point formats:                                                     */
+/*   pixel       u, v: int64 Q16 pixels, |u|, |v| <= CT_CAM_MAX_PIXEL px.   */
+/*   focal       fx, fy: int64 Q32 pixels in [1, CT_CAM_MAX_PIXEL] px       */
+/*               (Q32, not Q16: a Q16 focal length alone would turn 2^-17 px */
+/*               of rounding into ~1e-8 rad at the image edge).             */
+/*   centre      cx, cy: int64 Q32 pixels, |.| <= CT_CAM_MAX_PIXEL px.      */
+/*   distortion  int64 Q48 (dist_q48[0..7] = k1 k2 p1 p2 k3 k4 k5 k6),      */
+/*               |.| <= CT_CAM_MAX_DIST (2^10); unused entries must be 0.   */
+/*               (Q48: at the edge of a wide lens, r^2 ~ 40, k3 r^6 turns a */
+/*               Q32 coefficient's rounding into 2e-5 px.)                  */
+/*   normalised  image-plane coordinates x = X/Z, y = Y/Z (internal): int64 */
+/*               Q32 with x^2 + y^2 <= CT_CAM_MAX_R2 (64, i.e. <= 82.9 deg  */
+/*               off axis).  Every polynomial value is then < 2^60.2 in Q32:*/
+/*               |N|, |D| <= 1 + 2^10 (64 + 64^2 + 64^3) < 2^28.1; products */
+/*               are formed 64 x 64 -> 128 bits and rounded back; Horner's */
+/*               partial sums are kept in Q44 and Q38 (camera.c).           */
+/*   ray_cam     int32 Q30 unit vector in the camera frame, z > 0           */
+/*               (|component| <= 2^30; |ray| = 1 within 2^-29).             */
+/*   R_map_cam   int32 Q30, row-major; column j is camera axis j in the map */
+/*               frame (E, N, h).  Orthonormal within 2^-20, det +1.        */
+/*   dir_map     int64 Q39 map-frame direction (|.| < 2^40), the ray handed */
+/*               to the tracer (ct_ray_from_map's range).                   */
+/*                                                                          */
+/* Unprojection (OpenCV models): (x_d, y_d) = ((u - cx)/fx, (v - cy)/fy),   */
+/* then Newton's method with the analytic Jacobian and step halving on      */
+/* (x, y) |-> distort(x, y) = (x_d, y_d), at most CT_UNPROJECT_MAX_ITERS     */
+/* iterations.  A pixel unprojects (CT_OK) only if the distorted point of   */
+/* the solution is within CT_UNPROJECT_TOL_Q32 of (x_d, y_d) (max norm,     */
+/* normalised units; 2^-26 = 1.5e-8, i.e. 1.5e-5 px at fx = 1000 px), the   */
+/* solution lies inside the camera's valid field and the Jacobian's         */
+/* determinant there is >= CT_UNPROJECT_MIN_DET.  The valid field is the    */
+/* disc r <= r_max where, along every radius, the radial factor R = N/D     */
+/* stays in [2^-8, 2^8] and the distorted radius r*R grows with slope       */
+/* >= 2^-8 (ct_camera_init finds the first radius where that fails: the     */
+/* lens "folds over" there).  Anything else is CT_ERR_UNPROJECT, never a    */
+/* silently wrong ray.  PINHOLE needs no iteration.                         */
+/* Measured (tests/test_camera.cpp): see README "Geolocation".              */
+
+/* Status codes, continued (errors, < 0). */
+enum {
+    CT_ERR_LENS = -20,      /* bad lens parameters or model (ct_camera_init) */
+    CT_ERR_UNPROJECT = -21, /* pixel does not unproject: no convergence,
+                               outside the valid field, folded or extreme
+                               distortion, or behind the camera           */
+    CT_ERR_POSE = -22,      /* rotation not orthonormal with det +1, or the
+                               camera centre out of range                 */
+    CT_ERR_EFFECTS = -23    /* unsupported scene-effect flags             */
+};
+
+typedef enum {
+    CT_LENS_PINHOLE = 0, /* fx fy cx cy                                     */
+    CT_LENS_OPENCV4 = 1, /* + k1 k2 p1 p2                                   */
+    CT_LENS_OPENCV5 = 2, /* + k1 k2 p1 p2 k3                                */
+    CT_LENS_OPENCV8 = 3, /* + k1 k2 p1 p2 k3 k4 k5 k6 (rational)            */
+    CT_LENS_COUNT = 4
+} ct_lens_model;
+
+#define CT_CAM_MAX_PIXEL 1048576           /* 2^20 px                        */
+#define CT_CAM_MAX_DIST (INT64_C(1) << 58) /* 2^10 in Q48                    */
+#define CT_CAM_MAX_R2 64                   /* x^2 + y^2, normalised units    */
+#define CT_UNPROJECT_MAX_ITERS 24u   /* Newton iterations (each with up to
+                                        CT_UNPROJECT_MAX_HALVINGS halvings) */
+#define CT_UNPROJECT_MAX_HALVINGS 24u
+#define CT_UNPROJECT_TOL_Q32 64      /* 2^-26 normalised units            */
+#define CT_UNPROJECT_MIN_DET (INT64_C(1) << 16) /* 2^-16 in Q32           */
+#define CT_CAM_SCAN_STEPS 256u       /* valid-field scan samples (init)   */
+
+/* Lens parameters as the caller gives them (see the formats above).        */
+typedef struct {
+    uint32_t model;            /* ct_lens_model                             */
+    uint32_t width, height;    /* imager size in pixels (informational)     */
+    int64_t fx_q32, fy_q32;    /* focal lengths, Q32 pixels                 */
+    int64_t cx_q32, cy_q32;    /* principal point, Q32 pixels               */
+    int64_t dist_q48[8];       /* k1 k2 p1 p2 k3 k4 k5 k6, Q48              */
+} ct_lens;
+
+/* A validated lens with its valid field.  Fill with ct_camera_init.        */
+typedef struct {
+    ct_lens lens;
+    int64_t r2_max_q32;        /* valid field: x^2 + y^2 <= r2_max (Q32)     */
+    uint32_t ready;            /* set by ct_camera_init                      */
+} ct_camera;
+
+/* Camera pose: centre in the map frame and R_map_cam.                      */
+typedef struct {
+    int64_t e_nm, n_nm, h_nm;  /* camera centre, map frame, nm              */
+    int32_t R_map_cam_q30[9];  /* row-major, Q30                            */
+    uint32_t ready;            /* set by ct_pose_init                        */
+} ct_pose;
+
+/* Result of geolocating one pixel.                                         */
+typedef struct {
+    ct_status status;          /* as returned by ct_geolocate               */
+    uint32_t unproject_iters;  /* Newton iterations (0 for PINHOLE)         */
+    int32_t ray_cam_q30[3];    /* unit ray, camera frame (valid if the pixel
+                                  unprojected)                              */
+    int64_t dir_map_q39[3];    /* the same ray in the map frame             */
+    ct_hit hit;                /* the trace: hit.e_nm, n_nm, h_nm, steps    */
+} ct_geo;
+
+/* Validate *lens and find its valid field.  CT_OK or CT_ERR_LENS (unknown
+ * model, fx or fy outside [1, 2^20] px, |cx|, |cy| > 2^20 px, a distortion
+ * coefficient beyond 2^10 or set but unused by the model, or no valid field
+ * at all).                                                                 */
+ct_status ct_camera_init(ct_camera *cam, const ct_lens *lens);
+
+/* Pixel (u, v) (Q16) to the unit ray in the camera frame (Q30).  CT_OK or
+ * CT_ERR_UNPROJECT.  *iters (may be NULL) receives the Newton iterations.  */
+ct_status ct_camera_unproject(const ct_camera *cam, int64_t u_q16,
+                              int64_t v_q16, int32_t ray_cam_q30[3],
+                              uint32_t *iters);
+
+/* Camera-frame direction (any int32 vector with z > 0, not necessarily
+ * unit) to the pixel (Q16, rounded).  CT_ERR_UNPROJECT when the direction
+ * is behind the camera or outside the valid field.                          */
+ct_status ct_camera_project(const ct_camera *cam, const int32_t ray_cam[3],
+                            int64_t *u_q16, int64_t *v_q16);
+
+/* Validate and store a pose: R_map_cam (Q30) must be orthonormal within
+ * 2^-20 per entry of R^T R - I, with det > 0; |e|, |n|, |h| <= 2^61 nm.
+ * CT_OK or CT_ERR_POSE.                                                    */
+ct_status ct_pose_init(ct_pose *pose, const int32_t R_map_cam_q30[9],
+                       int64_t e_nm, int64_t n_nm, int64_t h_nm);
+
+/* dir_map = R_map_cam * ray_cam, Q39 (rounded).                             */
+ct_status ct_pose_rotate(const ct_pose *pose, const int32_t ray_cam_q30[3],
+                         int64_t dir_map_q39[3]);
+
+/* Geolocate pixel (u, v): unproject, rotate into the map frame, trace from
+ * the camera centre with `method`.  `effects` is a bit set of scene effects
+ * (earth curvature, refraction); none is supported yet: any non-zero value
+ * returns CT_ERR_EFFECTS.  Returns (and stores in out->status) CT_HIT or
+ * CT_HIT_VOID (out->hit.e_nm, n_nm, h_nm valid), CT_MISS, CT_BELOW, or an
+ * error: CT_ERR_UNPROJECT for the pixel; CT_ERR_ARG / CT_ERR_METHOD /
+ * CT_ERR_EFFECTS for the arguments; CT_ERR_RAY when the camera centre is
+ * beyond CT_MAX_ORIGIN_Q16 of the tile.                                     */
+ct_status ct_geolocate(const ct_package *pkg, const ct_camera *cam,
+                       const ct_pose *pose, ct_method method,
+                       uint32_t effects, int64_t u_q16, int64_t v_q16,
+                       ct_geo *out);
+
+/* Many pixels: uv_q16[2k], uv_q16[2k + 1] for k < count, results in
+ * out[0..count) (out_len >= count), each bit-identical to ct_geolocate's.
+ * The per-call setup (argument checks, the camera centre in the grid frame,
+ * the direction scaling) is done once.  Returns CT_OK when every pixel was
+ * processed (each with its own out[k].status), or the setup's error
+ * (nothing written).                                                        */
+ct_status ct_geolocate_batch(const ct_package *pkg, const ct_camera *cam,
+                             const ct_pose *pose, ct_method method,
+                             uint32_t effects, const int64_t *uv_q16,
+                             size_t count, ct_geo *out, size_t out_len);
+/* ======================== end of camera and geolocation ================= */
+
 #ifdef __cplusplus
 }
 #endif

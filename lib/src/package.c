@@ -487,7 +487,9 @@ ct_status ct_status_name(ct_status s, const char **out)
         "err_arg", "err_truncated", "err_magic", "err_version", "err_header",
         "err_crc", "err_dims", "err_sectors", "err_reduce", "err_levels",
         "err_size", "err_offset", "err_range", "err_georef", "err_flags",
-        "err_ray", "err_method", "err_internal", "err_verify"};
+        "err_ray", "err_method", "err_internal", "err_verify",
+        /* camera and geolocation */
+        "err_lens", "err_unproject", "err_pose", "err_effects"};
     CT_ASSERT(out != NULL);
     if (out == NULL) {
         return CT_ERR_ARG;
@@ -496,7 +498,7 @@ ct_status ct_status_name(ct_status s, const char **out)
         *out = names[s];
         return CT_OK;
     }
-    if (s < 0 && s >= CT_ERR_VERIFY) {
+    if (s < 0 && s >= CT_ERR_EFFECTS) {
         *out = errs[-s - 1];
         return CT_OK;
     }

@@ -367,10 +367,10 @@ static void check_fixed(const ct_vec_set *vs)
         eq_i64("boundary y", d->sy, sy);
     }
     g_where = "status names";
-    for (k = 0u; k < 26u; ++k) {
+    for (k = 0u; k < 30u; ++k) {
         const char *name = NULL;
-        ct_status s = (ct_status)k - 20;
-        ct_status want = (s >= CT_ERR_VERIFY && s <= CT_HIT_VOID) ? CT_OK : CT_ERR_ARG;
+        ct_status s = (ct_status)k - 24;
+        ct_status want = (s >= CT_ERR_EFFECTS && s <= CT_HIT_VOID) ? CT_OK : CT_ERR_ARG;
         g_idx = k;
         eq_i64("status_name", want, ct_status_name(s, &name));
         eq_i64("status_name set", 1, name != NULL);

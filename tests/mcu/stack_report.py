@@ -241,6 +241,12 @@ def load_helpers(objdump, elf):
         helpers.setdefault(name, Helper(name, insns))
     syms = subprocess.run([objdump, '-t', elf], check=True, capture_output=True, text=True).stdout
     by_addr = {}
+    # absolute symbols (linker-script constants such as __stack_size =
+    # 0x8000) are never call targets: objdump may use one to label an
+    # address inside a routine that spans it (a local branch)
+    absolute = {line.split()[-1] for line in syms.splitlines() if '*ABS*' in line.split()}
+    for h in helpers.values():
+        h.callees = [c for c in h.callees if c not in absolute]
     for line in syms.splitlines():
         # 00004a4c g     F .text  0000005c __aeabi_lmul
         parts = line.split()

@@ -1,0 +1,251 @@
+// camera_host.cpp -- see camera_host.hpp.
+#include "camera_host.hpp"
+
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+
+#include <unistd.h>
+
+extern "C" {
+#include <mrcal/mrcal.h>
+}
+
+#include "host_io.hpp"  // status_name
+#include "terrain.hpp"  // ct_host::Error
+
+namespace ct_host {
+
+typedef long double ld;
+
+void rotation_from_r(const ld r[3], ld R[9])
+{
+    ld t2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+    ld t = std::sqrt(t2);
+    // R = I + a [r]x + b [r]x^2, a = sin t / t, b = (1 - cos t) / t^2
+    ld a, b;
+    if (t < 1e-4L) {
+        a = 1 - t2 / 6 + t2 * t2 / 120;
+        b = 0.5L - t2 / 24 + t2 * t2 / 720;
+    } else {
+        a = std::sin(t) / t;
+        b = (1 - std::cos(t)) / t2;
+    }
+    const ld x = r[0], y = r[1], z = r[2];
+    // [r]x^2 = r r^T - t2 I
+    R[0] = 1 + b * (x * x - t2);
+    R[1] = -a * z + b * x * y;
+    R[2] = a * y + b * x * z;
+    R[3] = a * z + b * x * y;
+    R[4] = 1 + b * (y * y - t2);
+    R[5] = -a * x + b * y * z;
+    R[6] = -a * y + b * x * z;
+    R[7] = a * x + b * y * z;
+    R[8] = 1 + b * (z * z - t2);
+}
+
+HostPose pose_from_rt_cam_ref(const double rt[6])
+{
+    HostPose p;
+    ld r[3] = {rt[0], rt[1], rt[2]}, R_cam_map[9];
+    for (int k = 0; k < 6; ++k)
+        if (!std::isfinite(rt[k])) throw Error("extrinsics rt_cam_ref are not finite");
+    rotation_from_r(r, R_cam_map);
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) p.R_map_cam[3 * i + j] = R_cam_map[3 * j + i];
+    // c = -R_cam_map^T t = -R_map_cam t
+    for (int i = 0; i < 3; ++i) {
+        ld s = 0;
+        for (int j = 0; j < 3; ++j) s -= p.R_map_cam[3 * i + j] * (ld)rt[3 + j];
+        p.centre_m[i] = s;
+        ld nm = std::nearbyint(s * 1e9L);
+        if (!(std::fabs(nm) <= 2305843009213693952.0L)) throw Error("camera centre beyond 2^61 nm");
+        p.centre_nm[i] = (int64_t)nm;
+    }
+    for (int k = 0; k < 9; ++k) p.R_map_cam_q30[k] = (int32_t)std::llround(p.R_map_cam[k] * 1073741824.0L);
+    return p;
+}
+
+ct_lens lens_from_intrinsics(const std::string &model, const std::vector<double> &in, unsigned width,
+                             unsigned height)
+{
+    ct_lens l;
+    std::memset(&l, 0, sizeof l);
+    size_t n;
+    if (model == "LENSMODEL_PINHOLE") {
+        l.model = CT_LENS_PINHOLE;
+        n = 4;
+    } else if (model == "LENSMODEL_OPENCV4") {
+        l.model = CT_LENS_OPENCV4;
+        n = 8;
+    } else if (model == "LENSMODEL_OPENCV5") {
+        l.model = CT_LENS_OPENCV5;
+        n = 9;
+    } else if (model == "LENSMODEL_OPENCV8") {
+        l.model = CT_LENS_OPENCV8;
+        n = 12;
+    } else {
+        throw Error("lens model " + model +
+                    " is not supported (supported: LENSMODEL_PINHOLE, LENSMODEL_OPENCV4, LENSMODEL_OPENCV5, "
+                    "LENSMODEL_OPENCV8)");
+    }
+    if (in.size() != n)
+        throw Error(model + " needs " + std::to_string(n) + " intrinsics, got " + std::to_string(in.size()));
+    for (double v : in)
+        if (!std::isfinite(v)) throw Error("intrinsics are not finite");
+    const double pmax = (double)CT_CAM_MAX_PIXEL;
+    if (!(in[0] >= 1 && in[0] <= pmax && in[1] >= 1 && in[1] <= pmax))
+        throw Error("focal lengths must be in [1, 2^20] pixels");
+    if (!(std::fabs(in[2]) <= pmax && std::fabs(in[3]) <= pmax))
+        throw Error("principal point beyond 2^20 pixels");
+    const long double q32 = 4294967296.0L;
+    l.fx_q32 = std::llround(in[0] * q32);
+    l.fy_q32 = std::llround(in[1] * q32);
+    l.cx_q32 = std::llround(in[2] * q32);
+    l.cy_q32 = std::llround(in[3] * q32);
+    for (size_t k = 4; k < n; ++k) {
+        if (!(std::fabs(in[k]) <= 1024.0))
+            throw Error("distortion coefficient " + std::to_string(k - 4) + " = " + std::to_string(in[k]) +
+                        " beyond the library's range (|k| <= 1024)");
+        l.dist_q48[k - 4] = std::llround(in[k] * 281474976710656.0L);  // Q48
+    }
+    l.width = width;
+    l.height = height;
+    return l;
+}
+
+CameraModel read_cameramodel(const std::string &path)
+{
+    {
+        std::FILE *f = std::fopen(path.c_str(), "rb");
+        if (!f) throw Error(path + ": " + std::strerror(errno));
+        std::fclose(f);
+    }
+    // mrcal reports parse errors on stderr: capture them into one line
+    std::fflush(stderr);
+    std::FILE *cap = std::tmpfile();
+    int saved = dup(2);
+    if (cap && saved >= 0) dup2(fileno(cap), 2);
+    mrcal_cameramodel_t *m = mrcal_read_cameramodel_file(path.c_str());
+    std::fflush(stderr);
+    if (cap && saved >= 0) dup2(saved, 2);
+    if (saved >= 0) close(saved);
+    std::string why;
+    if (cap) {
+        std::rewind(cap);
+        char buf[512];
+        while (std::fgets(buf, sizeof buf, cap)) {
+            std::string s(buf);
+            while (!s.empty() && (s.back() == '\n' || s.back() == '\r')) s.pop_back();
+            // drop mrcal's "source.c(123): " prefix
+            size_t k = s.find("): ");
+            if (k != std::string::npos && k < 60) s = s.substr(k + 3);
+            if (!s.empty()) why = s;
+        }
+        std::fclose(cap);
+    }
+    if (!m) throw Error(path + ": not a valid mrcal .cameramodel" + (why.empty() ? "" : " (" + why + ")"));
+    CameraModel c;
+    char name[256];
+    if (!mrcal_lensmodel_name(name, sizeof name, &m->lensmodel)) {
+        mrcal_free_cameramodel(&m);
+        throw Error(path + ": unknown lens model");
+    }
+    c.model = name;
+    int n = mrcal_lensmodel_num_params(&m->lensmodel);
+    c.intrinsics.assign(m->intrinsics, m->intrinsics + (n > 0 ? n : 0));
+    for (int k = 0; k < 6; ++k) c.rt_cam_ref[k] = m->rt_cam_ref[k];
+    c.width = m->imagersize[0];
+    c.height = m->imagersize[1];
+    mrcal_free_cameramodel(&m);
+    return c;
+}
+
+LibCamera lib_camera(const CameraModel &m, const std::string &path)
+{
+    LibCamera c;
+    ct_lens l;
+    try {
+        l = lens_from_intrinsics(m.model, m.intrinsics, m.width, m.height);
+        c.host_pose = pose_from_rt_cam_ref(m.rt_cam_ref);
+    } catch (const Error &e) {
+        throw Error(path + ": " + e.what());
+    }
+    ct_status st = ct_camera_init(&c.cam, &l);
+    if (st != CT_OK) throw Error(path + ": the library refuses the lens (" + status_name(st) + ")");
+    st = ct_pose_init(&c.pose, c.host_pose.R_map_cam_q30, c.host_pose.centre_nm[0], c.host_pose.centre_nm[1],
+                      c.host_pose.centre_nm[2]);
+    if (st != CT_OK) throw Error(path + ": the library refuses the pose (" + status_name(st) + ")");
+    return c;
+}
+
+std::vector<PixelRow> read_pixels_csv(const std::string &path)
+{
+    std::ifstream in(path);
+    if (!in) throw Error(path + ": " + std::strerror(errno));
+    auto split = [](const std::string &s) {
+        std::vector<std::string> v;
+        std::string cur;
+        for (char ch : s) {
+            if (ch == ',') {
+                v.push_back(cur);
+                cur.clear();
+            } else if (ch != '\r' && ch != ' ' && ch != '\t') {
+                cur += ch;
+            }
+        }
+        v.push_back(cur);
+        return v;
+    };
+    std::string line;
+    if (!std::getline(in, line)) throw Error(path + ": empty file (expected a header u,v)");
+    std::vector<std::string> hdr = split(line);
+    const char *names[2] = {"u", "v"};
+    int col[2];
+    for (int k = 0; k < 2; ++k) {
+        col[k] = -1;
+        for (size_t c = 0; c < hdr.size(); ++c)
+            if (hdr[c] == names[k]) col[k] = (int)c;
+        if (col[k] < 0) throw Error(path + ":1: header lacks column '" + names[k] + "' (need u,v)");
+    }
+    std::vector<PixelRow> rows;
+    int lineno = 1;
+    while (std::getline(in, line)) {
+        ++lineno;
+        if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+        std::vector<std::string> f = split(line);
+        double v[2];
+        for (int k = 0; k < 2; ++k) {
+            if ((size_t)col[k] >= f.size()) throw Error(path + ":" + std::to_string(lineno) + ": too few columns");
+            char *end = nullptr;
+            v[k] = std::strtod(f[col[k]].c_str(), &end);
+            if (f[col[k]].empty() || !end || *end || !std::isfinite(v[k]))
+                throw Error(path + ":" + std::to_string(lineno) + ": bad number '" + f[col[k]] + "' in column " +
+                            names[k]);
+        }
+        rows.push_back(PixelRow{v[0], v[1], f[col[0]], f[col[1]]});
+    }
+    return rows;
+}
+
+bool pixel_to_q16(double u, double v, int64_t *uq, int64_t *vq)
+{
+    const double lim = (double)CT_CAM_MAX_PIXEL;
+    if (!(std::fabs(u) <= lim && std::fabs(v) <= lim)) return false;
+    *uq = std::llround(u * 65536.0);
+    *vq = std::llround(v * 65536.0);
+    return true;
+}
+
+std::string nm_to_decimal(int64_t nm)
+{
+    uint64_t a = nm < 0 ? (uint64_t)0 - (uint64_t)nm : (uint64_t)nm;
+    char buf[48];
+    std::snprintf(buf, sizeof buf, "%s%llu.%09llu", nm < 0 ? "-" : "", (unsigned long long)(a / 1000000000u),
+                  (unsigned long long)(a % 1000000000u));
+    return buf;
+}
+
+}  // namespace ct_host

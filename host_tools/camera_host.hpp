@@ -1,0 +1,79 @@
+// camera_host.hpp -- host side of the camera: mrcal .cameramodel files to
+// the library's fixed-point lens (ct_lens) and pose (ct_pose), and the
+// rotation helpers (long double).  See conetrace.h "Camera and geolocation".
+//
+// Where the pose conversion happens: mrcal's extrinsics rt_cam_ref (the
+// Rodrigues vector r and translation t that map map-frame points p_map to
+// camera-frame points p_cam = R(r) p_map + t) are turned here, in long
+// double, into R_map_cam = R(r)^T (Q30) and the camera centre
+// c = -R(r)^T t (integer nm).  The flight library only sees those.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "conetrace.h"
+#include "terrain.hpp"  // ct_host::Error
+
+namespace ct_host {
+
+// Rodrigues: R = rotation by |r| about r/|r|, row-major; well conditioned
+// for every angle (series for sin(t)/t and (1 - cos t)/t^2 near 0; exact
+// at t = pi: no r_from_R involved anywhere).
+void rotation_from_r(const long double r[3], long double R[9]);
+
+struct HostPose {
+    long double R_map_cam[9];      // row-major
+    long double centre_m[3];       // camera centre, map frame, metres
+    int32_t R_map_cam_q30[9];      // rounded to Q30
+    int64_t centre_nm[3];          // rounded to nm
+};
+// From mrcal's rt_cam_ref (map frame = reference).  Throws Error when the
+// centre is beyond +-2^61 nm or not finite.
+HostPose pose_from_rt_cam_ref(const double rt_cam_ref[6]);
+
+// A lens from mrcal's model name (LENSMODEL_PINHOLE, LENSMODEL_OPENCV4,
+// LENSMODEL_OPENCV5, LENSMODEL_OPENCV8) and intrinsics (fx fy cx cy then
+// the distortion), rounded to the library's formats (Q32 and Q48).  Throws Error
+// naming the problem (unsupported model, wrong count, value out of range).
+ct_lens lens_from_intrinsics(const std::string &model, const std::vector<double> &intrinsics,
+                             unsigned width, unsigned height);
+
+struct CameraModel {
+    std::string model;              // e.g. "LENSMODEL_OPENCV8"
+    std::vector<double> intrinsics; // as in the file
+    double rt_cam_ref[6] = {0, 0, 0, 0, 0, 0};
+    unsigned width = 0, height = 0;
+};
+// Read a .cameramodel with libmrcal's C reader (mrcal_read_cameramodel_file).
+// Throws Error("<path>: <reason>") (mrcal's own messages on stderr are
+// suppressed so a failure is one line).
+CameraModel read_cameramodel(const std::string &path);
+
+// A camera ready for the library: lens checked by ct_camera_init, pose by
+// ct_pose_init.  Throws Error("<path>: ...") when either refuses.
+struct LibCamera {
+    ct_camera cam;
+    ct_pose pose;
+    HostPose host_pose;
+};
+LibCamera lib_camera(const CameraModel &m, const std::string &path);
+
+// pixels.csv: header naming columns u and v (any order, other columns
+// ignored), one pixel per line (mrcal convention: (0,0) is the centre of
+// the top-left pixel).  Returns the values and the text of each field as
+// given.  Throws Error("<path>:<line>: <reason>").
+struct PixelRow {
+    double u, v;
+    std::string u_text, v_text;  // the fields as given (blanks removed)
+};
+std::vector<PixelRow> read_pixels_csv(const std::string &path);
+
+// Pixel to Q16 (rounded); false if beyond +-CT_CAM_MAX_PIXEL or not finite.
+bool pixel_to_q16(double u, double v, int64_t *u_q16, int64_t *v_q16);
+
+// Integer nanometres as exact decimal metres ("-123.000000456").
+std::string nm_to_decimal(int64_t nm);
+
+}  // namespace ct_host

@@ -1,0 +1,659 @@
+// test_camera.cpp -- lens models, fixed-point unprojection and the pose,
+// against mrcal's own C API (libmrcal 2.2).
+//
+// Unprojection: for PINHOLE, OPENCV4, OPENCV5, OPENCV8 with realistic and
+// strong (wide-angle, corner) distortion, and a lens that folds over inside
+// its image, seeded random pixels across the image (plus 10% margin),
+// corners, edges and the centre.  For every pixel ct_camera_unproject
+// returns a ray, then
+//   - mrcal_project(ray) is the input pixel within REPROJ_TOL_PX, and
+//   - the angle to mrcal_unproject's ray is <= ANGLE_TOL_RAD;
+// or CT_ERR_UNPROJECT, and then mrcal fails too (NaN), or mrcal's ray does
+// not re-project to the pixel, or lies outside the camera's valid field
+// (beyond the fold, or where the Jacobian's determinant is below the
+// library's minimum): never a silently wrong ray, never a refusal of a
+// well-posed pixel.  Realistic models must unproject every pixel of the
+// image.  Iteration counts are reported (mean, max) beside the cap.
+//
+// Pose: our Rodrigues (host, long double) vs mrcal_R_from_r on random and
+// edge-case vectors (0, tiny, exactly pi: built as angle * axis, never via
+// mrcal's r_from_R, which returns near-identity within ~1e-5 rad of pi);
+// R_from_r must give back rotations built from their axes (nadir: pi about
+// east); the camera centre vs mrcal_transform_point_rt_inverted; the whole
+// pixel -> map-direction chain vs mrcal; ct_pose_init's refusals.
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <string>
+#include <vector>
+
+extern "C" {
+#include <mrcal/mrcal.h>
+}
+
+#include "camera_host.hpp"
+#include "conetrace.h"
+#include "harness.h"
+
+typedef long double ld;
+
+namespace {
+
+// Bounds stated in README "Geolocation" (measured values printed below).
+const double ANGLE_TOL_RAD = 2.5e-9;   // ours vs mrcal_unproject (well conditioned)
+const double REPROJ_TOL_PX = 3e-5;     // mrcal_project(our ray) vs pixel
+const double PROJECT_TOL_PX = 2e-5;    // ct_camera_project vs mrcal_project
+
+struct Model {
+    const char *name;   // test name
+    const char *lens;   // mrcal name
+    std::vector<double> in;
+    unsigned w, h;
+    bool realistic;     // every pixel of the image must unproject
+};
+
+std::vector<Model> models()
+{
+    return {
+        {"pinhole", "LENSMODEL_PINHOLE", {1200, 1210, 959.5, 539.5}, 1920, 1080, true},
+        {"pinhole_wide", "LENSMODEL_PINHOLE", {300, 300, 1000.2, 750.7}, 2000, 1500, true},
+        {"opencv4", "LENSMODEL_OPENCV4", {1400, 1401.5, 1023.5, 767.5, -0.28, 0.09, 1e-4, -2e-4}, 2048, 1536,
+         true},
+        {"opencv5", "LENSMODEL_OPENCV5", {2200.3, 2200.1, 1511.2, 1003.9, -0.31, 0.12, 3e-4, 2e-4, -0.021}, 3000,
+         2000, true},
+        {"opencv5_pincushion", "LENSMODEL_OPENCV5", {1800, 1800, 960, 540, 0.25, 0.05, -1e-3, 5e-4, 0.01}, 1920,
+         1080, true},
+        // a wide-angle rational model like mrcal's tour (OPENCV8, ~160 deg diagonal)
+        {"opencv8_wide", "LENSMODEL_OPENCV8",
+         {1761.2, 1761.9, 2999.3, 1687.6, 2.82, 1.13, -1.1e-4, -5.3e-5, 0.061, 3.11, 2.21, 0.24}, 6000, 3376, true},
+        {"opencv8", "LENSMODEL_OPENCV8",
+         {1500, 1500, 1279.5, 959.5, 0.9, -0.05, 2e-4, -1e-4, 0.01, 1.2, 0.1, 0.003}, 2560, 1920, true},
+        // strong barrel that folds over inside the image: r_d = r (1 - 0.5 r^2)
+        // peaks at r = 0.816 (r_d = 0.544); the corners (r_d ~ 1) have no ray
+        {"opencv4_fold", "LENSMODEL_OPENCV4", {1000, 1000, 799.5, 599.5, -0.5, 0.0, 0.0, 0.0}, 1600, 1200, false},
+        // strong rational barrel with tangential terms, folding near the corners
+        {"opencv8_fold", "LENSMODEL_OPENCV8",
+         {900, 905, 1000, 700, -0.6, 0.3, 0.004, -0.003, -0.1, 0.4, 0.05, 0.01}, 2000, 1400, false},
+    };
+}
+
+bool make_camera(const Model &m, ct_camera *cam)
+{
+    ct_lens l = ct_host::lens_from_intrinsics(m.lens, m.in, m.w, m.h);
+    return ct_camera_init(cam, &l) == CT_OK;
+}
+
+mrcal_lensmodel_t mrcal_model(const char *name)
+{
+    mrcal_lensmodel_t lm;
+    mrcal_lensmodel_from_name(&lm, name);
+    return lm;
+}
+
+ld angle_between(const ld a[3], const ld b[3])
+{
+    ld c[3] = {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+    ld cn = std::sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+    ld d = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    return std::atan2(cn, d);
+}
+
+// Independent long-double forward model (normalised coordinates) and the
+// Jacobian determinant, for judging refusals.
+void distort_ld(const Model &m, ld x, ld y, ld *xd, ld *yd, ld *det, ld *smin = nullptr)
+{
+    ld k[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+    for (size_t i = 4; i < m.in.size(); ++i) k[i - 4] = m.in[i];
+    auto f = [&](ld a, ld b, ld *oa, ld *ob) {
+        ld r2 = a * a + b * b;
+        ld N = 1 + r2 * (k[0] + r2 * (k[1] + r2 * k[4]));
+        ld D = 1 + r2 * (k[5] + r2 * (k[6] + r2 * k[7]));
+        ld R = N / D;
+        *oa = a * R + 2 * k[2] * a * b + k[3] * (r2 + 2 * a * a);
+        *ob = b * R + k[2] * (r2 + 2 * b * b) + 2 * k[3] * a * b;
+    };
+    f(x, y, xd, yd);
+    ld e = 1e-7L, ax, ay, bx, by, cx, cy, dx, dy;
+    f(x + e, y, &ax, &ay);
+    f(x - e, y, &bx, &by);
+    f(x, y + e, &cx, &cy);
+    f(x, y - e, &dx, &dy);
+    ld jxx = (ax - bx) / (2 * e), jyx = (ay - by) / (2 * e), jxy = (cx - dx) / (2 * e), jyy = (cy - dy) / (2 * e);
+    *det = jxx * jyy - jxy * jyx;
+    if (smin) {
+        ld f2 = jxx * jxx + jxy * jxy + jyx * jyx + jyy * jyy;
+        *smin = std::sqrt(std::max<ld>(0, (f2 - std::sqrt(std::max<ld>(0, f2 * f2 - 4 * *det * *det))) / 2));
+    }
+}
+
+// The radial slope d(r R)/dr of the model at radius r (long double).
+ld radial_slope(const Model &m, ld r)
+{
+    ld k[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+    for (size_t i = 4; i < m.in.size(); ++i) k[i - 4] = m.in[i];
+    auto g = [&](ld s) {
+        ld r2 = s * s;
+        return s * (1 + r2 * (k[0] + r2 * (k[1] + r2 * k[4]))) / (1 + r2 * (k[5] + r2 * (k[6] + r2 * k[7])));
+    };
+    ld e = 1e-7L;
+    return (g(r + e) - g(r - e)) / (2 * e);
+}
+
+void ray_ld(const int32_t q[3], ld out[3])
+{
+    for (int k = 0; k < 3; ++k) out[k] = (ld)q[k] / 1073741824.0L;
+}
+
+struct Stats {
+    long n = 0, ok = 0, refused = 0, refused_in_image = 0, mrcal_nan = 0;
+    long iters_sum = 0;
+    double ns = 0;
+    uint32_t iters_max = 0;
+    double max_angle = 0, max_angle_ill = 0, max_reproj = 0;
+};
+
+// One pixel: returns "" or a failure description.
+std::string check_pixel(const Model &m, const ct_camera &cam, const mrcal_lensmodel_t &lm, int64_t uq, int64_t vq,
+                        Stats *st)
+{
+    const double u = (double)uq / 65536.0, v = (double)vq / 65536.0;
+    int32_t ray[3];
+    uint32_t it = 0;
+    auto t0 = std::chrono::steady_clock::now();
+    ct_status s = ct_camera_unproject(&cam, uq, vq, ray, &it);
+    st->ns += std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - t0).count();
+    mrcal_point2_t q = {{u, v}};
+    mrcal_point3_t mv;
+    mrcal_unproject(&mv, &q, 1, &lm, m.in.data());
+    bool mrcal_ok = std::isfinite(mv.x) && std::isfinite(mv.y) && std::isfinite(mv.z);
+    st->n++;
+    st->mrcal_nan += !mrcal_ok;
+    char buf[512];
+    bool in_image = u >= -0.5 && v >= -0.5 && u <= m.w - 0.5 && v <= m.h - 0.5;
+    if (s == CT_OK) {
+        st->ok++;
+        st->iters_sum += it;
+        st->iters_max = std::max(st->iters_max, it);
+        ld r[3];
+        ray_ld(ray, r);
+        ld n = std::sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
+        if (std::fabs(n - 1) > 4e-9L || r[2] <= 0) {
+            std::snprintf(buf, sizeof buf, "pixel (%.6f, %.6f): ray not unit or behind (|r| = %.12Lf)", u, v, n);
+            return buf;
+        }
+        mrcal_point3_t p = {{(double)r[0], (double)r[1], (double)r[2]}};
+        mrcal_point2_t qq;
+        mrcal_project(&qq, NULL, NULL, &p, 1, &lm, m.in.data());
+        double e = std::hypot(qq.x - u, qq.y - v);
+        st->max_reproj = std::max(st->max_reproj, e);
+        if (!(e <= REPROJ_TOL_PX)) {
+            std::snprintf(buf, sizeof buf, "pixel (%.6f, %.6f): our ray re-projects %.3g px away (mrcal_project)", u,
+                          v, e);
+            return buf;
+        }
+        if (mrcal_ok) {
+            ld mm[3] = {mv.x, mv.y, mv.z};
+            // mrcal's own ray must re-project too for the comparison to mean anything
+            mrcal_point2_t q2;
+            mrcal_project(&q2, NULL, NULL, &mv, 1, &lm, m.in.data());
+            if (std::hypot(q2.x - u, q2.y - v) < 1e-6) {
+                // the bound: ANGLE_TOL_RAD where the lens is well conditioned
+                // (smallest singular value of the distortion's Jacobian >=
+                // 1/4, every realistic pixel); near a fold the Newton
+                // residual (<= 2^-31) is divided by that singular value
+                double a = (double)angle_between(r, mm);
+                ld xd, yd, det, smin;
+                distort_ld(m, r[0] / r[2], r[1] / r[2], &xd, &yd, &det, &smin);
+                double tol = ANGLE_TOL_RAD + (smin < 0.25L ? (double)(0.5e-9L / smin) : 0.0);
+                if (smin >= 0.25L)
+                    st->max_angle = std::max(st->max_angle, a);
+                else
+                    st->max_angle_ill = std::max(st->max_angle_ill, a);
+                if (!(a <= tol)) {
+                    std::snprintf(buf, sizeof buf,
+                                  "pixel (%.6f, %.6f): %.3g rad from mrcal_unproject's ray (tolerance %.3g, "
+                                  "sigma_min %.3Lg)",
+                                  u, v, a, tol, smin);
+                    return buf;
+                }
+            }
+        }
+        return "";
+    }
+    if (s != CT_ERR_UNPROJECT) {
+        std::snprintf(buf, sizeof buf, "pixel (%.6f, %.6f): status %d", u, v, (int)s);
+        return buf;
+    }
+    st->refused++;
+    st->refused_in_image += in_image;
+    if (m.realistic && in_image) {
+        std::snprintf(buf, sizeof buf, "pixel (%.6f, %.6f) of a realistic model refused", u, v);
+        return buf;
+    }
+    if (!mrcal_ok) return "";
+    // mrcal has a ray: it must be one the library may refuse
+    mrcal_point2_t q2;
+    mrcal_project(&q2, NULL, NULL, &mv, 1, &lm, m.in.data());
+    if (std::hypot(q2.x - u, q2.y - v) > 1e-6) return "";  // mrcal's ray is not a solution
+    ld x = (ld)mv.x / mv.z, y = (ld)mv.y / mv.z, xd, yd, det;
+    distort_ld(m, x, y, &xd, &yd, &det);
+    ld r = std::sqrt(x * x + y * y);
+    ld rmax = std::sqrt((ld)cam.r2_max_q32 / 4294967296.0L);
+    if (mv.z <= 0 || r >= rmax * (1 - 1e-6L) || det <= 2.0L / 65536 || radial_slope(m, r) <= 1.0L / 128)
+        return "";  // beyond the valid field, folded, or ill-conditioned
+    std::snprintf(buf, sizeof buf,
+                  "pixel (%.6f, %.6f) refused, but mrcal's ray (r = %.6Lf < r_max = %.6Lf, det %.3Lg) is well posed", u,
+                  v, r, rmax, det);
+    return buf;
+}
+
+void test_unproject_vs_mrcal()
+{
+    ct_rng rng;
+    ct_rng_seed(&rng, ct_test_seed() * 7 + 1);
+    const int n_random = (int)(20000 * ct_test_scale());
+    for (const Model &m : models()) {
+        ct_camera cam;
+        TEST_ASSERT_MSG(make_camera(m, &cam), "%s: ct_camera_init refused", m.name);
+        mrcal_lensmodel_t lm = mrcal_model(m.lens);
+        Stats st;
+        std::vector<std::pair<double, double>> px;
+        // centre, corners, edge midpoints, and pixel-centre corners
+        px.push_back({m.in[2], m.in[3]});
+        for (double fu : {-0.5, 0.0, 0.5, 1.0, 1.5})
+            for (double fv : {-0.5, 0.0, 0.5, 1.0, 1.5}) px.push_back({fu * (m.w - 1), fv * (m.h - 1)});
+        for (int k = 0; k < n_random; ++k) {
+            double mu = 0.1 * m.w, mv = 0.1 * m.h;
+            px.push_back({-mu + ct_rng_unit(&rng) * (m.w + 2 * mu), -mv + ct_rng_unit(&rng) * (m.h + 2 * mv)});
+        }
+        for (auto &p : px) {
+            int64_t uq = std::llround(p.first * 65536), vq = std::llround(p.second * 65536);
+            std::string why = check_pixel(m, cam, lm, uq, vq, &st);
+            TEST_ASSERT_MSG(why.empty(), "%s: %s", m.name, why.c_str());
+        }
+        printf("  %-18s r_max %.4f: %ld pixels, %ld unprojected (%ld refused, %ld of them in the image; mrcal "
+               "NaN %ld); iterations mean %.2f max %u (cap %u); max angle vs mrcal %.2e rad (%.2e near a fold); "
+               "max re-projection %.2e px; %.0f ns per pixel\n",
+               m.name, std::sqrt((double)cam.r2_max_q32 / 4294967296.0), st.n, st.ok, st.refused,
+               st.refused_in_image, st.mrcal_nan, st.ok ? (double)st.iters_sum / st.ok : 0.0, st.iters_max,
+               CT_UNPROJECT_MAX_ITERS, st.max_angle, st.max_angle_ill, st.max_reproj, st.ns / std::max(1L, st.n));
+        if (!m.realistic) TEST_ASSERT_MSG(st.refused_in_image > 0, "%s: the fold was never detected", m.name);
+    }
+}
+
+void test_unproject_hard_values()
+{
+    Model m = models()[2];  // opencv4
+    ct_camera cam;
+    TEST_ASSERT(make_camera(m, &cam));
+    int32_t ray[3];
+    uint32_t it = 99;
+    // the principal point: exactly the optical axis
+    int64_t cxq = std::llround(m.in[2] * 65536), cyq = std::llround(m.in[3] * 65536);
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_camera_unproject(&cam, cxq, cyq, ray, &it));
+    TEST_ASSERT_EQUAL_INT(0, ray[0]);
+    TEST_ASSERT_EQUAL_INT(0, ray[1]);
+    TEST_ASSERT_EQUAL_INT(1 << 30, ray[2]);
+    TEST_ASSERT_EQUAL_INT(0, it);
+    // pinhole: pixel cx + fx (fx = 1200 exactly) is 45 degrees off axis
+    Model ph = models()[0];
+    TEST_ASSERT(make_camera(ph, &cam));
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_camera_unproject(&cam, std::llround((959.5 + 1200) * 65536), std::llround(539.5 * 65536), ray, &it));
+    TEST_ASSERT(std::abs(ray[0] - 759250125) <= 1);  // 2^30 / sqrt(2)
+    TEST_ASSERT(std::abs(ray[2] - 759250125) <= 1);
+    TEST_ASSERT_EQUAL_INT(0, ray[1]);
+    // beyond 82.9 deg (r^2 > 64) a pinhole refuses
+    TEST_ASSERT_EQUAL_INT(CT_ERR_UNPROJECT, ct_camera_unproject(&cam, std::llround((959.5 + 1200 * 8.1) * 65536), std::llround(539.5 * 65536), ray, &it));
+    // pixels beyond +-2^20
+    TEST_ASSERT_EQUAL_INT(CT_ERR_UNPROJECT, ct_camera_unproject(&cam, (int64_t)(CT_CAM_MAX_PIXEL + 1) << 16, 0, ray, &it));
+    TEST_ASSERT_EQUAL_INT(CT_ERR_UNPROJECT, ct_camera_unproject(&cam, 0, INT64_MIN, ray, &it));
+    // iters may be NULL
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_camera_unproject(&cam, cxq, cyq, ray, nullptr));
+}
+
+void test_lens_evil()
+{
+    ct_camera cam;
+    Model m = models()[6];  // opencv8
+    ct_lens good = ct_host::lens_from_intrinsics(m.lens, m.in, m.w, m.h), l;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_camera_init(&cam, &good));
+    struct Case {
+        const char *what;
+        void (*mutate)(ct_lens *);
+    };
+    const Case cases[] = {
+        {"unknown model", [](ct_lens *x) { x->model = CT_LENS_COUNT; }},
+        {"fx = 0", [](ct_lens *x) { x->fx_q32 = 0; }},
+        {"fy < 1 px", [](ct_lens *x) { x->fy_q32 = (INT64_C(1) << 32) - 1; }},
+        {"fx > 2^20 px", [](ct_lens *x) { x->fx_q32 = ((int64_t)CT_CAM_MAX_PIXEL << 32) + 1; }},
+        {"cx beyond 2^20 px", [](ct_lens *x) { x->cx_q32 = -((int64_t)CT_CAM_MAX_PIXEL << 32) - 1; }},
+        {"k1 > 1024", [](ct_lens *x) { x->dist_q48[0] = CT_CAM_MAX_DIST + 1; }},
+        {"k6 < -1024", [](ct_lens *x) { x->dist_q48[7] = -CT_CAM_MAX_DIST - 1; }},
+        {"OPENCV4 with k3 set", [](ct_lens *x) { x->model = CT_LENS_OPENCV4; }},
+        {"OPENCV5 with k4 set", [](ct_lens *x) { x->model = CT_LENS_OPENCV5; }},
+        {"PINHOLE with k1 set", [](ct_lens *x) { x->model = CT_LENS_PINHOLE; }},
+    };
+    for (const Case &c : cases) {
+        l = good;
+        c.mutate(&l);
+        ct_status s = ct_camera_init(&cam, &l);
+        TEST_ASSERT_MSG(s == CT_ERR_LENS, "%s: expected CT_ERR_LENS, got %d", c.what, (int)s);
+        int32_t ray[3];
+        // a failed init leaves the camera unusable
+        TEST_ASSERT_EQUAL_INT(CT_ERR_ARG, ct_camera_unproject(&cam, 0, 0, ray, nullptr));
+    }
+    // host-side conversion refusals
+    bool threw = false;
+    try {
+        ct_host::lens_from_intrinsics("LENSMODEL_SPLINED_STEREOGRAPHIC_order=3_Nx=16_Ny=12_fov_x_deg=100", {1, 2}, 10, 10);
+    } catch (const ct_host::Error &) {
+        threw = true;
+    }
+    TEST_ASSERT(threw);
+    threw = false;
+    try {
+        ct_host::lens_from_intrinsics("LENSMODEL_OPENCV4", {1000, 1000, 10, 10, 0.1}, 10, 10);
+    } catch (const ct_host::Error &) {
+        threw = true;
+    }
+    TEST_ASSERT(threw);
+    // k1 = -1000, k4 = 1000: the lens folds at r ~ 0.02: a tiny valid field
+    l = good;
+    l.dist_q48[0] = -(INT64_C(1000) << 48);
+    l.dist_q48[5] = INT64_C(1000) << 48;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_camera_init(&cam, &l));
+    TEST_ASSERT_MSG((double)cam.r2_max_q32 / 4294967296.0 < 0.001, "r2_max %.6f", (double)cam.r2_max_q32 / 4294967296.0);
+    // a radial factor whose denominator vanishes: the valid field stops short
+    l = good;
+    l.dist_q48[0] = 0;
+    l.dist_q48[1] = 0;
+    l.dist_q48[4] = 0;
+    l.dist_q48[5] = -(INT64_C(2) << 48);  // D = 1 - 2 r^2
+    l.dist_q48[6] = 0;
+    l.dist_q48[7] = 0;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_camera_init(&cam, &l));
+    TEST_ASSERT_MSG((double)cam.r2_max_q32 / 4294967296.0 < 0.5, "r2_max %.6f", (double)cam.r2_max_q32 / 4294967296.0);
+}
+
+void test_project_vs_mrcal()
+{
+    ct_rng rng;
+    ct_rng_seed(&rng, ct_test_seed() * 11 + 3);
+    double worst = 0, worst_rel = 0;
+    for (const Model &m : models()) {
+        ct_camera cam;
+        TEST_ASSERT(make_camera(m, &cam));
+        mrcal_lensmodel_t lm = mrcal_model(m.lens);
+        ld rmax = std::sqrt((ld)cam.r2_max_q32 / 4294967296.0L);
+        for (int k = 0; k < 4000; ++k) {
+            ld v[3];
+            bool far = k % 2 == 1;
+            if (!far) {
+                // the ray of a pixel in the image (+10%), by mrcal
+                mrcal_point2_t q = {{(-0.1 + 1.2 * (double)ct_rng_unit(&rng)) * m.w,
+                                     (-0.1 + 1.2 * (double)ct_rng_unit(&rng)) * m.h}};
+                mrcal_point3_t mv;
+                mrcal_unproject(&mv, &q, 1, &lm, m.in.data());
+                if (!std::isfinite(mv.x) || !std::isfinite(mv.y) || !(mv.z > 0)) continue;
+                ld r = std::hypot((ld)mv.x, (ld)mv.y) / mv.z;
+                if (r >= rmax * 0.999L) continue;
+                v[0] = mv.x, v[1] = mv.y, v[2] = mv.z;
+            } else {
+                // anywhere in the valid field (pixels far outside the image)
+                ld r = rmax * std::sqrt(ct_rng_unit(&rng)) * 0.999L, a = ct_rng_unit(&rng) * 2 * M_PI;
+                v[0] = r * std::cos(a), v[1] = r * std::sin(a), v[2] = 1;
+            }
+            ld nn = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+            int32_t q[3];
+            for (int i = 0; i < 3; ++i) q[i] = (int32_t)std::llround(v[i] / nn * 1073741824.0L);
+            int64_t u, vv;
+            ct_status s = ct_camera_project(&cam, q, &u, &vv);
+            if (s != CT_OK && far) continue;  // rounding to Q30 may step outside
+            TEST_ASSERT_MSG(s == CT_OK, "%s: project refused a ray of the image", m.name);
+            mrcal_point3_t p = {{(double)q[0], (double)q[1], (double)q[2]}};
+            mrcal_point2_t mq;
+            mrcal_project(&mq, NULL, NULL, &p, 1, &lm, m.in.data());
+            double e = std::hypot(u / 65536.0 - mq.x, vv / 65536.0 - mq.y);
+            if (!far) {
+                worst = std::max(worst, e);
+                TEST_ASSERT_MSG(e <= PROJECT_TOL_PX, "%s: project %.3g px from mrcal at (%.3f, %.3f)", m.name, e,
+                                mq.x, mq.y);
+            } else {
+                // far out, pixels reach ~1e7: a relative bound
+                double dist = std::hypot(mq.x - m.in[2], mq.y - m.in[3]), rel = e / std::max(1.0, dist);
+                if (dist > 1e4) worst_rel = std::max(worst_rel, rel);
+                TEST_ASSERT_MSG(rel <= 5e-10 || e <= PROJECT_TOL_PX, "%s: project %.3g px (%.3g relative) from mrcal at (%.6g, %.6g)",
+                                m.name, e, rel, mq.x, mq.y);
+            }
+        }
+        // behind the camera and outside the field
+        int32_t back[3] = {0, 0, -(1 << 30)}, side[3] = {1 << 30, 0, 0};
+        int64_t u, vv;
+        TEST_ASSERT_EQUAL_INT(CT_ERR_UNPROJECT, ct_camera_project(&cam, back, &u, &vv));
+        TEST_ASSERT_EQUAL_INT(CT_ERR_UNPROJECT, ct_camera_project(&cam, side, &u, &vv));
+    }
+    printf("  ct_camera_project vs mrcal_project: max %.2e px for rays of the image (+10%%), %.2e relative "
+           "for pixels beyond 1e4 px of the centre\n",
+           worst, worst_rel);
+}
+
+// ---- pose ---------------------------------------------------------------
+
+void mat_mrcal(const ld r[3], double R[9])
+{
+    double rd[3] = {(double)r[0], (double)r[1], (double)r[2]};
+    mrcal_R_from_r(R, NULL, rd);
+}
+
+void test_rodrigues_vs_mrcal()
+{
+    ct_rng rng;
+    ct_rng_seed(&rng, ct_test_seed() * 13 + 5);
+    double worst = 0;
+    for (int k = 0; k < 20000; ++k) {
+        // axis * angle, angles over [0, pi] with extra weight at 0 and pi
+        ld ax[3] = {ct_rng_unit(&rng) - 0.5L, ct_rng_unit(&rng) - 0.5L, ct_rng_unit(&rng) - 0.5L};
+        ld an = std::sqrt(ax[0] * ax[0] + ax[1] * ax[1] + ax[2] * ax[2]);
+        if (k % 5 == 0) ax[0] = 1, ax[1] = ax[2] = 0, an = 1;
+        ld th;
+        switch (k % 4) {
+        case 0: th = ct_rng_unit(&rng) * M_PI; break;
+        case 1: th = M_PI - std::pow(10.0L, -ct_rng_unit(&rng) * 12); break;
+        case 2: th = std::pow(10.0L, -ct_rng_unit(&rng) * 12); break;
+        default: th = (k % 8 == 3) ? M_PI : 0; break;
+        }
+        ld r[3] = {ax[0] / an * th, ax[1] / an * th, ax[2] / an * th};
+        ld R[9];
+        double M[9];
+        ct_host::rotation_from_r(r, R);
+        mat_mrcal(r, M);
+        for (int i = 0; i < 9; ++i) worst = std::max(worst, (double)std::fabs(R[i] - M[i]));
+    }
+    printf("  rotation_from_r vs mrcal_R_from_r: max |dR| %.2e\n", worst);
+    TEST_ASSERT_MSG(worst <= 4e-15, "max |dR| = %.3g", worst);
+}
+
+// Rotations built from the camera's axes; R_from_r must give them back.
+void test_rotations_from_axes()
+{
+    struct Case {
+        const char *what;
+        ld r[3];          // r_cam_map = angle * axis
+        ld cols[3][3];    // camera x, y, z axes in the map frame (E, N, h)
+    };
+    const ld s = std::sqrt(0.5L);
+    const Case cases[] = {
+        // nadir: x east, y south (image top = north), z down: pi about east
+        {"nadir", {M_PI, 0, 0}, {{1, 0, 0}, {0, -1, 0}, {0, 0, -1}}},
+        // nadir, x north, y east (image top = west), z down: pi about (1, 1, 0)/sqrt2
+        {"nadir_rot", {M_PI * s, M_PI * s, 0}, {{0, 1, 0}, {1, 0, 0}, {0, 0, -1}}},
+        // horizontal camera looking north: x east, y down, z north: -pi/2 about east
+        // (r_cam_map maps map to camera: the inverse rotation)
+        {"north_horizontal", {M_PI / 2, 0, 0}, {{1, 0, 0}, {0, 0, -1}, {0, 1, 0}}},
+        {"identity", {0, 0, 0}, {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}},
+    };
+    for (const Case &c : cases) {
+        // R_cam_map rows are the camera axes in the map frame
+        double M[9];
+        ld R[9];
+        mat_mrcal(c.r, M);
+        ct_host::rotation_from_r(c.r, R);
+        for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) {
+                TEST_ASSERT_MSG(std::fabs(M[3 * i + j] - (double)c.cols[i][j]) < 1e-15, "%s: mrcal R[%d][%d] = %.17g",
+                                c.what, i, j, M[3 * i + j]);
+                TEST_ASSERT_MSG(std::fabs(R[3 * i + j] - c.cols[i][j]) < 1e-15L, "%s: our R[%d][%d]", c.what, i, j);
+            }
+        // and the library accepts the pose (R_map_cam = transpose, Q30)
+        double rt[6] = {(double)c.r[0], (double)c.r[1], (double)c.r[2], 12.5, -4000000.25, 300};
+        ct_host::HostPose hp = ct_host::pose_from_rt_cam_ref(rt);
+        ct_pose pose;
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_pose_init(&pose, hp.R_map_cam_q30, hp.centre_nm[0], hp.centre_nm[1], hp.centre_nm[2]));
+        // the camera's z axis in the map frame is column 2 of R_map_cam
+        int32_t z[3] = {0, 0, 1 << 30};
+        int64_t d[3];
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_pose_rotate(&pose, z, d));
+        for (int i = 0; i < 3; ++i)
+            TEST_ASSERT_MSG(std::fabs((ld)d[i] / 549755813888.0L - c.cols[2][i]) < 1e-9L, "%s: z axis %d", c.what, i);
+    }
+}
+
+void test_pose_vs_mrcal()
+{
+    ct_rng rng;
+    ct_rng_seed(&rng, ct_test_seed() * 17 + 9);
+    double worst_c = 0, worst_a = 0;
+    for (int k = 0; k < 5000; ++k) {
+        ld ax[3] = {ct_rng_unit(&rng) - 0.5L, ct_rng_unit(&rng) - 0.5L, ct_rng_unit(&rng) - 0.5L};
+        ld an = std::sqrt(ax[0] * ax[0] + ax[1] * ax[1] + ax[2] * ax[2]);
+        ld th = (k % 3 == 0) ? M_PI : ct_rng_unit(&rng) * M_PI;
+        double rt[6] = {(double)(ax[0] / an * th), (double)(ax[1] / an * th), (double)(ax[2] / an * th), 0, 0, 0};
+        // a camera centre at UTM-like coordinates, then t = -R c (mrcal)
+        double c[3] = {300000 + 400000 * (double)ct_rng_unit(&rng), 3000000 + 2000000 * (double)ct_rng_unit(&rng),
+                       -100 + 9000 * (double)ct_rng_unit(&rng)};
+        double Rc[3];
+        mrcal_rotate_point_r(Rc, NULL, NULL, rt, c);
+        for (int i = 0; i < 3; ++i) rt[3 + i] = -Rc[i];
+        ct_host::HostPose hp = ct_host::pose_from_rt_cam_ref(rt);
+        // mrcal: the camera centre is the camera-frame origin mapped to the reference
+        double zero[3] = {0, 0, 0}, cm[3];
+        mrcal_transform_point_rt_inverted(cm, NULL, NULL, rt, zero);
+        for (int i = 0; i < 3; ++i) worst_c = std::max(worst_c, std::fabs(hp.centre_nm[i] * 1e-9 - cm[i]));
+        ct_pose pose;
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_pose_init(&pose, hp.R_map_cam_q30, hp.centre_nm[0], hp.centre_nm[1], hp.centre_nm[2]));
+        // a random camera-frame unit ray into the map frame vs mrcal
+        ld v[3] = {ct_rng_unit(&rng) - 0.5L, ct_rng_unit(&rng) - 0.5L, ct_rng_unit(&rng)};
+        ld vn = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+        int32_t q[3];
+        for (int i = 0; i < 3; ++i) q[i] = (int32_t)std::llround(v[i] / vn * 1073741824.0L);
+        int64_t d[3];
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_pose_rotate(&pose, q, d));
+        double vc[3] = {q[0] / 1073741824.0, q[1] / 1073741824.0, q[2] / 1073741824.0}, vm[3];
+        mrcal_rotate_point_r_inverted(vm, NULL, NULL, rt, vc);
+        ld a[3] = {(ld)d[0], (ld)d[1], (ld)d[2]}, b[3] = {vm[0], vm[1], vm[2]};
+        worst_a = std::max(worst_a, (double)angle_between(a, b));
+    }
+    printf("  camera centre vs mrcal_transform_point_rt_inverted: max %.2e m; R_map_cam ray vs mrcal: max %.2e rad\n",
+           worst_c, worst_a);
+    // mrcal's double arithmetic at ~5e6 m carries ~1e-9 m of its own error
+    TEST_ASSERT_MSG(worst_c <= 5e-9, "centre %.3g m", worst_c);
+    TEST_ASSERT_MSG(worst_a <= 5e-9, "rotation %.3g rad", worst_a);
+}
+
+void test_pixel_to_map_chain_vs_mrcal()
+{
+    // pixel -> ray_cam -> R_map_cam: against mrcal_unproject + the inverse transform
+    ct_rng rng;
+    ct_rng_seed(&rng, ct_test_seed() * 19 + 1);
+    double worst = 0;
+    for (const Model &m : models()) {
+        if (!m.realistic) continue;
+        ct_camera cam;
+        TEST_ASSERT(make_camera(m, &cam));
+        mrcal_lensmodel_t lm = mrcal_model(m.lens);
+        for (int k = 0; k < 500; ++k) {
+            double rt[6] = {(double)(ct_rng_unit(&rng) * 4 - 2), (double)(ct_rng_unit(&rng) * 4 - 2),
+                            (double)(ct_rng_unit(&rng) * 4 - 2), 1e5, -4e6, 2e3};
+            ct_host::HostPose hp = ct_host::pose_from_rt_cam_ref(rt);
+            ct_pose pose;
+            TEST_ASSERT_EQUAL_INT(CT_OK, ct_pose_init(&pose, hp.R_map_cam_q30, hp.centre_nm[0], hp.centre_nm[1], hp.centre_nm[2]));
+            int64_t uq = std::llround(ct_rng_unit(&rng) * (m.w - 1) * 65536), vq = std::llround(ct_rng_unit(&rng) * (m.h - 1) * 65536);
+            int32_t ray[3];
+            int64_t d[3];
+            TEST_ASSERT_EQUAL_INT(CT_OK, ct_camera_unproject(&cam, uq, vq, ray, nullptr));
+            TEST_ASSERT_EQUAL_INT(CT_OK, ct_pose_rotate(&pose, ray, d));
+            mrcal_point2_t q = {{uq / 65536.0, vq / 65536.0}};
+            mrcal_point3_t v;
+            mrcal_unproject(&v, &q, 1, &lm, m.in.data());
+            double vm[3];
+            mrcal_rotate_point_r_inverted(vm, NULL, NULL, rt, v.xyz);
+            ld a[3] = {(ld)d[0], (ld)d[1], (ld)d[2]}, b[3] = {vm[0], vm[1], vm[2]};
+            worst = std::max(worst, (double)angle_between(a, b));
+        }
+    }
+    printf("  pixel -> map direction vs mrcal (unproject, rotate): max %.2e rad\n", worst);
+    TEST_ASSERT_MSG(worst <= 2 * ANGLE_TOL_RAD, "%.3g rad", worst);
+}
+
+void test_pose_evil()
+{
+    ct_pose pose;
+    int32_t I[9] = {1 << 30, 0, 0, 0, 1 << 30, 0, 0, 0, 1 << 30};
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_pose_init(&pose, I, 0, 0, 0));
+    int32_t R[9];
+    std::memcpy(R, I, sizeof R);
+    R[8] = -(1 << 30);  // a reflection: det -1
+    TEST_ASSERT_EQUAL_INT(CT_ERR_POSE, ct_pose_init(&pose, R, 0, 0, 0));
+    std::memcpy(R, I, sizeof R);
+    R[1] = 1 << 12;  // not orthogonal (2^-18)
+    TEST_ASSERT_EQUAL_INT(CT_ERR_POSE, ct_pose_init(&pose, R, 0, 0, 0));
+    std::memcpy(R, I, sizeof R);
+    R[0] = (1 << 30) + (1 << 11);  // not unit (2^-19)
+    TEST_ASSERT_EQUAL_INT(CT_ERR_POSE, ct_pose_init(&pose, R, 0, 0, 0));
+    std::memcpy(R, I, sizeof R);
+    R[0] = INT32_MAX;
+    TEST_ASSERT_EQUAL_INT(CT_ERR_POSE, ct_pose_init(&pose, R, 0, 0, 0));
+    std::memset(R, 0, sizeof R);
+    TEST_ASSERT_EQUAL_INT(CT_ERR_POSE, ct_pose_init(&pose, R, 0, 0, 0));
+    TEST_ASSERT_EQUAL_INT(CT_ERR_POSE, ct_pose_init(&pose, I, (INT64_C(1) << 61) + 1, 0, 0));
+    TEST_ASSERT_EQUAL_INT(CT_ERR_POSE, ct_pose_init(&pose, I, 0, 0, INT64_MIN));
+    int32_t ray[3] = {0, 0, 1 << 30};
+    int64_t d[3];
+    TEST_ASSERT_EQUAL_INT(CT_ERR_ARG, ct_pose_rotate(&pose, ray, d));  // the failed init cleared it
+    // rounding: a Q30 rotation from a random r stays acceptable
+    ct_rng rng;
+    ct_rng_seed(&rng, 99);
+    for (int k = 0; k < 1000; ++k) {
+        double rt[6] = {(double)(ct_rng_unit(&rng) * 6 - 3), (double)(ct_rng_unit(&rng) * 6 - 3),
+                        (double)(ct_rng_unit(&rng) * 6 - 3), 0, 0, 0};
+        ct_host::HostPose hp = ct_host::pose_from_rt_cam_ref(rt);
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_pose_init(&pose, hp.R_map_cam_q30, 0, 0, 0));
+    }
+    const char *name = nullptr;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_status_name(CT_ERR_UNPROJECT, &name));
+    TEST_ASSERT(std::strcmp(name, "err_unproject") == 0);
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_status_name(CT_ERR_LENS, &name));
+    TEST_ASSERT(std::strcmp(name, "err_lens") == 0);
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_status_name(CT_ERR_POSE, &name));
+    TEST_ASSERT(std::strcmp(name, "err_pose") == 0);
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_status_name(CT_ERR_EFFECTS, &name));
+    TEST_ASSERT(std::strcmp(name, "err_effects") == 0);
+}
+
+}  // namespace
+
+int main()
+{
+    TEST_BEGIN("test_camera");
+    RUN_TEST(test_unproject_vs_mrcal);
+    RUN_TEST(test_unproject_hard_values);
+    RUN_TEST(test_lens_evil);
+    RUN_TEST(test_project_vs_mrcal);
+    RUN_TEST(test_rodrigues_vs_mrcal);
+    RUN_TEST(test_rotations_from_axes);
+    RUN_TEST(test_pose_vs_mrcal);
+    RUN_TEST(test_pixel_to_map_chain_vs_mrcal);
+    RUN_TEST(test_pose_evil);
+    return TEST_END();
+}

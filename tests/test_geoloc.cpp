@@ -1,0 +1,459 @@
+// test_geoloc.cpp -- pixel to ground (ct_geolocate, ct_geolocate_batch)
+// against mrcal's projection and the independent reference tracer.
+//
+// A package is built from a generated DEM (smooth hills, 30 m posting,
+// UTM-like coordinates ~(5e5, 4e6) m) with a high wall across it.  For
+// cameras looking at it (nadir, oblique, low oblique over the wall; OpenCV
+// lenses), seeded random points of the bilinear surface are projected to
+// pixels with mrcal (mrcal_transform_point_rt + mrcal_project).  Each
+// point's visibility is decided by the reference tracer (tests/reference.hpp)
+// on the exact ray from the camera centre to the point, with a clearance
+// margin so grazing tangents are not counted either way.  Then:
+//   - visible points: ct_geolocate returns CT_HIT within GEO_TOL_M
+//     horizontally (and vertically) of the point;
+//   - occluded points: the hit is the reference's first hit (in front of
+//     the point) within GEO_TOL_M, never the point itself;
+//   - ct_geolocate_batch gives bit-identical ct_geo records, and all four
+//     methods the same hit;
+//   - a camera below the terrain is CT_BELOW, sky pixels are CT_MISS, a pixel
+//     in a folded lens region CT_ERR_UNPROJECT, and the argument errors
+//     (effects, method, camera centre out of range, short buffer) have their
+//     codes.
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <vector>
+
+extern "C" {
+#include <mrcal/mrcal.h>
+}
+
+#include "camera_host.hpp"
+#include "conetrace.h"
+#include "dem_cases.hpp"
+#include "harness.h"
+#include "reference.hpp"
+
+typedef long double ld;
+
+namespace {
+
+const double GEO_TOL_M = 0.05;     // hit vs chosen ground point (30 m posting)
+const double RAY_TOL_RAD = 1e-8;   // ray handed to the tracer vs the exact ray
+
+struct World {
+    dem_cases::Case c;
+    ct_package p;
+    ref::Dem d;
+    int wall_row = 0;
+};
+
+World *world()
+{
+    static World *w = nullptr;
+    if (w) return w;
+    w = new World;
+    const int W = 128, H = 112;
+    std::vector<uint16_t> z = dem_cases::smooth(W, H, 42, 4000, 6400);  // 0.25 m LSB: 1000..1600 m
+    // a wall 3 posts thick along row 60, 700 m above the hills, columns 10..117
+    w->wall_row = 60;
+    for (int j = 59; j <= 61; ++j)
+        for (int i = 10; i <= 117; ++i) z[(size_t)j * W + i] = (uint16_t)std::min(65535, z[(size_t)j * W + i] + 2800);
+    w->c = dem_cases::make_case("geoloc_hills", dem_cases::make_terrain(W, H, z, 0.25), 24, 1);
+    if (ct_package_open(&w->p, w->c.pkg.data(), w->c.pkg.size()) != CT_OK) return nullptr;
+    w->d.w = W;
+    w->d.h = H;
+    w->d.z.assign(z.begin(), z.end());
+    return w;
+}
+
+// grid <-> map in long double, from the package's exact nm georeference
+struct Geo {
+    ld e0, n0, pe, pn, off, sc;
+    explicit Geo(const ct_package &p)
+        : e0(p.origin_e_nm * 1e-9L), n0(p.origin_n_nm * 1e-9L), pe(p.posting_e_nm * 1e-9L),
+          pn(p.posting_n_nm * 1e-9L), off(p.height_offset_nm * 1e-9L), sc(p.height_scale_nm * 1e-9L)
+    {
+    }
+    void to_map(ld x, ld y, ld z, ld m[3]) const
+    {
+        m[0] = e0 + (x + 0.5L) * pe;
+        m[1] = n0 + (y + 0.5L) * pn;
+        m[2] = off + z * sc;
+    }
+    void to_grid(const ld m[3], ld g[3]) const
+    {
+        g[0] = (m[0] - e0) / pe - 0.5L;
+        g[1] = (m[1] - n0) / pn - 0.5L;
+        g[2] = (m[2] - off) / sc;
+    }
+};
+
+// quaternion (w, x, y, z) helpers: rotations are composed here and turned
+// into Rodrigues vectors directly (atan2, well conditioned at pi), never by
+// mrcal's r_from_R
+struct Quat {
+    ld w, x, y, z;
+};
+Quat q_axis(ld ax, ld ay, ld az, ld angle)
+{
+    ld n = std::sqrt(ax * ax + ay * ay + az * az), s = std::sin(angle / 2) / n;
+    return {std::cos(angle / 2), ax * s, ay * s, az * s};
+}
+Quat q_mul(const Quat &a, const Quat &b)
+{
+    return {a.w * b.w - a.x * b.x - a.y * b.y - a.z * b.z, a.w * b.x + a.x * b.w + a.y * b.z - a.z * b.y,
+            a.w * b.y - a.x * b.z + a.y * b.w + a.z * b.x, a.w * b.z + a.x * b.y - a.y * b.x + a.z * b.w};
+}
+void q_to_r(Quat q, ld r[3])
+{
+    if (q.w < 0) q = {-q.w, -q.x, -q.y, -q.z};
+    ld s = std::sqrt(q.x * q.x + q.y * q.y + q.z * q.z);
+    ld th = 2 * std::atan2(s, q.w);
+    ld k = s > 0 ? th / s : 2;
+    r[0] = q.x * k, r[1] = q.y * k, r[2] = q.z * k;
+}
+
+struct Cam {
+    const char *name;
+    std::string lens;
+    std::vector<double> in;
+    unsigned w, h;
+    double rt[6];      // rt_cam_ref (map frame = reference)
+    ld centre[3];      // map, metres
+    ct_host::LibCamera lib;
+};
+
+// A camera at `centre` (map metres) looking along azimuth `az` (radians
+// clockwise from north) with depression `dep` (radians below horizontal;
+// pi/2 = nadir), image top towards the azimuth.
+Cam make_cam(const char *name, const std::string &lens, const std::vector<double> &in, unsigned w, unsigned h,
+             const ld centre[3], ld az, ld dep)
+{
+    Cam c;
+    c.name = name;
+    c.lens = lens;
+    c.in = in;
+    c.w = w;
+    c.h = h;
+    for (int k = 0; k < 3; ++k) c.centre[k] = centre[k];
+    // R_map_cam: start from a camera looking north horizontally (x east,
+    // y down, z north) = rotation by -pi/2 about east; tilt down by dep
+    // about east, then turn by az clockwise about up (= -az about +h)
+    Quat q0 = q_axis(1, 0, 0, -M_PI / 2);  // camera -> map for the level camera
+    Quat tilt = q_axis(1, 0, 0, -dep);
+    Quat turn = q_axis(0, 0, 1, -az);
+    Quat q_map_cam = q_mul(turn, q_mul(tilt, q0));
+    ld r_map_cam[3];
+    q_to_r(q_map_cam, r_map_cam);
+    ld r_cam_map[3] = {-r_map_cam[0], -r_map_cam[1], -r_map_cam[2]}, R[9];
+    ct_host::rotation_from_r(r_cam_map, R);
+    for (int k = 0; k < 3; ++k) c.rt[k] = (double)r_cam_map[k];
+    for (int i = 0; i < 3; ++i) c.rt[3 + i] = (double)-(R[3 * i] * centre[0] + R[3 * i + 1] * centre[1] + R[3 * i + 2] * centre[2]);
+    ct_host::CameraModel m;
+    m.model = lens;
+    m.intrinsics = in;
+    std::memcpy(m.rt_cam_ref, c.rt, sizeof c.rt);
+    m.width = w;
+    m.height = h;
+    c.lib = ct_host::lib_camera(m, name);
+    return c;
+}
+
+std::vector<Cam> cameras(const World &wd)
+{
+    Geo g(wd.p);
+    ld mid[3];
+    g.to_map(63.5, 55.5, 0, mid);
+    std::vector<Cam> v;
+    const std::vector<double> cv8 = {1500, 1500, 1279.5, 959.5, 0.9, -0.05, 2e-4, -1e-4, 0.01, 1.2, 0.1, 0.003};
+    const std::vector<double> cv4 = {2400, 2401, 1023.5, 767.5, -0.28, 0.09, 1e-4, -2e-4};
+    const std::vector<double> cv5 = {1800, 1800, 959.5, 539.5, -0.31, 0.12, 3e-4, 2e-4, -0.021};
+    {
+        // exact nadir (pi about east) 1600 m above the highest hills
+        ld c[3] = {mid[0] + 7.3L, mid[1] - 11.9L, 3300};
+        v.push_back(make_cam("nadir", "LENSMODEL_OPENCV8", cv8, 2560, 1920, c, 0, M_PI / 2));
+    }
+    {
+        // 45 deg oblique from south of the tile, looking north-north-east
+        ld c[3] = {mid[0] - 300, mid[1] - 2600, 3000};
+        v.push_back(make_cam("oblique45", "LENSMODEL_OPENCV4", cv4, 2048, 1536, c, 0.2L, M_PI / 4));
+    }
+    {
+        // low oblique (12 deg) from the south, over the wall
+        ld c[3] = {mid[0] + 200, mid[1] - 2900, 1900};
+        v.push_back(make_cam("low_oblique", "LENSMODEL_OPENCV5", cv5, 1920, 1080, c, -0.05L, 12 * M_PI / 180));
+    }
+    return v;
+}
+
+// Bilinear surface (codes) at grid (x, y)
+ld surface(const World &wd, ld x, ld y) { return ref::surface(wd.d, x, y); }
+
+struct Sample {
+    ld P[3];          // chosen ground point, map metres
+    int64_t uq, vq;   // its pixel (mrcal), Q16
+    bool visible;
+    ld first[3];      // the reference's first hit along the exact ray (map)
+};
+
+// Reference first hit on the exact ray from the camera centre through P
+// (t = 1 at P).  Returns false when the geometry is too close to a tangent
+// (clearance below `margin` LSB before the hit) to be judged.
+bool reference_first_hit(const World &wd, const Geo &g, const ld C[3], const ld P[3], bool *visible, ld first[3])
+{
+    ld cg[3], pg[3];
+    g.to_grid(C, cg);
+    g.to_grid(P, pg);
+    ref::Ray r;
+    r.ox = cg[0], r.oy = cg[1], r.oz = cg[2];
+    r.dx = pg[0] - cg[0], r.dy = pg[1] - cg[1], r.dz = pg[2] - cg[2];
+    r.tend = 1.5L;
+    ref::Hit h = ref::trace(wd.d, r);
+    if (h.status != ref::HIT) return false;
+    // a ray that enters the tile below its edge meets terrain the package
+    // does not hold (the library says CT_BELOW): not a usable sample
+    {
+        ld te = 0;
+        for (int k = 0; k < 2; ++k) {
+            ld o = k ? r.oy : r.ox, dd = k ? r.dy : r.dx, hi = (k ? wd.d.h : wd.d.w) - 1;
+            if (o < 0 && dd > 0) te = std::max(te, -o / dd);
+            if (o > hi && dd < 0) te = std::max(te, (hi - o) / dd);
+        }
+        ld ex = std::min<ld>(std::max<ld>(r.ox + te * r.dx, 0), wd.d.w - 1);
+        ld ey = std::min<ld>(std::max<ld>(r.oy + te * r.dy, 0), wd.d.h - 1);
+        if (r.oz + te * r.dz - ref::surface(wd.d, ex, ey) < 2) return false;
+    }
+    *visible = std::fabs(h.t - 1) < 1e-7L;
+    // clearance: the ray must stay >= 2 LSB (0.5 m) above the surface until
+    // 0.5 % of the distance before its first hit
+    ld m = ref::min_clearance(wd.d, r, 0, h.t * 0.995L);
+    if (m < 2) return false;
+    g.to_map(h.x, h.y, h.z, first);
+    return true;
+}
+
+void test_geolocate_vs_mrcal()
+{
+    World *wd = world();
+    TEST_ASSERT(wd != nullptr);
+    Geo g(wd->p);
+    ct_rng rng;
+    ct_rng_seed(&rng, ct_test_seed() * 23 + 7);
+    const int want = (int)(600 * ct_test_scale());
+    for (Cam &c : cameras(*wd)) {
+        mrcal_lensmodel_t lm;
+        mrcal_lensmodel_from_name(&lm, c.lens.c_str());
+        std::vector<Sample> smp;
+        int tries = 0;
+        while ((int)smp.size() < want && tries < 200 * want) {
+            ++tries;
+            ld x = 0.5L + ct_rng_unit(&rng) * (wd->d.w - 2), y = 0.5L + ct_rng_unit(&rng) * (wd->d.h - 2);
+            Sample s;
+            g.to_map(x, y, surface(*wd, x, y), s.P);
+            double Pd[3] = {(double)s.P[0], (double)s.P[1], (double)s.P[2]}, pc[3];
+            mrcal_transform_point_rt(pc, NULL, NULL, c.rt, Pd);
+            if (!(pc[2] > 0)) continue;
+            mrcal_point3_t p3 = {{pc[0], pc[1], pc[2]}};
+            mrcal_point2_t q;
+            mrcal_project(&q, NULL, NULL, &p3, 1, &lm, c.in.data());
+            if (!(q.x >= 0 && q.y >= 0 && q.x <= c.w - 1 && q.y <= c.h - 1)) continue;
+            if (!reference_first_hit(*wd, g, c.centre, s.P, &s.visible, s.first)) continue;
+            s.uq = std::llround(q.x * 65536);
+            s.vq = std::llround(q.y * 65536);
+            smp.push_back(s);
+        }
+        TEST_ASSERT_MSG((int)smp.size() == want, "%s: only %zu usable points", c.name, smp.size());
+        std::vector<int64_t> uv;
+        std::vector<ct_geo> single(smp.size());
+        double worst_h = 0, worst_v = 0, worst_occ = 0, worst_ang = 0;
+        long vis = 0, occ = 0, steps = 0;
+        for (size_t k = 0; k < smp.size(); ++k) {
+            const Sample &s = smp[k];
+            uv.push_back(s.uq);
+            uv.push_back(s.vq);
+            ct_geo &o = single[k];
+            ct_status st = ct_geolocate(&wd->p, &c.lib.cam, &c.lib.pose, CT_METHOD_DIRECTIONAL, 0u, s.uq, s.vq, &o);
+            TEST_ASSERT_MSG(st == CT_HIT && o.status == CT_HIT, "%s: point %zu: status %d", c.name, k, (int)st);
+            ld hit[3] = {o.hit.e_nm * 1e-9L, o.hit.n_nm * 1e-9L, o.hit.h_nm * 1e-9L};
+            const ld *want_p = s.visible ? s.P : s.first;
+            double dh = (double)std::hypot(hit[0] - want_p[0], hit[1] - want_p[1]);
+            double dv = (double)std::fabs(hit[2] - want_p[2]);
+            {
+                // the ray handed to the tracer vs the exact ray to the point:
+                // pixel rounding (2^-17 px / f), unprojection, pose
+                ld pd[3] = {want_p[0] - c.centre[0], want_p[1] - c.centre[1], want_p[2] - c.centre[2]};
+                ld dm[3] = {(ld)o.dir_map_q39[0], (ld)o.dir_map_q39[1], (ld)o.dir_map_q39[2]};
+                ld cr[3] = {pd[1] * dm[2] - pd[2] * dm[1], pd[2] * dm[0] - pd[0] * dm[2], pd[0] * dm[1] - pd[1] * dm[0]};
+                ld ang = std::sqrt(cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2]) /
+                         (std::sqrt(pd[0] * pd[0] + pd[1] * pd[1] + pd[2] * pd[2]) *
+                          std::sqrt(dm[0] * dm[0] + dm[1] * dm[1] + dm[2] * dm[2]));
+                if (s.visible) {
+                    worst_ang = std::max(worst_ang, (double)ang);
+                    TEST_ASSERT_MSG(ang <= RAY_TOL_RAD, "%s: point %zu: ray %.3Lg rad from the exact ray", c.name, k, ang);
+                }
+            }
+            if (s.visible) {
+                ++vis;
+                worst_h = std::max(worst_h, dh);
+                worst_v = std::max(worst_v, dv);
+            } else {
+                ++occ;
+                worst_occ = std::max(worst_occ, std::max(dh, dv));
+                // in front of the chosen point, not on it
+                ld dp = std::hypot(hit[0] - s.P[0], hit[1] - s.P[1]);
+                TEST_ASSERT_MSG(dp > 1.0L, "%s: occluded point %zu reported at the point itself", c.name, k);
+            }
+            TEST_ASSERT_MSG(dh <= GEO_TOL_M && dv <= GEO_TOL_M,
+                            "%s: point %zu (%s): hit %.4f m horizontally, %.4f m vertically from the expected point",
+                            c.name, k, s.visible ? "visible" : "occluded", dh, dv);
+            steps += o.hit.steps;
+            // all four methods agree
+            for (int m = 0; m < CT_METHOD_COUNT; ++m) {
+                ct_geo o2;
+                TEST_ASSERT_EQUAL_INT(CT_HIT, ct_geolocate(&wd->p, &c.lib.cam, &c.lib.pose, (ct_method)m, 0u, s.uq, s.vq, &o2));
+                TEST_ASSERT(o2.hit.e_nm == o.hit.e_nm && o2.hit.n_nm == o.hit.n_nm && o2.hit.h_nm == o.hit.h_nm);
+            }
+        }
+        // the batch form: bit-identical records
+        std::vector<ct_geo> batch(smp.size() + 3);
+        std::memset(batch.data(), 0x5a, batch.size() * sizeof(ct_geo));
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_geolocate_batch(&wd->p, &c.lib.cam, &c.lib.pose, CT_METHOD_DIRECTIONAL, 0u,
+                                                        uv.data(), smp.size(), batch.data(), batch.size()));
+        for (size_t k = 0; k < smp.size(); ++k) {
+            TEST_ASSERT_MSG(batch[k].status == single[k].status && batch[k].unproject_iters == single[k].unproject_iters &&
+                                std::memcmp(batch[k].ray_cam_q30, single[k].ray_cam_q30, sizeof batch[k].ray_cam_q30) == 0 &&
+                                std::memcmp(batch[k].dir_map_q39, single[k].dir_map_q39, sizeof batch[k].dir_map_q39) == 0 &&
+                                std::memcmp(&batch[k].hit, &single[k].hit, sizeof batch[k].hit) == 0,
+                            "%s: batch record %zu differs from ct_geolocate's", c.name, k);
+        }
+        // nothing written past count
+        const unsigned char *tail = (const unsigned char *)&batch[smp.size()];
+        for (size_t b = 0; b < 3 * sizeof(ct_geo); ++b) TEST_ASSERT(tail[b] == 0x5a);
+        printf("  %-12s %ld visible points: ray within %.2e rad of the exact one, hit within %.2e m horizontally, "
+               "%.2e m vertically; %ld occluded: first hit within %.2e m of the reference's; %.1f steps per pixel\n",
+               c.name, vis, worst_ang, worst_h, worst_v, occ, worst_occ, (double)steps / std::max<size_t>(1, smp.size()));
+        if (std::string(c.name) == "low_oblique") TEST_ASSERT_MSG(occ > 0, "no occluded point behind the wall");
+    }
+}
+
+// The wall in front of a chosen point: the first hit is the wall.
+void test_occluded_by_wall()
+{
+    World *wd = world();
+    TEST_ASSERT(wd != nullptr);
+    Geo g(wd->p);
+    std::vector<Cam> cams = cameras(*wd);
+    // 25 cells south of the wall, 100 m above its top, looking north 30 deg down
+    ld top = 0;
+    for (int i = 0; i < wd->d.w; ++i) top = std::max(top, (ld)wd->d.at(i, wd->wall_row));
+    ld centre[3];
+    g.to_map(63.5L, wd->wall_row + 25, top, centre);
+    centre[2] += 100;
+    Cam c = make_cam("wall_view", cams[2].lens, cams[2].in, cams[2].w, cams[2].h, centre, 0, 30 * M_PI / 180);
+    mrcal_lensmodel_t lm;
+    mrcal_lensmodel_from_name(&lm, c.lens.c_str());
+    int found = 0;
+    // points north of the wall (rows < 59: north is -y) in the view whose
+    // reference first hit is the wall
+    for (int k = 0; k < 4000 && found < 20; ++k) {
+        ld x = 12 + (k % 400) * 0.26L, y = 57 - (k / 400) * 1.3L;
+        ld P[3];
+        g.to_map(x, y, surface(*wd, x, y), P);
+        double Pd[3] = {(double)P[0], (double)P[1], (double)P[2]}, pc[3];
+        mrcal_transform_point_rt(pc, NULL, NULL, c.rt, Pd);
+        mrcal_point3_t p3 = {{pc[0], pc[1], pc[2]}};
+        mrcal_point2_t q;
+        mrcal_project(&q, NULL, NULL, &p3, 1, &lm, c.in.data());
+        if (!(pc[2] > 0 && q.x >= 0 && q.y >= 0 && q.x <= c.w - 1 && q.y <= c.h - 1)) continue;
+        bool visible;
+        ld first[3], fg[3];
+        if (!reference_first_hit(*wd, g, c.centre, P, &visible, first) || visible) continue;
+        g.to_grid(first, fg);
+        if (fg[1] < wd->wall_row - 1.5L || fg[1] > wd->wall_row + 1.5L) continue;  // hidden by a hill
+        ct_geo o;
+        TEST_ASSERT_EQUAL_INT(CT_HIT, ct_geolocate(&wd->p, &c.lib.cam, &c.lib.pose, CT_METHOD_DIRECTIONAL, 0u,
+                                                   std::llround(q.x * 65536), std::llround(q.y * 65536), &o));
+        // on the wall (cells of rows 58..61 touch it), well in front of P
+        TEST_ASSERT_MSG(o.hit.cell_y >= wd->wall_row - 2 && o.hit.cell_y <= wd->wall_row + 1,
+                        "hit in row %d, not on the wall", o.hit.cell_y);
+        ld dist_hit = std::hypot(o.hit.e_nm * 1e-9L - c.centre[0], o.hit.n_nm * 1e-9L - c.centre[1]);
+        ld dist_p = std::hypot(P[0] - c.centre[0], P[1] - c.centre[1]);
+        TEST_ASSERT(dist_hit < dist_p - 60);
+        TEST_ASSERT(std::hypot(o.hit.e_nm * 1e-9L - first[0], o.hit.n_nm * 1e-9L - first[1]) <= GEO_TOL_M);
+        ++found;
+    }
+    TEST_ASSERT_MSG(found >= 10, "only %d points hidden by the wall", found);
+}
+
+void test_statuses_and_errors()
+{
+    World *wd = world();
+    TEST_ASSERT(wd != nullptr);
+    Geo g(wd->p);
+    std::vector<Cam> cams = cameras(*wd);
+    const Cam &obl = cams[1];
+    ct_geo o;
+    int64_t cu = std::llround(obl.in[2] * 65536), cv = std::llround(obl.in[3] * 65536);
+    TEST_ASSERT_EQUAL_INT(CT_HIT, ct_geolocate(&wd->p, &obl.lib.cam, &obl.lib.pose, CT_METHOD_DIRECTIONAL, 0u, cu, cv, &o));
+    // sky: a camera 2000 m above the tile looking 20 deg up
+    {
+        ld c[3];
+        g.to_map(63.5, 55.5, 0, c);
+        c[2] = 4000;
+        Cam sky = make_cam("sky", cams[1].lens, cams[1].in, cams[1].w, cams[1].h, c, 1.0L, -20 * M_PI / 180);
+        TEST_ASSERT_EQUAL_INT(CT_MISS, ct_geolocate(&wd->p, &sky.lib.cam, &sky.lib.pose, CT_METHOD_DIRECTIONAL, 0u,
+                                                    cu, cv, &o));
+        TEST_ASSERT_EQUAL_INT(CT_MISS, o.status);
+    }
+    // effects: none supported yet
+    for (uint32_t fx : {1u, 2u, 3u, 0x80000000u}) {
+        TEST_ASSERT_EQUAL_INT(CT_ERR_EFFECTS, ct_geolocate(&wd->p, &obl.lib.cam, &obl.lib.pose, CT_METHOD_DIRECTIONAL, fx, cu, cv, &o));
+        TEST_ASSERT_EQUAL_INT(CT_ERR_EFFECTS, o.status);
+        int64_t uv[2] = {cu, cv};
+        TEST_ASSERT_EQUAL_INT(CT_ERR_EFFECTS, ct_geolocate_batch(&wd->p, &obl.lib.cam, &obl.lib.pose, CT_METHOD_DIRECTIONAL, fx, uv, 1, &o, 1));
+    }
+    TEST_ASSERT_EQUAL_INT(CT_ERR_METHOD, ct_geolocate(&wd->p, &obl.lib.cam, &obl.lib.pose, (ct_method)7, 0u, cu, cv, &o));
+    int64_t uv[4] = {cu, cv, cu, cv};
+    ct_geo two[2];
+    TEST_ASSERT_EQUAL_INT(CT_ERR_ARG, ct_geolocate_batch(&wd->p, &obl.lib.cam, &obl.lib.pose, CT_METHOD_DIRECTIONAL, 0u, uv, 2, two, 1));
+    TEST_ASSERT_EQUAL_INT(CT_ERR_ARG, ct_geolocate_batch(&wd->p, &obl.lib.cam, &obl.lib.pose, CT_METHOD_DIRECTIONAL, 0u, nullptr, 2, two, 2));
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_geolocate_batch(&wd->p, &obl.lib.cam, &obl.lib.pose, CT_METHOD_DIRECTIONAL, 0u, nullptr, 0, nullptr, 0));
+    ct_camera blank;
+    std::memset(&blank, 0, sizeof blank);
+    TEST_ASSERT_EQUAL_INT(CT_ERR_ARG, ct_geolocate(&wd->p, &blank, &obl.lib.pose, CT_METHOD_DIRECTIONAL, 0u, cu, cv, &o));
+    // a camera centre beyond 2^30 cells of the tile
+    ct_pose far = obl.lib.pose;
+    // (2^60 nm up = 4.6e9 height LSB of 0.25 m > 2^30)
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_pose_init(&far, obl.lib.pose.R_map_cam_q30, obl.lib.pose.e_nm,
+                                              obl.lib.pose.n_nm, obl.lib.pose.h_nm + (INT64_C(1) << 60)));
+    TEST_ASSERT_EQUAL_INT(CT_ERR_RAY, ct_geolocate(&wd->p, &obl.lib.cam, &far, CT_METHOD_DIRECTIONAL, 0u, cu, cv, &o));
+    // a camera below the terrain
+    ct_pose under = obl.lib.pose;
+    ld mid[3];
+    g.to_map(63.5, 30.5, 0, mid);
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_pose_init(&under, obl.lib.pose.R_map_cam_q30, (int64_t)std::llround(mid[0] * 1e9L),
+                                              (int64_t)std::llround(mid[1] * 1e9L), wd->p.height_offset_nm + 1000000000));
+    TEST_ASSERT_EQUAL_INT(CT_BELOW, ct_geolocate(&wd->p, &obl.lib.cam, &under, CT_METHOD_DIRECTIONAL, 0u, cu, cv, &o));
+    // a folded lens: pixels beyond the fold are CT_ERR_UNPROJECT, per pixel in a batch
+    ct_lens fold = ct_host::lens_from_intrinsics("LENSMODEL_OPENCV4", {1000, 1000, 799.5, 599.5, -0.5, 0, 0, 0}, 1600, 1200);
+    ct_camera fc;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_camera_init(&fc, &fold));
+    int64_t px[4] = {std::llround(799.5 * 65536), std::llround(599.5 * 65536), 0, 0};
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_geolocate_batch(&wd->p, &fc, &cams[0].lib.pose, CT_METHOD_DIRECTIONAL, 0u, px, 2, two, 2));
+    TEST_ASSERT_EQUAL_INT(CT_HIT, two[0].status);
+    TEST_ASSERT_EQUAL_INT(CT_ERR_UNPROJECT, two[1].status);
+    TEST_ASSERT_EQUAL_INT(0, two[1].hit.steps);
+}
+
+}  // namespace
+
+int main()
+{
+    TEST_BEGIN("test_geoloc");
+    RUN_TEST(test_geolocate_vs_mrcal);
+    RUN_TEST(test_occluded_by_wall);
+    RUN_TEST(test_statuses_and_errors);
+    return TEST_END();
+}

@@ -1,0 +1,327 @@
+// test_geoloc_cli.cpp -- `conetrace geoloc` end to end (runs the real binary).
+//
+// In a fresh scratch directory (mkdtemp under /tmp): a package built from a
+// generated DEM, an mrcal .cameramodel written with full precision (exact
+// nadir: r = pi about east, translations at UTM magnitudes) and pixel CSVs.
+// Checks: the header u,v,status,E,N,h,steps; one row per pixel in input
+// order with the u,v echoed; each hit's E,N,h (nine decimals) equal to the
+// library's ct_geolocate on the same camera in-process (bit-identical);
+// statuses for pixels beyond the lens's field and off the terrain; column
+// order free in the input; --method and --effects ""; and bad inputs
+// (missing or unparsable camera, unsupported lens model, bad CSV, missing
+// option, unknown method, --effects curvature): non-zero exit, one stderr
+// line "conetrace: ..." naming the file or option, no output file, no
+// temporary left behind, an existing output untouched.
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "camera_host.hpp"
+#include "conetrace.h"
+#include "dem_cases.hpp"
+#include "harness.h"
+#include "host_io.hpp"
+
+#ifndef CT_CLI
+#error "CT_CLI must be defined (path of the conetrace binary)"
+#endif
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string g_dir;
+
+std::string slurp(const std::string &path)
+{
+    std::ifstream in(path, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+void spit(const std::string &path, const std::string &text)
+{
+    std::ofstream o(path, std::ios::binary | std::ios::trunc);
+    o << text;
+}
+
+std::vector<std::string> lines_of(const std::string &text)
+{
+    std::vector<std::string> v;
+    std::istringstream in(text);
+    std::string l;
+    while (std::getline(in, l)) v.push_back(l);
+    return v;
+}
+
+std::vector<std::string> split(const std::string &s)
+{
+    std::vector<std::string> v;
+    std::string cur;
+    for (char c : s) {
+        if (c == ',') {
+            v.push_back(cur);
+            cur.clear();
+        } else {
+            cur += c;
+        }
+    }
+    v.push_back(cur);
+    return v;
+}
+
+std::string quote(const std::string &s)
+{
+    std::string r = "'";
+    for (char c : s) r += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    return r + "'";
+}
+
+struct Run {
+    int code = -1;
+    std::string out, err;
+    std::vector<std::string> err_lines;
+};
+
+Run run(const std::vector<std::string> &args)
+{
+    std::string cmd = "cd " + quote(g_dir) + " && exec " + quote(CT_CLI);
+    for (const auto &a : args) cmd += " " + quote(a);
+    std::string fo = g_dir + "/../stdout.txt", fe = g_dir + "/../stderr.txt";
+    cmd += " </dev/null >" + quote(fo) + " 2>" + quote(fe);
+    int st = std::system(cmd.c_str());
+    Run r;
+    r.code = st == -1 ? -1 : (WIFEXITED(st) ? WEXITSTATUS(st) : 128 + (WIFSIGNALED(st) ? WTERMSIG(st) : 0));
+    r.out = slurp(fo);
+    r.err = slurp(fe);
+    r.err_lines = lines_of(r.err);
+    if (getenv("CT_TEST_VERBOSE")) printf("  $ conetrace ... -> %d\n%s", r.code, r.err.c_str());
+    return r;
+}
+
+std::set<std::string> listing()
+{
+    std::set<std::string> s;
+    for (const auto &e : fs::directory_iterator(g_dir)) s.insert(e.path().filename().string());
+    return s;
+}
+
+// The camera of the test: exact nadir above the tile, OPENCV4.
+const char *kModel =
+    "# conetrace test camera: nadir, r = pi about east\n"
+    "{\n"
+    "    'lensmodel':  'LENSMODEL_OPENCV4',\n"
+    "    'intrinsics': [ 3000, 3001.5, 1023.5, 767.5, -0.28, 0.09, 0.0001, -0.0002 ],\n"
+    "    'extrinsics': [ 3.141592653589793, 0, 0, %.17g, %.17g, %.17g ],\n"
+    "    'imagersize': [ 2048, 1536 ],\n"
+    "}\n";
+
+struct Setup {
+    dem_cases::Case c;
+    ct_package p;
+    double centre[3];
+    std::string model_text;
+};
+
+Setup *setup()
+{
+    static Setup *s = nullptr;
+    if (s) return s;
+    s = new Setup;
+    const int W = 64, H = 56;
+    s->c = dem_cases::make_case("cli", dem_cases::make_terrain(W, H, dem_cases::smooth(W, H, 5, 4000, 6000), 0.25), 8,
+                                1);
+    if (ct_package_open(&s->p, s->c.pkg.data(), s->c.pkg.size()) != CT_OK) return nullptr;
+    // centre above the middle of the tile, 2 km up; nadir R_cam_map =
+    // diag(1, -1, -1), so t = -R c = (-cE, cN, ch)
+    s->centre[0] = 500000.0 + 31.25 * 30 + 0.123456789;
+    s->centre[1] = 4000000.0 - 27.5 * 30 - 0.987654321;
+    s->centre[2] = 3500.0;
+    char buf[1024];
+    std::snprintf(buf, sizeof buf, kModel, -s->centre[0], s->centre[1], s->centre[2]);
+    s->model_text = buf;
+    spit(g_dir + "/t.ctp", std::string(s->c.pkg.begin(), s->c.pkg.end()));
+    spit(g_dir + "/cam.cameramodel", s->model_text);
+    return s;
+}
+
+// pixels: inside the image, fractional, corners, beyond 2^20 px, far outside
+const char *kPixels =
+    "u,v\n"
+    "1023.5,767.5\n"
+    "0,0\n"
+    "2047,1535\n"
+    "100.25,1400.75\n"
+    "1500.125,30.0625\n"
+    "5e6,3\n"          // beyond 2^20 px
+    "-900000,700\n"    // far outside the image: a ray ~80 deg off axis
+    "  512 , 384 \n"
+    "\n"
+    "1800.5,200.5\n";
+
+void test_geoloc_end_to_end()
+{
+    Setup *s = setup();
+    TEST_ASSERT(s != nullptr);
+    spit(g_dir + "/px.csv", kPixels);
+    Run r = run({"geoloc", "t.ctp", "--camera", "cam.cameramodel", "--pixels", "px.csv", "-o", "g.csv"});
+    TEST_ASSERT_MSG(r.code == 0, "exit %d: %s", r.code, r.err.c_str());
+    TEST_ASSERT_MSG(r.err.empty(), "stderr: %s", r.err.c_str());
+    std::vector<std::string> rows = lines_of(slurp(g_dir + "/g.csv"));
+    TEST_ASSERT_EQUAL_INT(10, rows.size());
+    TEST_ASSERT_MSG(rows[0] == "u,v,status,E,N,h,steps", "header '%s'", rows[0].c_str());
+    // the library on the same camera, in-process
+    ct_host::CameraModel cm = ct_host::read_cameramodel(g_dir + "/cam.cameramodel");
+    ct_host::LibCamera lc = ct_host::lib_camera(cm, "cam");
+    std::vector<ct_host::PixelRow> px = ct_host::read_pixels_csv(g_dir + "/px.csv");
+    TEST_ASSERT_EQUAL_INT(9, px.size());
+    const char *echo[9][2] = {{"1023.5", "767.5"}, {"0", "0"}, {"2047", "1535"}, {"100.25", "1400.75"},
+                              {"1500.125", "30.0625"}, {"5e6", "3"}, {"-900000", "700"}, {"512", "384"},
+                              {"1800.5", "200.5"}};
+    int hits = 0;
+    for (size_t k = 0; k < px.size(); ++k) {
+        std::vector<std::string> f = split(rows[k + 1]);
+        TEST_ASSERT_MSG(f.size() == 7, "row %zu: '%s'", k + 1, rows[k + 1].c_str());
+        TEST_ASSERT_MSG(f[0] == echo[k][0] && f[1] == echo[k][1], "row %zu echoes '%s,%s'", k + 1, f[0].c_str(),
+                        f[1].c_str());
+        int64_t uq, vq;
+        ct_status want = CT_ERR_UNPROJECT;
+        ct_geo g;
+        if (ct_host::pixel_to_q16(px[k].u, px[k].v, &uq, &vq))
+            want = ct_geolocate(&s->p, &lc.cam, &lc.pose, CT_METHOD_DIRECTIONAL, 0u, uq, vq, &g);
+        TEST_ASSERT_MSG(f[2] == ct_host::status_name(want), "row %zu: status %s, library %s", k + 1, f[2].c_str(),
+                        ct_host::status_name(want).c_str());
+        if (want == CT_HIT) {
+            ++hits;
+            TEST_ASSERT(f[3] == ct_host::nm_to_decimal(g.hit.e_nm));
+            TEST_ASSERT(f[4] == ct_host::nm_to_decimal(g.hit.n_nm));
+            TEST_ASSERT(f[5] == ct_host::nm_to_decimal(g.hit.h_nm));
+            TEST_ASSERT(f[6] == std::to_string(g.hit.steps));
+            // nine decimals, UTM magnitudes: "4000xxx.xxxxxxxxx"
+            TEST_ASSERT_MSG(f[4].size() == 17 && f[4][7] == '.', "northing '%s'", f[4].c_str());
+        } else {
+            TEST_ASSERT(f[3] == "nan" && f[4] == "nan" && f[5] == "nan");
+        }
+    }
+    TEST_ASSERT_MSG(hits >= 6, "only %d hits", hits);
+    TEST_ASSERT(split(rows[6])[2] == "err_unproject");
+    TEST_ASSERT(split(rows[7])[2] == "miss");  // ~80 deg off axis: over the horizon
+    // the centre pixel of an exact nadir camera lands below its centre (the
+    // camera's optical axis is vertical): within a millimetre
+    std::vector<std::string> f = split(rows[1]);
+    TEST_ASSERT_MSG(std::fabs(std::stod(f[3]) - s->centre[0]) < 1e-3 && std::fabs(std::stod(f[4]) - s->centre[1]) < 1e-3,
+                    "nadir centre pixel at %s, %s", f[3].c_str(), f[4].c_str());
+    // column order is free; other columns are ignored; --method, --effects ""
+    spit(g_dir + "/px2.csv", "id,v,u\na,767.5,1023.5\nb,1400.75,100.25\n");
+    r = run({"geoloc", "t.ctp", "--camera", "cam.cameramodel", "--pixels", "px2.csv", "--method", "incremental",
+             "--effects", "", "-o", "g2.csv"});
+    TEST_ASSERT_MSG(r.code == 0, "exit %d: %s", r.code, r.err.c_str());
+    std::vector<std::string> rows2 = lines_of(slurp(g_dir + "/g2.csv"));
+    TEST_ASSERT_EQUAL_INT(3, rows2.size());
+    std::vector<std::string> a = split(rows2[1]), b = split(rows[1]), c2 = split(rows2[2]), d = split(rows[4]);
+    for (int k = 0; k < 6; ++k) {
+        TEST_ASSERT(a[k] == b[k]);
+        TEST_ASSERT(c2[k] == d[k]);
+    }
+    fs::remove(g_dir + "/g.csv");
+    fs::remove(g_dir + "/g2.csv");
+    fs::remove(g_dir + "/px2.csv");
+}
+
+void test_geoloc_bad_inputs()
+{
+    Setup *s = setup();
+    TEST_ASSERT(s != nullptr);
+    spit(g_dir + "/px.csv", kPixels);
+    spit(g_dir + "/garbage.cameramodel", "{ 'lensmodel': 'LENSMODEL_OPENCV4', 'intrinsics': [ 1, 2,\n");
+    std::string stereo = s->model_text;
+    stereo.replace(stereo.find("LENSMODEL_OPENCV4"), 17, "LENSMODEL_STEREOGRAPHIC");
+    const std::string intr = "[ 3000, 3001.5, 1023.5, 767.5, -0.28, 0.09, 0.0001, -0.0002 ]";
+    stereo.replace(stereo.find(intr), intr.size(), "[ 3000, 3001.5, 1023.5, 767.5 ]");
+    spit(g_dir + "/stereo.cameramodel", stereo);
+    spit(g_dir + "/badnum.csv", "u,v\n1,2\n3,x4\n");
+    spit(g_dir + "/nocol.csv", "u,w\n1,2\n");
+    spit(g_dir + "/empty.csv", "");
+    spit(g_dir + "/bad.ctp", "not a package");
+    struct Case {
+        std::vector<std::string> args;
+        std::string needle;
+    };
+    const std::vector<std::string> base = {"geoloc", "t.ctp", "--camera", "cam.cameramodel", "--pixels", "px.csv"};
+    auto with = [&](const std::string &key, const std::string &val) {
+        std::vector<std::string> v = base;
+        for (size_t k = 0; k + 1 < v.size(); ++k)
+            if (v[k] == key) v[k + 1] = val;
+        v.push_back("-o");
+        v.push_back("out.csv");
+        return v;
+    };
+    std::vector<Case> cases = {
+        {with("--camera", "missing.cameramodel"), "missing.cameramodel"},
+        {with("--camera", "garbage.cameramodel"), "garbage.cameramodel"},
+        {with("--camera", "stereo.cameramodel"), "LENSMODEL_STEREOGRAPHIC"},
+        {with("--pixels", "missing.csv"), "missing.csv"},
+        {with("--pixels", "badnum.csv"), "badnum.csv:3"},
+        {with("--pixels", "nocol.csv"), "nocol.csv:1"},
+        {with("--pixels", "empty.csv"), "empty.csv"},
+        {with("t.ctp", "bad.ctp"), "bad.ctp"},
+        {{"geoloc", "t.ctp", "--camera", "cam.cameramodel", "-o", "out.csv"}, "--pixels"},
+        {{"geoloc", "t.ctp", "--camera", "cam.cameramodel", "--pixels", "px.csv"}, "-o"},
+        {{"geoloc", "t.ctp", "--camera", "cam.cameramodel", "--pixels", "px.csv", "--method", "bogus", "-o", "out.csv"},
+         "bogus"},
+        {{"geoloc", "t.ctp", "--camera", "cam.cameramodel", "--pixels", "px.csv", "--effects", "curvature", "-o",
+          "out.csv"},
+         "--effects"},
+        {{"geoloc", "t.ctp", "--camera", "cam.cameramodel", "--pixels", "px.csv", "--bogus", "1", "-o", "out.csv"},
+         "--bogus"},
+    };
+    // pixels 'bad.ctp' swap: the package is the second argument
+    cases[7].args = {"geoloc", "bad.ctp", "--camera", "cam.cameramodel", "--pixels", "px.csv", "-o", "out.csv"};
+    for (const Case &c : cases) {
+        std::set<std::string> before = listing();
+        Run r = run(c.args);
+        std::string all;
+        for (const auto &a : c.args) all += a + " ";
+        TEST_ASSERT_MSG(r.code != 0 && r.code < 128, "%s: exit %d", all.c_str(), r.code);
+        TEST_ASSERT_MSG(r.out.empty(), "%s: stdout '%s'", all.c_str(), r.out.c_str());
+        TEST_ASSERT_MSG(r.err_lines.size() == 1, "%s: %zu stderr lines:\n%s", all.c_str(), r.err_lines.size(),
+                        r.err.c_str());
+        TEST_ASSERT_MSG(r.err_lines[0].rfind("conetrace: ", 0) == 0 && r.err_lines[0].find(c.needle) != std::string::npos,
+                        "%s: stderr '%s' lacks '%s'", all.c_str(), r.err_lines[0].c_str(), c.needle.c_str());
+        TEST_ASSERT_MSG(listing() == before, "%s: the directory changed (partial output or temporary left)",
+                        all.c_str());
+    }
+    // an existing output survives a failed run
+    spit(g_dir + "/out.csv", "keep me\n");
+    Run r = run(with("--pixels", "badnum.csv"));
+    TEST_ASSERT(r.code != 0);
+    TEST_ASSERT(slurp(g_dir + "/out.csv") == "keep me\n");
+}
+
+}  // namespace
+
+int main()
+{
+    TEST_BEGIN("test_geoloc_cli");
+    char tmpl[] = "/tmp/ct_geoloc_cli_XXXXXX";
+    if (!mkdtemp(tmpl)) {
+        printf("cannot create a scratch directory\n");
+        return 1;
+    }
+    fs::create_directory(std::string(tmpl) + "/work");
+    g_dir = std::string(tmpl) + "/work";
+    RUN_TEST(test_geoloc_end_to_end);
+    RUN_TEST(test_geoloc_bad_inputs);
+    int rc = TEST_END();
+    if (!getenv("CT_TEST_KEEP")) fs::remove_all(tmpl);
+    return rc;
+}
