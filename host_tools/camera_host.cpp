@@ -20,6 +20,39 @@ namespace ct_host {
 
 typedef long double ld;
 
+namespace {
+
+// Run f with stderr redirected to a temporary file; return the last line
+// mrcal wrote there, without its "source.c(123): " prefix ("" if none).
+template <class F>
+std::string quiet_mrcal(F f)
+{
+    std::fflush(stderr);
+    std::FILE *cap = std::tmpfile();
+    int saved = dup(2);
+    if (cap && saved >= 0) dup2(fileno(cap), 2);
+    f();
+    std::fflush(stderr);
+    if (cap && saved >= 0) dup2(saved, 2);
+    if (saved >= 0) close(saved);
+    std::string why;
+    if (cap) {
+        std::rewind(cap);
+        char buf[512];
+        while (std::fgets(buf, sizeof buf, cap)) {
+            std::string s(buf);
+            while (!s.empty() && (s.back() == '\n' || s.back() == '\r')) s.pop_back();
+            size_t k = s.find("): ");
+            if (k != std::string::npos && k < 60) s = s.substr(k + 3);
+            if (!s.empty()) why = s;
+        }
+        std::fclose(cap);
+    }
+    return why;
+}
+
+}  // namespace
+
 void rotation_from_r(const ld r[3], ld R[9])
 {
     ld t2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
@@ -124,28 +157,8 @@ CameraModel read_cameramodel(const std::string &path)
         std::fclose(f);
     }
     // mrcal reports parse errors on stderr: capture them into one line
-    std::fflush(stderr);
-    std::FILE *cap = std::tmpfile();
-    int saved = dup(2);
-    if (cap && saved >= 0) dup2(fileno(cap), 2);
-    mrcal_cameramodel_t *m = mrcal_read_cameramodel_file(path.c_str());
-    std::fflush(stderr);
-    if (cap && saved >= 0) dup2(saved, 2);
-    if (saved >= 0) close(saved);
-    std::string why;
-    if (cap) {
-        std::rewind(cap);
-        char buf[512];
-        while (std::fgets(buf, sizeof buf, cap)) {
-            std::string s(buf);
-            while (!s.empty() && (s.back() == '\n' || s.back() == '\r')) s.pop_back();
-            // drop mrcal's "source.c(123): " prefix
-            size_t k = s.find("): ");
-            if (k != std::string::npos && k < 60) s = s.substr(k + 3);
-            if (!s.empty()) why = s;
-        }
-        std::fclose(cap);
-    }
+    mrcal_cameramodel_t *m = nullptr;
+    std::string why = quiet_mrcal([&] { m = mrcal_read_cameramodel_file(path.c_str()); });
     if (!m) throw Error(path + ": not a valid mrcal .cameramodel" + (why.empty() ? "" : " (" + why + ")"));
     CameraModel c;
     char name[256];
@@ -163,17 +176,76 @@ CameraModel read_cameramodel(const std::string &path)
     return c;
 }
 
-LibCamera lib_camera(const CameraModel &m, const std::string &path)
+bool is_parametric(const std::string &model)
+{
+    return model == "LENSMODEL_PINHOLE" || model == "LENSMODEL_OPENCV4" || model == "LENSMODEL_OPENCV5" ||
+           model == "LENSMODEL_OPENCV8";
+}
+
+BakedGrid bake_grid(const CameraModel &m, double step_px)
+{
+    mrcal_lensmodel_t lm;
+    if (!mrcal_lensmodel_from_name(&lm, m.model.c_str())) throw Error("unknown lens model " + m.model);
+    if ((int)m.intrinsics.size() != mrcal_lensmodel_num_params(&lm))
+        throw Error(m.model + ": wrong number of intrinsics");
+    if (!(step_px >= 1 && step_px <= 4096)) throw Error("grid step must be in [1, 4096] pixels");
+    if (m.width == 0 || m.height == 0) throw Error("the camera model has no imager size");
+    BakedGrid b;
+    ct_unproject_grid &g = b.grid;
+    g.step_q16 = std::llround(step_px * 65536.0);
+    const double step = g.step_q16 / 65536.0;
+    const double u0 = -0.5 - step, v0 = -0.5 - step;
+    g.u0_q16 = std::llround(u0 * 65536.0);
+    g.v0_q16 = std::llround(v0 * 65536.0);
+    const double su = g.u0_q16 / 65536.0, sv = g.v0_q16 / 65536.0;
+    long nu = (long)std::floor((m.width - 0.5 - su) / step) + 3, nv = (long)std::floor((m.height - 0.5 - sv) / step) + 3;
+    if (nu > (long)CT_GRID_MAX_NODES || nv > (long)CT_GRID_MAX_NODES)
+        throw Error("grid of " + std::to_string(nu) + " x " + std::to_string(nv) + " nodes exceeds the library's " +
+                    std::to_string(CT_GRID_MAX_NODES) + " per side; use a larger step");
+    g.nu = (uint32_t)nu;
+    g.nv = (uint32_t)nv;
+    std::vector<mrcal_point2_t> q((size_t)nu * nv);
+    for (long j = 0; j < nv; ++j)
+        for (long i = 0; i < nu; ++i) {
+            q[(size_t)j * nu + i].x = su + i * step;
+            q[(size_t)j * nu + i].y = sv + j * step;
+        }
+    std::vector<mrcal_point3_t> v(q.size());
+    bool ok = false;
+    std::string why = quiet_mrcal([&] { ok = mrcal_unproject(v.data(), q.data(), (int)q.size(), &lm, m.intrinsics.data()); });
+    if (!ok) throw Error(m.model + ": mrcal cannot unproject this model" + (why.empty() ? "" : " (" + why + ")"));
+    b.rays = std::make_shared<std::vector<int32_t>>(3 * q.size(), 0);
+    for (size_t k = 0; k < q.size(); ++k) {
+        ld x = v[k].x, y = v[k].y, z = v[k].z, n = std::sqrt(x * x + y * y + z * z);
+        if (!std::isfinite((double)n) || !(n > 0)) {
+            ++b.missing;
+            continue;
+        }
+        (*b.rays)[3 * k] = (int32_t)std::llround(x / n * 1073741824.0L);
+        (*b.rays)[3 * k + 1] = (int32_t)std::llround(y / n * 1073741824.0L);
+        (*b.rays)[3 * k + 2] = (int32_t)std::llround(z / n * 1073741824.0L);
+    }
+    g.rays_q30 = b.rays->data();
+    g.rays_len = b.rays->size();
+    return b;
+}
+
+LibCamera lib_camera(const CameraModel &m, const std::string &path, double grid_step_px)
 {
     LibCamera c;
-    ct_lens l;
+    ct_status st;
     try {
-        l = lens_from_intrinsics(m.model, m.intrinsics, m.width, m.height);
         c.host_pose = pose_from_rt_cam_ref(m.rt_cam_ref);
+        if (is_parametric(m.model)) {
+            ct_lens l = lens_from_intrinsics(m.model, m.intrinsics, m.width, m.height);
+            st = ct_camera_init(&c.cam, &l);
+        } else {
+            c.baked = bake_grid(m, grid_step_px);
+            st = ct_camera_init_grid(&c.cam, &c.baked.grid);
+        }
     } catch (const Error &e) {
         throw Error(path + ": " + e.what());
     }
-    ct_status st = ct_camera_init(&c.cam, &l);
     if (st != CT_OK) throw Error(path + ": the library refuses the lens (" + status_name(st) + ")");
     st = ct_pose_init(&c.pose, c.host_pose.R_map_cam_q30, c.host_pose.centre_nm[0], c.host_pose.centre_nm[1],
                       c.host_pose.centre_nm[2]);

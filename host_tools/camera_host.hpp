@@ -10,6 +10,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -51,14 +52,35 @@ struct CameraModel {
 // suppressed so a failure is one line).
 CameraModel read_cameramodel(const std::string &path);
 
-// A camera ready for the library: lens checked by ct_camera_init, pose by
-// ct_pose_init.  Throws Error("<path>: ...") when either refuses.
+// Any mrcal lens model baked into an unprojection grid (ct_unproject_grid):
+// unit rays from mrcal_unproject at pixels u0 + i * step covering the
+// imager (pixel centres -0.5 .. width - 0.5) with the 4 x 4 Catmull-Rom
+// support; nodes mrcal cannot unproject are (0, 0, 0).  The table is
+// shared so copies of the grid stay valid.  Throws Error when the grid
+// would exceed the library's limits.
+struct BakedGrid {
+    std::shared_ptr<std::vector<int32_t>> rays;
+    ct_unproject_grid grid;
+    long missing = 0;  // nodes without a ray
+};
+BakedGrid bake_grid(const CameraModel &m, double step_px);
+
+// Default grid step for models the library has no closed form for (see
+// README "Geolocation": accuracy vs step).
+constexpr double kDefaultGridStepPx = 16.0;
+
+// A camera ready for the library: lens checked by ct_camera_init (PINHOLE,
+// OPENCV4/5/8) or baked into a grid (any other model mrcal can unproject,
+// step grid_step_px), pose by ct_pose_init.  Throws Error("<path>: ...")
+// when either refuses.
 struct LibCamera {
     ct_camera cam;
     ct_pose pose;
     HostPose host_pose;
+    BakedGrid baked;  // grid cameras only
 };
-LibCamera lib_camera(const CameraModel &m, const std::string &path);
+bool is_parametric(const std::string &model);
+LibCamera lib_camera(const CameraModel &m, const std::string &path, double grid_step_px = kDefaultGridStepPx);
 
 // pixels.csv: header naming columns u and v (any order, other columns
 // ignored), one pixel per line (mrcal convention: (0,0) is the centre of

@@ -1,11 +1,14 @@
 // cmd_geoloc.cpp -- `conetrace geoloc`: pixels of a camera to map points.
 //
 //   conetrace geoloc PKG --camera C.cameramodel --pixels px.csv [--method M]
-//                        [--effects LIST] -o g.csv
+//                        [--effects LIST] [--grid-step PX] -o g.csv
 //
 // C.cameramodel: an mrcal camera model (read by libmrcal's C reader); its
 //   extrinsics are rt_cam_ref with the package's map frame (metres) as the
-//   reference.  Lens models: LENSMODEL_PINHOLE, LENSMODEL_OPENCV4/5/8.
+//   reference.  Lens models: LENSMODEL_PINHOLE, LENSMODEL_OPENCV4/5/8 in
+//   closed form; any other model mrcal can unproject (e.g.
+//   LENSMODEL_SPLINED_STEREOGRAPHIC_...) is baked into an unprojection grid
+//   with --grid-step PX (default 16) between nodes.
 // px.csv: header naming u and v, one pixel per line (mrcal convention:
 //   (0,0) is the centre of the top-left pixel).
 // g.csv: header u,v,status,E,N,h,steps; one row per pixel, in input order;
@@ -17,6 +20,7 @@
 // ct_geolocate_batch.  Errors print one line and exit non-zero; the output
 // is written atomically (never a partial file).
 #include <cstdio>
+#include <cstdlib>
 #include <map>
 #include <sstream>
 #include <string>
@@ -33,7 +37,7 @@ int cmd_geoloc(int argc, char **argv)
 {
     std::vector<std::string> pos;
     std::map<std::string, std::string> opt;
-    const char *valued[] = {"--camera", "--pixels", "--method", "--effects", "-o"};
+    const char *valued[] = {"--camera", "--pixels", "--method", "--effects", "--grid-step", "-o"};
     for (int k = 2; k < argc; ++k) {
         std::string s = argv[k];
         if (s.size() > 1 && s[0] == '-') {
@@ -64,12 +68,21 @@ int cmd_geoloc(int argc, char **argv)
         else throw Error("unknown method '" + s + "' (incremental, hierarchical, cone, directional)");
     }
 
+    double grid_step = kDefaultGridStepPx;
+    if (opt.count("--grid-step")) {
+        const std::string &g = opt["--grid-step"];
+        char *end = nullptr;
+        grid_step = std::strtod(g.c_str(), &end);
+        if (g.empty() || !end || *end || !(grid_step >= 1 && grid_step <= 4096))
+            throw Error("--grid-step needs a number of pixels in [1, 4096], got '" + g + "'");
+    }
+
     std::vector<uint8_t> bytes = read_file(pos[0]);
     ct_package p;
     ct_status st = ct_package_open(&p, bytes.data(), bytes.size());
     if (st != CT_OK) throw Error(pos[0] + ": not a valid package (" + status_name(st) + ")");
     const std::string &cpath = opt["--camera"];
-    LibCamera cam = lib_camera(read_cameramodel(cpath), cpath);
+    LibCamera cam = lib_camera(read_cameramodel(cpath), cpath, grid_step);
     std::vector<PixelRow> px = read_pixels_csv(opt["--pixels"]);
 
     std::vector<int64_t> uv(2 * px.size());

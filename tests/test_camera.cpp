@@ -438,6 +438,163 @@ void test_project_vs_mrcal()
            worst, worst_rel);
 }
 
+// ---- unprojection grids ----------------------------------------------------
+
+// A splined stereographic lens (mrcal's richest model) with a smooth
+// distortion of a few pixels on top of the stereographic projection.
+ct_host::CameraModel splined_model()
+{
+    ct_host::CameraModel m;
+    const int nx = 16, ny = 12;
+    m.model = "LENSMODEL_SPLINED_STEREOGRAPHIC_order=3_Nx=16_Ny=12_fov_x_deg=120";
+    m.width = 2000;
+    m.height = 1500;
+    m.intrinsics = {866.0, 867.5, 999.3, 751.2};
+    for (int j = 0; j < ny; ++j)
+        for (int i = 0; i < nx; ++i) {
+            double a = (i - 7.5) / 7.5, b = (j - 5.5) / 5.5;
+            m.intrinsics.push_back(0.004 * a * b + 0.003 * std::sin(2.1 * a + 0.7 * b));
+            m.intrinsics.push_back(-0.003 * a * a + 0.002 * std::cos(1.3 * b - 0.4 * a));
+        }
+    return m;
+}
+
+ct_host::CameraModel opencv8_wide_model()
+{
+    ct_host::CameraModel m;
+    const std::vector<Model> ms = models();
+    const Model &w = ms[5];
+    m.model = w.lens;
+    m.intrinsics = w.in;
+    m.width = w.w;
+    m.height = w.h;
+    return m;
+}
+
+// Accuracy vs grid step against mrcal_unproject, over random pixels of the
+// image.  Returns the largest angle (rad); counts refusals.
+double grid_error(const ct_host::CameraModel &m, double step, int n, long *refused, double *mean)
+{
+    ct_host::BakedGrid b = ct_host::bake_grid(m, step);
+    ct_camera cam;
+    if (ct_camera_init_grid(&cam, &b.grid) != CT_OK) return 1e9;
+    mrcal_lensmodel_t lm = mrcal_model(m.model.c_str());
+    ct_rng rng;
+    ct_rng_seed(&rng, ct_test_seed() * 29 + (uint64_t)step);
+    double worst = 0, sum = 0;
+    long cnt = 0;
+    *refused = 0;
+    for (int k = 0; k < n; ++k) {
+        double u = -0.5 + ct_rng_unit(&rng) * m.width, v = -0.5 + ct_rng_unit(&rng) * m.height;
+        int64_t uq = std::llround(u * 65536), vq = std::llround(v * 65536);
+        int32_t ray[3];
+        if (ct_camera_unproject(&cam, uq, vq, ray, nullptr) != CT_OK) {
+            ++*refused;
+            continue;
+        }
+        mrcal_point2_t q = {{uq / 65536.0, vq / 65536.0}};
+        mrcal_point3_t mv;
+        mrcal_unproject(&mv, &q, 1, &lm, m.intrinsics.data());
+        ld r[3], mm[3] = {mv.x, mv.y, mv.z};
+        ray_ld(ray, r);
+        double a = (double)angle_between(r, mm);
+        worst = std::max(worst, a);
+        sum += a;
+        ++cnt;
+    }
+    *mean = cnt ? sum / cnt : 0;
+    return worst;
+}
+
+void test_grid_accuracy_vs_step()
+{
+    const double GRID16_TOL_RAD = 3e-7;  // at a 16 px step (README)
+    for (const ct_host::CameraModel &m : {opencv8_wide_model(), splined_model()}) {
+        double prev = 0;
+        for (double step : {64.0, 32.0, 16.0, 8.0, 4.0}) {
+            long refused = 0;
+            double mean = 0, e = grid_error(m, step, (int)(4000 * ct_test_scale()), &refused, &mean);
+            ct_host::BakedGrid b = ct_host::bake_grid(m, step);
+            printf("  grid %-60.60s step %2.0f px (%4u x %4u nodes, %7.1f KB): max %.2e rad, mean %.2e rad, "
+                   "%ld refused\n",
+                   m.model.c_str(), step, b.grid.nu, b.grid.nv, b.rays->size() * 4 / 1024.0, e, mean, refused);
+            TEST_ASSERT_MSG(refused == 0, "%s step %g: %ld pixels of the image refused", m.model.c_str(), step, refused);
+            if (step == 16.0) TEST_ASSERT_MSG(e <= GRID16_TOL_RAD, "%s: %.3g rad at 16 px", m.model.c_str(), e);
+            // cubic convergence until the Q30 floor
+            if (prev > 1e-8) TEST_ASSERT_MSG(e < prev, "%s: error did not shrink with the step", m.model.c_str());
+            prev = e;
+        }
+    }
+}
+
+void test_grid_evil()
+{
+    ct_host::CameraModel m = splined_model();
+    ct_host::BakedGrid b = ct_host::bake_grid(m, 32);
+    ct_camera cam;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_camera_init_grid(&cam, &b.grid));
+    int32_t ray[3];
+    int64_t u, v;
+    // the principal point unprojects; projection is not available
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_camera_unproject(&cam, std::llround(999.3 * 65536), std::llround(751.2 * 65536), ray, nullptr));
+    TEST_ASSERT_MSG(ray[2] > 1073000000 && std::abs(ray[0]) < 10000000 && std::abs(ray[1]) < 10000000, "axis %d %d %d",
+                    ray[0], ray[1], ray[2]);
+    TEST_ASSERT_EQUAL_INT(CT_ERR_LENS, ct_camera_project(&cam, ray, &u, &v));
+    // outside the grid's support
+    TEST_ASSERT_EQUAL_INT(CT_ERR_UNPROJECT, ct_camera_unproject(&cam, -40 * 65536, 700 * 65536, ray, nullptr));
+    TEST_ASSERT_EQUAL_INT(CT_ERR_UNPROJECT, ct_camera_unproject(&cam, 700 * 65536, 1600 * 65536, ray, nullptr));
+    // a node without a ray: the 4 x 4 pixels around it refuse, others do not
+    std::vector<int32_t> t = *b.rays;
+    ct_unproject_grid g = b.grid;
+    g.rays_q30 = t.data();
+    size_t node = (size_t)10 * g.nu + 12;
+    t[3 * node] = t[3 * node + 1] = t[3 * node + 2] = 0;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_camera_init_grid(&cam, &g));
+    double nu_px = g.u0_q16 / 65536.0 + 12 * 32, nv_px = g.v0_q16 / 65536.0 + 10 * 32;
+    TEST_ASSERT_EQUAL_INT(CT_ERR_UNPROJECT, ct_camera_unproject(&cam, std::llround((nu_px + 5) * 65536), std::llround((nv_px - 40) * 65536), ray, nullptr));
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_camera_unproject(&cam, std::llround((nu_px + 70) * 65536), std::llround((nv_px - 40) * 65536), ray, nullptr));
+    // rays that disagree (a node flipped): refused, never averaged into nonsense
+    t = *b.rays;
+    for (int k = 0; k < 3; ++k) t[3 * node + k] = -t[3 * node + k];
+    for (int k = 0; k < 3; ++k) t[3 * (node + 1) + k] = -t[3 * (node + 1) + k];
+    for (int k = 0; k < 3; ++k) t[3 * (node + g.nu) + k] = -t[3 * (node + g.nu) + k];
+    for (int k = 0; k < 3; ++k) t[3 * (node + g.nu + 1) + k] = -t[3 * (node + g.nu + 1) + k];
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_camera_init_grid(&cam, &g));
+    TEST_ASSERT_EQUAL_INT(CT_ERR_UNPROJECT, ct_camera_unproject(&cam, std::llround((nu_px + 16) * 65536), std::llround((nv_px + 16) * 65536), ray, nullptr));
+    // bad geometry and bad nodes
+    struct Case {
+        const char *what;
+        void (*mutate)(ct_unproject_grid *, std::vector<int32_t> *);
+    };
+    const Case cases[] = {
+        {"nu < 4", [](ct_unproject_grid *x, std::vector<int32_t> *) { x->nu = 3; }},
+        {"nv > max", [](ct_unproject_grid *x, std::vector<int32_t> *) { x->nv = CT_GRID_MAX_NODES + 1; }},
+        {"step 0", [](ct_unproject_grid *x, std::vector<int32_t> *) { x->step_q16 = 0; }},
+        {"step < 1 px", [](ct_unproject_grid *x, std::vector<int32_t> *) { x->step_q16 = 65535; }},
+        {"step > 4096 px", [](ct_unproject_grid *x, std::vector<int32_t> *) { x->step_q16 = (INT64_C(4096) << 16) + 1; }},
+        {"u0 beyond 2^20 px", [](ct_unproject_grid *x, std::vector<int32_t> *) { x->u0_q16 = INT64_MIN; }},
+        {"table too short", [](ct_unproject_grid *x, std::vector<int32_t> *) { x->rays_len = 3 * x->nu * x->nv - 1; }},
+        {"no table", [](ct_unproject_grid *x, std::vector<int32_t> *) { x->rays_q30 = nullptr; }},
+        {"node not unit", [](ct_unproject_grid *, std::vector<int32_t> *tt) { (*tt)[3 * 57 + 2] += 1 << 12; }},
+        {"node component too big", [](ct_unproject_grid *, std::vector<int32_t> *tt) { (*tt)[3 * 5] = INT32_MIN; }},
+    };
+    for (const Case &c : cases) {
+        t = *b.rays;
+        g = b.grid;
+        g.rays_q30 = t.data();
+        c.mutate(&g, &t);
+        ct_status st = ct_camera_init_grid(&cam, &g);
+        TEST_ASSERT_MSG(st == CT_ERR_LENS, "%s: expected CT_ERR_LENS, got %d", c.what, (int)st);
+        TEST_ASSERT_EQUAL_INT(CT_ERR_ARG, ct_camera_unproject(&cam, 0, 0, ray, nullptr));
+    }
+    // ct_camera_init refuses the grid model (it needs its table)
+    ct_lens l;
+    std::memset(&l, 0, sizeof l);
+    l.model = CT_LENS_GRID;
+    l.fx_q32 = l.fy_q32 = INT64_C(1000) << 32;
+    TEST_ASSERT_EQUAL_INT(CT_ERR_LENS, ct_camera_init(&cam, &l));
+}
+
 // ---- pose ---------------------------------------------------------------
 
 void mat_mrcal(const ld r[3], double R[9])
@@ -650,6 +807,8 @@ int main()
     RUN_TEST(test_unproject_hard_values);
     RUN_TEST(test_lens_evil);
     RUN_TEST(test_project_vs_mrcal);
+    RUN_TEST(test_grid_accuracy_vs_step);
+    RUN_TEST(test_grid_evil);
     RUN_TEST(test_rodrigues_vs_mrcal);
     RUN_TEST(test_rotations_from_axes);
     RUN_TEST(test_pose_vs_mrcal);

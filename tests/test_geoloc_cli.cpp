@@ -237,17 +237,81 @@ void test_geoloc_end_to_end()
     fs::remove(g_dir + "/px2.csv");
 }
 
+// A lens model without a closed form in the library (mrcal's splined
+// stereographic) is baked into an unprojection grid: the command's rows
+// equal the library's on the same baked grid, for the default and an
+// explicit --grid-step.
+void test_geoloc_splined_grid()
+{
+    Setup *s = setup();
+    TEST_ASSERT(s != nullptr);
+    std::string txt = "{\n    'lensmodel':  'LENSMODEL_SPLINED_STEREOGRAPHIC_order=3_Nx=16_Ny=12_fov_x_deg=32',\n"
+                      "    'intrinsics': [ 3800, 3801, 1023.5, 767.5";
+    for (int j = 0; j < 12; ++j)
+        for (int i = 0; i < 16; ++i) {
+            char b[64];
+            std::snprintf(b, sizeof b, ", %.6f, %.6f", 0.002 * std::sin(0.4 * i + 0.3 * j),
+                          -0.0015 * std::cos(0.2 * i - 0.5 * j));
+            txt += b;
+        }
+    char tail[256];
+    std::snprintf(tail, sizeof tail,
+                  " ],\n    'extrinsics': [ 3.141592653589793, 0, 0, %.17g, %.17g, %.17g ],\n"
+                  "    'imagersize': [ 2048, 1536 ],\n}\n",
+                  -s->centre[0], s->centre[1], s->centre[2]);
+    txt += tail;
+    spit(g_dir + "/spl.cameramodel", txt);
+    spit(g_dir + "/px.csv", kPixels);
+    for (double step : {ct_host::kDefaultGridStepPx, 8.0}) {
+        std::vector<std::string> args = {"geoloc", "t.ctp", "--camera", "spl.cameramodel", "--pixels", "px.csv",
+                                         "-o", "gs.csv"};
+        if (step != ct_host::kDefaultGridStepPx) {
+            args.push_back("--grid-step");
+            args.push_back("8");
+        }
+        Run r = run(args);
+        TEST_ASSERT_MSG(r.code == 0, "exit %d: %s", r.code, r.err.c_str());
+        std::vector<std::string> rows = lines_of(slurp(g_dir + "/gs.csv"));
+        TEST_ASSERT_EQUAL_INT(10, rows.size());
+        ct_host::LibCamera lc = ct_host::lib_camera(ct_host::read_cameramodel(g_dir + "/spl.cameramodel"), "spl", step);
+        TEST_ASSERT_EQUAL_INT(CT_LENS_GRID, lc.cam.lens.model);
+        std::vector<ct_host::PixelRow> px = ct_host::read_pixels_csv(g_dir + "/px.csv");
+        int hits = 0;
+        for (size_t k = 0; k < px.size(); ++k) {
+            std::vector<std::string> f = split(rows[k + 1]);
+            int64_t uq, vq;
+            ct_status want = CT_ERR_UNPROJECT;
+            ct_geo g;
+            if (ct_host::pixel_to_q16(px[k].u, px[k].v, &uq, &vq))
+                want = ct_geolocate(&s->p, &lc.cam, &lc.pose, CT_METHOD_DIRECTIONAL, 0u, uq, vq, &g);
+            TEST_ASSERT_MSG(f[2] == ct_host::status_name(want), "row %zu: %s vs %s", k + 1, f[2].c_str(),
+                            ct_host::status_name(want).c_str());
+            if (want == CT_HIT) {
+                ++hits;
+                TEST_ASSERT(f[3] == ct_host::nm_to_decimal(g.hit.e_nm) && f[4] == ct_host::nm_to_decimal(g.hit.n_nm) &&
+                            f[5] == ct_host::nm_to_decimal(g.hit.h_nm));
+            }
+        }
+        // pixels of the image hit; the two beyond it are outside the grid
+        TEST_ASSERT_MSG(hits == 7, "%d hits", hits);
+        TEST_ASSERT(split(rows[6])[2] == "err_unproject" && split(rows[7])[2] == "err_unproject");
+        fs::remove(g_dir + "/gs.csv");
+    }
+    fs::remove(g_dir + "/spl.cameramodel");
+}
+
 void test_geoloc_bad_inputs()
 {
     Setup *s = setup();
     TEST_ASSERT(s != nullptr);
     spit(g_dir + "/px.csv", kPixels);
     spit(g_dir + "/garbage.cameramodel", "{ 'lensmodel': 'LENSMODEL_OPENCV4', 'intrinsics': [ 1, 2,\n");
-    std::string stereo = s->model_text;
-    stereo.replace(stereo.find("LENSMODEL_OPENCV4"), 17, "LENSMODEL_STEREOGRAPHIC");
+    // CAHVORE: mrcal itself cannot unproject it, so it cannot be baked
+    std::string cah = s->model_text;
+    cah.replace(cah.find("LENSMODEL_OPENCV4"), 17, "LENSMODEL_CAHVORE_linearity=1.00");
     const std::string intr = "[ 3000, 3001.5, 1023.5, 767.5, -0.28, 0.09, 0.0001, -0.0002 ]";
-    stereo.replace(stereo.find(intr), intr.size(), "[ 3000, 3001.5, 1023.5, 767.5 ]");
-    spit(g_dir + "/stereo.cameramodel", stereo);
+    cah.replace(cah.find(intr), intr.size(), "[ 3000, 3001.5, 1023.5, 767.5, 0, 0, 0, 0, 0, 0, 0, 0 ]");
+    spit(g_dir + "/cahvore.cameramodel", cah);
     spit(g_dir + "/badnum.csv", "u,v\n1,2\n3,x4\n");
     spit(g_dir + "/nocol.csv", "u,w\n1,2\n");
     spit(g_dir + "/empty.csv", "");
@@ -268,7 +332,7 @@ void test_geoloc_bad_inputs()
     std::vector<Case> cases = {
         {with("--camera", "missing.cameramodel"), "missing.cameramodel"},
         {with("--camera", "garbage.cameramodel"), "garbage.cameramodel"},
-        {with("--camera", "stereo.cameramodel"), "LENSMODEL_STEREOGRAPHIC"},
+        {with("--camera", "cahvore.cameramodel"), "CAHVORE"},
         {with("--pixels", "missing.csv"), "missing.csv"},
         {with("--pixels", "badnum.csv"), "badnum.csv:3"},
         {with("--pixels", "nocol.csv"), "nocol.csv:1"},
@@ -283,6 +347,9 @@ void test_geoloc_bad_inputs()
          "--effects"},
         {{"geoloc", "t.ctp", "--camera", "cam.cameramodel", "--pixels", "px.csv", "--bogus", "1", "-o", "out.csv"},
          "--bogus"},
+        {{"geoloc", "t.ctp", "--camera", "cam.cameramodel", "--pixels", "px.csv", "--grid-step", "0.5", "-o",
+          "out.csv"},
+         "--grid-step"},
     };
     // pixels 'bad.ctp' swap: the package is the second argument
     cases[7].args = {"geoloc", "bad.ctp", "--camera", "cam.cameramodel", "--pixels", "px.csv", "-o", "out.csv"};
@@ -320,6 +387,7 @@ int main()
     fs::create_directory(std::string(tmpl) + "/work");
     g_dir = std::string(tmpl) + "/work";
     RUN_TEST(test_geoloc_end_to_end);
+    RUN_TEST(test_geoloc_splined_grid);
     RUN_TEST(test_geoloc_bad_inputs);
     int rc = TEST_END();
     if (!getenv("CT_TEST_KEEP")) fs::remove_all(tmpl);

@@ -417,7 +417,8 @@ typedef enum {
     CT_LENS_OPENCV4 = 1, /* + k1 k2 p1 p2                                   */
     CT_LENS_OPENCV5 = 2, /* + k1 k2 p1 p2 k3                                */
     CT_LENS_OPENCV8 = 3, /* + k1 k2 p1 p2 k3 k4 k5 k6 (rational)            */
-    CT_LENS_COUNT = 4
+    CT_LENS_COUNT = 4,   /* parametric models above                         */
+    CT_LENS_GRID = 16    /* unprojection grid (ct_camera_init_grid)         */
 } ct_lens_model;
 
 #define CT_CAM_MAX_PIXEL 1048576           /* 2^20 px                        */
@@ -439,10 +440,34 @@ typedef struct {
     int64_t dist_q48[8];       /* k1 k2 p1 p2 k3 k4 k5 k6, Q48              */
 } ct_lens;
 
-/* A validated lens with its valid field.  Fill with ct_camera_init.        */
+/* Unprojection grid: any lens (e.g. mrcal's LENSMODEL_SPLINED_STEREOGRAPHIC)
+ * baked on the host into unit rays at grid pixels
+ *   (u, v) = (u0 + i * step, v0 + j * step),  i < nu, j < nv,
+ * stored row-major (j outer) as int32 Q30 triples in caller memory (may be
+ * const in flash; not copied).  A node without a ray is (0, 0, 0).  The
+ * library interpolates with separable Catmull-Rom cubics over the 4 x 4
+ * nodes around the pixel (exact for rays that vary cubically with the
+ * pixel) and renormalises; the cell position is kept to 2^-20 of a step.
+ * A pixel whose 4 x 4 nodes are not all inside the grid and valid, or
+ * whose interpolated vector is shorter than half a unit or more than 60 deg
+ * from any of those nodes (rays that disagree), is CT_ERR_UNPROJECT.  Rays
+ * may point anywhere (fields of view beyond 180 deg).  Accuracy vs step:
+ * README "Geolocation" (1.3e-7 rad at a 16 px step on a 160 deg lens).    */
+#define CT_GRID_MAX_NODES 16384u          /* per side                     */
 typedef struct {
-    ct_lens lens;
+    uint32_t nu, nv;           /* nodes per row / column, 4..CT_GRID_MAX_NODES */
+    int64_t u0_q16, v0_q16;    /* pixel of node (0, 0), Q16, |.| <= 2^20 px */
+    int64_t step_q16;          /* node spacing, Q16 px, in [1, 4096] px      */
+    const int32_t *rays_q30;   /* 3 * nu * nv int32: unit rays, Q30          */
+    size_t rays_len;           /* int32 entries available (>= 3 nu nv)      */
+} ct_unproject_grid;
+
+/* A validated lens with its valid field.  Fill with ct_camera_init (or
+ * ct_camera_init_grid).                                                    */
+typedef struct {
+    ct_lens lens;              /* lens.model == CT_LENS_GRID for a grid     */
     int64_t r2_max_q32;        /* valid field: x^2 + y^2 <= r2_max (Q32)     */
+    ct_unproject_grid grid;    /* CT_LENS_GRID only                         */
     uint32_t ready;            /* set by ct_camera_init                      */
 } ct_camera;
 
@@ -469,6 +494,12 @@ typedef struct {
  * at all).                                                                 */
 ct_status ct_camera_init(ct_camera *cam, const ct_lens *lens);
 
+/* A camera from an unprojection grid (the table stays in caller memory).
+ * Checks the geometry and every node (unit within 2^-20, or (0, 0, 0)):
+ * CT_OK or CT_ERR_LENS.  ct_camera_project is not available for it
+ * (CT_ERR_LENS).                                                           */
+ct_status ct_camera_init_grid(ct_camera *cam, const ct_unproject_grid *grid);
+
 /* Pixel (u, v) (Q16) to the unit ray in the camera frame (Q30).  CT_OK or
  * CT_ERR_UNPROJECT.  *iters (may be NULL) receives the Newton iterations.  */
 ct_status ct_camera_unproject(const ct_camera *cam, int64_t u_q16,
@@ -477,7 +508,8 @@ ct_status ct_camera_unproject(const ct_camera *cam, int64_t u_q16,
 
 /* Camera-frame direction (any int32 vector with z > 0, not necessarily
  * unit) to the pixel (Q16, rounded).  CT_ERR_UNPROJECT when the direction
- * is behind the camera or outside the valid field.                          */
+ * is behind the camera or outside the valid field; CT_ERR_LENS for a grid
+ * camera.                                                                  */
 ct_status ct_camera_project(const ct_camera *cam, const int32_t ray_cam[3],
                             int64_t *u_q16, int64_t *v_q16);
 

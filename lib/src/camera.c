@@ -49,6 +49,8 @@ typedef struct {
     int64_t jxx, jxy, jyy;      /* Jacobian (symmetric off-diagonal)       */
 } lens_eval;
 
+static ct_status grid_unproject(const ct_camera *c, int64_t u, int64_t v, int32_t out[3]);
+
 static int has_distortion(const ct_lens *l) { return l->model != CT_LENS_PINHOLE; }
 
 /* -lim <= v <= lim without forming |v| (v may be INT64_MIN) */
@@ -357,6 +359,9 @@ ct_status ct_camera_unproject(const ct_camera *cam, int64_t u, int64_t v, int32_
     if (!within(u, (int64_t)CT_CAM_MAX_PIXEL << 16) || !within(v, (int64_t)CT_CAM_MAX_PIXEL << 16)) {
         return CT_ERR_UNPROJECT;
     }
+    if (l->model == CT_LENS_GRID) {
+        return grid_unproject(cam, u, v, ray);
+    }
     /* x_d = (u 2^16 - cx) 2^32 / fx (all Q32): |u 2^16 - cx| <= 2^53, so
      * the numerator < 2^85; fx <= 2^52 */
     if (!ct_div_round(ct_i128_shl(ct_i128_from64(u * 65536 - l->cx_q32), 32u), l->fx_q32, XD_MAX, &xt) ||
@@ -393,6 +398,9 @@ ct_status ct_camera_project(const ct_camera *cam, const int32_t ray[3], int64_t 
         return CT_ERR_ARG;
     }
     l = &cam->lens;
+    if (l->model == CT_LENS_GRID) {
+        return CT_ERR_LENS;
+    }
     if (ray[2] <= 0) {
         return CT_ERR_UNPROJECT; /* behind the camera (or at 90 deg) */
     }
@@ -412,6 +420,152 @@ ct_status ct_camera_project(const ct_camera *cam, const int32_t ray[3], int64_t 
                                                           ct_i128_shl(ct_i128_from64(l->cy_q32), 32u)),
                                               ct_i128_from64(INT64_C(1) << 47)),
                                   48u));
+    return CT_OK;
+}
+
+/* ------------------------------------------------------------------------ */
+/* Unprojection grid.                                                        */
+
+#define GRID_T_BITS 20u
+#define GRID_STEP_MAX (INT64_C(4096) << 16)
+
+ct_status ct_camera_init_grid(ct_camera *cam, const ct_unproject_grid *g)
+{
+    uint32_t k, n;
+    const int32_t lim = (INT32_C(1) << 30) + (INT32_C(1) << 12);
+    CT_ASSERT(cam != NULL && g != NULL);
+    if (cam == NULL || g == NULL) {
+        return CT_ERR_ARG;
+    }
+    cam->ready = 0u;
+    if (g->rays_q30 == NULL || g->nu < 4u || g->nv < 4u || g->nu > CT_GRID_MAX_NODES ||
+        g->nv > CT_GRID_MAX_NODES || g->step_q16 < 65536 || g->step_q16 > GRID_STEP_MAX ||
+        !within(g->u0_q16, (int64_t)CT_CAM_MAX_PIXEL << 16) || !within(g->v0_q16, (int64_t)CT_CAM_MAX_PIXEL << 16)) {
+        return CT_ERR_LENS;
+    }
+    n = g->nu * g->nv; /* <= 2^28: 3 n < 2^30 fits size_t and uint32 */
+    if (g->rays_len / 3u < (size_t)n) {
+        return CT_ERR_LENS;
+    }
+    /* every node a unit vector within 2^-20, or (0, 0, 0).  bound: nu nv */
+    for (k = 0u; k < n; ++k) {
+        const int32_t *r = g->rays_q30 + 3u * k;
+        int64_t l2;
+        if (r[0] == 0 && r[1] == 0 && r[2] == 0) {
+            continue;
+        }
+        if (r[0] > lim || r[0] < -lim || r[1] > lim || r[1] < -lim || r[2] > lim || r[2] < -lim) {
+            return CT_ERR_LENS;
+        }
+        /* each square <= 2^60.0001: the sum < 2^62 */
+        l2 = (int64_t)r[0] * r[0] + (int64_t)r[1] * r[1] + (int64_t)r[2] * r[2];
+        if (ct_abs64(l2 - (INT64_C(1) << 60)) > (INT64_C(1) << 41)) {
+            return CT_ERR_LENS;
+        }
+    }
+    cam->lens.model = CT_LENS_GRID;
+    cam->lens.width = cam->lens.height = 0u;
+    cam->lens.fx_q32 = cam->lens.fy_q32 = cam->lens.cx_q32 = cam->lens.cy_q32 = 0;
+    /* bound: 8 coefficients */
+    for (k = 0u; k < 8u; ++k) {
+        cam->lens.dist_q48[k] = 0;
+    }
+    cam->r2_max_q32 = 0;
+    cam->grid = *g;
+    cam->ready = CAM_READY;
+    return CT_OK;
+}
+
+/* Catmull-Rom weights, doubled, for t in [0, 1) given in Q20: Q60.  Each
+ * term < 5 * 2^60 < 2^63; the weights sum to 2^61 and sum |w| < 2.6 * 2^60. */
+static void cr_weights(int64_t t, int64_t w[4])
+{
+    int64_t t2 = t * t << GRID_T_BITS; /* t^2, Q60 */
+    int64_t t3 = t * t * t;            /* t^3, Q60 */
+    int64_t t1 = t << 40;              /* t, Q60   */
+    w[0] = -t3 + 2 * t2 - t1;
+    w[1] = 3 * t3 - 5 * t2 + (INT64_C(2) << 60);
+    w[2] = -3 * t3 + 4 * t2 + t1;
+    w[3] = t3 - t2;
+}
+
+/* Node index and fraction (Q20) along one axis: the pixel lies in
+ * [node i, node i + 1) with 1 <= i <= n - 3 (so i - 1 .. i + 2 exist). */
+static int grid_axis(int64_t p, int64_t p0, int64_t step, uint32_t n, uint32_t *i, int64_t *t)
+{
+    int64_t d = p - p0, k, rem; /* |p - p0| <= 2^37 */
+    k = ct_floor_div(d, step);
+    if (k < 1 || k > (int64_t)n - 3) {
+        return 0;
+    }
+    rem = d - k * step;                            /* [0, step), step <= 2^28 */
+    *t = ct_floor_div(rem << GRID_T_BITS, step);   /* < 2^20 */
+    *i = (uint32_t)k;
+    return 1;
+}
+
+static ct_status grid_unproject(const ct_camera *c, int64_t u, int64_t v, int32_t out[3])
+{
+    const ct_unproject_grid *g = &c->grid;
+    uint32_t i, j, a, b, k;
+    int64_t tu, tv, wu[4], wv[4], row[4][3], V[3];
+    ct_i128 l2;
+    int64_t L;
+    if (!grid_axis(u, g->u0_q16, g->step_q16, g->nu, &i, &tu) ||
+        !grid_axis(v, g->v0_q16, g->step_q16, g->nv, &j, &tv)) {
+        return CT_ERR_UNPROJECT;
+    }
+    cr_weights(tu, wu);
+    cr_weights(tv, wv);
+    /* along u for rows j-1 .. j+2: |w| < 2^61.3, |ray| <= 2^30: sums
+     * < 2^93 (128-bit); >> 44 leaves < 2^49.  bound: 4 x 4 x 3 */
+    for (b = 0u; b < 4u; ++b) {
+        const int32_t *rowp = g->rays_q30 + 3u * ((j + b - 1u) * g->nu + (i - 1u));
+        for (k = 0u; k < 3u; ++k) {
+            ct_i128 acc = ct_i128_from64(0);
+            for (a = 0u; a < 4u; ++a) {
+                const int32_t *r = rowp + 3u * a;
+                if (k == 0u && r[0] == 0 && r[1] == 0 && r[2] == 0) {
+                    return CT_ERR_UNPROJECT; /* a node without a ray */
+                }
+                acc = ct_i128_add(acc, ct_i128_mul(wu[a], r[k]));
+            }
+            row[b][k] = ct_i128_to64(ct_i128_sar(acc, 44u));
+        }
+    }
+    /* along v: < 4 * 2^61.3 * 2^49 = 2^112.3; >> 62 leaves < 2^51 */
+    for (k = 0u; k < 3u; ++k) {
+        ct_i128 acc = ct_i128_from64(0);
+        for (b = 0u; b < 4u; ++b) {
+            acc = ct_i128_add(acc, ct_i128_mul(wv[b], row[b][k]));
+        }
+        V[k] = ct_i128_to64(ct_i128_sar(acc, 62u));
+    }
+    /* coherent unit rays give |V| ~ 2^46 (weights sum to 2, Q60 x Q30 >>
+     * 106): shorter than 2^45 means the 16 rays disagree */
+    l2 = ct_i128_add(ct_i128_add(ct_i128_mul(V[0], V[0]), ct_i128_mul(V[1], V[1])), ct_i128_mul(V[2], V[2]));
+    L = (int64_t)ct_i128_isqrt(l2); /* l2 < 3 * 2^102 */
+    if (L < (INT64_C(1) << 45)) {
+        return CT_ERR_UNPROJECT;
+    }
+    /* bound: 3 components; |V 2^30| < 2^81, quotient <= 2^30 */
+    for (k = 0u; k < 3u; ++k) {
+        int64_t q = 0;
+        (void)ct_div_round(ct_i128_shl(ct_i128_from64(V[k]), 30u), L, INT64_C(1) << 30, &q);
+        out[k] = (int32_t)q;
+    }
+    /* the result must lie within 60 deg of each of its 16 nodes (cos >=
+     * 1/2: dot >= 2^59 in Q60; products < 2^61, sums < 2^63).
+     * bound: 4 x 4 nodes */
+    for (b = 0u; b < 4u; ++b) {
+        for (a = 0u; a < 4u; ++a) {
+            const int32_t *r = g->rays_q30 + 3u * ((j + b - 1u) * g->nu + (i - 1u + a));
+            int64_t dot = (int64_t)r[0] * out[0] + (int64_t)r[1] * out[1] + (int64_t)r[2] * out[2];
+            if (dot < (INT64_C(1) << 59)) {
+                return CT_ERR_UNPROJECT;
+            }
+        }
+    }
     return CT_OK;
 }
 
