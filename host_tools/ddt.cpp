@@ -1,0 +1,559 @@
+// ddt.cpp -- directional distance transforms by line traversal; the
+// algorithm and its exactness argument are in ddt.hpp.
+#include "ddt.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <memory>
+#include <string>
+#include <thread>
+
+#include "conetrace.h"
+#include "terrain.hpp"  // ct_host::Error
+
+namespace ct_host {
+namespace ddt {
+
+void Stats::add(const Stats &o)
+{
+    pixels += o.pixels;
+    lines += o.lines;
+    candidates += o.candidates;
+    never_valid += o.never_valid;
+    activated += o.activated;
+    dominated += o.dominated;
+    comparisons += o.comparisons;
+    walk_steps += o.walk_steps;
+}
+
+namespace {
+
+using i128 = __int128;
+
+// |.| of each operand < 2^32: each product < 2^64, exact in 128 bits.
+i128 cross(int64_t ux, int64_t uy, int64_t vx, int64_t vy) { return (i128)ux * vy - (i128)uy * vx; }
+
+constexpr int64_t kMaxSide = INT64_C(1) << 20;  // pixels per side (keys stay < 2^53)
+constexpr int kLineChunk = 64;                   // lines per work unit
+
+bool int32_range(int64_t v) { return v >= INT32_MIN && v <= INT32_MAX; }
+
+// A piece: wedge of at most 90 degrees inside one closed quadrant.
+struct Piece {
+    int64_t b1x, b1y, b2x, b2y;
+};
+
+// Split the ccw wedge b1 -> b2 (0 < opening <= 180) at the axis directions
+// strictly inside it.
+std::vector<Piece> split_wedge(const Wedge &w)
+{
+    if (!int32_range(w.b1x) || !int32_range(w.b1y) || !int32_range(w.b2x) || !int32_range(w.b2y))
+        throw Error("ddt: sector boundary outside the int32 range");
+    if ((w.b1x == 0 && w.b1y == 0) || (w.b2x == 0 && w.b2y == 0))
+        throw Error("ddt: zero sector boundary vector");
+    const i128 c = cross(w.b1x, w.b1y, w.b2x, w.b2y);
+    const i128 dot = (i128)w.b1x * w.b2x + (i128)w.b1y * w.b2y;
+    if (c < 0 || (c == 0 && dot >= 0))
+        throw Error("ddt: sector must open counterclockwise from b1 to b2 by more than 0 and at most 180 degrees");
+    static const int64_t ax[4][2] = {{1, 0}, {0, 1}, {-1, 0}, {0, -1}};
+    std::vector<std::array<int64_t, 2>> cuts;
+    for (const auto &e : ax)
+        if (cross(w.b1x, w.b1y, e[0], e[1]) > 0 && cross(e[0], e[1], w.b2x, w.b2y) > 0)
+            cuts.push_back({e[0], e[1]});
+    // at most two cuts (180 degrees); order them counterclockwise from b1
+    if (cuts.size() == 2 && cross(cuts[0][0], cuts[0][1], cuts[1][0], cuts[1][1]) < 0)
+        std::swap(cuts[0], cuts[1]);
+    std::vector<Piece> out;
+    int64_t px = w.b1x, py = w.b1y;
+    for (const auto &e : cuts) {
+        out.push_back({px, py, e[0], e[1]});
+        px = e[0];
+        py = e[1];
+    }
+    out.push_back({px, py, w.b2x, w.b2y});
+    return out;
+}
+
+// The canonical frame of a piece (see ddt.hpp).  Original -> canonical:
+// flip x if fx, flip y if fy, then swap x and y if transpose.
+struct Frame {
+    int W = 0, H = 0;      // original size
+    int Wc = 0, Hc = 0;    // canonical size
+    bool fx = false, fy = false, transpose = false;
+    int64_t base = 0, stepx = 0, stepy = 0;  // original index of canonical (x', y')
+    int dir = 0;                             // pass-1 table for canonical +x'
+    int64_t a1 = 1, c1 = 0, a2 = 0, c2 = 1;  // canonical boundaries
+};
+
+Frame make_frame(int W, int H, const Piece &p)
+{
+    Frame f;
+    f.W = W;
+    f.H = H;
+    // a direction strictly inside the piece decides the quadrant
+    const int64_t mx = p.b1x + p.b2x, my = p.b1y + p.b2y;
+    f.fx = mx < 0;
+    f.fy = my < 0;
+    const int64_t sx = f.fx ? -1 : 1, sy = f.fy ? -1 : 1;
+    int64_t ux = sx * p.b1x, uy = sy * p.b1y, vx = sx * p.b2x, vy = sy * p.b2y;
+    if (sx * sy < 0) {  // a reflection reverses the orientation
+        std::swap(ux, vx);
+        std::swap(uy, vy);
+    }
+    if (ux < 0 || uy < 0 || vx < 0 || vy < 0 || cross(ux, uy, vx, vy) <= 0)
+        throw Error("ddt: internal error: piece not in one quadrant");
+    // frame A: as is; frame B: transposed (u' = T v, v' = T u)
+    const double inf = std::numeric_limits<double>::infinity();
+    const double t1a = uy == 0 ? inf : (double)ux / (double)uy, t2a = (double)vx / (double)vy;
+    const double t1b = vx == 0 ? inf : (double)vy / (double)vx, t2b = (double)uy / (double)ux;
+    const bool oka = t2a <= std::max(1.0, W / 8.0), okb = t2b <= std::max(1.0, H / 8.0);
+    bool useb;
+    if (oka != okb)
+        useb = okb;
+    else if (oka)
+        useb = (t1b - t2b) > (t1a - t2a);
+    else
+        useb = t2b < t2a;
+    f.transpose = useb;
+    if (!useb) {
+        f.a1 = ux;
+        f.c1 = uy;
+        f.a2 = vx;
+        f.c2 = vy;
+    } else {
+        f.a1 = vy;
+        f.c1 = vx;
+        f.a2 = uy;
+        f.c2 = ux;
+    }
+    f.Wc = useb ? H : W;
+    f.Hc = useb ? W : H;
+    const int64_t x0 = f.fx ? W - 1 : 0, y0 = f.fy ? H - 1 : 0;
+    f.base = y0 * (int64_t)W + x0;
+    const int64_t ix = f.fx ? -1 : 1, iy = f.fy ? -(int64_t)W : (int64_t)W;
+    f.stepx = useb ? iy : ix;
+    f.stepy = useb ? ix : iy;
+    f.dir = useb ? (f.fy ? 3 : 2) : (f.fx ? 1 : 0);
+    return f;
+}
+
+// D in canonical coordinates (the transpose swaps the arguments).
+template <class D, bool kT>
+struct CanonDist {
+    const D &d;
+    typename D::value_type operator()(int64_t ax, int64_t ay) const { return kT ? d(ay, ax) : d(ax, ay); }
+};
+
+struct Cand {
+    int32_t r, col;      // canonical row and column of the feature
+    int64_t key1, key2;  // V1 - c1*k and V2 - c2*k (see ddt.hpp)
+};
+struct Node {
+    Cand c;
+    int32_t next;
+};
+
+// kCount: keep operation counts (off when no Stats were asked for).
+template <class D, bool kT, bool kCount>
+class Kernel {
+public:
+    using V = typename D::value_type;
+
+    Kernel(const Prepared &bm, const Frame &f, const D &dist, V *dt, Point *ft, const Options &opt)
+        : f_(f), dist_{dist}, dt_(dt), ft_(ft), next_(bm.next(f.dir)), rule1_(opt.rule1), rule2_(opt.rule2)
+    {
+        const int Hc = f.Hc;
+        L_.resize(Hc);
+        phi_.resize(Hc);
+        psi_.resize(Hc);
+        phimin_.resize(Hc);
+        psimax_.resize(Hc);
+        lb_.resize(Hc);
+        // Y*a2 < 2^20 * 2^32; c1*L <= a1*Y + c1 (theta1 < theta2): all < 2^53.
+        for (int Y = 0; Y < Hc; ++Y) {
+            L_[Y] = (Y * f.a2 + f.c2 - 1) / f.c2;
+            phi_[Y] = f.c1 * L_[Y] - f.a1 * Y;
+            psi_[Y] = f.c2 * L_[Y] - f.a2 * Y;
+            phimin_[Y] = Y ? std::min(phimin_[Y - 1], phi_[Y]) : phi_[Y];
+            psimax_[Y] = Y ? std::max(psimax_[Y - 1], psi_[Y]) : psi_[Y];
+            lb_[Y] = L_[Y] < f.Wc ? dist_(L_[Y], Y) : Inf<V>::value;
+        }
+        const i128 x12 = (i128)f.a1 * f.c2 - (i128)f.c1 * f.a2;
+        tau_ = (double)f.c1 * (double)f.c2 / (double)x12;
+        kmax_ = f.Wc - 1;
+        kmin_ = -L_[Hc - 1];
+    }
+
+    int64_t line_count() const { return kmax_ - kmin_ + 1; }
+
+    // Lines kmax - chunk*kLineChunk ... for chunks tid, tid + nth, ...
+    void run(int tid, int nth, Stats &st)
+    {
+        head_.assign(f_.Hc, -1);
+        pool_.reserve(2 * (size_t)f_.Hc + 16);
+        list_.reserve(2 * (size_t)f_.Hc + 16);
+        const int64_t nchunks = (line_count() + kLineChunk - 1) / kLineChunk;
+        for (int64_t ch = tid; ch < nchunks; ch += nth) {
+            const int64_t hi = kmax_ - ch * kLineChunk;
+            const int64_t lo = std::max(kmin_, hi - kLineChunk + 1);
+            for (int64_t k = hi; k >= lo; --k)
+                line(k, st);
+        }
+    }
+
+private:
+    const Frame f_;
+    CanonDist<D, kT> dist_;
+    V *dt_;
+    Point *ft_;
+    const int32_t *next_;
+    const bool rule1_, rule2_;
+    std::vector<int64_t> L_, phi_, psi_, phimin_, psimax_;
+    std::vector<V> lb_;
+    double tau_ = 0.0;
+    int64_t kmax_ = 0, kmin_ = 0;
+    // per-thread scratch (one Kernel per thread)
+    std::vector<int32_t> head_;
+    std::vector<Node> pool_;
+    std::vector<Cand> list_;
+
+    static void count(uint64_t &c)
+    {
+        if (kCount)
+            ++c;
+    }
+
+    Point to_orig(int64_t cx, int64_t cy) const
+    {
+        const int64_t xf = f_.transpose ? cy : cx, yf = f_.transpose ? cx : cy;
+        Point p;
+        p.x = (int32_t)(f_.fx ? f_.W - 1 - xf : xf);
+        p.y = (int32_t)(f_.fy ? f_.H - 1 - yf : yf);
+        return p;
+    }
+
+    // E is in the sector whenever A is, at every row Y' <= Y of the line.
+    bool covers(const Cand &e, const Cand &a, int Y) const
+    {
+        return (e.key1 <= a.key1 || e.key1 <= phimin_[Y]) && (e.key2 >= a.key2 || e.key2 >= psimax_[Y]);
+    }
+
+    // Insert into the row-sorted list (top = back = newest row), rule 2.
+    void insert(const Cand &a, int Y, Stats &st)
+    {
+        const size_t n = list_.size();
+        size_t i = n;
+        if (rule2_) {
+            while (i > 0 && list_[i - 1].r <= a.r) {  // newer (or same row): may dominate a
+                const Cand &e = list_[i - 1];
+                count(st.comparisons);
+                if (e.col <= a.col && covers(e, a, Y)) {
+                    count(st.dominated);
+                    return;
+                }
+                --i;
+            }
+        } else {
+            while (i > 0 && list_[i - 1].r < a.r)
+                --i;
+        }
+        count(st.activated);
+        size_t j = i;  // older entries a dominates: the run just below i
+        if (rule2_) {
+            while (j > 0) {
+                const Cand &b = list_[j - 1];
+                count(st.comparisons);
+                if (!(b.col >= a.col && covers(a, b, Y)))
+                    break;
+                --j;
+                count(st.dominated);
+            }
+        }
+        if (i == n) {  // the usual case: a is the newest
+            list_.resize(j);
+            list_.push_back(a);
+        } else if (j < i) {  // replace the dominated run [j, i) by a
+            list_[j] = a;
+            list_.erase(list_.begin() + (std::ptrdiff_t)(j + 1), list_.begin() + (std::ptrdiff_t)i);
+        } else {
+            list_.insert(list_.begin() + (std::ptrdiff_t)i, a);
+        }
+    }
+
+    // A candidate of row Y (its own row) at column col, h = col - col(Y).
+    void create(int Y, int64_t col, int64_t h, int Ytop, Stats &st)
+    {
+        Cand c;
+        c.r = Y;
+        c.col = (int32_t)col;
+        c.key1 = phi_[Y] + f_.c1 * h;
+        c.key2 = psi_[Y] + f_.c2 * h;
+        count(st.candidates);
+        if (!rule1_) {
+            insert(c, Y, st);
+            return;
+        }
+        // Activation row: the first row Y1 <= Y (going up) with key1 <= phi.
+        // Valid at Y' implies Y - Y' > (h - 1) * tau (ddt.hpp), so the walk
+        // starts from Y - floor((h - 1) * tau), safe for errors below 1.
+        int64_t Y1 = Y;
+        if (f_.c1 != 0 && h >= 1) {
+            const double est = std::floor((double)(h - 1) * tau_);
+            if (est > (double)(Y - Ytop) + 1.0) {
+                count(st.never_valid);
+                return;
+            }
+            Y1 = Y - (int64_t)est;
+            while (Y1 >= Ytop && c.key1 > phi_[Y1]) {
+                --Y1;
+                count(st.walk_steps);
+            }
+        }
+        if (Y1 < Ytop) {
+            count(st.never_valid);
+            return;
+        }
+        if (Y1 == Y) {
+            insert(c, Y, st);
+            return;
+        }
+        pool_.push_back(Node{c, head_[Y1]});
+        head_[Y1] = (int32_t)(pool_.size() - 1);
+    }
+
+    void line(int64_t k, Stats &st)
+    {
+        const int Wc = f_.Wc, Hc = f_.Hc;
+        const int Ytop = (int)(std::lower_bound(L_.begin(), L_.end(), -k) - L_.begin());
+        const int Ybot = (int)(std::upper_bound(L_.begin(), L_.end(), (int64_t)(Wc - 1) - k) - L_.begin()) - 1;
+        if (Ytop > Ybot || Ytop >= Hc)
+            return;
+        count(st.lines);
+        list_.clear();
+        pool_.clear();
+        for (int Y = Ybot; Y >= Ytop; --Y) {
+            const int64_t col = k + L_[Y];
+            const int64_t idx = f_.base + col * f_.stepx + (int64_t)Y * f_.stepy;
+            const int32_t d0 = next_[idx];
+            const bool feat = d0 == 0;
+            count(st.pixels);
+            // candidates of row Y
+            if (feat) {
+                Cand q0{Y, (int32_t)col, phi_[Y], psi_[Y]};
+                count(st.candidates);
+                insert(q0, Y, st);
+                // secondary: needed unless q0 stays on the left side for all
+                // rows to come (then the left start of row Y is col(Y))
+                if (col + 1 < Wc && !(rule2_ && psi_[Y] >= psimax_[Y])) {
+                    const int32_t d1 = next_[idx + f_.stepx];
+                    if (d1 < Prepared::kNone)
+                        create(Y, col + 1 + d1, 1 + d1, Ytop, st);
+                }
+            } else if (d0 < Prepared::kNone) {
+                create(Y, col + d0, d0, Ytop, st);
+            }
+            // activations due at this row
+            for (int32_t n = head_[Y]; n >= 0; n = pool_[(size_t)n].next)
+                insert(pool_[(size_t)n].c, Y, st);
+            head_[Y] = -1;
+            // answer P_Y
+            V best = dt_[idx];
+            int64_t bc = -1, br = -1;
+            if (feat) {
+                const V d = dist_(0, 0);
+                if (d < best) {
+                    best = d;
+                    bc = col;
+                    br = Y;
+                }
+            } else {
+                const int64_t phiY = phi_[Y], psiY = psi_[Y];
+                for (size_t j = list_.size(); j-- > 0;) {
+                    const Cand &e = list_[j];
+                    const int dy = e.r - Y;
+                    if (rule1_ && !(lb_[dy] < best))
+                        break;
+                    count(st.comparisons);
+                    if (e.key1 <= phiY && e.key2 >= psiY) {
+                        const V d = dist_(e.col - col, dy);
+                        if (d < best) {
+                            best = d;
+                            bc = e.col;
+                            br = e.r;
+                        }
+                    }
+                }
+            }
+            if (bc >= 0) {
+                dt_[idx] = best;
+                ft_[idx] = to_orig(bc, br);
+            }
+        }
+    }
+};
+
+int thread_count(const Options &opt)
+{
+    int n = opt.threads > 0 ? opt.threads : (int)std::max(1u, std::thread::hardware_concurrency());
+    return std::min(n, 64);
+}
+
+template <class D, bool kT, bool kCount>
+void run_frame(const Prepared &bm, const Frame &f, const D &dist, typename D::value_type *dt, Point *ft,
+               const Options &opt, Stats *stats)
+{
+    // one heap object per thread: no false sharing of scratch or counters
+    const int nth = thread_count(opt);
+    std::vector<std::unique_ptr<Kernel<D, kT, kCount>>> ks;
+    std::vector<std::unique_ptr<Stats>> st;
+    ks.emplace_back(new Kernel<D, kT, kCount>(bm, f, dist, dt, ft, opt));
+    st.emplace_back(new Stats());
+    const int64_t nchunks = (ks[0]->line_count() + kLineChunk - 1) / kLineChunk;
+    const int used = (int)std::min<int64_t>(nth, nchunks);
+    for (int t = 1; t < used; ++t) {
+        ks.emplace_back(new Kernel<D, kT, kCount>(bm, f, dist, dt, ft, opt));
+        st.emplace_back(new Stats());
+    }
+    if (used <= 1) {
+        ks[0]->run(0, 1, *st[0]);
+    } else {
+        std::vector<std::thread> pool;
+        for (int t = 1; t < used; ++t)
+            pool.emplace_back([&, t] { ks[(size_t)t]->run(t, used, *st[(size_t)t]); });
+        ks[0]->run(0, used, *st[0]);
+        for (auto &th : pool)
+            th.join();
+    }
+    if (stats)
+        for (const auto &s : st)
+            stats->add(*s);
+}
+
+template <class D>
+void run_pieces(const Prepared &bm, const std::vector<Piece> &pieces, const D &dist,
+                std::vector<typename D::value_type> &dt, std::vector<Point> &ft, const Options &opt,
+                Stats *stats)
+{
+    const size_t n = (size_t)bm.width() * (size_t)bm.height();
+    dt.assign(n, Inf<typename D::value_type>::value);
+    ft.assign(n, Point());
+    for (const Piece &p : pieces) {
+        const Frame f = make_frame(bm.width(), bm.height(), p);
+        if (f.transpose && stats)
+            run_frame<D, true, true>(bm, f, dist, dt.data(), ft.data(), opt, stats);
+        else if (f.transpose)
+            run_frame<D, true, false>(bm, f, dist, dt.data(), ft.data(), opt, stats);
+        else if (stats)
+            run_frame<D, false, true>(bm, f, dist, dt.data(), ft.data(), opt, stats);
+        else
+            run_frame<D, false, false>(bm, f, dist, dt.data(), ft.data(), opt, stats);
+    }
+}
+
+}  // namespace
+
+Wedge sector_wedge(uint32_t sectors, uint32_t s)
+{
+    if (sectors < 1u || sectors > CT_MAX_SECTORS || s >= sectors)
+        throw Error("ddt: sector " + std::to_string(s) + " of " + std::to_string(sectors) + " out of range");
+    int32_t x0, y0, x1, y1;
+    if (ct_sector_boundary(sectors, s, &x0, &y0) != CT_OK || ct_sector_boundary(sectors, s + 1u, &x1, &y1) != CT_OK)
+        throw Error("ddt: ct_sector_boundary failed");
+    Wedge w;
+    w.b1x = x0;
+    w.b1y = y0;
+    w.b2x = x1;
+    w.b2y = y1;
+    return w;
+}
+
+bool in_wedge(const Wedge &w, int64_t dx, int64_t dy)
+{
+    return cross(w.b1x, w.b1y, dx, dy) >= 0 && cross(dx, dy, w.b2x, w.b2y) >= 0;
+}
+
+Prepared::Prepared(int width, int height, const uint8_t *bits) : w_(width), h_(height)
+{
+    if (width < 1 || height < 1 || width > kMaxSide || height > kMaxSide ||
+        (int64_t)width * height >= (INT64_C(1) << 31) || bits == nullptr)
+        throw Error("ddt: bitmap size out of range");
+    const size_t W = (size_t)width, H = (size_t)height;
+    for (auto &v : next_)
+        v.resize(W * H);
+    for (size_t y = 0; y < H; ++y) {
+        const uint8_t *row = bits + y * W;
+        int32_t *r0 = next_[0].data() + y * W, *r1 = next_[1].data() + y * W;
+        int32_t n = kNone;
+        for (size_t x = W; x-- > 0;) {
+            n = row[x] ? 0 : (n < kNone ? n + 1 : kNone);
+            r0[x] = n;
+        }
+        n = kNone;
+        for (size_t x = 0; x < W; ++x) {
+            n = row[x] ? 0 : (n < kNone ? n + 1 : kNone);
+            r1[x] = n;
+        }
+    }
+    for (size_t y = H; y-- > 0;) {  // +y: from the bottom row up
+        const uint8_t *row = bits + y * W;
+        int32_t *r = next_[2].data() + y * W;
+        const int32_t *below = y + 1 < H ? r + W : nullptr;
+        for (size_t x = 0; x < W; ++x)
+            r[x] = row[x] ? 0 : (below && below[x] < kNone ? below[x] + 1 : kNone);
+    }
+    for (size_t y = 0; y < H; ++y) {  // -y: from the top row down
+        const uint8_t *row = bits + y * W;
+        int32_t *r = next_[3].data() + y * W;
+        const int32_t *above = y > 0 ? r - W : nullptr;
+        for (size_t x = 0; x < W; ++x)
+            r[x] = row[x] ? 0 : (above && above[x] < kNone ? above[x] + 1 : kNone);
+    }
+}
+
+template <class D>
+void directional(const Prepared &bm, const Wedge &w, const D &dist, std::vector<typename D::value_type> &dt,
+                 std::vector<Point> &ft, const Options &opt, Stats *stats)
+{
+    run_pieces(bm, split_wedge(w), dist, dt, ft, opt, stats);
+}
+
+template <class D>
+void directional(const Prepared &bm, uint32_t sectors, uint32_t s, const D &dist,
+                 std::vector<typename D::value_type> &dt, std::vector<Point> &ft, const Options &opt,
+                 Stats *stats)
+{
+    const Wedge w = sector_wedge(sectors, s);
+    if (sectors == 1u)  // the whole plane (ct_in_wedge: always inside)
+        unconstrained(bm, dist, dt, ft, opt, stats);
+    else
+        directional(bm, w, dist, dt, ft, opt, stats);
+}
+
+template <class D>
+void unconstrained(const Prepared &bm, const D &dist, std::vector<typename D::value_type> &dt,
+                   std::vector<Point> &ft, const Options &opt, Stats *stats)
+{
+    const std::vector<Piece> quadrants = {{1, 0, 0, 1}, {0, 1, -1, 0}, {-1, 0, 0, -1}, {0, -1, 1, 0}};
+    run_pieces(bm, quadrants, dist, dt, ft, opt, stats);
+}
+
+#define CT_DDT_INSTANTIATE(D)                                                                              \
+    template void directional<D>(const Prepared &, const Wedge &, const D &,                              \
+                                 std::vector<D::value_type> &, std::vector<Point> &, const Options &,     \
+                                 Stats *);                                                                 \
+    template void directional<D>(const Prepared &, uint32_t, uint32_t, const D &,                         \
+                                 std::vector<D::value_type> &, std::vector<Point> &, const Options &,     \
+                                 Stats *);                                                                 \
+    template void unconstrained<D>(const Prepared &, const D &, std::vector<D::value_type> &,             \
+                                   std::vector<Point> &, const Options &, Stats *);
+CT_DDT_INSTANTIATE(EuclideanSq)
+CT_DDT_INSTANTIATE(CityBlock)
+CT_DDT_INSTANTIATE(Chessboard)
+CT_DDT_INSTANTIATE(ChamferInt)
+CT_DDT_INSTANTIATE(ChamferReal)
+CT_DDT_INSTANTIATE(TableDistance)
+#undef CT_DDT_INSTANTIATE
+
+}  // namespace ddt
+}  // namespace ct_host
