@@ -107,14 +107,22 @@ Frame make_frame(int W, int H, const Piece &p)
     const double inf = std::numeric_limits<double>::infinity();
     const double t1a = uy == 0 ? inf : (double)ux / (double)uy, t2a = (double)vx / (double)vy;
     const double t1b = vx == 0 ? inf : (double)vy / (double)vx, t2b = (double)uy / (double)ux;
+    // Frame choice.  Lines with t2 > 1 skip columns; in a transposed frame
+    // they also skip memory rows (a measured 2x slowdown at 2048^2), so a
+    // transposed frame is only taken with t2 <= 1 or when it is the only one
+    // with t2 <= max(1, W'/8).  Otherwise the larger t1 - t2 (shorter walks).
     const bool oka = t2a <= std::max(1.0, W / 8.0), okb = t2b <= std::max(1.0, H / 8.0);
     bool useb;
     if (oka != okb)
         useb = okb;
-    else if (oka)
-        useb = (t1b - t2b) > (t1a - t2a);
-    else
+    else if (!oka)
         useb = t2b < t2a;
+    else if (t2b > 1.0)
+        useb = false;
+    else if ((t1b - t2b) == (t1a - t2a))  // both infinite: a quadrant; rows
+        useb = true;                        // of memory as lines (measured faster)
+    else
+        useb = (t1b - t2b) > (t1a - t2a);
     f.transpose = useb;
     if (!useb) {
         f.a1 = ux;
@@ -160,8 +168,11 @@ class Kernel {
 public:
     using V = typename D::value_type;
 
-    Kernel(const Prepared &bm, const Frame &f, const D &dist, V *dt, Point *ft, const Options &opt)
-        : f_(f), dist_{dist}, dt_(dt), ft_(ft), next_(bm.next(f.dir)), rule1_(opt.rule1), rule2_(opt.rule2)
+    // first: the first piece writes every pixel (dt, ft need no prior fill);
+    // later pieces keep the minimum.
+    Kernel(const Prepared &bm, const Frame &f, const D &dist, V *dt, Point *ft, const Options &opt, bool first)
+        : f_(f), dist_{dist}, dt_(dt), ft_(ft), next_(bm.next(f.dir)), rule1_(opt.rule1), rule2_(opt.rule2),
+          first_(first)
     {
         const int Hc = f.Hc;
         L_.resize(Hc);
@@ -191,8 +202,8 @@ public:
     void run(int tid, int nth, Stats &st)
     {
         head_.assign(f_.Hc, -1);
-        pool_.reserve(2 * (size_t)f_.Hc + 16);
-        list_.reserve(2 * (size_t)f_.Hc + 16);
+        pool_.resize(2 * (size_t)f_.Hc + 2);
+        list_.resize(2 * (size_t)f_.Hc + 2);
         const int64_t nchunks = (line_count() + kLineChunk - 1) / kLineChunk;
         for (int64_t ch = tid; ch < nchunks; ch += nth) {
             const int64_t hi = kmax_ - ch * kLineChunk;
@@ -208,15 +219,17 @@ private:
     V *dt_;
     Point *ft_;
     const int32_t *next_;
-    const bool rule1_, rule2_;
+    const bool rule1_, rule2_, first_;
     std::vector<int64_t> L_, phi_, psi_, phimin_, psimax_;
     std::vector<V> lb_;
     double tau_ = 0.0;
     int64_t kmax_ = 0, kmin_ = 0;
-    // per-thread scratch (one Kernel per thread)
+    // per-thread scratch (one Kernel per thread); a line creates at most two
+    // candidates per pixel, so pool and list never exceed 2 * Hc entries
     std::vector<int32_t> head_;
     std::vector<Node> pool_;
     std::vector<Cand> list_;
+    size_t pn_ = 0, ln_ = 0;  // used entries of pool_ and list_
 
     static void count(uint64_t &c)
     {
@@ -242,7 +255,7 @@ private:
     // Insert into the row-sorted list (top = back = newest row), rule 2.
     void insert(const Cand &a, int Y, Stats &st)
     {
-        const size_t n = list_.size();
+        const size_t n = ln_;
         size_t i = n;
         if (rule2_) {
             while (i > 0 && list_[i - 1].r <= a.r) {  // newer (or same row): may dominate a
@@ -270,14 +283,18 @@ private:
                 count(st.dominated);
             }
         }
+        Cand *l = list_.data();
         if (i == n) {  // the usual case: a is the newest
-            list_.resize(j);
-            list_.push_back(a);
+            l[j] = a;
+            ln_ = j + 1;
         } else if (j < i) {  // replace the dominated run [j, i) by a
-            list_[j] = a;
-            list_.erase(list_.begin() + (std::ptrdiff_t)(j + 1), list_.begin() + (std::ptrdiff_t)i);
+            l[j] = a;
+            std::copy(l + i, l + n, l + j + 1);
+            ln_ = n - (i - j) + 1;
         } else {
-            list_.insert(list_.begin() + (std::ptrdiff_t)i, a);
+            std::copy_backward(l + i, l + n, l + n + 1);
+            l[i] = a;
+            ln_ = n + 1;
         }
     }
 
@@ -294,12 +311,14 @@ private:
             insert(c, Y, st);
             return;
         }
-        // Activation row: the first row Y1 <= Y (going up) with key1 <= phi.
-        // Valid at Y' implies Y - Y' > (h - 1) * tau (ddt.hpp), so the walk
-        // starts from Y - floor((h - 1) * tau), safe for errors below 1.
+        // Activation row Y1: the first row going up where key1 <= phi.  Valid
+        // at Y' implies Y - Y' > (h - 1) * tau (ddt.hpp), so the walk starts
+        // from Y - floor((h - 1) * tau), safe for rounding errors below 1.
+        // (Activating at that bound without the walk is also exact -- queries
+        // check validity -- but measured no faster: more invalid entries.)
         int64_t Y1 = Y;
         if (f_.c1 != 0 && h >= 1) {
-            const double est = std::floor((double)(h - 1) * tau_);
+            const double est = (double)(h - 1) * tau_;  // >= 0: truncation is floor
             if (est > (double)(Y - Ytop) + 1.0) {
                 count(st.never_valid);
                 return;
@@ -318,8 +337,8 @@ private:
             insert(c, Y, st);
             return;
         }
-        pool_.push_back(Node{c, head_[Y1]});
-        head_[Y1] = (int32_t)(pool_.size() - 1);
+        pool_[pn_] = Node{c, head_[Y1]};
+        head_[Y1] = (int32_t)pn_++;
     }
 
     void line(int64_t k, Stats &st)
@@ -330,8 +349,8 @@ private:
         if (Ytop > Ybot || Ytop >= Hc)
             return;
         count(st.lines);
-        list_.clear();
-        pool_.clear();
+        ln_ = 0;
+        pn_ = 0;
         for (int Y = Ybot; Y >= Ytop; --Y) {
             const int64_t col = k + L_[Y];
             const int64_t idx = f_.base + col * f_.stepx + (int64_t)Y * f_.stepy;
@@ -358,7 +377,7 @@ private:
                 insert(pool_[(size_t)n].c, Y, st);
             head_[Y] = -1;
             // answer P_Y
-            V best = dt_[idx];
+            V best = first_ ? Inf<V>::value : dt_[idx];
             int64_t bc = -1, br = -1;
             if (feat) {
                 const V d = dist_(0, 0);
@@ -369,7 +388,7 @@ private:
                 }
             } else {
                 const int64_t phiY = phi_[Y], psiY = psi_[Y];
-                for (size_t j = list_.size(); j-- > 0;) {
+                for (size_t j = ln_; j-- > 0;) {
                     const Cand &e = list_[j];
                     const int dy = e.r - Y;
                     if (rule1_ && !(lb_[dy] < best))
@@ -388,6 +407,9 @@ private:
             if (bc >= 0) {
                 dt_[idx] = best;
                 ft_[idx] = to_orig(bc, br);
+            } else if (first_) {
+                dt_[idx] = Inf<V>::value;
+                ft_[idx] = Point();
             }
         }
     }
@@ -401,18 +423,18 @@ int thread_count(const Options &opt)
 
 template <class D, bool kT, bool kCount>
 void run_frame(const Prepared &bm, const Frame &f, const D &dist, typename D::value_type *dt, Point *ft,
-               const Options &opt, Stats *stats)
+               const Options &opt, bool first, Stats *stats)
 {
     // one heap object per thread: no false sharing of scratch or counters
     const int nth = thread_count(opt);
     std::vector<std::unique_ptr<Kernel<D, kT, kCount>>> ks;
     std::vector<std::unique_ptr<Stats>> st;
-    ks.emplace_back(new Kernel<D, kT, kCount>(bm, f, dist, dt, ft, opt));
+    ks.emplace_back(new Kernel<D, kT, kCount>(bm, f, dist, dt, ft, opt, first));
     st.emplace_back(new Stats());
     const int64_t nchunks = (ks[0]->line_count() + kLineChunk - 1) / kLineChunk;
     const int used = (int)std::min<int64_t>(nth, nchunks);
     for (int t = 1; t < used; ++t) {
-        ks.emplace_back(new Kernel<D, kT, kCount>(bm, f, dist, dt, ft, opt));
+        ks.emplace_back(new Kernel<D, kT, kCount>(bm, f, dist, dt, ft, opt, first));
         st.emplace_back(new Stats());
     }
     if (used <= 1) {
@@ -436,18 +458,20 @@ void run_pieces(const Prepared &bm, const std::vector<Piece> &pieces, const D &d
                 Stats *stats)
 {
     const size_t n = (size_t)bm.width() * (size_t)bm.height();
-    dt.assign(n, Inf<typename D::value_type>::value);
-    ft.assign(n, Point());
+    dt.resize(n);  // the first piece writes every pixel
+    ft.resize(n);
+    bool first = true;
     for (const Piece &p : pieces) {
         const Frame f = make_frame(bm.width(), bm.height(), p);
         if (f.transpose && stats)
-            run_frame<D, true, true>(bm, f, dist, dt.data(), ft.data(), opt, stats);
+            run_frame<D, true, true>(bm, f, dist, dt.data(), ft.data(), opt, first, stats);
         else if (f.transpose)
-            run_frame<D, true, false>(bm, f, dist, dt.data(), ft.data(), opt, stats);
+            run_frame<D, true, false>(bm, f, dist, dt.data(), ft.data(), opt, first, stats);
         else if (stats)
-            run_frame<D, false, true>(bm, f, dist, dt.data(), ft.data(), opt, stats);
+            run_frame<D, false, true>(bm, f, dist, dt.data(), ft.data(), opt, first, stats);
         else
-            run_frame<D, false, false>(bm, f, dist, dt.data(), ft.data(), opt, stats);
+            run_frame<D, false, false>(bm, f, dist, dt.data(), ft.data(), opt, first, stats);
+        first = false;
     }
 }
 
