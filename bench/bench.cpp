@@ -141,7 +141,11 @@ double run_embree(const EmbreeTerrain &e, const std::vector<ct_ray> &rays, long 
 }
 #endif
 
-void bench_dem(const char *title, const ct_host::Terrain &t, int n, const std::vector<int> &reduces)
+int g_slices = 0, g_window = 8;  // --slices K, --window R (slice builder)
+bool g_only_slices = false;
+
+void bench_dem(const char *title, const ct_host::Terrain &t, int n, const std::vector<int> &reduces,
+               const std::vector<ct_host::PptBuilder> &builders)
 {
     std::printf("\n=== %s: %dx%d posts, 30 m grid, %.4g m per LSB ===\n", title, t.width, t.height, t.height_scale_m);
     size_t dem_bytes = (size_t)t.width * t.height * 2;
@@ -150,10 +154,15 @@ void bench_dem(const char *title, const ct_host::Terrain &t, int n, const std::v
     std::printf("Embree 3 scene: %.1f MB (%.1fx the DEM), built in %.2f s\n", emb.memory_bytes() / 1e6,
                 (double)emb.memory_bytes() / dem_bytes, emb.build_seconds());
 #endif
+    for (ct_host::PptBuilder builder : builders)
     for (int r : reduces) {
         ct_host::BuildOptions o;
         o.sectors = 24;
         o.reduce = r;
+        o.builder = builder;
+        o.slices = g_slices;
+        o.window = g_window;
+        const char *bname = builder == ct_host::PptBuilder::Brute ? "brute-force builder" : "slice builder";
         ct_host::BuildStats bs;
         std::vector<uint8_t> pkg = ct_host::build_package(t, o, &bs);
         ct_package p;
@@ -161,7 +170,7 @@ void bench_dem(const char *title, const ct_host::Terrain &t, int n, const std::v
             std::printf("package did not open\n");
             return;
         }
-        std::printf("\npackage N=24 r=%d: %zu bytes = %.2fx the 16-bit DEM (built in %.1f s, %.2f%% degenerate cones)\n", r,
+        std::printf("\npackage N=24 r=%d, %s: %zu bytes = %.2fx the 16-bit DEM (built in %.1f s, %.2f%% degenerate cones)\n", r, bname,
                     pkg.size(), (double)pkg.size() / dem_bytes, bs.seconds,
                     100.0 * bs.degenerate_cones / std::max<size_t>(1, bs.cones));
         auto fams = make_families(t, p, n, 2024);
@@ -196,7 +205,7 @@ void bench_dem(const char *title, const ct_host::Terrain &t, int n, const std::v
 
 int main(int argc, char **argv)
 {
-    bool quick = false, big = true;
+    bool quick = false, big = true, brute_big = false;
     int n = 20000;
     for (int k = 1; k < argc; ++k) {
         if (!std::strcmp(argv[k], "--quick")) {
@@ -205,12 +214,24 @@ int main(int argc, char **argv)
             big = false;
         } else if (!std::strcmp(argv[k], "--rays") && k + 1 < argc) {
             n = std::atoi(argv[++k]);
+        } else if (!std::strcmp(argv[k], "--slices") && k + 1 < argc) {
+            g_slices = std::atoi(argv[++k]);
+        } else if (!std::strcmp(argv[k], "--window") && k + 1 < argc) {
+            g_window = std::atoi(argv[++k]);
+        } else if (!std::strcmp(argv[k], "--only-slices")) {
+            g_only_slices = true;
         } else if (!std::strcmp(argv[k], "--no-2048")) {
             big = false;
+        } else if (!std::strcmp(argv[k], "--brute-2048")) {
+            brute_big = true;  // the brute-force builder takes minutes at 2048^2
         }
     }
     ct_host::Terrain t = dem_cases::real_terrain();
-    bench_dem("jacksboro_fault_dem (fixture)", t, n, {1, 3});
+    using B = ct_host::PptBuilder;
+    if (g_only_slices)
+        bench_dem("jacksboro_fault_dem (fixture)", t, n, {1, 3}, {B::Slices});
+    else
+        bench_dem("jacksboro_fault_dem (fixture)", t, n, {1, 3}, {B::Slices, B::Brute});
     if (big && !quick) {
         // mirror-tile the fixture to 2048 x 2048
         ct_host::Terrain b = t;
@@ -223,7 +244,10 @@ int main(int argc, char **argv)
                 if (pj >= t.height) pj = 2 * t.height - 1 - pj;
                 b.codes[(size_t)j * 2048 + i] = t.at(pi, pj);
             }
-        bench_dem("jacksboro mirror-tiled", b, n, {3});
+        if (brute_big)
+            bench_dem("jacksboro mirror-tiled", b, n, {3}, {B::Slices, B::Brute});
+        else
+            bench_dem("jacksboro mirror-tiled", b, n, {3}, {B::Slices});
     }
     return 0;
 }

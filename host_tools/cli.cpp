@@ -39,7 +39,7 @@ namespace {
     std::fprintf(stderr,
                  "usage: conetrace build DEM -o OUT.ctp [--sectors N] [--reduce r] [--slices K]\n"
                  "                       [--height-scale M] [--posting M] [--threads T]\n"
-                 "                       [--emit-c NAME]\n"
+                 "                       [--builder slices|brute] [--window R] [--emit-c NAME]\n"
                  "       conetrace info PKG\n"
                  "       conetrace trace PKG --rays rays.csv [--method M] -o hits.csv\n"
                  "       conetrace demo DEM\n"
@@ -124,10 +124,27 @@ Terrain load_terrain(const std::string &path, double posting, double hscale)
     }
 }
 
+// A field of /proc/self/status in KiB (0 when unavailable).
+double proc_status_kib(const char *key)
+{
+    std::ifstream f("/proc/self/status");
+    std::string line;
+    size_t n = std::strlen(key);
+    while (std::getline(f, line))
+        if (line.compare(0, n, key) == 0 && line.size() > n && line[n] == ':') return std::atof(line.c_str() + n + 1);
+    return 0.0;
+}
+// Reset VmHWM to the current resident size (Linux >= 4.0; harmless elsewhere).
+void reset_peak_rss()
+{
+    std::ofstream f("/proc/self/clear_refs");
+    f << "5";
+}
+
 int cmd_build(int argc, char **argv)
 {
     Args a = parse(argc, argv, 2,
-                   {"-o", "--sectors", "--reduce", "--slices", "--height-scale", "--posting", "--threads", "--emit-c"});
+                   {"-o", "--sectors", "--reduce", "--slices", "--height-scale", "--posting", "--threads", "--emit-c", "--builder", "--window"});
     if (a.pos.size() != 1) usage("build needs exactly one DEM file");
     if (!a.opt.count("-o")) usage("build needs -o OUT.ctp");
     BuildOptions o;
@@ -135,6 +152,14 @@ int cmd_build(int argc, char **argv)
     o.reduce = to_int(a, "--reduce", 1);
     o.slices = to_int(a, "--slices", 0);
     o.threads = to_int(a, "--threads", 0);
+    o.window = to_int(a, "--window", o.window);
+    if (a.opt.count("--builder")) {
+        const std::string &b = a.opt["--builder"];
+        if (b == "slices") o.builder = PptBuilder::Slices;
+        else if (b == "brute") o.builder = PptBuilder::Brute;
+        else usage("--builder " + b + ": expected slices or brute");
+    }
+    if (o.window < 1 || o.window > 64) usage("--window must be in 1..64");
     if (o.sectors < 1 || o.sectors > 64) usage("--sectors must be in 1..64");
     if (o.reduce < 1 || o.reduce > 8) usage("--reduce must be in 1..8");
     if (o.slices < 0) usage("--slices must be >= 0");
@@ -146,7 +171,13 @@ int cmd_build(int argc, char **argv)
     Progress bar("building cones");
     o.progress = [&](size_t d, size_t n) { bar.update(d, n); };
     BuildStats st;
+    // working memory of the build: the peak resident size during
+    // build_package (including the package it returns) above the resident
+    // size before it (the DEM and the libraries)
+    double rss0 = proc_status_kib("VmRSS") * 1024.0;
+    reset_peak_rss();
     std::vector<uint8_t> pkg = build_package(t, o, &st);
+    double work = std::max(0.0, proc_status_kib("VmHWM") * 1024.0 - rss0);
     bar.finish();
     write_file_atomic(out, pkg);
     if (a.opt.count("--emit-c")) {
@@ -159,10 +190,18 @@ int cmd_build(int argc, char **argv)
     }
     double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     size_t dem_bytes = (size_t)t.width * t.height * 2;
+    std::string how = "brute-force builder";
+    if (o.builder == PptBuilder::Slices) {
+        char buf[160];
+        std::snprintf(buf, sizeof buf, "slice builder: %d levels, %d slices x %d sectors transformed", st.slices,
+                      st.slices_transformed, o.sectors);
+        how = buf;
+    }
     std::printf("%s: %dx%d posts, %d sectors, r=%d, package %zu bytes (%.2fx the 16-bit DEM), "
-                "%.1f%% degenerate cones, built in %.2f s\n",
+                "%.1f%% degenerate cones, built in %.2f s (%s), working memory %.1f MB (%.2fx the DEM)\n",
                 out.c_str(), t.width, t.height, o.sectors, o.reduce, pkg.size(), (double)pkg.size() / dem_bytes,
-                100.0 * st.degenerate_cones / std::max<size_t>(1, st.cones), secs);
+                100.0 * st.degenerate_cones / std::max<size_t>(1, st.cones), secs, how.c_str(), work / 1e6,
+                work / dem_bytes);
     return 0;
 }
 

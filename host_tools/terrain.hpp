@@ -32,14 +32,20 @@ struct Terrain {
     uint16_t at(int i, int j) const { return codes[(size_t)j * (size_t)width + (size_t)i]; }
 };
 
-enum class PptBuilder { Brute };
+// Slices: the paper's slice-by-slice directional-DT builder (the default;
+// builder_slices.cpp).  Brute: per-cell branch and bound over exact
+// geometry (builder_brute.cpp): tighter cones, slower; the test reference.
+enum class PptBuilder { Slices, Brute };
 
 struct BuildOptions {
     int sectors = 24;      // N, 1..64
     int reduce = 1;        // r, 1..8
-    int slices = 0;        // K > 0: apexes rounded up to K evenly spaced levels
+    int slices = 0;        // K > 0: apexes rounded up to K evenly spaced levels;
+                           // 0: exact apexes (Brute), DEFAULT_SLICES (Slices)
     int threads = 0;       // 0 = hardware concurrency
-    PptBuilder builder = PptBuilder::Brute;
+    PptBuilder builder = PptBuilder::Slices;
+    int window = 8;        // Slices: near window Rw in coarse cells (>= 1)
+    static constexpr int DEFAULT_SLICES = 64;
     // progress(done, total) called from the calling thread now and then
     std::function<void(size_t, size_t)> progress;
 };
@@ -48,6 +54,11 @@ struct BuildStats {
     double seconds = 0.0;
     size_t degenerate_cones = 0;   // (cell, sector) pairs with code 0
     size_t cones = 0;              // (cell, sector) pairs
+    int slices = 0;                // Slices: levels K used / slices transformed
+    int slices_transformed = 0;
+    size_t far_narrowed = 0;       // Slices: codes narrowed by a far (DT) term
+    double seconds_local = 0.0;    // Slices: near + window terms
+    double seconds_dt = 0.0;       // Slices: slice DTs and far terms
 };
 
 struct Error : std::runtime_error {

@@ -366,15 +366,25 @@ struct Checker {
     }
 };
 
-void check_package(const char *name, const ct_host::Terrain &t, int n, int r, int slices = 0)
+// builder: the default (the slice builder), or the one given; window: the
+// slice builder's near window Rw (small windows send most terrain through
+// the slice DTs).  *stats_out: the build's stats.
+void check_package(const char *name, const ct_host::Terrain &t, int n, int r, int slices = 0,
+                   ct_host::PptBuilder builder = ct_host::BuildOptions().builder, int window = 8,
+                   ct_host::BuildStats *stats_out = nullptr)
 {
     ct_host::BuildOptions o;
     o.sectors = n;
     o.reduce = r;
     o.slices = slices;
-    std::vector<uint8_t> b = ct_host::build_package(t, o);
+    o.builder = builder;
+    o.window = window;
+    ct_host::BuildStats bst;
+    std::vector<uint8_t> b = ct_host::build_package(t, o, &bst);
+    if (stats_out) *stats_out = bst;
     ct_package p;
     TEST_ASSERT_EQUAL_INT(CT_OK, ct_package_open(&p, b.data(), b.size()));
+    if (ct_harness_g.current_failed) return;
     Checker c;
     c.t = &t;
     c.p = &p;
@@ -412,9 +422,9 @@ void check_package(const char *name, const ct_host::Terrain &t, int n, int r, in
                 }
             }
         }
-    std::printf("  %-16s N=%-2d r=%d K=%-2d: %ld cones (%ld degenerate), %ld regions; worst excess %.3Lg LSB; "
+    std::printf("  %-5s %-16s N=%-2d r=%d K=%-2d W=%-2d: %ld cones (%ld degenerate), %ld regions; worst excess %.3Lg LSB; "
                 "violations %ld, undecided %ld\n",
-                name, n, r, slices, cones, degenerate, c.regions, c.worst, c.violations, c.undecided);
+                builder == ct_host::PptBuilder::Brute ? "brute" : "slice", name, n, r, slices, window, cones, degenerate, c.regions, c.worst, c.violations, c.undecided);
     TEST_ASSERT_MSG(c.violations == 0, "%s N=%d r=%d: %ld promise violations", name, n, r, c.violations);
     TEST_ASSERT_MSG(c.undecided == 0, "%s N=%d r=%d: %ld undecided regions", name, n, r, c.undecided);
 }
@@ -442,28 +452,59 @@ ct_host::Terrain small(int kind, int w, int h)
     }
 }
 
+using B = ct_host::PptBuilder;
+
 void test_promise_sectors()
 {
     ct_host::Terrain t0 = small(0, 12, 10), t1 = small(1, 13, 11), t2 = small(2, 12, 12), t3 = small(3, 9, 8);
     const int ns[] = {1, 2, 3, 4, 8, 24};
-    for (int n : ns) {
-        check_package("noise", t0, n, 1);
-        check_package("spikes_wall", t1, n, 2);
-        check_package("smooth", t2, n, 3);
-        check_package("extremes", t3, n, 1);
-        if (ct_harness_g.current_failed) return;
-    }
+    for (B b : {B::Brute, B::Slices})
+        for (int n : ns) {
+            check_package("noise", t0, n, 1, 0, b);
+            check_package("spikes_wall", t1, n, 2, 0, b);
+            check_package("smooth", t2, n, 3, 0, b);
+            check_package("extremes", t3, n, 1, 0, b);
+            if (ct_harness_g.current_failed) return;
+        }
 }
 
 void test_promise_reduce_and_slices()
 {
     ct_host::Terrain t1 = small(1, 14, 12), t2 = small(2, 13, 11);
-    for (int r = 1; r <= 4; ++r) {
-        check_package("spikes_wall", t1, 7, r);
-        check_package("smooth+slices", t2, 16, r, 12);
-        if (ct_harness_g.current_failed) return;
+    for (B b : {B::Brute, B::Slices}) {
+        for (int r = 1; r <= 4; ++r) {
+            check_package("spikes_wall", t1, 7, r, 0, b);
+            check_package("smooth+slices", t2, 16, r, 12, b);
+            if (ct_harness_g.current_failed) return;
+        }
+        check_package("smooth", t2, 64, 1, 0, b);
     }
-    check_package("smooth", t2, 64, 1);
+}
+
+// The slice builder (the default) for N in {1, 4, 8, 16, 24, 32, 64} and r in
+// 1..4.  Windows of 1 and 2 coarse cells send nearly all terrain through the
+// slice DTs and their widened sectors; the DEMs are large enough (in coarse
+// cells) that far terms narrow many cones, which is asserted so that the
+// far path is known to be exercised.
+void test_promise_slice_builder()
+{
+    ct_host::Terrain ts[3] = {small(1, 19, 17), small(2, 18, 18), small(0, 17, 15)};
+    const char *names[3] = {"spikes_wall", "smooth", "noise"};
+    const int ns[] = {1, 4, 8, 16, 24, 32, 64};
+    size_t narrowed[5] = {0, 0, 0, 0, 0};
+    int k = 0;
+    for (int n : ns)
+        for (int r = 1; r <= 4; ++r, ++k) {
+            int which = k % 3, window = 1 + (k / 3) % 2, slices = (k % 2) ? 0 : 5 + 7 * (k % 5);
+            ct_host::BuildStats st;
+            check_package(names[which], ts[which], n, r, slices, B::Slices, window, &st);
+            narrowed[r] += st.far_narrowed;
+            if (ct_harness_g.current_failed) return;
+        }
+    for (int r = 1; r <= 4; ++r) {
+        std::printf("  r=%d: %zu cones narrowing events by far (slice DT) terms\n", r, narrowed[r]);
+        TEST_ASSERT_MSG(narrowed[r] > 0, "r=%d: the slice DTs never narrowed a cone", r);
+    }
 }
 
 }  // namespace
@@ -473,5 +514,6 @@ int main()
     TEST_BEGIN("test_promise");
     RUN_TEST(test_promise_sectors);
     RUN_TEST(test_promise_reduce_and_slices);
+    RUN_TEST(test_promise_slice_builder);
     return TEST_END();
 }

@@ -1,0 +1,277 @@
+// builder_common.hpp -- geometry shared by the PPT builders (host, C++17):
+// exact sector (wedge) tests on integer vectors, distances from a coarse
+// cell's footprint to a rectangle within a wedge, the max pyramid, the
+// bilinear patches' directional slopes (the "near" term of DESIGN.md's
+// promise) and the angle-code choice.  Units: fine cells horizontally, height
+// LSB vertically.  Internal to host_tools (builder_brute.cpp,
+// builder_slices.cpp).
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include "conetrace.h"
+#include "terrain.hpp"
+
+namespace ct_host {
+namespace bld {
+
+constexpr double K_NEAR = 1.0;          // cells          // cells
+constexpr double INF = std::numeric_limits<double>::infinity();
+constexpr size_t BELOW_POP_CAP = 4096;  // effort cap for negative cones
+constexpr double GEOM_EPS = 1e-9;       // cells: slab expansion
+
+struct Wedge {
+    int n = 1;
+    std::vector<int64_t> bx, by;  // n + 1 integer boundary vectors (|b| ~ 2^30)
+    std::vector<double> ux, uy;   // the same, unit length
+};
+
+inline Wedge make_wedge(int n)
+{
+    Wedge w;
+    w.n = n;
+    for (int k = 0; k <= n; ++k) {
+        int32_t x, y;
+        if (ct_sector_boundary((uint32_t)n, (uint32_t)k, &x, &y) != CT_OK) {
+            throw Error("bad sector count");
+        }
+        w.bx.push_back(x);
+        w.by.push_back(y);
+        double l = std::hypot((double)x, (double)y);
+        w.ux.push_back(x / l);
+        w.uy.push_back(y / l);
+    }
+    return w;
+}
+
+// exact closed / open wedge tests for integer vectors (|v| <= 2^20)
+inline bool in_closed(const Wedge &w, int s, int64_t x, int64_t y)
+{
+    if (w.n == 1) return true;
+    int64_t c0 = w.bx[s] * y - w.by[s] * x;
+    int64_t c1 = x * w.by[s + 1] - y * w.bx[s + 1];
+    return c0 >= 0 && c1 >= 0;
+}
+inline bool in_open(const Wedge &w, int s, int64_t x, int64_t y)
+{
+    if (w.n == 1) return x != 0 || y != 0;
+    int64_t c0 = w.bx[s] * y - w.by[s] * x;
+    int64_t c1 = x * w.by[s + 1] - y * w.bx[s + 1];
+    return c0 > 0 && c1 > 0;
+}
+
+// Rational p/q with q >= 0 (q == 0: +infinity).
+struct Frac {
+    int64_t p, q;
+};
+inline bool frac_lt(Frac a, Frac b)
+{
+    if (a.q == 0) return false;
+    if (b.q == 0) return true;
+    return a.p * b.q < b.p * a.q;  // |p| <= 2^18, q <= 2^30
+}
+
+// Does {l * b : l > 0} meet the open rectangle (x0,x1) x (y0,y1)?  Exact.
+inline bool ray_meets_open_rect(int64_t bx, int64_t by, int64_t x0, int64_t x1, int64_t y0, int64_t y1)
+{
+    Frac lo{0, 1}, hi{1, 0};
+    auto axis = [&](int64_t b, int64_t a0, int64_t a1) {
+        if (b == 0) return a0 < 0 && 0 < a1;
+        Frac l = b > 0 ? Frac{a0, b} : Frac{-a1, -b};
+        Frac h = b > 0 ? Frac{a1, b} : Frac{-a0, -b};
+        if (frac_lt(lo, l)) lo = l;
+        if (frac_lt(h, hi)) hi = h;
+        return true;
+    };
+    if (!axis(bx, x0, x1) || !axis(by, y0, y1)) return false;
+    return frac_lt(lo, hi);
+}
+
+// R = B (-) F as integer rectangle [x0,x1] x [y0,y1] (cells).
+struct Rect {
+    int64_t x0, x1, y0, y1;
+};
+
+// Does R intersect W_s with positive area?  Exact.
+inline bool overlaps(const Wedge &w, int s, const Rect &r)
+{
+    if (w.n == 1) return true;
+    if (r.x0 < 0 && 0 < r.x1 && r.y0 < 0 && 0 < r.y1) return true;
+    if (in_open(w, s, r.x0 + r.x1, r.y0 + r.y1)) return true;
+    return ray_meets_open_rect(w.bx[s], w.by[s], r.x0, r.x1, r.y0, r.y1) ||
+           ray_meets_open_rect(w.bx[s + 1], w.by[s + 1], r.x0, r.x1, r.y0, r.y1);
+}
+
+// Slab interval of the unit ray (ux, uy) through R expanded by GEOM_EPS.
+inline bool slab(double ux, double uy, const Rect &r, double *tlo, double *thi)
+{
+    double lo = 0.0, hi = INF;
+    auto axis = [&](double u, double a0, double a1) {
+        a0 -= GEOM_EPS;
+        a1 += GEOM_EPS;
+        if (u == 0.0) return a0 <= 0.0 && 0.0 <= a1;
+        double t0 = a0 / u, t1 = a1 / u;
+        if (t0 > t1) std::swap(t0, t1);
+        lo = std::max(lo, t0);
+        hi = std::min(hi, t1);
+        return true;
+    };
+    if (!axis(ux, (double)r.x0, (double)r.x1) || !axis(uy, (double)r.y0, (double)r.y1)) return false;
+    *tlo = lo;
+    *thi = hi;
+    return lo <= hi;
+}
+
+// min |v| over v in R intersected with closed W_s (a lower bound), INF if empty.
+inline double dist_min(const Wedge &w, int s, const Rect &r)
+{
+    int64_t cx = std::clamp<int64_t>(0, r.x0, r.x1), cy = std::clamp<int64_t>(0, r.y0, r.y1);
+    if (in_closed(w, s, cx, cy)) return std::hypot((double)cx, (double)cy) * (1.0 - 1e-12);
+    double best = INF;
+    for (int k = s; k <= s + 1; ++k) {
+        double lo, hi;
+        if (slab(w.ux[k], w.uy[k], r, &lo, &hi)) best = std::min(best, lo);
+    }
+    return best * (1.0 - 1e-12);
+}
+
+// max |v| over v in R intersected with closed W_s (an upper bound).
+inline double dist_max(const Wedge &w, int s, const Rect &r)
+{
+    double best = 0.0;
+    const int64_t xs[2] = {r.x0, r.x1}, ys[2] = {r.y0, r.y1};
+    for (int a = 0; a < 2; ++a)
+        for (int b = 0; b < 2; ++b)
+            if (in_closed(w, s, xs[a], ys[b])) best = std::max(best, std::hypot((double)xs[a], (double)ys[b]));
+    if (w.n > 1) {
+        for (int k = s; k <= s + 1; ++k) {
+            double lo, hi;
+            if (slab(w.ux[k], w.uy[k], r, &lo, &hi)) best = std::max(best, hi);
+        }
+    }
+    return best * (1.0 + 1e-12) + 1e-12;
+}
+
+// Max pyramid of fine-cell maxima: level 0 = fine cells.
+struct Pyramid {
+    std::vector<std::vector<uint16_t>> lv;
+    std::vector<int> w, h;
+    uint16_t at(int l, int i, int j) const { return lv[l][(size_t)j * w[l] + i]; }
+};
+
+inline Pyramid make_pyramid(const std::vector<uint16_t> &fm, int cx, int cy)
+{
+    Pyramid p;
+    p.lv.push_back(fm);
+    p.w.push_back(cx);
+    p.h.push_back(cy);
+    while (p.w.back() > 1 || p.h.back() > 1) {
+        int pw = p.w.back(), ph = p.h.back(), nw = (pw + 1) / 2, nh = (ph + 1) / 2;
+        std::vector<uint16_t> nx((size_t)nw * nh, 0);
+        const auto &pr = p.lv.back();
+        for (int j = 0; j < ph; ++j)
+            for (int i = 0; i < pw; ++i) {
+                uint16_t &d = nx[(size_t)(j / 2) * nw + i / 2];
+                d = std::max(d, pr[(size_t)j * pw + i]);
+            }
+        p.lv.push_back(std::move(nx));
+        p.w.push_back(nw);
+        p.h.push_back(nh);
+    }
+    return p;
+}
+
+struct Ctx {
+    const Terrain *t;
+    int cx, cy, r, n;
+    Wedge wedge;
+    std::vector<uint16_t> fm;          // fine-cell tallest corner
+    Pyramid pyr;
+    int64_t cot_q16[256];
+    uint8_t cot_ok[256];
+};
+
+// Max over u in W_s of the directional derivative of cell (i, j)'s patch
+// (LSB per cell); gradient extremes are at the corners.
+inline double max_slope(const Ctx &c, int s, int i, int j)
+{
+    const Terrain &t = *c.t;
+    double h00 = t.at(i, j), h10 = t.at(i + 1, j), h01 = t.at(i, j + 1), h11 = t.at(i + 1, j + 1);
+    double a = h10 - h00, b = h01 - h00, cc = h11 - h10 - h01 + h00;
+    double best = -INF;
+    for (int v = 0; v < 2; ++v)
+        for (int u = 0; u < 2; ++u) {
+            // gx, gy: integers below 2^18, exact; g1 = |gx| + |gy| >= |g|
+            // widens the tolerances (conservative: "inside" takes |g|)
+            double gx = a + cc * v, gy = b + cc * u, m;
+            double g1 = std::fabs(gx) + std::fabs(gy);
+            bool inside = c.wedge.n == 1;
+            if (!inside) {
+                double c0 = c.wedge.ux[s] * gy - c.wedge.uy[s] * gx;
+                double c1 = gx * c.wedge.uy[s + 1] - gy * c.wedge.ux[s + 1];
+                inside = c0 >= -1e-12 * g1 && c1 >= -1e-12 * g1;
+            }
+            if (inside) {
+                m = std::sqrt(gx * gx + gy * gy);
+            } else {
+                m = std::max(gx * c.wedge.ux[s] + gy * c.wedge.uy[s], gx * c.wedge.ux[s + 1] + gy * c.wedge.uy[s + 1]);
+            }
+            best = std::max(best, m + 1e-9 * (g1 + 1.0));
+        }
+    return best;
+}
+
+
+inline Rect block_rect(const Ctx &c, int l, int bi, int bj, int fx0, int fx1, int fy0, int fy1)
+{
+    int64_t bx0 = (int64_t)bi << l, by0 = (int64_t)bj << l;
+    int64_t bx1 = std::min<int64_t>((int64_t)(bi + 1) << l, c.cx), by1 = std::min<int64_t>((int64_t)(bj + 1) << l, c.cy);
+    return Rect{bx0 - fx1, bx1 - fx0, by0 - fy1, by1 - fy0};
+}
+
+// Far term of a sub-square at depth k >= 1: fine cell (i >> k, j >> k),
+// the square [i, i+1] x [j, j+1] / 2^k in fine-cell units.  The bilinear
+// patch is linear along each axis, so its maximum over the square is the
+// largest of the patch at the square's four corners (dyadic: exact in
+
+// The near term: for terrain points q with rho_s(q) <= K_NEAR, S(q) - a <=
+// rho * (max directional slope, over W_s, of the patches met on the segment
+// from the nearest point p* of F to q).  Those patches lie in fine cells
+// within K_NEAR of F in W_s.  F's own cells do not count: a segment from the
+// nearest point p* of F to a point q outside F never runs through F's
+// interior (a point of F nearer to q would lie on it).  -INF if none.
+inline double near_term(const Ctx &c, int s, int fx0, int fx1, int fy0, int fy1)
+{
+    double best = -INF;
+    for (int j = std::max(0, fy0 - 2); j < std::min(c.cy, fy1 + 2); ++j)
+        for (int i = std::max(0, fx0 - 2); i < std::min(c.cx, fx1 + 2); ++i) {
+            if (i >= fx0 && i < fx1 && j >= fy0 && j < fy1) continue;
+            Rect rr = block_rect(c, 0, i, j, fx0, fx1, fy0, fy1);
+            if (!overlaps(c.wedge, s, rr)) continue;
+            if (dist_min(c.wedge, s, rr) > K_NEAR) continue;
+            best = std::max(best, max_slope(c, s, i, j));
+        }
+    return best;
+}
+
+// Widest code whose tracer cot covers `need` (LSB per cell).
+inline uint8_t code_for(const Ctx &c, double need)
+{
+    if (need == -INF) return 255;
+    double q = need * 65536.0;
+    q = q + std::fabs(q) * 1e-9 + 2.0;  // margin for double rounding
+    if (q > 9.0e18) return 0;
+    int64_t need_q = (int64_t)std::ceil(q);
+    int lo = 0;  // largest k with cot_ok[k] && cot_q16[k] >= need_q; 0 if none
+    for (int k = 1; k < 256; ++k) {
+        if (c.cot_ok[k] && c.cot_q16[k] >= need_q) lo = k;
+    }
+    return (uint8_t)lo;
+}
+
+}  // namespace bld
+}  // namespace ct_host

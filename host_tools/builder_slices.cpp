@@ -1,0 +1,273 @@
+// builder_slices.cpp -- the paper's PPT builder (Paglieroni 1997, sec. 2.3):
+// directional distance transforms of horizontal cross-sections, processed
+// bottom-up one slice at a time, made conservative for DESIGN.md's promise.
+//
+// Grid: coarse cells G (r x r fine cells, height Hc(G) = max over its fine
+// cells of the tallest corner).  Levels L_0 < L_1 < ... < L_K (integer height
+// codes, L_0 = hmin, L_K = hmax, evenly spaced, duplicates removed).  Apex of
+// coarse cell F: a = L_k0, the lowest level not below Hc(F).  Slice k is the
+// bitmap B_k = { G : Hc(G) > L_k }.
+//
+// The needed cot C(F, s) (LSB per fine cell) must bound (S(q) - a) / rho_s(q)
+// for every terrain point q with S(q) > a, rho_s(q) = min |q - p| over p in
+// F's footprint with q - p in the closed wedge W_s (DESIGN.md).  Three parts,
+// each a valid bound for the points it covers:
+//  near    rho_s(q) <= K_NEAR: the surface's directional slopes (shared with
+//          the brute-force builder, builder_common.hpp);
+//  window  q in a coarse cell G = F + v with |v|_inf <= Rw: the column bound
+//          (Hc(G) - a) / max(K_NEAR, min rho over G in W_s), exact geometry,
+//          offsets precomputed per sector;
+//  far     q in G with |v|_inf > Rw.  Let S(q) be in (L_k, L_k+1] (k >= k0);
+//          then G is in B_k, and
+//            rho_s(q) >= r * (|v| - sqrt2)          (p, q anywhere in F, G)
+//            rho_s(q) >= r * Rw                    (|v|_inf >= Rw + 1)
+//          and, since q - p in W_s and |r v - (q - p)| <= r sqrt2, v lies
+//          within the angle delta = asin(sqrt2 / (Rw + 1)) of W_s: in the
+//          widened wedge W'_s = W_s rotated outwards by delta on both sides.
+//          With DT_k(F) the exact Euclidean directional DT of B_k at F over
+//          W'_s (ddt.hpp: rasterized line traversal), DT_k(F) <= |v|, so
+//            (S(q) - a) / rho_s(q) <= (L_k+1 - a) / (r * max(Rw, DT_k - sqrt2)).
+//          The radius is held constant across the band (L_k, L_k+1], as the
+//          paper prescribes.
+// The code stored is the widest angle whose tracer cot covers max(0, near,
+// window, far_k for all k >= k0), rounded down (code_for).  Slices are done
+// bottom-up with one slice's bitmap and DT arrays in memory; each slice's
+// sectors run on the worker threads (one sector per thread at a time).
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <thread>
+
+#include "builder_common.hpp"
+#include "builder_slices.hpp"
+#include "ddt.hpp"
+
+namespace ct_host {
+namespace bld {
+namespace {
+
+struct WinOffset {
+    int dx, dy;      // coarse cells
+    double rho;      // max(K_NEAR, min rho over the offset's rectangle in W_s), fine cells
+};
+
+// Offsets of the window (|v|_inf <= rw, v != 0) whose rectangle of q - p
+// meets W_s with positive area, per sector.  Coarse offsets with |v|_inf <=
+// FINE_RING go to `fine` as the fine cells they hold (offsets from F's
+// top-left fine cell; the column bound per fine cell is far tighter than
+// per coarse cell next to F), the rest to `coarse`.
+constexpr int FINE_RING = 2;
+void window_offsets(const Ctx &c, int rw, std::vector<std::vector<WinOffset>> *fine,
+                    std::vector<std::vector<WinOffset>> *coarse)
+{
+    fine->assign((size_t)c.n, {});
+    coarse->assign((size_t)c.n, {});
+    const int64_t r = c.r;
+    for (int s = 0; s < c.n; ++s) {
+        for (int dy = -rw; dy <= rw; ++dy)
+            for (int dx = -rw; dx <= rw; ++dx) {
+                if (std::max(std::abs(dx), std::abs(dy)) <= FINE_RING) continue;
+                Rect rr{r * dx - r, r * dx + r, r * dy - r, r * dy + r};
+                if (!overlaps(c.wedge, s, rr)) continue;
+                double d = dist_min(c.wedge, s, rr);
+                if (d == INF) continue;
+                (*coarse)[(size_t)s].push_back(WinOffset{dx, dy, std::max(K_NEAR, d)});
+            }
+        const int lo = -FINE_RING * (int)r, hi = (FINE_RING + 1) * (int)r;
+        for (int oy = lo; oy < hi; ++oy)
+            for (int ox = lo; ox < hi; ++ox) {
+                if (ox >= 0 && ox < r && oy >= 0 && oy < r) continue;  // F's own cells: below a
+                Rect rr{ox - r, ox + 1, oy - r, oy + 1};
+                if (!overlaps(c.wedge, s, rr)) continue;
+                double d = dist_min(c.wedge, s, rr);
+                if (d == INF) continue;
+                (*fine)[(size_t)s].push_back(WinOffset{ox, oy, std::max(K_NEAR, d)});
+            }
+    }
+}
+
+// The widened wedge W'_s as pieces of at most 90 degrees (closed, sharing
+// their inner boundaries exactly), or an empty list for "every direction".
+std::vector<ddt::Wedge> widened_pieces(const Ctx &c, int s, double delta)
+{
+    std::vector<ddt::Wedge> out;
+    if (c.n == 1) return out;
+    constexpr double PI = 3.14159265358979323846;
+    double t0 = std::atan2((double)c.wedge.by[s], (double)c.wedge.bx[s]);
+    double t1 = std::atan2((double)c.wedge.by[s + 1], (double)c.wedge.bx[s + 1]);
+    double open = t1 - t0;
+    while (open <= 0.0) open += 2.0 * PI;
+    double a0 = t0 - delta, span = open + 2.0 * delta;
+    if (span >= 2.0 * PI - 1e-6) return out;
+    int m = (int)std::ceil(span / (PI / 2.0) - 1e-12);
+    auto vec = [](double t, int64_t *x, int64_t *y) {
+        *x = (int64_t)std::llround(std::cos(t) * 1073741824.0);
+        *y = (int64_t)std::llround(std::sin(t) * 1073741824.0);
+    };
+    int64_t px, py;
+    vec(a0, &px, &py);
+    for (int k = 1; k <= m; ++k) {
+        int64_t qx, qy;
+        vec(a0 + span * k / m, &qx, &qy);
+        ddt::Wedge w;
+        w.b1x = px;
+        w.b1y = py;
+        w.b2x = qx;
+        w.b2y = qy;
+        out.push_back(w);
+        px = qx;
+        py = qy;
+    }
+    return out;
+}
+
+}  // namespace
+
+void slice_angles(const Ctx &c, const SliceInput &in, std::vector<uint8_t> &codes, SliceStats *st)
+{
+    const int r = c.r, wc = (c.cx + r - 1) / r, hc = (c.cy + r - 1) / r;
+    const size_t plane = (size_t)wc * hc;
+    const int rw = in.window;
+    if (rw < 1) throw Error("slice builder window must be >= 1 coarse cell");
+    const int nthreads = std::max(1, in.threads);
+    codes.assign(plane * (size_t)c.n, 0);
+
+    // coarse heights
+    std::vector<uint16_t> hcm(plane, 0);
+    for (int j = 0; j < c.cy; ++j)
+        for (int i = 0; i < c.cx; ++i) {
+            uint16_t &d = hcm[(size_t)(j / r) * wc + i / r];
+            d = std::max(d, c.fm[(size_t)j * c.cx + i]);
+        }
+    const std::vector<int> &lv = *in.levels;
+    const std::vector<int> &k0 = *in.apex_level;
+    const std::vector<int> &apex = *in.apex;
+    const int K = (int)lv.size() - 1;
+
+    // cot of each code as a double lower bound, for the monotone update
+    double cot_of[256];
+    for (int k = 0; k < 256; ++k) cot_of[k] = c.cot_ok[k] ? ((double)c.cot_q16[k] * (1.0 - 1e-9) - 3.0) / 65536.0 : -INF;  // stricter than code_for
+
+    auto t_start = std::chrono::steady_clock::now();
+    // ---- near + window terms, threads over rows of coarse cells
+    std::vector<std::vector<WinOffset>> win, wfine;
+    window_offsets(c, std::max(rw, FINE_RING), &wfine, &win);
+    {
+        std::atomic<int> next{0};
+        auto worker = [&]() {
+            for (;;) {
+                int cj = next.fetch_add(1);
+                if (cj >= hc) break;
+                for (int ci = 0; ci < wc; ++ci) {
+                    size_t f = (size_t)cj * wc + ci;
+                    double a = apex[f];
+                    int fx0 = ci * r, fy0 = cj * r, fx1 = std::min(fx0 + r, c.cx), fy1 = std::min(fy0 + r, c.cy);
+                    for (int s = 0; s < c.n; ++s) {
+                        double need = std::max(0.0, near_term(c, s, fx0, fx1, fy0, fy1));
+                        for (const WinOffset &o : wfine[(size_t)s]) {
+                            int qi = fx0 + o.dx, qj = fy0 + o.dy;
+                            if (qi < 0 || qj < 0 || qi >= c.cx || qj >= c.cy) continue;
+                            double h = c.fm[(size_t)qj * c.cx + qi];
+                            if (h > a) need = std::max(need, (h - a) / o.rho);
+                        }
+                        for (const WinOffset &o : win[(size_t)s]) {
+                            int gi = ci + o.dx, gj = cj + o.dy;
+                            if (gi < 0 || gj < 0 || gi >= wc || gj >= hc) continue;
+                            double h = hcm[(size_t)gj * wc + gi];
+                            if (h > a) need = std::max(need, (h - a) / o.rho);
+                        }
+                        codes[(size_t)s * plane + f] = code_for(c, need);
+                    }
+                }
+            }
+        };
+        std::vector<std::thread> pool;
+        for (int t = 0; t < nthreads; ++t) pool.emplace_back(worker);
+        for (auto &th : pool) th.join();
+    }
+
+    auto t_local = std::chrono::steady_clock::now();
+    // ---- far terms, slice by slice, bottom-up
+    constexpr double SQRT2 = 1.41421356237309515;  // rounded up
+    const double delta = std::asin(std::min(1.0, SQRT2 / (rw + 1))) + 1e-7;
+    std::vector<std::vector<ddt::Wedge>> pieces((size_t)c.n);
+    for (int s = 0; s < c.n; ++s) pieces[(size_t)s] = widened_pieces(c, s, delta);
+    int kmin = K;
+    for (int v : k0) kmin = std::min(kmin, v);
+    std::vector<uint8_t> bits(plane);
+    struct Scratch {  // one DT's arrays per thread, kept across slices
+        std::vector<int64_t> dt, dmin;
+        std::vector<ddt::Point> ft;
+        ddt::Options opt;
+    };
+    std::vector<Scratch> scratch((size_t)nthreads);
+    std::vector<size_t> narrowed((size_t)nthreads, 0);
+    for (int k = kmin; k < K; ++k) {
+        size_t nfeat = 0;
+        for (size_t f = 0; f < plane; ++f) {
+            bits[f] = hcm[f] > lv[(size_t)k];
+            nfeat += bits[f];
+        }
+        if (in.progress) in.progress((size_t)(k - kmin), (size_t)(K - kmin));
+        if (nfeat == 0) break;  // and every higher slice is empty too
+        if (st) st->slices++;
+        ddt::Prepared bm(wc, hc, bits.data());
+        const double top = lv[(size_t)k + 1];
+        std::atomic<int> next{0};
+        auto worker = [&](int tid) {
+            Scratch &sc = scratch[(size_t)tid];
+            for (;;) {
+                int s = next.fetch_add(1);
+                if (s >= c.n) break;
+                const auto &ps = pieces[(size_t)s];
+                if (ps.empty()) {
+                    ddt::unconstrained(bm, ddt::EuclideanSq(), sc.dmin, sc.ft, sc.opt);
+                } else {
+                    for (size_t p = 0; p < ps.size(); ++p) {
+                        ddt::directional(bm, ps[p], ddt::EuclideanSq(), p == 0 ? sc.dmin : sc.dt, sc.ft, sc.opt);
+                        if (p > 0)
+                            for (size_t f = 0; f < plane; ++f) sc.dmin[f] = std::min(sc.dmin[f], sc.dt[f]);
+                    }
+                }
+                // term = (top - a) / (r max(Rw, sqrt(D2) - sqrt2)) > cot  <=>
+                // X = (top - a) / cot > r Rw  and  D2 < (X / r + sqrt2)^2
+                uint8_t *cs = &codes[(size_t)s * plane];
+                const int64_t *dm = sc.dmin.data();
+                for (size_t f = 0; f < plane; ++f) {
+                    if (k0[f] > k || cs[f] == 0 || dm[f] == ddt::Inf<int64_t>::value) continue;
+                    double rise = top - apex[f], cot = cot_of[cs[f]];
+                    if (rise <= 0.0) continue;
+                    if (cot > 0.0) {
+                        double x = rise / cot;
+                        if (x <= r * (double)rw) continue;
+                        double lim = x / r + SQRT2;
+                        if ((double)dm[f] >= lim * lim * (1.0 + 1e-12)) continue;
+                    }
+                    double d = std::sqrt((double)dm[f]) * (1.0 - 1e-15) - SQRT2;
+                    double rho = r * std::max((double)rw, d);
+                    double term = rise / rho;
+                    if (term > cot) {
+                        uint8_t nc = code_for(c, term);
+                        if (nc < cs[f]) {
+                            cs[f] = nc;
+                            narrowed[(size_t)tid]++;
+                        }
+                    }
+                }
+            }
+        };
+        std::vector<std::thread> pool;
+        for (int t = 0; t < std::min(nthreads, c.n); ++t) pool.emplace_back(worker, t);
+        for (auto &th : pool) th.join();
+    }
+    if (in.progress) in.progress((size_t)(K - kmin), (size_t)(K - kmin));
+    if (st) {
+        auto t_end = std::chrono::steady_clock::now();
+        for (size_t v : narrowed) st->far_narrowed += v;
+        st->seconds_local = std::chrono::duration<double>(t_local - t_start).count();
+        st->seconds_dt = std::chrono::duration<double>(t_end - t_local).count();
+    }
+}
+
+}  // namespace bld
+}  // namespace ct_host

@@ -1,0 +1,34 @@
+// builder_slices.hpp -- the slice-by-slice directional-DT PPT builder
+// (builder_slices.cpp), called by build_package for PptBuilder::Slices.
+#pragma once
+
+#include <cstddef>
+#include <functional>
+#include <vector>
+
+#include "builder_common.hpp"
+
+namespace ct_host {
+namespace bld {
+
+struct SliceInput {
+    const std::vector<int> *levels = nullptr;      // L_0 < ... < L_K, height codes
+    const std::vector<int> *apex = nullptr;        // per coarse cell: apex height a >= Hc
+    const std::vector<int> *apex_level = nullptr;  // per coarse cell: k0, the largest k with L_k <= a
+    int window = 8;                                // Rw, coarse cells (>= 1)
+    int threads = 1;
+    std::function<void(size_t, size_t)> progress;
+};
+
+struct SliceStats {
+    int slices = 0;  // slices whose DTs were computed
+    size_t far_narrowed = 0;  // (cell, sector) codes narrowed by a far (DT) term
+    double seconds_local = 0.0;   // near + window terms
+    double seconds_dt = 0.0;      // the slices' DTs and far terms
+};
+
+// Angle codes (N planes of coarse cells, sector-major) for ctx c.
+void slice_angles(const Ctx &c, const SliceInput &in, std::vector<uint8_t> &codes, SliceStats *st);
+
+}  // namespace bld
+}  // namespace ct_host
