@@ -260,7 +260,7 @@ std::vector<uint8_t> build_package(const Terrain &t, const BuildOptions &opt, Bu
     {
         size_t off = so[CT_SEC_MIPMAP];
         for (uint32_t l = 1; l <= levels; ++l) {
-            const auto &lv = c.pyr.lv[l];
+            const auto &lv = c.pyr.lv[l];  // level 0 (fine cells) is not stored
             for (uint16_t v : lv) {
                 put16(b, off, v);
                 off += 2;
@@ -272,7 +272,9 @@ std::vector<uint8_t> build_package(const Terrain &t, const BuildOptions &opt, Bu
     size_t plane = (size_t)wc * hc;
     int nthreads = opt.threads > 0 ? opt.threads : (int)std::max(1u, std::thread::hardware_concurrency());
     std::vector<int> apex(plane);
-    std::vector<uint8_t> codes;
+    // the angle planes, written in place in the package (sector-major, then
+    // the omnidirectional plane when N > 1)
+    uint8_t *codes = &b[so[CT_SEC_ANGLES]];
     int slices_header = opt.slices;
     for (int cj = 0; cj < hc; ++cj)
         for (int ci = 0; ci < wc; ++ci) {
@@ -313,6 +315,7 @@ std::vector<uint8_t> build_package(const Terrain &t, const BuildOptions &opt, Bu
             stats->slices_transformed = sst.slices;
             stats->seconds_local = sst.seconds_local;
             stats->far_narrowed = sst.far_narrowed;
+            stats->dts_skipped = sst.dts_skipped;
             stats->seconds_dt = sst.seconds_dt;
         }
     } else {
@@ -325,7 +328,6 @@ std::vector<uint8_t> build_package(const Terrain &t, const BuildOptions &opt, Bu
                 m = std::min<int>(hmax, std::max(m, lvl));
             }
         }
-        codes.assign(plane * (size_t)c.n, 0);
         std::atomic<int> next_row{0};
         std::atomic<size_t> rows_done{0};
         auto worker = [&]() {
@@ -357,16 +359,16 @@ std::vector<uint8_t> build_package(const Terrain &t, const BuildOptions &opt, Bu
     }
     for (size_t f = 0; f < plane; ++f) put16(b, so[CT_SEC_APEX] + 2 * f, (uint32_t)apex[f]);
 
-    size_t degenerate = 0;
-    for (size_t k = 0; k < codes.size(); ++k) {
-        b[so[CT_SEC_ANGLES] + k] = codes[k];
-        degenerate += codes[k] == 0;
+    if (stats) {
+        stats->cones = plane * (size_t)c.n;
     }
+    size_t degenerate = 0;
+    for (size_t k = 0; k < plane * (size_t)c.n; ++k) degenerate += codes[k] == 0;
     if (c.n > 1) {
         for (size_t k = 0; k < plane; ++k) {
             uint8_t m = 255;
             for (int s = 0; s < c.n; ++s) m = std::min(m, codes[(size_t)s * plane + k]);
-            b[so[CT_SEC_ANGLES] + (size_t)c.n * plane + k] = m;
+            codes[(size_t)c.n * plane + k] = m;
         }
     }
     if (voids) {
@@ -410,7 +412,6 @@ std::vector<uint8_t> build_package(const Terrain &t, const BuildOptions &opt, Bu
     if (stats) {
         stats->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         stats->degenerate_cones = degenerate;
-        stats->cones = codes.size();
     }
     return b;
 }

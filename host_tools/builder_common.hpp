@@ -157,22 +157,26 @@ inline double dist_max(const Wedge &w, int s, const Rect &r)
 }
 
 // Max pyramid of fine-cell maxima: level 0 = fine cells.
+// Max pyramid: level 0 is the fine-cell maxima themselves (not copied: the
+// pyramid must not outlive `fm`), levels 1.. are 2x2 maxima.
 struct Pyramid {
-    std::vector<std::vector<uint16_t>> lv;
+    const std::vector<uint16_t> *base = nullptr;
+    std::vector<std::vector<uint16_t>> lv;  // lv[0] empty
     std::vector<int> w, h;
-    uint16_t at(int l, int i, int j) const { return lv[l][(size_t)j * w[l] + i]; }
+    uint16_t at(int l, int i, int j) const { return (l == 0 ? *base : lv[l])[(size_t)j * w[l] + i]; }
 };
 
 inline Pyramid make_pyramid(const std::vector<uint16_t> &fm, int cx, int cy)
 {
     Pyramid p;
-    p.lv.push_back(fm);
+    p.base = &fm;
+    p.lv.emplace_back();
     p.w.push_back(cx);
     p.h.push_back(cy);
     while (p.w.back() > 1 || p.h.back() > 1) {
         int pw = p.w.back(), ph = p.h.back(), nw = (pw + 1) / 2, nh = (ph + 1) / 2;
         std::vector<uint16_t> nx((size_t)nw * nh, 0);
-        const auto &pr = p.lv.back();
+        const auto &pr = p.lv.size() == 1 ? fm : p.lv.back();
         for (int j = 0; j < ph; ++j)
             for (int i = 0; i < pw; ++i) {
                 uint16_t &d = nx[(size_t)(j / 2) * nw + i / 2];

@@ -57,11 +57,15 @@ struct WinOffset {
 // top-left fine cell; the column bound per fine cell is far tighter than
 // per coarse cell next to F), the rest to `coarse`.
 constexpr int FINE_RING = 2;
+// `near`: the fine cells of near_term() (builder_common.hpp) for a whole
+// footprint, as offsets from F's top-left fine cell (a superset of a partial
+// edge cell's: distances to a subset of F are no shorter).
 void window_offsets(const Ctx &c, int rw, std::vector<std::vector<WinOffset>> *fine,
-                    std::vector<std::vector<WinOffset>> *coarse)
+                    std::vector<std::vector<WinOffset>> *coarse, std::vector<std::vector<WinOffset>> *nearl)
 {
     fine->assign((size_t)c.n, {});
     coarse->assign((size_t)c.n, {});
+    nearl->assign((size_t)c.n, {});
     const int64_t r = c.r;
     for (int s = 0; s < c.n; ++s) {
         for (int dy = -rw; dy <= rw; ++dy)
@@ -72,6 +76,14 @@ void window_offsets(const Ctx &c, int rw, std::vector<std::vector<WinOffset>> *f
                 double d = dist_min(c.wedge, s, rr);
                 if (d == INF) continue;
                 (*coarse)[(size_t)s].push_back(WinOffset{dx, dy, std::max(K_NEAR, d)});
+            }
+        for (int oy = -2; oy < r + 2; ++oy)
+            for (int ox = -2; ox < r + 2; ++ox) {
+                if (ox >= 0 && ox < r && oy >= 0 && oy < r) continue;
+                Rect rr{ox - r, ox + 1, oy - r, oy + 1};
+                if (!overlaps(c.wedge, s, rr)) continue;
+                if (dist_min(c.wedge, s, rr) > K_NEAR) continue;
+                (*nearl)[(size_t)s].push_back(WinOffset{ox, oy, 0.0});
             }
         const int lo = -FINE_RING * (int)r, hi = (FINE_RING + 1) * (int)r;
         for (int oy = lo; oy < hi; ++oy)
@@ -123,14 +135,14 @@ std::vector<ddt::Wedge> widened_pieces(const Ctx &c, int s, double delta)
 
 }  // namespace
 
-void slice_angles(const Ctx &c, const SliceInput &in, std::vector<uint8_t> &codes, SliceStats *st)
+void slice_angles(const Ctx &c, const SliceInput &in, uint8_t *codes, SliceStats *st)
 {
     const int r = c.r, wc = (c.cx + r - 1) / r, hc = (c.cy + r - 1) / r;
     const size_t plane = (size_t)wc * hc;
     const int rw = in.window;
     if (rw < 1) throw Error("slice builder window must be >= 1 coarse cell");
     const int nthreads = std::max(1, in.threads);
-    codes.assign(plane * (size_t)c.n, 0);
+    std::fill(codes, codes + plane * (size_t)c.n, (uint8_t)0);
 
     // coarse heights
     std::vector<uint16_t> hcm(plane, 0);
@@ -150,8 +162,8 @@ void slice_angles(const Ctx &c, const SliceInput &in, std::vector<uint8_t> &code
 
     auto t_start = std::chrono::steady_clock::now();
     // ---- near + window terms, threads over rows of coarse cells
-    std::vector<std::vector<WinOffset>> win, wfine;
-    window_offsets(c, std::max(rw, FINE_RING), &wfine, &win);
+    std::vector<std::vector<WinOffset>> win, wfine, wnear;
+    window_offsets(c, std::max(rw, FINE_RING), &wfine, &win, &wnear);
     {
         std::atomic<int> next{0};
         auto worker = [&]() {
@@ -161,9 +173,14 @@ void slice_angles(const Ctx &c, const SliceInput &in, std::vector<uint8_t> &code
                 for (int ci = 0; ci < wc; ++ci) {
                     size_t f = (size_t)cj * wc + ci;
                     double a = apex[f];
-                    int fx0 = ci * r, fy0 = cj * r, fx1 = std::min(fx0 + r, c.cx), fy1 = std::min(fy0 + r, c.cy);
+                    int fx0 = ci * r, fy0 = cj * r;
                     for (int s = 0; s < c.n; ++s) {
-                        double need = std::max(0.0, near_term(c, s, fx0, fx1, fy0, fy1));
+                        double need = 0.0;
+                        for (const WinOffset &o : wnear[(size_t)s]) {
+                            int qi = fx0 + o.dx, qj = fy0 + o.dy;
+                            if (qi < 0 || qj < 0 || qi >= c.cx || qj >= c.cy) continue;
+                            need = std::max(need, max_slope(c, s, qi, qj));
+                        }
                         for (const WinOffset &o : wfine[(size_t)s]) {
                             int qi = fx0 + o.dx, qj = fy0 + o.dy;
                             if (qi < 0 || qj < 0 || qi >= c.cx || qj >= c.cy) continue;
@@ -201,7 +218,7 @@ void slice_angles(const Ctx &c, const SliceInput &in, std::vector<uint8_t> &code
         ddt::Options opt;
     };
     std::vector<Scratch> scratch((size_t)nthreads);
-    std::vector<size_t> narrowed((size_t)nthreads, 0);
+    std::vector<size_t> narrowed((size_t)nthreads, 0), skipped((size_t)nthreads, 0);
     for (int k = kmin; k < K; ++k) {
         size_t nfeat = 0;
         for (size_t f = 0; f < plane; ++f) {
@@ -220,6 +237,16 @@ void slice_angles(const Ctx &c, const SliceInput &in, std::vector<uint8_t> &code
                 int s = next.fetch_add(1);
                 if (s >= c.n) break;
                 const auto &ps = pieces[(size_t)s];
+                uint8_t *cs = &codes[(size_t)s * plane];
+                // Skip the DT when no active cell could be narrowed by it:
+                // every far term is at most (top - a) / (r Rw).
+                bool useful = false;
+                for (size_t f = 0; f < plane && !useful; ++f)
+                    useful = k0[f] <= k && cs[f] != 0 && top - apex[f] > cot_of[cs[f]] * (r * (double)rw);
+                if (!useful) {
+                    skipped[(size_t)tid]++;
+                    continue;
+                }
                 if (ps.empty()) {
                     ddt::unconstrained(bm, ddt::EuclideanSq(), sc.dmin, sc.ft, sc.opt);
                 } else {
@@ -231,7 +258,6 @@ void slice_angles(const Ctx &c, const SliceInput &in, std::vector<uint8_t> &code
                 }
                 // term = (top - a) / (r max(Rw, sqrt(D2) - sqrt2)) > cot  <=>
                 // X = (top - a) / cot > r Rw  and  D2 < (X / r + sqrt2)^2
-                uint8_t *cs = &codes[(size_t)s * plane];
                 const int64_t *dm = sc.dmin.data();
                 for (size_t f = 0; f < plane; ++f) {
                     if (k0[f] > k || cs[f] == 0 || dm[f] == ddt::Inf<int64_t>::value) continue;
@@ -264,6 +290,7 @@ void slice_angles(const Ctx &c, const SliceInput &in, std::vector<uint8_t> &code
     if (st) {
         auto t_end = std::chrono::steady_clock::now();
         for (size_t v : narrowed) st->far_narrowed += v;
+        for (size_t v : skipped) st->dts_skipped += v;
         st->seconds_local = std::chrono::duration<double>(t_local - t_start).count();
         st->seconds_dt = std::chrono::duration<double>(t_end - t_local).count();
     }

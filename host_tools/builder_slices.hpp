@@ -22,13 +22,15 @@ struct SliceInput {
 
 struct SliceStats {
     int slices = 0;  // slices whose DTs were computed
-    size_t far_narrowed = 0;  // (cell, sector) codes narrowed by a far (DT) term
+    size_t far_narrowed = 0;
+    size_t dts_skipped = 0;   // (slice, sector) DTs skipped: no active cone could narrow  // (cell, sector) codes narrowed by a far (DT) term
     double seconds_local = 0.0;   // near + window terms
     double seconds_dt = 0.0;      // the slices' DTs and far terms
 };
 
-// Angle codes (N planes of coarse cells, sector-major) for ctx c.
-void slice_angles(const Ctx &c, const SliceInput &in, std::vector<uint8_t> &codes, SliceStats *st);
+// Angle codes (N planes of coarse cells, sector-major) for ctx c, into
+// codes[0 .. N * planes).
+void slice_angles(const Ctx &c, const SliceInput &in, uint8_t *codes, SliceStats *st);
 
 }  // namespace bld
 }  // namespace ct_host

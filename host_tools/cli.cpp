@@ -192,9 +192,9 @@ int cmd_build(int argc, char **argv)
     size_t dem_bytes = (size_t)t.width * t.height * 2;
     std::string how = "brute-force builder";
     if (o.builder == PptBuilder::Slices) {
-        char buf[160];
-        std::snprintf(buf, sizeof buf, "slice builder: %d levels, %d slices x %d sectors transformed", st.slices,
-                      st.slices_transformed, o.sectors);
+        char buf[200];
+        std::snprintf(buf, sizeof buf, "slice builder: %d levels, %d slices x %d sectors, %zu DTs skipped; %.2f s near, %.2f s slices",
+                      st.slices, st.slices_transformed, o.sectors, st.dts_skipped, st.seconds_local, st.seconds_dt);
         how = buf;
     }
     std::printf("%s: %dx%d posts, %d sectors, r=%d, package %zu bytes (%.2fx the 16-bit DEM), "

@@ -57,6 +57,7 @@ struct BuildStats {
     int slices = 0;                // Slices: levels K used / slices transformed
     int slices_transformed = 0;
     size_t far_narrowed = 0;       // Slices: codes narrowed by a far (DT) term
+    size_t dts_skipped = 0;        // Slices: (slice, sector) DTs found useless and skipped
     double seconds_local = 0.0;    // Slices: near + window terms
     double seconds_dt = 0.0;       // Slices: slice DTs and far terms
 };
