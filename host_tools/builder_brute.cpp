@@ -288,11 +288,26 @@ std::vector<uint8_t> build_package(const Terrain &t, const BuildOptions &opt, Bu
         slices_header = K;
         // levels L_k = ceil(hmin + k (hmax - hmin) / K), duplicates removed
         std::vector<int> lv;
-        for (int k = 0; k <= K; ++k) {
-            int l = (int)std::ceil(hmin + (double)k * (hmax - hmin) / K - 1e-9);
-            l = std::clamp<int>(l, hmin, hmax);
-            if (k == K) l = hmax;
-            if (lv.empty() || l > lv.back()) lv.push_back(l);
+        if (!opt.levels_m.empty()) {
+            // given levels in metres -> codes (rounded up: a level is only a
+            // height at which a slice is cut), plus the extremes
+            lv.push_back(hmin);
+            lv.push_back(hmax);
+            for (double m : opt.levels_m) {
+                if (!std::isfinite(m)) throw Error("slice level is not a number");
+                double code = std::ceil((m - t.height_offset_m) / t.height_scale_m - 1e-9);
+                if (code > hmin && code < hmax) lv.push_back((int)code);
+            }
+            std::sort(lv.begin(), lv.end());
+            lv.erase(std::unique(lv.begin(), lv.end()), lv.end());
+            slices_header = (int)lv.size() - 1;
+        } else {
+            for (int k = 0; k <= K; ++k) {
+                int l = (int)std::ceil(hmin + (double)k * (hmax - hmin) / K - 1e-9);
+                l = std::clamp<int>(l, hmin, hmax);
+                if (k == K) l = hmax;
+                if (lv.empty() || l > lv.back()) lv.push_back(l);
+            }
         }
         std::vector<int> k0(plane);
         for (size_t f = 0; f < plane; ++f) {

@@ -39,7 +39,8 @@ namespace {
     std::fprintf(stderr,
                  "usage: conetrace build DEM -o OUT.ctp [--sectors N] [--reduce r] [--slices K]\n"
                  "                       [--height-scale M] [--posting M] [--threads T]\n"
-                 "                       [--builder slices|brute] [--window R] [--emit-c NAME]\n"
+                 "                       [--builder slices|brute] [--window R] [--levels H1,H2,...]\n"
+                 "                       [--emit-c NAME]\n"
                  "       conetrace info PKG\n"
                  "       conetrace trace PKG --rays rays.csv [--method M] -o hits.csv\n"
                  "       conetrace demo DEM\n"
@@ -144,7 +145,7 @@ void reset_peak_rss()
 int cmd_build(int argc, char **argv)
 {
     Args a = parse(argc, argv, 2,
-                   {"-o", "--sectors", "--reduce", "--slices", "--height-scale", "--posting", "--threads", "--emit-c", "--builder", "--window"});
+                   {"-o", "--sectors", "--reduce", "--slices", "--height-scale", "--posting", "--threads", "--emit-c", "--builder", "--window", "--levels"});
     if (a.pos.size() != 1) usage("build needs exactly one DEM file");
     if (!a.opt.count("-o")) usage("build needs -o OUT.ctp");
     BuildOptions o;
@@ -160,6 +161,19 @@ int cmd_build(int argc, char **argv)
         else usage("--builder " + b + ": expected slices or brute");
     }
     if (o.window < 1 || o.window > 64) usage("--window must be in 1..64");
+    if (a.opt.count("--levels")) {
+        if (o.builder != PptBuilder::Slices) usage("--levels needs the slice builder");
+        if (a.opt.count("--slices")) usage("--levels and --slices exclude each other");
+        std::stringstream ls(a.opt["--levels"]);
+        std::string item;
+        while (std::getline(ls, item, ',')) {
+            char *end = nullptr;
+            double v = std::strtod(item.c_str(), &end);
+            if (item.empty() || *end != '\0' || !std::isfinite(v)) usage("--levels: '" + item + "' is not a height in metres");
+            o.levels_m.push_back(v);
+        }
+        if (o.levels_m.empty()) usage("--levels needs at least one height");
+    }
     if (o.sectors < 1 || o.sectors > 64) usage("--sectors must be in 1..64");
     if (o.reduce < 1 || o.reduce > 8) usage("--reduce must be in 1..8");
     if (o.slices < 0) usage("--slices must be >= 0");

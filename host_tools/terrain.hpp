@@ -45,6 +45,8 @@ struct BuildOptions {
     int threads = 0;       // 0 = hardware concurrency
     PptBuilder builder = PptBuilder::Slices;
     int window = 8;        // Slices: near window Rw in coarse cells (>= 1)
+    std::vector<double> levels_m;  // Slices: given levels (metres) instead of K even ones;
+                                   // the DEM's lowest and highest heights are always levels
     static constexpr int DEFAULT_SLICES = 64;
     // progress(done, total) called from the calling thread now and then
     std::function<void(size_t, size_t)> progress;

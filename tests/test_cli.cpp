@@ -676,6 +676,12 @@ static void test_bad_inputs(void)
     // write_geotiff writes ModelPixelScale (|posting_e|, |posting_n|) as given
     w = write_small(in + "/nonsq.tif", false, false, -20.0);
     TEST_ASSERT_MSG(w.empty(), "write_geotiff (non-square): %s", w.c_str());
+    try {  // one post wider than the package format allows (CT_MAX_POSTS = 32768)
+        std::vector<double> wide((size_t)(32768 + 1) * 2, 100.0);
+        ct_host::write_geotiff(in + "/wide.tif", 32768 + 1, 2, wide, SampleType::Int16, small_geo(-30.0), false, 0);
+    } catch (const std::exception &e) {
+        TEST_FAIL_MSG("write_geotiff (wide): %s", e.what());
+    }
     const std::string pkg = fixture_package();
     TEST_ASSERT_MSG(!pkg.empty(), "no fixture package");
     std::string bytes = slurp(pkg);
@@ -716,6 +722,9 @@ static void test_bad_inputs(void)
         {"sectors2^32+8", {"build", "@ok.tif", "-o", "X.ctp", "--sectors", "4294967304"}, "", "--sectors", true, ""},
         {"hscale_nan", {"build", "@ok.tif", "-o", "X.ctp", "--height-scale", "nan"}, "", "--height-scale|ok.tif", true, ""},
         {"posting_nan", {"build", "@ok.tif", "-o", "X.ctp", "--posting", "nan"}, "", "--posting|ok.tif", true, ""},
+        {"toolarge", {"build", "@wide.tif", "-o", "X.ctp"}, "wide.tif", "exceeds the package limit", false, ""},
+        {"builder", {"build", "@ok.tif", "-o", "X.ctp", "--builder", "magic"}, "", "--builder", true, ""},
+        {"window0", {"build", "@ok.tif", "-o", "X.ctp", "--window", "0"}, "", "--window", true, ""},
     };
     std::vector<Job> jobs;
     std::vector<std::string> dirs;

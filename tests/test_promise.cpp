@@ -371,7 +371,7 @@ struct Checker {
 // the slice DTs).  *stats_out: the build's stats.
 void check_package(const char *name, const ct_host::Terrain &t, int n, int r, int slices = 0,
                    ct_host::PptBuilder builder = ct_host::BuildOptions().builder, int window = 8,
-                   ct_host::BuildStats *stats_out = nullptr)
+                   ct_host::BuildStats *stats_out = nullptr, const std::vector<double> *levels_m = nullptr)
 {
     ct_host::BuildOptions o;
     o.sectors = n;
@@ -379,6 +379,7 @@ void check_package(const char *name, const ct_host::Terrain &t, int n, int r, in
     o.slices = slices;
     o.builder = builder;
     o.window = window;
+    if (levels_m) o.levels_m = *levels_m;
     ct_host::BuildStats bst;
     std::vector<uint8_t> b = ct_host::build_package(t, o, &bst);
     if (stats_out) *stats_out = bst;
@@ -501,6 +502,11 @@ void test_promise_slice_builder()
             narrowed[r] += st.far_narrowed;
             if (ct_harness_g.current_failed) return;
         }
+    // given (uneven) levels, in metres: h = 100 m + code * scale
+    const std::vector<double> lv = {100.0 + 0.5 * 5000, 100.0 + 0.5 * 9000, 100.0 + 0.5 * 9500, 100.0 + 0.5 * 14000};
+    ct_host::BuildStats st;
+    check_package("smooth+levels", ts[1], 24, 2, 0, B::Slices, 1, &st, &lv);
+    TEST_ASSERT_MSG(st.slices == 4 || st.slices == 5, "given levels: %d slices", st.slices);
     for (int r = 1; r <= 4; ++r) {
         std::printf("  r=%d: %zu cones narrowing events by far (slice DT) terms\n", r, narrowed[r]);
         TEST_ASSERT_MSG(narrowed[r] > 0, "r=%d: the slice DTs never narrowed a cone", r);
