@@ -192,6 +192,49 @@ void run_cases(const std::vector<dem_cases::Case> &cases)
 
 void test_adversarial_dems() { run_cases(dem_cases::adversarial_cases()); }
 
+// The default (slice) builder over the whole grid of sector counts and
+// reductions the builder issue names, windows of 2 coarse cells so that far
+// terrain goes through the slice DTs, and the brute-force builder on two of
+// them: every method against the reference.
+void test_builder_grid()
+{
+    std::vector<dem_cases::Case> cases;
+    const int ns[] = {1, 4, 8, 16, 24, 32, 64};
+    int k = 0;
+    for (int n : ns)
+        for (int r = 1; r <= 4; ++r, ++k) {
+            int w = 41 + 3 * (k % 5), h = 37 + 2 * (k % 3);
+            std::vector<uint16_t> z = dem_cases::smooth(w, h, 700 + k, 0, 30000);
+            ct_rng g;
+            ct_rng_seed(&g, 900 + k);
+            for (int q = 0; q < 6; ++q)  // spikes and a short wall on the smooth hills
+                z[(size_t)ct_rng_range(&g, 0, h - 1) * w + ct_rng_range(&g, 0, w - 1)] = 52000;
+            for (int j = h / 4; j < h / 2; ++j) z[(size_t)j * w + w / 3] = 45000;
+            dem_cases::Case c;
+            c.name = "grid_k" + std::to_string(k);
+            c.t = dem_cases::make_terrain(w, h, z, 0.05);
+            c.opt.sectors = n;
+            c.opt.reduce = r;
+            c.opt.window = 2;
+            c.opt.slices = (k % 2) ? 0 : 24;
+            if (k == 13 || k == 22) {
+                c.opt.builder = ct_host::PptBuilder::Brute;
+                c.name += "_brute";
+            }
+            c.pkg = ct_host::build_package(c.t, c.opt);
+            cases.push_back(std::move(c));
+        }
+    // a twentieth of the per-DEM rays each (28 DEMs)
+    const char *env = getenv("CT_TEST_RAYS");
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%ld", std::max(1000L, rays_per_dem() / 20));
+    std::string old = env ? env : "";
+    setenv("CT_TEST_RAYS", buf, 1);
+    run_cases(cases);
+    if (env) setenv("CT_TEST_RAYS", old.c_str(), 1);
+    else unsetenv("CT_TEST_RAYS");
+}
+
 void test_real_dem()
 {
     std::vector<dem_cases::Case> cs = dem_cases::real_cases();
@@ -205,6 +248,7 @@ int main()
 {
     TEST_BEGIN("test_trace");
     RUN_TEST(test_adversarial_dems);
+    RUN_TEST(test_builder_grid);
     RUN_TEST(test_real_dem);
     return TEST_END();
 }
