@@ -243,6 +243,7 @@ std::vector<uint8_t> build_package(const Terrain &t, const BuildOptions &opt, Bu
     }
     if (sc <= 0) throw Error("height scale must be positive");
     if (ct_cot_table(pe, sc, c.cot_q16, c.cot_ok) != CT_OK) throw Error("posting or height scale out of range");
+    prepare_codes(c);
 
     bool voids = !t.void_post.empty();
     uint32_t so[CT_SEC_COUNT], ss[CT_SEC_COUNT], levels, total;

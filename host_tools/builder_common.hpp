@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <vector>
 
@@ -197,7 +198,30 @@ struct Ctx {
     Pyramid pyr;
     int64_t cot_q16[256];
     uint8_t cot_ok[256];
+    // code_for's search: the usable codes 1..255 by cot, descending, with the
+    // largest code among each prefix (set by prepare_codes)
+    std::vector<int64_t> by_cot;
+    std::vector<uint8_t> prefix_max_code;
 };
+
+// Fill c.by_cot / c.prefix_max_code from c.cot_q16 / c.cot_ok.
+inline void prepare_codes(Ctx &c)
+{
+    std::vector<std::pair<int64_t, int>> v;
+    for (int k = 1; k < 256; ++k)
+        if (c.cot_ok[k]) v.push_back({c.cot_q16[k], k});
+    std::sort(v.begin(), v.end(), [](const std::pair<int64_t, int> &x, const std::pair<int64_t, int> &y) {
+        return x.first > y.first;
+    });
+    c.by_cot.clear();
+    c.prefix_max_code.clear();
+    int m = 0;
+    for (const auto &e : v) {
+        m = std::max(m, e.second);
+        c.by_cot.push_back(e.first);
+        c.prefix_max_code.push_back((uint8_t)m);
+    }
+}
 
 // Max over u in W_s of the directional derivative of cell (i, j)'s patch
 // (LSB per cell); gradient extremes are at the corners.
@@ -270,11 +294,11 @@ inline uint8_t code_for(const Ctx &c, double need)
     q = q + std::fabs(q) * 1e-9 + 2.0;  // margin for double rounding
     if (q > 9.0e18) return 0;
     int64_t need_q = (int64_t)std::ceil(q);
-    int lo = 0;  // largest k with cot_ok[k] && cot_q16[k] >= need_q; 0 if none
-    for (int k = 1; k < 256; ++k) {
-        if (c.cot_ok[k] && c.cot_q16[k] >= need_q) lo = k;
-    }
-    return (uint8_t)lo;
+    // largest k with cot_ok[k] && cot_q16[k] >= need_q; 0 if none: the
+    // entries with cot >= need_q are a prefix of by_cot
+    size_t n = (size_t)(std::upper_bound(c.by_cot.begin(), c.by_cot.end(), need_q, std::greater<int64_t>()) -
+                        c.by_cot.begin());
+    return n == 0 ? (uint8_t)0 : c.prefix_max_code[n - 1];
 }
 
 }  // namespace bld

@@ -35,6 +35,7 @@
 // sectors run on the worker threads (one sector per thread at a time).
 #include <atomic>
 #include <chrono>
+#include <map>
 #include <cmath>
 #include <thread>
 
@@ -161,12 +162,39 @@ void slice_angles(const Ctx &c, const SliceInput &in, uint8_t *codes, SliceStats
     for (int k = 0; k < 256; ++k) cot_of[k] = c.cot_ok[k] ? ((double)c.cot_q16[k] * (1.0 - 1e-9) - 3.0) / 65536.0 : -INF;  // stricter than code_for
 
     auto t_start = std::chrono::steady_clock::now();
-    // ---- near + window terms, threads over rows of coarse cells
+    // ---- near + window terms, threads over rows of coarse cells.  The
+    // per-sector offset lists are merged: each offset is visited once per
+    // cell (one height load and compare), then credited to its sectors.
     std::vector<std::vector<WinOffset>> win, wfine, wnear;
     window_offsets(c, std::max(rw, FINE_RING), &wfine, &win, &wnear);
+    struct Merged {
+        int dx, dy;
+        size_t first, count;  // into secs / rhos
+    };
+    struct MergedList {
+        std::vector<Merged> offs;
+        std::vector<int> secs;
+        std::vector<double> rhos;
+    };
+    auto merge = [&](const std::vector<std::vector<WinOffset>> &per) {
+        std::map<std::pair<int, int>, std::vector<std::pair<int, double>>> m;
+        for (int s = 0; s < c.n; ++s)
+            for (const WinOffset &o : per[(size_t)s]) m[{o.dy, o.dx}].push_back({s, o.rho});
+        MergedList out;
+        for (const auto &kv : m) {
+            out.offs.push_back(Merged{kv.first.second, kv.first.first, out.secs.size(), kv.second.size()});
+            for (const auto &e : kv.second) {
+                out.secs.push_back(e.first);
+                out.rhos.push_back(e.second);
+            }
+        }
+        return out;
+    };
+    const MergedList mnear = merge(wnear), mfine = merge(wfine), mcoarse = merge(win);
     {
         std::atomic<int> next{0};
         auto worker = [&]() {
+            std::vector<double> need((size_t)c.n);
             for (;;) {
                 int cj = next.fetch_add(1);
                 if (cj >= hc) break;
@@ -174,27 +202,36 @@ void slice_angles(const Ctx &c, const SliceInput &in, uint8_t *codes, SliceStats
                     size_t f = (size_t)cj * wc + ci;
                     double a = apex[f];
                     int fx0 = ci * r, fy0 = cj * r;
-                    for (int s = 0; s < c.n; ++s) {
-                        double need = 0.0;
-                        for (const WinOffset &o : wnear[(size_t)s]) {
-                            int qi = fx0 + o.dx, qj = fy0 + o.dy;
-                            if (qi < 0 || qj < 0 || qi >= c.cx || qj >= c.cy) continue;
-                            need = std::max(need, max_slope(c, s, qi, qj));
+                    std::fill(need.begin(), need.end(), 0.0);
+                    for (const Merged &o : mnear.offs) {
+                        int qi = fx0 + o.dx, qj = fy0 + o.dy;
+                        if (qi < 0 || qj < 0 || qi >= c.cx || qj >= c.cy) continue;
+                        for (size_t e = o.first; e < o.first + o.count; ++e) {
+                            int s = mnear.secs[e];
+                            need[(size_t)s] = std::max(need[(size_t)s], max_slope(c, s, qi, qj));
                         }
-                        for (const WinOffset &o : wfine[(size_t)s]) {
-                            int qi = fx0 + o.dx, qj = fy0 + o.dy;
-                            if (qi < 0 || qj < 0 || qi >= c.cx || qj >= c.cy) continue;
-                            double h = c.fm[(size_t)qj * c.cx + qi];
-                            if (h > a) need = std::max(need, (h - a) / o.rho);
-                        }
-                        for (const WinOffset &o : win[(size_t)s]) {
-                            int gi = ci + o.dx, gj = cj + o.dy;
-                            if (gi < 0 || gj < 0 || gi >= wc || gj >= hc) continue;
-                            double h = hcm[(size_t)gj * wc + gi];
-                            if (h > a) need = std::max(need, (h - a) / o.rho);
-                        }
-                        codes[(size_t)s * plane + f] = code_for(c, need);
                     }
+                    for (const Merged &o : mfine.offs) {
+                        int qi = fx0 + o.dx, qj = fy0 + o.dy;
+                        if (qi < 0 || qj < 0 || qi >= c.cx || qj >= c.cy) continue;
+                        double rise = c.fm[(size_t)qj * c.cx + qi] - a;
+                        if (rise <= 0.0) continue;
+                        for (size_t e = o.first; e < o.first + o.count; ++e) {
+                            double &nd = need[(size_t)mfine.secs[e]];
+                            nd = std::max(nd, rise / mfine.rhos[e]);
+                        }
+                    }
+                    for (const Merged &o : mcoarse.offs) {
+                        int gi = ci + o.dx, gj = cj + o.dy;
+                        if (gi < 0 || gj < 0 || gi >= wc || gj >= hc) continue;
+                        double rise = hcm[(size_t)gj * wc + gi] - a;
+                        if (rise <= 0.0) continue;
+                        for (size_t e = o.first; e < o.first + o.count; ++e) {
+                            double &nd = need[(size_t)mcoarse.secs[e]];
+                            nd = std::max(nd, rise / mcoarse.rhos[e]);
+                        }
+                    }
+                    for (int s = 0; s < c.n; ++s) codes[(size_t)s * plane + f] = code_for(c, need[(size_t)s]);
                 }
             }
         };
