@@ -43,7 +43,9 @@ namespace {
                  "       conetrace info PKG\n"
                  "       conetrace trace PKG --rays rays.csv [--method M] -o hits.csv\n"
                  "       conetrace demo DEM\n"
-                 "       conetrace geoloc PKG --camera C.cameramodel --pixels px.csv [--method M] -o g.csv\n"
+                 "       conetrace geoloc PKG --camera C.cameramodel --pixels px.csv [--method M]\n"
+                 "                        [--effects curvature,refraction] [--refraction-k K]\n"
+                 "                        [--earth-radius M] [--grid-step PX] -o g.csv\n"
                  "methods: incremental, hierarchical, cone, directional (default)\n");
     std::exit(2);
 }
