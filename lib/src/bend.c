@@ -121,6 +121,23 @@ static int range_in_box(const bent *b, int64_t *s0, int64_t *s1)
     return 1;
 }
 
+/* floor(n / d) of a non-negative 128-bit n by 1 <= d < 2^32, as a 128-bit
+ * value: the high word, then the low word in two 32-bit halves (each
+ * partial dividend (r << 32) | half < 2^64 since r < d < 2^32). */
+static ct_i128 udiv128_small(ct_i128 n, uint64_t d)
+{
+    ct_i128 q;
+    uint64_t r, x;
+    q.hi = n.hi / d;
+    r = n.hi % d;
+    x = (r << 32) | (n.lo >> 32);
+    q.lo = (x / d) << 32;
+    r = x % d;
+    x = (r << 32) | (n.lo & 0xFFFFFFFFu);
+    q.lo |= x / d;
+    return q;
+}
+
 ct_status ct_bend_segment(const ct_package *p, const ct_bend *bd, int64_t *delta)
 {
     if (bd->coeff_q16 < -(4 * 65536) || bd->coeff_q16 > 4 * 65536 || bd->radius_nm < (INT64_C(1) << 40) ||
@@ -131,10 +148,13 @@ ct_status ct_bend_segment(const ct_package *p, const ct_bend *bd, int64_t *delta
     *delta = 0;
     if (bd->coeff_q16 != 0) {
         /* Delta in nm: sqrt(8 eps R 2^16 / |c|): eps R < 2^104, * 2^19 <
-         * 2^123; then Q16 cells: * 2^16 / posting (< 2^62: saturated) */
+         * 2^123, and so is the quotient (|c| >= 1 in Q16): divided as a
+         * 128-bit value (udiv128_small; the quotient must not be saturated
+         * to 64 bits: 8 eps R alone is ~2^75 nm^2 for 1 mm and 6371 km).
+         * Then Q16 cells: Delta_nm < 2^62, * 2^16 / posting (saturated). */
         ct_i128 num = ct_i128_shl(ct_umul64((uint64_t)bd->chord_nm, (uint64_t)bd->radius_nm), 19);
-        int64_t q = ct_i128_floor_div_sat(num, ct_abs64((int64_t)bd->coeff_q16));
-        uint64_t dn = ct_i128_isqrt(ct_i128_from64(q));
+        ct_i128 q = udiv128_small(num, (uint64_t)ct_abs64((int64_t)bd->coeff_q16));
+        uint64_t dn = ct_i128_isqrt(q);
         *delta = ct_i128_floor_div_sat(ct_i128_shl(ct_i128_from64((int64_t)dn), 16), ct_abs64(p->posting_e_nm));
         if (*delta < 1024) {
             return CT_ERR_ARG; /* chord too small for this posting */
