@@ -71,8 +71,8 @@ int main(int argc, char **argv)
         }
     }
     const char *names[] = {"nadir", "oblique30", "grazing3", "long30km", "wide_opencv8"};
-    std::printf("geolocation benchmark: every %s pixel of each scene's image, one thread; ns per pixel\n",
-                stride == 1 ? "" : "4th (--quick)");
+    std::printf("geolocation benchmark: every %spixel of each scene's image, one thread; ns per pixel\n",
+                stride == 1 ? "" : "4th (--quick) ");
     std::printf("| scene | effects | pixels hit | unproject ns | directional: trace ns / steps | incremental: trace ns / "
                 "steps | incr. / dir. time | straight dir.: trace ns / steps | error RMS / max (m), N points |\n");
     std::printf("|---|---|---|---|---|---|---|---|---|\n");
