@@ -44,7 +44,9 @@ namespace {
                  "       conetrace info PKG\n"
                  "       conetrace trace PKG --rays rays.csv [--method M] -o hits.csv\n"
                  "       conetrace demo DEM\n"
-                 "       conetrace geoloc PKG --camera C.cameramodel --pixels px.csv [--method M] -o g.csv\n"
+                 "       conetrace geoloc PKG --camera C.cameramodel --pixels px.csv [--method M]\n"
+                 "                        [--effects curvature,refraction] [--refraction-k K]\n"
+                 "                        [--earth-radius M] [--grid-step PX] -o g.csv\n"
                  "       conetrace render IN --what bitmap|dt|ddt|angles|apex -o OUT.png [--level H]\n"
                  "                        [--sectors N] [--sector S1,S2,...] [--scale K]\n"
                  "methods: incremental, hierarchical, cone, directional (default)\n");

@@ -1,7 +1,8 @@
 // cmd_geoloc.cpp -- `conetrace geoloc`: pixels of a camera to map points.
 //
 //   conetrace geoloc PKG --camera C.cameramodel --pixels px.csv [--method M]
-//                        [--effects LIST] [--grid-step PX] -o g.csv
+//                        [--effects LIST] [--refraction-k K] [--earth-radius M]
+//                        [--grid-step PX] -o g.csv
 //
 // C.cameramodel: an mrcal camera model (read by libmrcal's C reader); its
 //   extrinsics are rt_cam_ref with the package's map frame (metres) as the
@@ -14,12 +15,17 @@
 // g.csv: header u,v,status,E,N,h,steps; one row per pixel, in input order;
 //   u,v echoed as given; E,N,h in metres with all nine decimals of the library's nanometres
 //   (nan when nothing is hit); steps as in `trace`.
-// --effects: scene effects (earth curvature, refraction); none is supported
-//   yet, only an empty list is accepted.
+// --effects LIST: scene effects, comma-separated: curvature, refraction
+//   (empty: a straight line of sight).  The library's model (ct_effects):
+//   the line of sight's height above the datum gains c rho^2 / 2R at
+//   horizontal range rho, c = [curvature] - k [refraction].
+//   --refraction-k K (default 0.13, in [-2, 2]; needs refraction) and
+//   --earth-radius M (metres, default 6371000; needs an effect).
 // The work is the flight library's: ct_camera_init, ct_pose_init,
 // ct_geolocate_batch.  Errors print one line and exit non-zero; the output
 // is written atomically (never a partial file).
 #include <cstdio>
+#include <cmath>
 #include <cstdlib>
 #include <map>
 #include <sstream>
@@ -37,7 +43,8 @@ int cmd_geoloc(int argc, char **argv)
 {
     std::vector<std::string> pos;
     std::map<std::string, std::string> opt;
-    const char *valued[] = {"--camera", "--pixels", "--method", "--effects", "--grid-step", "-o"};
+    const char *valued[] = {"--camera", "--pixels",       "--method",       "--effects",
+                            "--grid-step", "--refraction-k", "--earth-radius", "-o"};
     for (int k = 2; k < argc; ++k) {
         std::string s = argv[k];
         if (s.size() > 1 && s[0] == '-') {
@@ -54,10 +61,36 @@ int cmd_geoloc(int argc, char **argv)
     if (!opt.count("--camera")) throw Error("geoloc needs --camera C.cameramodel");
     if (!opt.count("--pixels")) throw Error("geoloc needs --pixels pixels.csv");
     if (!opt.count("-o")) throw Error("geoloc needs -o out.csv");
-    if (opt.count("--effects") && opt["--effects"].find_first_not_of(" ,") != std::string::npos)
-        throw Error("--effects '" + opt["--effects"] +
-                    "': scene effects (earth curvature, refraction) are not supported yet; only an empty list is "
-                    "accepted");
+    ct_effects fx = {0u, CT_REFRACTION_K_STD_Q16, CT_EARTH_RADIUS_NM, 0};
+    if (opt.count("--effects")) {
+        std::string list = opt["--effects"], tok;
+        std::stringstream ss(list);
+        while (std::getline(ss, tok, ',')) {
+            tok.erase(0, tok.find_first_not_of(' '));
+            tok.erase(tok.find_last_not_of(' ') + 1);
+            if (tok.empty()) continue;
+            if (tok == "curvature") fx.flags |= CT_EFFECT_CURVATURE;
+            else if (tok == "refraction") fx.flags |= CT_EFFECT_REFRACTION;
+            else throw Error("--effects '" + list + "': unknown effect '" + tok + "' (curvature, refraction)");
+        }
+    }
+    auto number = [&](const char *name, double lo, double hi, const char *what) {
+        const std::string &g = opt[name];
+        char *end = nullptr;
+        double v = std::strtod(g.c_str(), &end);
+        if (g.empty() || !end || *end || !(v >= lo && v <= hi))
+            throw Error(std::string(name) + " needs " + what + ", got '" + g + "'");
+        return v;
+    };
+    if (opt.count("--refraction-k")) {
+        if (!(fx.flags & CT_EFFECT_REFRACTION)) throw Error("--refraction-k needs --effects refraction");
+        fx.refraction_k_q16 = (int32_t)std::lround(number("--refraction-k", -2, 2, "a coefficient in [-2, 2]") * 65536);
+    }
+    if (opt.count("--earth-radius")) {
+        if (!fx.flags) throw Error("--earth-radius needs --effects curvature and/or refraction");
+        fx.earth_radius_nm = (int64_t)std::llround(
+            number("--earth-radius", 1100, 1.8e7, "a radius in metres in [1100, 1.8e7]") * 1e9);
+    }
     ct_method m = CT_METHOD_DIRECTIONAL;
     if (opt.count("--method")) {
         const std::string &s = opt["--method"];
@@ -92,7 +125,9 @@ int cmd_geoloc(int argc, char **argv)
         if (!in_range[k]) uv[2 * k] = uv[2 * k + 1] = 0;
     }
     std::vector<ct_geo> g(px.size());
-    st = ct_geolocate_batch(&p, &cam.cam, &cam.pose, m, 0u, uv.data(), px.size(), g.data(), g.size());
+    st = ct_geolocate_batch(&p, &cam.cam, &cam.pose, m, &fx, uv.data(), px.size(), g.data(), g.size());
+    if (st == CT_ERR_EFFECTS)
+        throw Error("--effects: the effect parameters are out of range for this package (" + status_name(st) + ")");
     if (st != CT_OK) throw Error(cpath + ": cannot geolocate from this camera (" + status_name(st) + ")");
 
     std::ostringstream out;

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <vector>
 
+#include "bend.h"
 #include "conetrace.h"
 #include "dem_cases.hpp"
 #include "harness.h"
@@ -222,12 +223,47 @@ void test_bent_arguments()
     TEST_ASSERT(h.z_q16 == hs.z_q16);
 }
 
+// Regression: the segment length Delta = sqrt(8 chord R / |c|) was formed
+// through a 64-bit quotient saturated at 2^62 nm^2, so for a real earth
+// (8 chord R ~ 5e22 nm^2 at 1 mm) Delta came out ~2 m instead of ~240 m:
+// exact still, but ~100x more segments (and time) per ray.
+void test_bent_segment_length_regression()
+{
+    auto cs = dem_cases::make_case("flat", dem_cases::make_terrain(9, 9, std::vector<uint16_t>(81, 100)), 4, 1);
+    ct_package p;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_package_open(&p, cs.pkg.data(), cs.pkg.size()));
+    struct {
+        int32_t c;
+        int64_t r_nm, chord_nm;
+    } cases[] = {{57016, INT64_C(6371000000000000), 1000000},   {65536, INT64_C(6371000000000000), 5000000},
+                 {-8520, INT64_C(6371000000000000), 1000000},   {65536, INT64_C(1) << 54, INT64_C(1) << 50},
+                 {1, INT64_C(6371000000000000), 1000000},       {4 * 65536, INT64_C(1) << 40, 1 << 20}};
+    for (const auto &k : cases) {
+        ct_bend bd = {k.c, k.r_nm, k.chord_nm};
+        int64_t delta = 0;
+        ct_status st = ct_bend_segment(&p, &bd, &delta);
+        long double want = std::sqrt(8.0L * k.chord_nm * k.r_nm * 65536 / std::fabs((long double)k.c)) * 65536 /
+                           (long double)std::llabs(p.posting_e_nm);
+        if (want < 1024) {
+            TEST_ASSERT_EQUAL_INT(CT_ERR_ARG, st);
+            continue;
+        }
+        TEST_ASSERT_EQUAL_INT(CT_OK, st);
+        want = std::min(want, std::ldexp(1.0L, 62));
+        // floor of the exact value (the polyline never deviates more than chord)
+        TEST_ASSERT_MSG(delta <= want && delta >= want - 2 - want * 1e-15L,
+                        "c %d R %lld chord %lld: Delta %lld Q16 cells, want %.3Lf", (int)k.c, (long long)k.r_nm,
+                        (long long)k.chord_nm, (long long)delta, want);
+    }
+}
+
 }  // namespace
 
 int main()
 {
     TEST_BEGIN("test_bend");
     RUN_TEST(test_bent_arguments);
+    RUN_TEST(test_bent_segment_length_regression);
     RUN_TEST(test_bent_vs_reference);
     return TEST_END();
 }

@@ -304,7 +304,7 @@ void test_geolocate_vs_mrcal()
             uv.push_back(s.uq);
             uv.push_back(s.vq);
             ct_geo &o = single[k];
-            ct_status st = ct_geolocate(&wd->p, &c.lib.cam, &c.lib.pose, CT_METHOD_DIRECTIONAL, 0u, s.uq, s.vq, &o);
+            ct_status st = ct_geolocate(&wd->p, &c.lib.cam, &c.lib.pose, CT_METHOD_DIRECTIONAL, nullptr, s.uq, s.vq, &o);
             TEST_ASSERT_MSG(st == CT_HIT && o.status == CT_HIT, "%s: point %zu: status %d", c.name, k, (int)st);
             ld hit[3] = {o.hit.e_nm * 1e-9L, o.hit.n_nm * 1e-9L, o.hit.h_nm * 1e-9L};
             const ld *want_p = s.visible ? s.P : s.first;
@@ -345,14 +345,14 @@ void test_geolocate_vs_mrcal()
             // all four methods agree
             for (int m = 0; m < CT_METHOD_COUNT; ++m) {
                 ct_geo o2;
-                TEST_ASSERT_EQUAL_INT(CT_HIT, ct_geolocate(&wd->p, &c.lib.cam, &c.lib.pose, (ct_method)m, 0u, s.uq, s.vq, &o2));
+                TEST_ASSERT_EQUAL_INT(CT_HIT, ct_geolocate(&wd->p, &c.lib.cam, &c.lib.pose, (ct_method)m, nullptr, s.uq, s.vq, &o2));
                 TEST_ASSERT(o2.hit.e_nm == o.hit.e_nm && o2.hit.n_nm == o.hit.n_nm && o2.hit.h_nm == o.hit.h_nm);
             }
         }
         // the batch form: bit-identical records
         std::vector<ct_geo> batch(smp.size() + 3);
         std::memset(batch.data(), 0x5a, batch.size() * sizeof(ct_geo));
-        TEST_ASSERT_EQUAL_INT(CT_OK, ct_geolocate_batch(&wd->p, &c.lib.cam, &c.lib.pose, CT_METHOD_DIRECTIONAL, 0u,
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_geolocate_batch(&wd->p, &c.lib.cam, &c.lib.pose, CT_METHOD_DIRECTIONAL, nullptr,
                                                         uv.data(), smp.size(), batch.data(), batch.size()));
         for (size_t k = 0; k < smp.size(); ++k) {
             TEST_ASSERT_MSG(batch[k].status == single[k].status && batch[k].unproject_iters == single[k].unproject_iters &&
@@ -406,7 +406,7 @@ void test_occluded_by_wall()
         g.to_grid(first, fg);
         if (fg[1] < wd->wall_row - 1.5L || fg[1] > wd->wall_row + 1.5L) continue;  // hidden by a hill
         ct_geo o;
-        TEST_ASSERT_EQUAL_INT(CT_HIT, ct_geolocate(&wd->p, &c.lib.cam, &c.lib.pose, CT_METHOD_DIRECTIONAL, 0u,
+        TEST_ASSERT_EQUAL_INT(CT_HIT, ct_geolocate(&wd->p, &c.lib.cam, &c.lib.pose, CT_METHOD_DIRECTIONAL, nullptr,
                                                    std::llround(q.x * 65536), std::llround(q.y * 65536), &o));
         // on the wall (cells of rows 58..61 touch it), well in front of P
         TEST_ASSERT_MSG(o.hit.cell_y >= wd->wall_row - 2 && o.hit.cell_y <= wd->wall_row + 1,
@@ -429,52 +429,70 @@ void test_statuses_and_errors()
     const Cam &obl = cams[1];
     ct_geo o;
     int64_t cu = std::llround(obl.in[2] * 65536), cv = std::llround(obl.in[3] * 65536);
-    TEST_ASSERT_EQUAL_INT(CT_HIT, ct_geolocate(&wd->p, &obl.lib.cam, &obl.lib.pose, CT_METHOD_DIRECTIONAL, 0u, cu, cv, &o));
+    TEST_ASSERT_EQUAL_INT(CT_HIT, ct_geolocate(&wd->p, &obl.lib.cam, &obl.lib.pose, CT_METHOD_DIRECTIONAL, nullptr, cu, cv, &o));
     // sky: a camera 2000 m above the tile looking 20 deg up
     {
         ld c[3];
         g.to_map(63.5, 55.5, 0, c);
         c[2] = 4000;
         Cam sky = make_cam("sky", cams[1].lens, cams[1].in, cams[1].w, cams[1].h, c, 1.0L, -20 * M_PI / 180);
-        TEST_ASSERT_EQUAL_INT(CT_MISS, ct_geolocate(&wd->p, &sky.lib.cam, &sky.lib.pose, CT_METHOD_DIRECTIONAL, 0u,
+        TEST_ASSERT_EQUAL_INT(CT_MISS, ct_geolocate(&wd->p, &sky.lib.cam, &sky.lib.pose, CT_METHOD_DIRECTIONAL, nullptr,
                                                     cu, cv, &o));
         TEST_ASSERT_EQUAL_INT(CT_MISS, o.status);
     }
-    // effects: none supported yet
-    for (uint32_t fx : {1u, 2u, 3u, 0x80000000u}) {
-        TEST_ASSERT_EQUAL_INT(CT_ERR_EFFECTS, ct_geolocate(&wd->p, &obl.lib.cam, &obl.lib.pose, CT_METHOD_DIRECTIONAL, fx, cu, cv, &o));
-        TEST_ASSERT_EQUAL_INT(CT_ERR_EFFECTS, o.status);
-        int64_t uv[2] = {cu, cv};
-        TEST_ASSERT_EQUAL_INT(CT_ERR_EFFECTS, ct_geolocate_batch(&wd->p, &obl.lib.cam, &obl.lib.pose, CT_METHOD_DIRECTIONAL, fx, uv, 1, &o, 1));
+    // effects: parameters out of range are CT_ERR_EFFECTS for the call
+    {
+        const ct_effects good = {CT_EFFECT_ALL, CT_REFRACTION_K_STD_Q16, 0, 0};
+        std::vector<ct_effects> bad(7, good);
+        bad[0].flags = 4u;
+        bad[1].flags = 0x80000000u | CT_EFFECT_CURVATURE;
+        bad[2].refraction_k_q16 = 2 * 65536 + 1;
+        bad[3].earth_radius_nm = 1000;                     // below 2^40 nm
+        bad[4].earth_radius_nm = (INT64_C(1) << 54) + 1;
+        bad[5].chord_nm = 1;                               // below 2^10 nm
+        bad[6].chord_nm = 1 << 12;                         // segment < 1/64 cell at R = 6371 km
+        bad[6].earth_radius_nm = INT64_C(1) << 40;
+        for (const ct_effects &fx : bad) {
+            TEST_ASSERT_EQUAL_INT(CT_ERR_EFFECTS, ct_geolocate(&wd->p, &obl.lib.cam, &obl.lib.pose, CT_METHOD_DIRECTIONAL, &fx, cu, cv, &o));
+            TEST_ASSERT_EQUAL_INT(CT_ERR_EFFECTS, o.status);
+            int64_t uv1[2] = {cu, cv};
+            TEST_ASSERT_EQUAL_INT(CT_ERR_EFFECTS, ct_geolocate_batch(&wd->p, &obl.lib.cam, &obl.lib.pose, CT_METHOD_DIRECTIONAL, &fx, uv1, 1, &o, 1));
+        }
+        TEST_ASSERT_EQUAL_INT(CT_HIT, ct_geolocate(&wd->p, &obl.lib.cam, &obl.lib.pose, CT_METHOD_DIRECTIONAL, &good, cu, cv, &o));
+        // k outside [-2, 2] is refused only when refraction is on
+        ct_effects curv = good;
+        curv.flags = CT_EFFECT_CURVATURE;
+        curv.refraction_k_q16 = 9 << 16;
+        TEST_ASSERT_EQUAL_INT(CT_HIT, ct_geolocate(&wd->p, &obl.lib.cam, &obl.lib.pose, CT_METHOD_DIRECTIONAL, &curv, cu, cv, &o));
     }
-    TEST_ASSERT_EQUAL_INT(CT_ERR_METHOD, ct_geolocate(&wd->p, &obl.lib.cam, &obl.lib.pose, (ct_method)7, 0u, cu, cv, &o));
+    TEST_ASSERT_EQUAL_INT(CT_ERR_METHOD, ct_geolocate(&wd->p, &obl.lib.cam, &obl.lib.pose, (ct_method)7, nullptr, cu, cv, &o));
     int64_t uv[4] = {cu, cv, cu, cv};
     ct_geo two[2];
-    TEST_ASSERT_EQUAL_INT(CT_ERR_ARG, ct_geolocate_batch(&wd->p, &obl.lib.cam, &obl.lib.pose, CT_METHOD_DIRECTIONAL, 0u, uv, 2, two, 1));
-    TEST_ASSERT_EQUAL_INT(CT_ERR_ARG, ct_geolocate_batch(&wd->p, &obl.lib.cam, &obl.lib.pose, CT_METHOD_DIRECTIONAL, 0u, nullptr, 2, two, 2));
-    TEST_ASSERT_EQUAL_INT(CT_OK, ct_geolocate_batch(&wd->p, &obl.lib.cam, &obl.lib.pose, CT_METHOD_DIRECTIONAL, 0u, nullptr, 0, nullptr, 0));
+    TEST_ASSERT_EQUAL_INT(CT_ERR_ARG, ct_geolocate_batch(&wd->p, &obl.lib.cam, &obl.lib.pose, CT_METHOD_DIRECTIONAL, nullptr, uv, 2, two, 1));
+    TEST_ASSERT_EQUAL_INT(CT_ERR_ARG, ct_geolocate_batch(&wd->p, &obl.lib.cam, &obl.lib.pose, CT_METHOD_DIRECTIONAL, nullptr, nullptr, 2, two, 2));
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_geolocate_batch(&wd->p, &obl.lib.cam, &obl.lib.pose, CT_METHOD_DIRECTIONAL, nullptr, nullptr, 0, nullptr, 0));
     ct_camera blank;
     std::memset(&blank, 0, sizeof blank);
-    TEST_ASSERT_EQUAL_INT(CT_ERR_ARG, ct_geolocate(&wd->p, &blank, &obl.lib.pose, CT_METHOD_DIRECTIONAL, 0u, cu, cv, &o));
+    TEST_ASSERT_EQUAL_INT(CT_ERR_ARG, ct_geolocate(&wd->p, &blank, &obl.lib.pose, CT_METHOD_DIRECTIONAL, nullptr, cu, cv, &o));
     // a camera centre beyond 2^30 cells of the tile
     ct_pose far = obl.lib.pose;
     // (2^60 nm up = 4.6e9 height LSB of 0.25 m > 2^30)
     TEST_ASSERT_EQUAL_INT(CT_OK, ct_pose_init(&far, obl.lib.pose.R_map_cam_q30, obl.lib.pose.e_nm,
                                               obl.lib.pose.n_nm, obl.lib.pose.h_nm + (INT64_C(1) << 60)));
-    TEST_ASSERT_EQUAL_INT(CT_ERR_RAY, ct_geolocate(&wd->p, &obl.lib.cam, &far, CT_METHOD_DIRECTIONAL, 0u, cu, cv, &o));
+    TEST_ASSERT_EQUAL_INT(CT_ERR_RAY, ct_geolocate(&wd->p, &obl.lib.cam, &far, CT_METHOD_DIRECTIONAL, nullptr, cu, cv, &o));
     // a camera below the terrain
     ct_pose under = obl.lib.pose;
     ld mid[3];
     g.to_map(63.5, 30.5, 0, mid);
     TEST_ASSERT_EQUAL_INT(CT_OK, ct_pose_init(&under, obl.lib.pose.R_map_cam_q30, (int64_t)std::llround(mid[0] * 1e9L),
                                               (int64_t)std::llround(mid[1] * 1e9L), wd->p.height_offset_nm + 1000000000));
-    TEST_ASSERT_EQUAL_INT(CT_BELOW, ct_geolocate(&wd->p, &obl.lib.cam, &under, CT_METHOD_DIRECTIONAL, 0u, cu, cv, &o));
+    TEST_ASSERT_EQUAL_INT(CT_BELOW, ct_geolocate(&wd->p, &obl.lib.cam, &under, CT_METHOD_DIRECTIONAL, nullptr, cu, cv, &o));
     // a folded lens: pixels beyond the fold are CT_ERR_UNPROJECT, per pixel in a batch
     ct_lens fold = ct_host::lens_from_intrinsics("LENSMODEL_OPENCV4", {1000, 1000, 799.5, 599.5, -0.5, 0, 0, 0}, 1600, 1200);
     ct_camera fc;
     TEST_ASSERT_EQUAL_INT(CT_OK, ct_camera_init(&fc, &fold));
     int64_t px[4] = {std::llround(799.5 * 65536), std::llround(599.5 * 65536), 0, 0};
-    TEST_ASSERT_EQUAL_INT(CT_OK, ct_geolocate_batch(&wd->p, &fc, &cams[0].lib.pose, CT_METHOD_DIRECTIONAL, 0u, px, 2, two, 2));
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_geolocate_batch(&wd->p, &fc, &cams[0].lib.pose, CT_METHOD_DIRECTIONAL, nullptr, px, 2, two, 2));
     TEST_ASSERT_EQUAL_INT(CT_HIT, two[0].status);
     TEST_ASSERT_EQUAL_INT(CT_ERR_UNPROJECT, two[1].status);
     TEST_ASSERT_EQUAL_INT(0, two[1].hit.steps);

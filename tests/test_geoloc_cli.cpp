@@ -197,7 +197,7 @@ void test_geoloc_end_to_end()
         ct_status want = CT_ERR_UNPROJECT;
         ct_geo g;
         if (ct_host::pixel_to_q16(px[k].u, px[k].v, &uq, &vq))
-            want = ct_geolocate(&s->p, &lc.cam, &lc.pose, CT_METHOD_DIRECTIONAL, 0u, uq, vq, &g);
+            want = ct_geolocate(&s->p, &lc.cam, &lc.pose, CT_METHOD_DIRECTIONAL, nullptr, uq, vq, &g);
         TEST_ASSERT_MSG(f[2] == ct_host::status_name(want), "row %zu: status %s, library %s", k + 1, f[2].c_str(),
                         ct_host::status_name(want).c_str());
         if (want == CT_HIT) {
@@ -235,6 +235,66 @@ void test_geoloc_end_to_end()
     fs::remove(g_dir + "/g.csv");
     fs::remove(g_dir + "/g2.csv");
     fs::remove(g_dir + "/px2.csv");
+}
+
+// --effects curvature,refraction with --refraction-k and --earth-radius:
+// the rows are the library's ct_geolocate with the same ct_effects, bit for
+// bit, and (with an exaggerated 30 km earth) differ from the straight rays.
+void test_geoloc_effects()
+{
+    Setup *s = setup();
+    TEST_ASSERT(s != nullptr);
+    spit(g_dir + "/px.csv", kPixels);
+    Run r0 = run({"geoloc", "t.ctp", "--camera", "cam.cameramodel", "--pixels", "px.csv", "-o", "g0.csv"});
+    TEST_ASSERT_MSG(r0.code == 0, "exit %d: %s", r0.code, r0.err.c_str());
+    struct Opt {
+        std::vector<std::string> extra;
+        ct_effects fx;
+    };
+    const Opt opts[] = {
+        {{"--effects", "curvature, refraction", "--refraction-k", "0.25", "--earth-radius", "30000"},
+         {CT_EFFECT_CURVATURE | CT_EFFECT_REFRACTION, 16384, INT64_C(30000000000000), 0}},
+        {{"--effects", "refraction", "--earth-radius", "20000"},
+         {CT_EFFECT_REFRACTION, CT_REFRACTION_K_STD_Q16, INT64_C(20000000000000), 0}},
+        {{"--effects", "curvature"}, {CT_EFFECT_CURVATURE, 0, CT_EARTH_RADIUS_NM, 0}},
+    };
+    std::vector<std::string> rows0 = lines_of(slurp(g_dir + "/g0.csv"));
+    ct_host::LibCamera lc = ct_host::lib_camera(ct_host::read_cameramodel(g_dir + "/cam.cameramodel"), "cam");
+    std::vector<ct_host::PixelRow> px = ct_host::read_pixels_csv(g_dir + "/px.csv");
+    for (const Opt &o : opts) {
+        std::vector<std::string> args = {"geoloc", "t.ctp", "--camera", "cam.cameramodel", "--pixels", "px.csv"};
+        args.insert(args.end(), o.extra.begin(), o.extra.end());
+        args.push_back("-o");
+        args.push_back("g1.csv");
+        Run r = run(args);
+        TEST_ASSERT_MSG(r.code == 0, "%s: exit %d: %s", o.extra[1].c_str(), r.code, r.err.c_str());
+        std::vector<std::string> rows = lines_of(slurp(g_dir + "/g1.csv"));
+        TEST_ASSERT_EQUAL_INT(rows0.size(), rows.size());
+        int hits = 0, differ = 0;
+        for (size_t k = 0; k < px.size(); ++k) {
+            std::vector<std::string> f = split(rows[k + 1]);
+            int64_t uq, vq;
+            ct_status want = CT_ERR_UNPROJECT;
+            ct_geo g;
+            if (ct_host::pixel_to_q16(px[k].u, px[k].v, &uq, &vq))
+                want = ct_geolocate(&s->p, &lc.cam, &lc.pose, CT_METHOD_DIRECTIONAL, &o.fx, uq, vq, &g);
+            TEST_ASSERT_MSG(f[2] == ct_host::status_name(want), "%s row %zu: status %s, library %s",
+                            o.extra[1].c_str(), k + 1, f[2].c_str(), ct_host::status_name(want).c_str());
+            if (want == CT_HIT) {
+                ++hits;
+                TEST_ASSERT(f[3] == ct_host::nm_to_decimal(g.hit.e_nm) && f[4] == ct_host::nm_to_decimal(g.hit.n_nm) &&
+                            f[5] == ct_host::nm_to_decimal(g.hit.h_nm) && f[6] == std::to_string(g.hit.steps));
+                differ += rows[k + 1] != rows0[k + 1];
+            }
+        }
+        TEST_ASSERT(hits >= 6);
+        // every off-centre hit moves (a nadir camera: the centre pixel's
+        // ray is vertical and does not bend)
+        TEST_ASSERT_MSG(differ >= hits - 1, "%s: only %d of %d hits differ from the straight rays",
+                        o.extra[1].c_str(), differ, hits);
+    }
+    fs::remove(g_dir + "/g0.csv");
+    fs::remove(g_dir + "/g1.csv");
 }
 
 // A lens model without a closed form in the library (mrcal's splined
@@ -283,7 +343,7 @@ void test_geoloc_splined_grid()
             ct_status want = CT_ERR_UNPROJECT;
             ct_geo g;
             if (ct_host::pixel_to_q16(px[k].u, px[k].v, &uq, &vq))
-                want = ct_geolocate(&s->p, &lc.cam, &lc.pose, CT_METHOD_DIRECTIONAL, 0u, uq, vq, &g);
+                want = ct_geolocate(&s->p, &lc.cam, &lc.pose, CT_METHOD_DIRECTIONAL, nullptr, uq, vq, &g);
             TEST_ASSERT_MSG(f[2] == ct_host::status_name(want), "row %zu: %s vs %s", k + 1, f[2].c_str(),
                             ct_host::status_name(want).c_str());
             if (want == CT_HIT) {
@@ -342,9 +402,21 @@ void test_geoloc_bad_inputs()
         {{"geoloc", "t.ctp", "--camera", "cam.cameramodel", "--pixels", "px.csv"}, "-o"},
         {{"geoloc", "t.ctp", "--camera", "cam.cameramodel", "--pixels", "px.csv", "--method", "bogus", "-o", "out.csv"},
          "bogus"},
-        {{"geoloc", "t.ctp", "--camera", "cam.cameramodel", "--pixels", "px.csv", "--effects", "curvature", "-o",
+        {{"geoloc", "t.ctp", "--camera", "cam.cameramodel", "--pixels", "px.csv", "--effects", "curvature,fog", "-o",
           "out.csv"},
-         "--effects"},
+         "fog"},
+        {{"geoloc", "t.ctp", "--camera", "cam.cameramodel", "--pixels", "px.csv", "--effects", "curvature",
+          "--refraction-k", "0.1", "-o", "out.csv"},
+         "--refraction-k"},
+        {{"geoloc", "t.ctp", "--camera", "cam.cameramodel", "--pixels", "px.csv", "--effects", "refraction",
+          "--refraction-k", "2.5", "-o", "out.csv"},
+         "--refraction-k"},
+        {{"geoloc", "t.ctp", "--camera", "cam.cameramodel", "--pixels", "px.csv", "--effects", "curvature",
+          "--earth-radius", "5", "-o", "out.csv"},
+         "--earth-radius"},
+        {{"geoloc", "t.ctp", "--camera", "cam.cameramodel", "--pixels", "px.csv", "--earth-radius", "6e6", "-o",
+          "out.csv"},
+         "--earth-radius"},
         {{"geoloc", "t.ctp", "--camera", "cam.cameramodel", "--pixels", "px.csv", "--bogus", "1", "-o", "out.csv"},
          "--bogus"},
         {{"geoloc", "t.ctp", "--camera", "cam.cameramodel", "--pixels", "px.csv", "--grid-step", "0.5", "-o",
@@ -387,6 +459,7 @@ int main()
     fs::create_directory(std::string(tmpl) + "/work");
     g_dir = std::string(tmpl) + "/work";
     RUN_TEST(test_geoloc_end_to_end);
+    RUN_TEST(test_geoloc_effects);
     RUN_TEST(test_geoloc_splined_grid);
     RUN_TEST(test_geoloc_bad_inputs);
     int rc = TEST_END();

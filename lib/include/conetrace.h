@@ -409,7 +409,8 @@ enum {
                                distortion, or behind the camera           */
     CT_ERR_POSE = -22,      /* rotation not orthonormal with det +1, or the
                                camera centre out of range                 */
-    CT_ERR_EFFECTS = -23    /* unsupported scene-effect flags             */
+    CT_ERR_EFFECTS = -23    /* unknown scene-effect flags or an effect
+                               parameter out of range (ct_effects)        */
 };
 
 typedef enum {
@@ -478,6 +479,36 @@ typedef struct {
     uint32_t ready;            /* set by ct_pose_init                        */
 } ct_pose;
 
+/* Scene effects for ct_geolocate: earth curvature and atmospheric
+ * refraction over a projected-grid DEM (whose "vertical" is the map
+ * frame's h axis everywhere).  Model: the line of sight leaves the camera
+ * along the pixel's ray and its height above the datum gains
+ *     c * rho^2 / (2 R),   c = (CURVATURE ? 1 : 0) - (REFRACTION ? k : 0)
+ * at horizontal range rho from the camera (the earth falls away below the
+ * tangent plane by rho^2/2R; refraction bends the ray down along an arc of
+ * radius R/k).  Both: (1 - k) rho^2 / 2R.  The ray is traced by
+ * ct_trace_bent (a polyline within chord_nm of that parabola, each segment
+ * traced exactly), so the tracer's exactness and its step bound
+ * (CT_WCET_BENT_ITERS) hold with effects on.  A zero field means the
+ * default where one is given.                                              */
+#define CT_EFFECT_CURVATURE 1u   /* earth curvature                          */
+#define CT_EFFECT_REFRACTION 2u  /* atmospheric refraction, coefficient k    */
+#define CT_EFFECT_ALL 3u
+#define CT_EARTH_RADIUS_NM INT64_C(6371000000000000) /* 6371 km (mean)     */
+#define CT_REFRACTION_K_STD_Q16 8520  /* k = 0.13 (standard atmosphere), Q16 */
+#define CT_EFFECTS_CHORD_NM INT64_C(1000000)         /* 1 mm               */
+typedef struct {
+    uint32_t flags;            /* CT_EFFECT_* bits; 0 = a straight ray       */
+    int32_t refraction_k_q16;  /* k in Q16, [-2, 2] (used with REFRACTION;
+                                  0 is k = 0, not a default)                */
+    int64_t earth_radius_nm;   /* R; 0 = CT_EARTH_RADIUS_NM; else
+                                  [2^40, 2^54] nm (1.1 km .. 18,000 km)     */
+    int64_t chord_nm;          /* polyline tolerance; 0 = CT_EFFECTS_CHORD_NM;
+                                  else [2^10, 2^50] nm, and the polyline's
+                                  segment sqrt(8 chord R / |c|) must be at
+                                  least 1/64 of a cell (else CT_ERR_EFFECTS) */
+} ct_effects;
+
 /* Result of geolocating one pixel.                                         */
 typedef struct {
     ct_status status;          /* as returned by ct_geolocate               */
@@ -524,17 +555,20 @@ ct_status ct_pose_rotate(const ct_pose *pose, const int32_t ray_cam_q30[3],
                          int64_t dir_map_q39[3]);
 
 /* Geolocate pixel (u, v): unproject, rotate into the map frame, trace from
- * the camera centre with `method`.  `effects` is a bit set of scene effects
- * (earth curvature, refraction); none is supported yet: any non-zero value
- * returns CT_ERR_EFFECTS.  Returns (and stores in out->status) CT_HIT or
- * CT_HIT_VOID (out->hit.e_nm, n_nm, h_nm valid), CT_MISS, CT_BELOW, or an
- * error: CT_ERR_UNPROJECT for the pixel; CT_ERR_ARG / CT_ERR_METHOD /
- * CT_ERR_EFFECTS for the arguments; CT_ERR_RAY when the camera centre is
- * beyond CT_MAX_ORIGIN_Q16 of the tile.                                     */
+ * the camera centre with `method`, bent by `effects` (NULL or flags 0: a
+ * straight ray; see ct_effects).  Returns (and stores in out->status)
+ * CT_HIT or CT_HIT_VOID (out->hit.e_nm, n_nm, h_nm valid), CT_MISS,
+ * CT_BELOW, or an error: CT_ERR_UNPROJECT for the pixel; CT_ERR_ARG /
+ * CT_ERR_METHOD / CT_ERR_EFFECTS for the arguments; CT_ERR_RAY when the
+ * camera centre is beyond CT_MAX_ORIGIN_Q16 of the tile; CT_ERR_RANGE when
+ * a bent ray would need more than CT_BEND_MAX_SEGMENTS segments or the
+ * camera is more than 2^52 nm (4500 km) from the tile.  With effects,
+ * out->hit.t_q26 is the parameter on the polyline segment holding the hit
+ * and steps/iters are summed over segments (ct_trace_bent).                */
 ct_status ct_geolocate(const ct_package *pkg, const ct_camera *cam,
                        const ct_pose *pose, ct_method method,
-                       uint32_t effects, int64_t u_q16, int64_t v_q16,
-                       ct_geo *out);
+                       const ct_effects *effects, int64_t u_q16,
+                       int64_t v_q16, ct_geo *out);
 
 /* Many pixels: uv_q16[2k], uv_q16[2k + 1] for k < count, results in
  * out[0..count) (out_len >= count), each bit-identical to ct_geolocate's.
@@ -544,7 +578,8 @@ ct_status ct_geolocate(const ct_package *pkg, const ct_camera *cam,
  * (nothing written).                                                        */
 ct_status ct_geolocate_batch(const ct_package *pkg, const ct_camera *cam,
                              const ct_pose *pose, ct_method method,
-                             uint32_t effects, const int64_t *uv_q16,
+                             const ct_effects *effects,
+                             const int64_t *uv_q16,
                              size_t count, ct_geo *out, size_t out_len);
 /* ======================== end of camera and geolocation ================= */
 

@@ -19,7 +19,7 @@
  *                 2R (< 2^55) and by the height scale, saturated at 2^62.
  *   vertex        O + s * U / L: s * U < 2^63 * 2^30 (128-bit), / L.
  */
-#include "conetrace.h"
+#include "bend.h"
 #include "fixed.h"
 
 #define ONE16 INT64_C(65536)
@@ -121,6 +121,48 @@ static int range_in_box(const bent *b, int64_t *s0, int64_t *s1)
     return 1;
 }
 
+/* floor(n / d) of a non-negative 128-bit n by 1 <= d < 2^32, as a 128-bit
+ * value: the high word, then the low word in two 32-bit halves (each
+ * partial dividend (r << 32) | half < 2^64 since r < d < 2^32). */
+static ct_i128 udiv128_small(ct_i128 n, uint64_t d)
+{
+    ct_i128 q;
+    uint64_t r, x;
+    q.hi = n.hi / d;
+    r = n.hi % d;
+    x = (r << 32) | (n.lo >> 32);
+    q.lo = (x / d) << 32;
+    r = x % d;
+    x = (r << 32) | (n.lo & 0xFFFFFFFFu);
+    q.lo |= x / d;
+    return q;
+}
+
+ct_status ct_bend_segment(const ct_package *p, const ct_bend *bd, int64_t *delta)
+{
+    if (bd->coeff_q16 < -(4 * 65536) || bd->coeff_q16 > 4 * 65536 || bd->radius_nm < (INT64_C(1) << 40) ||
+        bd->radius_nm > (INT64_C(1) << 54) || bd->chord_nm < (INT64_C(1) << 10) ||
+        bd->chord_nm > (INT64_C(1) << 50)) {
+        return CT_ERR_ARG;
+    }
+    *delta = 0;
+    if (bd->coeff_q16 != 0) {
+        /* Delta in nm: sqrt(8 eps R 2^16 / |c|): eps R < 2^104, * 2^19 <
+         * 2^123, and so is the quotient (|c| >= 1 in Q16): divided as a
+         * 128-bit value (udiv128_small; the quotient must not be saturated
+         * to 64 bits: 8 eps R alone is ~2^75 nm^2 for 1 mm and 6371 km).
+         * Then Q16 cells: Delta_nm < 2^62, * 2^16 / posting (saturated). */
+        ct_i128 num = ct_i128_shl(ct_umul64((uint64_t)bd->chord_nm, (uint64_t)bd->radius_nm), 19);
+        ct_i128 q = udiv128_small(num, (uint64_t)ct_abs64((int64_t)bd->coeff_q16));
+        uint64_t dn = ct_i128_isqrt(q);
+        *delta = ct_i128_floor_div_sat(ct_i128_shl(ct_i128_from64((int64_t)dn), 16), ct_abs64(p->posting_e_nm));
+        if (*delta < 1024) {
+            return CT_ERR_ARG; /* chord too small for this posting */
+        }
+    }
+    return CT_OK;
+}
+
 ct_status ct_trace_bent(const ct_package *p, const ct_ray *ray, const ct_bend *bd, ct_method m,
                         ct_hit *h)
 {
@@ -134,10 +176,9 @@ ct_status ct_trace_bent(const ct_package *p, const ct_ray *ray, const ct_bend *b
     if (p == NULL || ray == NULL || bd == NULL || h == NULL) {
         return CT_ERR_ARG;
     }
-    if (bd->coeff_q16 < -(4 * 65536) || bd->coeff_q16 > 4 * 65536 || bd->radius_nm < (INT64_C(1) << 40) ||
-        bd->radius_nm > (INT64_C(1) << 54) || bd->chord_nm < (INT64_C(1) << 10) ||
-        bd->chord_nm > (INT64_C(1) << 50)) {
-        return CT_ERR_ARG;
+    st = ct_bend_segment(p, bd, &delta);
+    if (st != CT_OK) {
+        return st;
     }
     if (bd->coeff_q16 == 0 || (ray->dx == 0 && ray->dy == 0)) {
         return ct_trace(p, ray, m, h);
@@ -185,17 +226,6 @@ ct_status ct_trace_bent(const ct_package *p, const ct_ray *ray, const ct_bend *b
         h->x_q16 = h->y_q16 = h->z_q16 = 0;
         h->cell_x = h->cell_y = -1;
         return CT_MISS;
-    }
-    {
-        /* Delta in nm: sqrt(8 eps R 2^16 / |c|): eps R < 2^104, * 2^19 <
-         * 2^123; then Q16 cells: * 2^16 / posting (< 2^62: saturated) */
-        ct_i128 num = ct_i128_shl(ct_umul64((uint64_t)bd->chord_nm, (uint64_t)bd->radius_nm), 19);
-        int64_t q = ct_i128_floor_div_sat(num, ct_abs64(b.coeff));
-        uint64_t dn = ct_i128_isqrt(ct_i128_from64(q));
-        delta = ct_i128_floor_div_sat(ct_i128_shl(ct_i128_from64((int64_t)dn), 16), b.posting);
-        if (delta < 1024) {
-            return CT_ERR_ARG; /* chord too small for this posting */
-        }
     }
     k0 = s0 / delta;
     k1 = s1 / delta + 1;

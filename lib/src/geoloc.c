@@ -1,8 +1,14 @@
 /*
  * geoloc.c -- pixel to ground: unproject (camera.c), rotate into the map
  * frame (Q39), convert to a grid-frame ray from the camera centre and trace
- * it (trace.c).  Scene effects (earth curvature, refraction) are not here
- * yet: any non-zero `effects` is refused with CT_ERR_EFFECTS.
+ * it (trace.c), or, with scene effects (earth curvature, refraction), trace
+ * the bent ray (bend.c: the observer is the camera centre).
+ *
+ * Effects: c = (CURVATURE ? 1 : 0) - (REFRACTION ? k : 0) in Q16, with
+ * k in [-2, 2] (Q16): c in [-2, 3] (Q16 |c| <= 3 * 2^16), inside
+ * ct_bend's |c| <= 4 * 2^16.  The bend's parameters (R, chord, and the
+ * resulting segment length) are checked once per call (ct_bend_segment),
+ * so a bad parameter is CT_ERR_EFFECTS for the call, never per pixel.
  *
  * Grid direction: as ct_ray_from_map, (dE s_e, dN s_n, dh |p_e|) with
  * s_e = sign(p_e) * scale, s_n = sign(p_n) * scale (scale = height_scale_nm,
@@ -15,27 +21,75 @@
  * a relative precision of ~2^-58 max|s| / min|s| (far below the tracer's
  * own 2^-25 direction quantisation).
  */
+#include "bend.h"
 #include "camera.h"
 
 typedef struct {
     int64_t ox, oy, oz;   /* camera centre, grid frame, Q16 */
     int64_t sx, sy, sz;   /* direction scale factors        */
     unsigned shift;       /* common right shift (0..63)     */
+    ct_bend bend;         /* coeff_q16 == 0: straight rays  */
 } geo_setup;
 
+#define K_MAX_Q16 (2 * 65536)
+
+/* Effects to a bend (coeff 0 = none); CT_ERR_EFFECTS when out of range. */
+static ct_status effects_to_bend(const ct_package *p, const ct_effects *fx, ct_bend *bd)
+{
+    int64_t delta;
+    int32_t c = 0;
+    bd->coeff_q16 = 0;
+    bd->radius_nm = CT_EARTH_RADIUS_NM;
+    bd->chord_nm = CT_EFFECTS_CHORD_NM;
+    if (fx == NULL) {
+        return CT_OK;
+    }
+    if ((fx->flags & ~CT_EFFECT_ALL) != 0u) {
+        return CT_ERR_EFFECTS;
+    }
+    if ((fx->flags & CT_EFFECT_CURVATURE) != 0u) {
+        c = 65536;
+    }
+    if ((fx->flags & CT_EFFECT_REFRACTION) != 0u) {
+        if (fx->refraction_k_q16 < -K_MAX_Q16 || fx->refraction_k_q16 > K_MAX_Q16) {
+            return CT_ERR_EFFECTS;
+        }
+        c -= fx->refraction_k_q16; /* |c| <= 3 * 2^16 */
+    }
+    if (fx->earth_radius_nm != 0) {
+        bd->radius_nm = fx->earth_radius_nm;
+    }
+    if (fx->chord_nm != 0) {
+        bd->chord_nm = fx->chord_nm;
+    }
+    bd->coeff_q16 = c;
+    /* ranges of R and chord, and the segment length (also for c = 0, so a
+     * bad parameter is refused whatever k is) */
+    {
+        ct_bend chk = *bd;
+        if (chk.coeff_q16 == 0) {
+            chk.coeff_q16 = 65536;
+        }
+        if (ct_bend_segment(p, &chk, &delta) != CT_OK) {
+            return CT_ERR_EFFECTS;
+        }
+    }
+    return CT_OK;
+}
+
 static ct_status setup(const ct_package *p, const ct_camera *cam, const ct_pose *pose, ct_method m,
-                       uint32_t effects, geo_setup *s)
+                       const ct_effects *effects, geo_setup *s)
 {
     int64_t big;
     unsigned b = 0u;
     if (p == NULL || cam == NULL || pose == NULL || cam->ready == 0u || pose->ready == 0u) {
         return CT_ERR_ARG;
     }
-    if (effects != 0u) {
-        return CT_ERR_EFFECTS;
-    }
     if ((unsigned)m >= (unsigned)CT_METHOD_COUNT) {
         return CT_ERR_METHOD;
+    }
+    if (effects_to_bend(p, effects, &s->bend) != CT_OK) {
+        return CT_ERR_EFFECTS;
     }
     if (ct_map_to_grid(p, pose->e_nm, pose->n_nm, pose->h_nm, &s->ox, &s->oy, &s->oz) != CT_OK ||
         ct_abs64(s->ox) > CT_MAX_ORIGIN_Q16 || ct_abs64(s->oy) > CT_MAX_ORIGIN_Q16 ||
@@ -87,14 +141,15 @@ static ct_status one_pixel(const ct_package *p, const ct_camera *cam, const ct_p
         ray.dx = scale_dir(out->dir_map_q39[0], s->sx, s->shift);
         ray.dy = scale_dir(out->dir_map_q39[1], s->sy, s->shift);
         ray.dz = scale_dir(out->dir_map_q39[2], s->sz, s->shift);
-        st = ct_trace(p, &ray, m, &out->hit);
+        st = s->bend.coeff_q16 == 0 ? ct_trace(p, &ray, m, &out->hit)
+                                    : ct_trace_bent(p, &ray, &s->bend, m, &out->hit);
     }
     out->status = st;
     return st;
 }
 
 ct_status ct_geolocate(const ct_package *pkg, const ct_camera *cam, const ct_pose *pose, ct_method method,
-                       uint32_t effects, int64_t u_q16, int64_t v_q16, ct_geo *out)
+                       const ct_effects *effects, int64_t u_q16, int64_t v_q16, ct_geo *out)
 {
     geo_setup s;
     ct_status st;
@@ -111,7 +166,8 @@ ct_status ct_geolocate(const ct_package *pkg, const ct_camera *cam, const ct_pos
 }
 
 ct_status ct_geolocate_batch(const ct_package *pkg, const ct_camera *cam, const ct_pose *pose, ct_method method,
-                             uint32_t effects, const int64_t *uv_q16, size_t count, ct_geo *out, size_t out_len)
+                             const ct_effects *effects, const int64_t *uv_q16, size_t count, ct_geo *out,
+                             size_t out_len)
 {
     geo_setup s;
     ct_status st;

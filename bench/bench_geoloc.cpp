@@ -1,0 +1,150 @@
+// bench_geoloc.cpp -- `make bench`, geolocation part: every pixel of each
+// scene's 1024 x 768 image (fixtures/scenes), one thread.  Per scene: ns
+// per pixel for the unprojection alone (ct_camera_unproject + the pose
+// rotation, i.e. everything but the trace) and for the whole
+// ct_geolocate_batch with the scene's effects, with the directional and the
+// incremental method in the same run (tracing = whole - unprojection); the
+// steps per pixel; hits; and the error statistics against the scene's
+// ground truth (tests/scene.hpp: mrcal + the reference tracer, --samples
+// points).  Also the directional trace without effects (straight rays),
+// to show what bending costs.  Nothing here is a pass/fail test; it only
+// reports (and says so) if the two methods ever disagree.
+//
+// Options: --quick (every 4th pixel in each direction, 300 samples),
+//          --samples N, --scene NAME (only that one).
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "scene.hpp"
+
+namespace {
+
+using clk = std::chrono::steady_clock;
+
+double now_ns() { return (double)std::chrono::duration_cast<std::chrono::nanoseconds>(clk::now().time_since_epoch()).count(); }
+
+struct Run {
+    double ns = 0, steps = 0;
+    long hits = 0;
+};
+
+Run geolocate(const scene::World &w, const std::vector<int64_t> &uv, ct_method m, const ct_effects *fx,
+              std::vector<ct_geo> *out)
+{
+    size_t n = uv.size() / 2;
+    out->resize(n);
+    Run r;
+    double t0 = now_ns();
+    ct_status st = ct_geolocate_batch(&w.p, &w.cam.cam, &w.cam.pose, m, fx, uv.data(), n, out->data(), n);
+    r.ns = (now_ns() - t0) / (double)n;
+    if (st != CT_OK) std::printf("  ct_geolocate_batch: status %d\n", (int)st);
+    for (const ct_geo &g : *out) {
+        r.steps += g.hit.steps;
+        r.hits += g.status == CT_HIT || g.status == CT_HIT_VOID;
+    }
+    r.steps /= (double)n;
+    return r;
+}
+
+}  // namespace
+
+int main(int argc, char **argv)
+{
+    int stride = 1, samples = 2000;
+    std::string only;
+    for (int k = 1; k < argc; ++k) {
+        if (!std::strcmp(argv[k], "--quick")) {
+            stride = 4;
+            samples = 300;
+        } else if (!std::strcmp(argv[k], "--samples") && k + 1 < argc) {
+            samples = std::atoi(argv[++k]);
+        } else if (!std::strcmp(argv[k], "--scene") && k + 1 < argc) {
+            only = argv[++k];
+        } else {
+            std::fprintf(stderr, "usage: ct_bench_geoloc [--quick] [--samples N] [--scene NAME]\n");
+            return 2;
+        }
+    }
+    const char *names[] = {"nadir", "oblique30", "grazing3", "long30km", "wide_opencv8"};
+    std::printf("geolocation benchmark: every %spixel of each scene's image, one thread; ns per pixel\n",
+                stride == 1 ? "" : "4th (--quick) ");
+    std::printf("| scene | effects | pixels hit | unproject ns | directional: trace ns / steps | incremental: trace ns / "
+                "steps | incr. / dir. time | straight dir.: trace ns / steps | error RMS / max (m), N points |\n");
+    std::printf("|---|---|---|---|---|---|---|---|---|\n");
+    for (const char *name : names) {
+        if (!only.empty() && only != name) continue;
+        scene::World *w;
+        try {
+            w = scene::load_world(std::string(CT_SCENES_DIR) + "/" + name + ".scene");
+        } catch (const std::exception &e) {
+            std::printf("%s: %s\n", name, e.what());
+            return 1;
+        }
+        std::vector<int64_t> uv;
+        for (unsigned v = 0; v < w->s.height; v += (unsigned)stride)
+            for (unsigned u = 0; u < w->s.width; u += (unsigned)stride) {
+                uv.push_back((int64_t)u << 16);
+                uv.push_back((int64_t)v << 16);
+            }
+        size_t n = uv.size() / 2;
+        // unprojection + rotation alone (best of 3)
+        double un = 1e30;
+        for (int rep = 0; rep < 3; ++rep) {
+            int32_t ray[3];
+            int64_t dm[3];
+            int64_t sink = 0;
+            double t0 = now_ns();
+            for (size_t k = 0; k < n; ++k) {
+                if (ct_camera_unproject(&w->cam.cam, uv[2 * k], uv[2 * k + 1], ray, nullptr) == CT_OK &&
+                    ct_pose_rotate(&w->cam.pose, ray, dm) == CT_OK)
+                    sink += dm[0];
+            }
+            un = std::min(un, (now_ns() - t0) / (double)n);
+            if (sink == 42) std::printf(" ");
+        }
+        ct_effects fx = scene::lib_effects(w->s, w->s.effects);
+        std::vector<ct_geo> gd, gi, gs;
+        Run rd = geolocate(*w, uv, CT_METHOD_DIRECTIONAL, &fx, &gd);
+        Run rd2 = geolocate(*w, uv, CT_METHOD_DIRECTIONAL, &fx, &gd);  // warm
+        rd.ns = std::min(rd.ns, rd2.ns);
+        Run ri = geolocate(*w, uv, CT_METHOD_INCREMENTAL, &fx, &gi);
+        Run rs = geolocate(*w, uv, CT_METHOD_DIRECTIONAL, nullptr, &gs);
+        long differ = 0;
+        for (size_t k = 0; k < n; ++k)
+            differ += gd[k].status != gi[k].status || gd[k].hit.e_nm != gi[k].hit.e_nm ||
+                      gd[k].hit.n_nm != gi[k].hit.n_nm || gd[k].hit.h_nm != gi[k].hit.h_nm;
+        if (differ) std::printf("  %s: directional and incremental differ on %ld pixels!\n", name, differ);
+        // error statistics against the scene's ground truth
+        scene::SimOptions o;
+        o.effects = w->s.effects;
+        o.n = samples;
+        o.seed = 4242;
+        scene::SimStats ss;
+        std::vector<scene::Sample> smp = scene::simulate(*w, o, &ss);
+        double s2 = 0, mx = 0;
+        long cnt = 0;
+        for (const scene::Sample &s : smp) {
+            ct_geo g;
+            if (ct_geolocate(&w->p, &w->cam.cam, &w->cam.pose, CT_METHOD_DIRECTIONAL, &fx, s.uq, s.vq, &g) != CT_HIT) {
+                mx = INFINITY;
+                continue;
+            }
+            double e = (double)std::hypot(g.hit.e_nm * 1e-9L - s.first[0], g.hit.n_nm * 1e-9L - s.first[1]);
+            s2 += e * e;
+            mx = std::max(mx, e);
+            ++cnt;
+        }
+        std::printf("| %s | %s | %.1f %% | %.0f | %.0f / %.1f | %.0f / %.1f | %.1fx | %.0f / %.1f | %.4f / %.4f, %ld |\n",
+                    name, scene::fx_names(w->s.effects).c_str(), 100.0 * (double)rd.hits / (double)n, un, rd.ns - un,
+                    rd.steps, ri.ns - un, ri.steps, (ri.ns - un) / std::max(1.0, rd.ns - un), rs.ns - un, rs.steps,
+                    std::sqrt(s2 / std::max(1L, cnt)), mx, cnt);
+        std::fflush(stdout);
+        delete w;
+    }
+    return 0;
+}

@@ -1,0 +1,316 @@
+// test_scenes.cpp -- geolocation scenes (fixtures/scenes/*.scene) against
+// ground truth made by mrcal and the independent long-double reference
+// tracer, with exactly the effects each scene lists (tests/scene.hpp).
+//
+// Per scene:
+//   - the committed .cameramodel matches the scene's lens and pose;
+//   - accuracy: points of the terrain are projected to pixels by mrcal (their
+//     apparent position under the scene's effects) and geolocated by the
+//     library run with exactly the scene's effects.  Visible points: the hit
+//     is the point; occluded ones: the hit is the reference's first hit (the
+//     occluder).  Acceptance (the issue's): where the line of sight meets
+//     the terrain at alpha >= 5 deg (incidence, = depression on flat ground)
+//     the horizontal error is <= 5 % of the posting, and the RMS over the
+//     pixels at depression >= 5 deg is <= 1 % of the posting; below 5 deg
+//     the bound scales as tan(5 deg) / tan(alpha) (the same error
+//     perpendicular to the surface, i.e. the same ray error), and the RMS
+//     of the error scaled by tan(alpha) / tan(5 deg) is <= 1 %.  Zero
+//     wrong-surface hits (a hit outside its bound, or more than a posting
+//     from the reference's first hit).  Tighter: the error across the
+//     surface (error x sin(incidence)) <= 1 cm.  Tangent lines of sight (passing
+//     within 5 cm of the surface before their first hit, or meeting it at
+//     less than 0.25 deg) are excluded and counted;
+//   - the ray the library traces is within 5e-9 rad + 2^-15 px / f of the exact apparent
+//     line of sight (pixel round trip through mrcal);
+//   - the four methods and the batch form give identical hits with effects;
+//   - the error budget: the library run *without* each listed effect
+//     (distortion: the same camera as a pinhole) fails the acceptance above
+//     (the effect is needed), and each effect the scene does not list
+//     (curvature, refraction), if simulated, would pass it (the omission is
+//     justified).  The table is printed (README "Geolocation").
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "harness.h"
+#include "scene.hpp"
+
+namespace {
+
+using scene::ld;
+
+const char *kScenes[] = {"nadir", "oblique30", "grazing3", "long30km", "wide_opencv8"};
+
+scene::World *world(const std::string &name)
+{
+    static std::map<std::string, scene::World *> cache;
+    auto it = cache.find(name);
+    if (it != cache.end()) return it->second;
+    scene::World *w = scene::load_world(std::string(CT_SCENES_DIR) + "/" + name + ".scene");
+    cache[name] = w;
+    return w;
+}
+
+struct Acc {
+    long n = 0, fail = 0, wrong_surface = 0, miss = 0, vis = 0, occ = 0;
+    long steep = 0;            // depression >= 5 deg
+    double sum2_steep = 0;     // squared errors, depression >= 5 deg
+    double sum2_norm = 0;      // squared angle-normalised errors, all
+    double max_steep = 0;      // max error where alpha >= 5 deg
+    double max_norm = 0;       // max error * min(1, tan(alpha)/tan 5)
+    double max_perp = 0;       // max error * sin(alpha) (3D error across the surface)
+    double worst_ratio = 0;    // max error / bound
+    double rms_steep() const { return steep ? std::sqrt(sum2_steep / steep) : 0; }
+    double rms_norm() const { return n ? std::sqrt(sum2_norm / n) : 0; }
+};
+
+const ld kTan5 = std::tan(5 * (ld)M_PI / 180);
+
+// the acceptance bound at incidence alpha (metres)
+double bound_m(double posting, ld inc_deg)
+{
+    ld t = std::tan(inc_deg * (ld)M_PI / 180);
+    return (double)(0.05L * posting * std::max<ld>(1, kTan5 / t));
+}
+
+void add(Acc *a, double posting, const scene::Sample &s, double err, bool hit)
+{
+    a->n++;
+    if (s.visible) a->vis++;
+    else a->occ++;
+    if (!hit) {
+        a->miss++;
+        a->fail++;
+        a->sum2_norm += 1e12;
+        a->worst_ratio = INFINITY;
+        return;
+    }
+    ld t = std::tan(s.inc_deg * (ld)M_PI / 180);
+    double norm = err * (double)std::min<ld>(1, t / kTan5);
+    a->sum2_norm += norm * norm;
+    a->max_norm = std::max(a->max_norm, norm);
+    a->max_perp = std::max(a->max_perp, err * (double)std::sin(s.inc_deg * (ld)M_PI / 180));
+    if (s.dep_deg >= 5) {
+        a->steep++;
+        a->sum2_steep += err * err;
+    }
+    if (s.inc_deg >= 5) a->max_steep = std::max(a->max_steep, err);
+    double b = bound_m(posting, s.inc_deg);
+    a->worst_ratio = std::max(a->worst_ratio, err / b);
+    if (err > b) a->fail++;
+    if (err > posting) a->wrong_surface++;
+}
+
+// the acceptance on a set of errors
+bool accepted(const Acc &a, double posting)
+{
+    return a.fail == 0 && a.rms_steep() <= 0.01 * posting && a.rms_norm() <= 0.01 * posting;
+}
+
+// Geolocate the samples with `cam` and `fx`; errors against each sample's
+// reference first hit (`vis_only`: visible samples only).
+Acc evaluate(const scene::World &w, const std::vector<scene::Sample> &smp, const ct_host::LibCamera &cam,
+             const ct_effects &fx, bool vis_only, std::vector<ct_geo> *out = nullptr)
+{
+    Acc a;
+    const double posting = std::fabs(w.t.geo.posting_e);
+    if (out) out->resize(smp.size());
+    for (size_t k = 0; k < smp.size(); ++k) {
+        const scene::Sample &s = smp[k];
+        if (vis_only && !s.visible) continue;
+        ct_geo g;
+        ct_status st = ct_geolocate(&w.p, &cam.cam, &cam.pose, CT_METHOD_DIRECTIONAL, &fx, s.uq, s.vq, &g);
+        if (out) (*out)[k] = g;
+        bool hit = st == CT_HIT;
+        double err = hit ? (double)std::hypot(g.hit.e_nm * 1e-9L - s.first[0], g.hit.n_nm * 1e-9L - s.first[1]) : 0;
+        add(&a, posting, s, err, hit);
+    }
+    return a;
+}
+
+void test_scene_files()
+{
+    for (const char *name : kScenes) {
+        scene::World *w = world(name);
+        TEST_ASSERT(w != nullptr);
+        // the .cameramodel is the scene's lens and pose (regenerate with
+        // ct_make_scene_cameras when a scene changes)
+        ct_host::CameraModel want = scene::model_of(w->s);
+        TEST_ASSERT_MSG(w->file_model.model == want.model && w->file_model.width == want.width &&
+                            w->file_model.height == want.height && w->file_model.intrinsics == want.intrinsics,
+                        "%s: %s does not match the scene's lens", name, w->s.camera.c_str());
+        for (int k = 0; k < 6; ++k)
+            TEST_ASSERT_MSG(std::fabs(w->file_model.rt_cam_ref[k] - want.rt_cam_ref[k]) <= 1e-9 * std::max(1.0, std::fabs(want.rt_cam_ref[k])),
+                            "%s: %s does not match the scene's pose (rt[%d] %.17g vs %.17g)", name, w->s.camera.c_str(),
+                            k, w->file_model.rt_cam_ref[k], want.rt_cam_ref[k]);
+        TEST_ASSERT(std::fabs(w->cam.host_pose.centre_m[0] - w->s.pose[0]) < 1e-6 &&
+                    std::fabs(w->cam.host_pose.centre_m[1] - w->s.pose[1]) < 1e-6 &&
+                    std::fabs(w->cam.host_pose.centre_m[2] - w->s.pose[2]) < 1e-6);
+        printf("  %-13s %4dx%-4d posts (tile %dx%d), N=%d r=%d, package built in %.1f s; %s %ux%u; effects: %s\n", name,
+               w->t.width, w->t.height, w->s.tile_x, w->s.tile_y, w->s.sectors, w->s.reduce, w->build_s,
+               w->s.lens_model.c_str(), w->s.width, w->s.height, scene::fx_names(w->s.effects).c_str());
+    }
+    // the reader refuses a lens that contradicts the effect list
+    const char *path = "/tmp/ct_scene_bad.scene";
+    std::FILE *f = std::fopen(path, "w");
+    TEST_ASSERT(f != nullptr);
+    std::fprintf(f, "dem x.tif\ncamera c.cameramodel\nlens LENSMODEL_OPENCV4 1 1 1 1 0.1 0 0 0\nimager 2 2\n"
+                    "pose 0 0 0 0 0 0\neffects curvature\n");
+    std::fclose(f);
+    bool threw = false;
+    try {
+        scene::read_scene(path);
+    } catch (const ct_host::Error &) {
+        threw = true;
+    }
+    std::remove(path);
+    TEST_ASSERT(threw);
+}
+
+void test_scene_accuracy()
+{
+    long total_wrong = 0;
+    for (const char *name : kScenes) {
+        scene::World *w = world(name);
+        const double posting = std::fabs(w->t.geo.posting_e);
+        scene::SimOptions o;
+        o.effects = w->s.effects;
+        o.n = (int)(300 * ct_test_scale());
+        o.seed = ct_test_seed() * 101 + std::strlen(name);
+        scene::SimStats ss;
+        std::vector<scene::Sample> smp = scene::simulate(*w, o, &ss);
+        TEST_ASSERT_MSG((int)smp.size() == o.n, "%s: only %zu usable samples of %ld tries", name, smp.size(), ss.tries);
+        ct_effects fx = scene::lib_effects(w->s, w->s.effects);
+        std::vector<ct_geo> geo;
+        Acc a = evaluate(*w, smp, w->cam, fx, false, &geo);
+        // the ray handed to the tracer vs the exact apparent line of sight
+        double worst_ang = 0, min_dep = 90, max_dep = -90, max_range = 0;
+        long steps = 0;
+        const scene::ld *C = w->cam.host_pose.centre_m;
+        ld c = scene::bend_coeff(w->s, w->s.effects);
+        for (size_t k = 0; k < smp.size(); ++k) {
+            const scene::Sample &s = smp[k];
+            min_dep = std::min(min_dep, (double)s.dep_deg);
+            max_dep = std::max(max_dep, (double)s.dep_deg);
+            max_range = std::max(max_range, (double)s.range_m);
+            steps += geo[k].hit.steps;
+            ld rho = std::hypot(s.P[0] - C[0], s.P[1] - C[1]);
+            ld pd[3] = {s.P[0] - C[0], s.P[1] - C[1], s.P[2] - c * rho * rho / (2 * (ld)w->s.radius_m) - C[2]};
+            ld dm[3] = {(ld)geo[k].dir_map_q39[0], (ld)geo[k].dir_map_q39[1], (ld)geo[k].dir_map_q39[2]};
+            ld cr[3] = {pd[1] * dm[2] - pd[2] * dm[1], pd[2] * dm[0] - pd[0] * dm[2], pd[0] * dm[1] - pd[1] * dm[0]};
+            ld ang = std::sqrt(cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2]) /
+                     (std::sqrt(pd[0] * pd[0] + pd[1] * pd[1] + pd[2] * pd[2]) *
+                      std::sqrt(dm[0] * dm[0] + dm[1] * dm[1] + dm[2] * dm[2]));
+            worst_ang = std::max(worst_ang, (double)ang);
+            // pixel rounding to Q16 (2^-17 px per axis), magnified up to 2x
+            // by the distortion, plus 5e-9 rad for unprojection and pose
+            double tol = 5e-9 + std::ldexp(1.0, -15) / std::min(w->s.intrinsics[0], w->s.intrinsics[1]);
+            TEST_ASSERT_MSG(ang <= tol, "%s: sample %zu: the traced ray is %.3Lg rad from the line of sight", name, k,
+                            ang);
+        }
+        printf("  %-13s %ld points (%ld visible, %ld occluded; excluded: %ld tangent, %ld below 0.25 deg), "
+               "depression %.1f..%.1f deg, range up to %.1f km, %.1f steps/px\n"
+               "  %-13s ray within %.2e rad; error: RMS %.4f m (depression >= 5 deg, %ld px), max %.4f m "
+               "(incidence >= 5 deg), angle-normalised RMS %.4f / max %.4f m, across the surface max %.4f m; "
+               "worst error/bound %.4f; wrong-surface %ld\n",
+               name, a.n, a.vis, a.occ, ss.tangent, ss.shallow, min_dep, max_dep, max_range / 1000,
+               (double)steps / std::max<size_t>(1, smp.size()), "", worst_ang, a.rms_steep(), a.steep, a.max_steep,
+               a.rms_norm(), a.max_norm, a.max_perp, a.worst_ratio, a.wrong_surface);
+        TEST_ASSERT_MSG(a.miss == 0, "%s: %ld points not hit", name, a.miss);
+        TEST_ASSERT_MSG(a.fail == 0, "%s: %ld points beyond the bound", name, a.fail);
+        TEST_ASSERT(accepted(a, posting));
+        // tighter than the bound: the error across the surface
+        // (error x sin(incidence)) is the library's own: the 1 mm polyline
+        // chord plus the 2^-25 direction quantisation (measured <= 1.7 mm)
+        TEST_ASSERT_MSG(a.max_perp <= 0.01, "%s: error across the surface %.4f m", name, a.max_perp);
+        total_wrong += a.wrong_surface;
+        if (std::string(name) == "grazing3") TEST_ASSERT_MSG(a.occ * 4 >= a.n, "%s: only %ld occluded", name, a.occ);
+        // all methods, and the batch form, give the same hits with effects
+        std::vector<int64_t> uv;
+        for (size_t k = 0; k < smp.size(); ++k) {
+            uv.push_back(smp[k].uq);
+            uv.push_back(smp[k].vq);
+            if (k % 8) continue;
+            for (int m = 0; m < CT_METHOD_COUNT; ++m) {
+                ct_geo g2;
+                ct_status st = ct_geolocate(&w->p, &w->cam.cam, &w->cam.pose, (ct_method)m, &fx, smp[k].uq, smp[k].vq, &g2);
+                TEST_ASSERT(st == geo[k].status && g2.hit.e_nm == geo[k].hit.e_nm && g2.hit.n_nm == geo[k].hit.n_nm &&
+                            g2.hit.h_nm == geo[k].hit.h_nm);
+            }
+        }
+        std::vector<ct_geo> batch(smp.size());
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_geolocate_batch(&w->p, &w->cam.cam, &w->cam.pose, CT_METHOD_DIRECTIONAL, &fx,
+                                                        uv.data(), smp.size(), batch.data(), batch.size()));
+        for (size_t k = 0; k < smp.size(); ++k)
+            TEST_ASSERT(std::memcmp(&batch[k].hit, &geo[k].hit, sizeof(ct_hit)) == 0 && batch[k].status == geo[k].status);
+    }
+    TEST_ASSERT_EQUAL_INT(0, total_wrong);
+}
+
+std::string cell(const Acc &a)
+{
+    char b[96];
+    if (a.miss) std::snprintf(b, sizeof b, "%.3g / %.3g m (%ld lost)", a.rms_norm(), a.max_norm, a.miss);
+    else std::snprintf(b, sizeof b, "%.3g / %.3g m", a.rms_norm(), a.max_norm);
+    return b;
+}
+
+void test_error_budget()
+{
+    printf("  error budget: angle-normalised horizontal error RMS / max (visible points; the acceptance is "
+           "RMS <= 0.30 m, max <= 1.5 m at 30 m posting)\n");
+    printf("  | scene | effects listed | all listed | without distortion | without curvature | without refraction |\n");
+    for (const char *name : kScenes) {
+        scene::World *w = world(name);
+        const double posting = std::fabs(w->t.geo.posting_e);
+        scene::SimOptions o;
+        o.n = (int)(200 * ct_test_scale());
+        o.seed = ct_test_seed() * 211 + std::strlen(name);
+        o.effects = w->s.effects;
+        scene::SimStats ss;
+        std::vector<scene::Sample> smp = scene::simulate(*w, o, &ss);
+        TEST_ASSERT(!smp.empty());
+        Acc all = evaluate(*w, smp, w->cam, scene::lib_effects(w->s, w->s.effects), true);
+        std::string row = std::string("  | ") + name + " | " + scene::fx_names(w->s.effects) + " | " + cell(all);
+        for (unsigned e : {(unsigned)scene::FX_DISTORTION, (unsigned)scene::FX_CURVATURE, (unsigned)scene::FX_REFRACTION}) {
+            Acc a;
+            bool listed = (w->s.effects & e) != 0;
+            if (listed) {
+                // the library ignores the effect the scene has
+                const ct_host::LibCamera &cam = e == scene::FX_DISTORTION ? w->pinhole : w->cam;
+                a = evaluate(*w, smp, cam, scene::lib_effects(w->s, w->s.effects & ~e), true);
+                row += " | " + cell(a);
+                TEST_ASSERT_MSG(!accepted(a, posting), "%s: lists %s, but the library is accurate without it (%s)",
+                                name, scene::fx_names(e).c_str(), cell(a).c_str());
+            } else if (e == scene::FX_DISTORTION) {
+                row += " | (pinhole)";
+            } else {
+                // the world had it, the scene (and the library) leave it out
+                scene::SimOptions o2 = o;
+                o2.effects = w->s.effects | e;
+                scene::SimStats s2;
+                std::vector<scene::Sample> smp2 = scene::simulate(*w, o2, &s2);
+                a = evaluate(*w, smp2, w->cam, scene::lib_effects(w->s, w->s.effects), true);
+                row += " | not listed: " + cell(a);
+                TEST_ASSERT_MSG(accepted(a, posting), "%s: leaves out %s, which costs %s", name,
+                                scene::fx_names(e).c_str(), cell(a).c_str());
+            }
+        }
+        printf("%s |\n", row.c_str());
+    }
+}
+
+}  // namespace
+
+int main()
+{
+    TEST_BEGIN("test_scenes");
+    RUN_TEST(test_scene_files);
+    RUN_TEST(test_scene_accuracy);
+    RUN_TEST(test_error_budget);
+    return TEST_END();
+}
