@@ -21,6 +21,8 @@ demo: all
 bench: all
 	$(BUILD)/bench/ct_bench
 	$(BUILD)/bench/ct_bench_geoloc
+	$(BUILD)/bench/ct_bench_build
+	$(BUILD)/bench/ct_bench_ddt
 
 cross: deps
 	scripts/cross.sh $(BUILD)/cross
