@@ -141,7 +141,7 @@ double run_embree(const EmbreeTerrain &e, const std::vector<ct_ray> &rays, long 
 }
 #endif
 
-int g_slices = 0, g_window = 8;  // --slices K, --window R (slice builder)
+int g_slices = 0, g_window = 12;  // --slices K, --window R (slice builder)
 bool g_only_slices = false;
 
 void bench_dem(const char *title, const ct_host::Terrain &t, int n, const std::vector<int> &reduces,

@@ -51,27 +51,6 @@ struct Node {
     bool operator<(const Node &o) const { return bound < o.bound; }
 };
 
-// double).  Distances in units of 2^-k cells, exact wedge tests.
-constexpr int SUB_DEPTH = 3;  // refine far cells down to 1/8 cell
-double sub_term(const Ctx &c, int s, double a, int k, int64_t i, int64_t j, int fx0, int fx1, int fy0, int fy1)
-{
-    const Terrain &t = *c.t;
-    int ci = (int)(i >> k), cj = (int)(j >> k);
-    double h00 = t.at(ci, cj), h10 = t.at(ci + 1, cj), h01 = t.at(ci, cj + 1), h11 = t.at(ci + 1, cj + 1);
-    double sc = 1.0 / (double)(1 << k), hm = -INF;
-    double u0 = (double)(i - ((int64_t)ci << k)) * sc, v0 = (double)(j - ((int64_t)cj << k)) * sc;
-    for (int dv = 0; dv < 2; ++dv)
-        for (int du = 0; du < 2; ++du) {
-            double u = u0 + du * sc, v = v0 + dv * sc;
-            hm = std::max(hm, h00 * (1 - u) * (1 - v) + h10 * u * (1 - v) + h01 * (1 - u) * v + h11 * u * v);
-        }
-    if (hm <= a) return -INF;
-    Rect rr{i - ((int64_t)fx1 << k), i + 1 - ((int64_t)fx0 << k), j - ((int64_t)fy1 << k), j + 1 - ((int64_t)fy0 << k)};
-    if (!overlaps(c.wedge, s, rr)) return -INF;
-    double d = dist_min(c.wedge, s, rr) * sc;
-    if (d == INF) return -INF;
-    return (hm - a) / std::max(K_NEAR, d);
-}
 
 // Needed cot (LSB per fine cell) for coarse cell (ci, cj), sector s, apex a.
 // seed: a fine cell index likely to be the maximiser (or -1); updated.

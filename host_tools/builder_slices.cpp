@@ -193,8 +193,39 @@ void slice_angles(const Ctx &c, const SliceInput &in, uint8_t *codes, SliceStats
     const MergedList mnear = merge(wnear), mfine = merge(wfine), mcoarse = merge(win);
     {
         std::atomic<int> next{0};
+        // the fine window's three largest terms per sector (value, cell),
+        // and the largest of the rest, for the sub-square refinement
+        struct Top {
+            double v[3];
+            int qi[3], qj[3];
+            double rest;
+            void reset()
+            {
+                v[0] = v[1] = v[2] = rest = -INF;
+            }
+            void add(double x, int i, int j)
+            {
+                if (x <= v[2]) {
+                    rest = std::max(rest, x);
+                    return;
+                }
+                rest = std::max(rest, v[2]);
+                int k = 2;
+                while (k > 0 && x > v[k - 1]) {
+                    v[k] = v[k - 1], qi[k] = qi[k - 1], qj[k] = qj[k - 1];
+                    --k;
+                }
+                v[k] = x, qi[k] = i, qj[k] = j;
+            }
+        };
         auto worker = [&]() {
             std::vector<double> need((size_t)c.n);
+            std::vector<Top> top((size_t)c.n);
+            struct Sub {
+                int k;
+                int64_t i, j;
+            };
+            std::vector<Sub> stack;
             for (;;) {
                 int cj = next.fetch_add(1);
                 if (cj >= hc) break;
@@ -203,6 +234,7 @@ void slice_angles(const Ctx &c, const SliceInput &in, uint8_t *codes, SliceStats
                     double a = apex[f];
                     int fx0 = ci * r, fy0 = cj * r;
                     std::fill(need.begin(), need.end(), 0.0);
+                    for (Top &tp : top) tp.reset();
                     for (const Merged &o : mnear.offs) {
                         int qi = fx0 + o.dx, qj = fy0 + o.dy;
                         if (qi < 0 || qj < 0 || qi >= c.cx || qj >= c.cy) continue;
@@ -216,22 +248,66 @@ void slice_angles(const Ctx &c, const SliceInput &in, uint8_t *codes, SliceStats
                         if (qi < 0 || qj < 0 || qi >= c.cx || qj >= c.cy) continue;
                         double rise = c.fm[(size_t)qj * c.cx + qi] - a;
                         if (rise <= 0.0) continue;
-                        for (size_t e = o.first; e < o.first + o.count; ++e) {
-                            double &nd = need[(size_t)mfine.secs[e]];
-                            nd = std::max(nd, rise / mfine.rhos[e]);
-                        }
+                        for (size_t e = o.first; e < o.first + o.count; ++e)
+                            top[(size_t)mfine.secs[e]].add(rise / mfine.rhos[e], qi, qj);
                     }
                     for (const Merged &o : mcoarse.offs) {
                         int gi = ci + o.dx, gj = cj + o.dy;
                         if (gi < 0 || gj < 0 || gi >= wc || gj >= hc) continue;
                         double rise = hcm[(size_t)gj * wc + gi] - a;
                         if (rise <= 0.0) continue;
-                        for (size_t e = o.first; e < o.first + o.count; ++e) {
-                            double &nd = need[(size_t)mcoarse.secs[e]];
-                            nd = std::max(nd, rise / mcoarse.rhos[e]);
+                        if (r == 1) {  // a coarse cell is a fine cell: refinable too
+                            for (size_t e = o.first; e < o.first + o.count; ++e)
+                                top[(size_t)mcoarse.secs[e]].add(rise / mcoarse.rhos[e], gi, gj);
+                        } else {
+                            for (size_t e = o.first; e < o.first + o.count; ++e) {
+                                double &nd = need[(size_t)mcoarse.secs[e]];
+                                nd = std::max(nd, rise / mcoarse.rhos[e]);
+                            }
                         }
                     }
-                    for (int s = 0; s < c.n; ++s) codes[(size_t)s * plane + f] = code_for(c, need[(size_t)s]);
+                    const int fx1 = std::min(fx0 + r, c.cx), fy1 = std::min(fy0 + r, c.cy);
+                    for (int s = 0; s < c.n; ++s) {
+                        // Refine the largest fine-window terms to 1/8-cell
+                        // sub-squares (the column bound at the cell's tallest
+                        // corner and nearest point over-estimates most next
+                        // to F) while one of them is the maximum; at most 3.
+                        Top &tp = top[(size_t)s];
+                        double other = std::max(need[(size_t)s], tp.rest);
+                        bool done[3] = {false, false, false};
+                        for (int it = 0; it < 3; ++it) {
+                            int m = 0;
+                            for (int q = 1; q < 3; ++q)
+                                if (tp.v[q] > tp.v[m]) m = q;
+                            if (tp.v[m] <= other || done[m]) break;
+                            // best-first over the quadtree of sub-squares: a
+                            // sub-square's bound covers its children, so only
+                            // those above every other term are split; the
+                            // result is exact where it matters (above `floor`)
+                            const double floor = other;
+                            double vr = -INF;
+                            stack.clear();
+                            stack.push_back(Sub{0, tp.qi[m], tp.qj[m]});
+                            while (!stack.empty()) {
+                                Sub sq = stack.back();
+                                stack.pop_back();
+                                for (int d = 0; d < 4; ++d) {
+                                    int64_t ci2 = sq.i * 2 + (d & 1), cj2 = sq.j * 2 + (d >> 1);
+                                    double b = sub_term(c, s, a, sq.k + 1, ci2, cj2, fx0, fx1, fy0, fy1);
+                                    if (b <= std::max(floor, vr)) continue;
+                                    if (sq.k + 1 == SUB_DEPTH)
+                                        vr = b;
+                                    else
+                                        stack.push_back(Sub{sq.k + 1, ci2, cj2});
+                                }
+                            }
+                            // vr = -INF: nothing of the cell rises above floor
+                            tp.v[m] = std::min(tp.v[m], std::max(vr, floor));
+                            done[m] = true;
+                        }
+                        double nd = std::max(other, std::max(tp.v[0], std::max(tp.v[1], tp.v[2])));
+                        codes[(size_t)s * plane + f] = code_for(c, std::max(0.0, nd));
+                    }
                 }
             }
         };

@@ -44,7 +44,7 @@ struct BuildOptions {
                            // 0: exact apexes (Brute), DEFAULT_SLICES (Slices)
     int threads = 0;       // 0 = hardware concurrency
     PptBuilder builder = PptBuilder::Slices;
-    int window = 8;        // Slices: near window Rw in coarse cells (>= 1)
+    int window = 12;       // Slices: near window Rw in coarse cells (>= 1)
     std::vector<double> levels_m;  // Slices: given levels (metres) instead of K even ones;
                                    // the DEM's lowest and highest heights are always levels
     static constexpr int DEFAULT_SLICES = 64;

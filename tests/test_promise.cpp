@@ -370,7 +370,7 @@ struct Checker {
 // slice builder's near window Rw (small windows send most terrain through
 // the slice DTs).  *stats_out: the build's stats.
 void check_package(const char *name, const ct_host::Terrain &t, int n, int r, int slices = 0,
-                   ct_host::PptBuilder builder = ct_host::BuildOptions().builder, int window = 8,
+                   ct_host::PptBuilder builder = ct_host::BuildOptions().builder, int window = ct_host::BuildOptions().window,
                    ct_host::BuildStats *stats_out = nullptr, const std::vector<double> *levels_m = nullptr)
 {
     ct_host::BuildOptions o;
