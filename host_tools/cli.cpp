@@ -44,6 +44,10 @@ namespace {
                  "       conetrace trace PKG --rays rays.csv [--method M] -o hits.csv\n"
                  "       conetrace demo DEM\n"
                  "       conetrace geoloc PKG --camera C.cameramodel --pixels px.csv [--method M] -o g.csv\n"
+                 "       conetrace render DEM_or_PKG --what bitmap|dt|ddt|angles|apex -o OUT.png\n"
+                 "                       [--slice H | --level k --slices K] [--reduce r] [--sectors N]\n"
+                 "                       [--sector LIST] [--range LO,HI] [--hillshade] [--zoom Z]\n"
+                 "                       [--columns C] [--no-legend] [--threads T]\n"
                  "methods: incremental, hierarchical, cone, directional (default)\n");
     std::exit(2);
 }
@@ -305,6 +309,7 @@ int cmd_demo(int argc, char **argv)
 }  // namespace
 
 int cmd_geoloc(int argc, char **argv);  // cmd_geoloc.cpp
+int cmd_render(int argc, char **argv);  // cmd_render.cpp
 
 int main(int argc, char **argv)
 {
@@ -316,6 +321,7 @@ int main(int argc, char **argv)
         if (cmd == "trace") return cmd_trace(argc, argv);
         if (cmd == "demo") return cmd_demo(argc, argv);
         if (cmd == "geoloc") return cmd_geoloc(argc, argv);
+        if (cmd == "render") return cmd_render(argc, argv);
         if (cmd == "-h" || cmd == "--help" || cmd == "help") usage("help");
         usage("unknown command '" + cmd + "'");
     } catch (const std::exception &e) {
