@@ -20,6 +20,7 @@ demo: all
 
 bench: all
 	$(BUILD)/bench/ct_bench
+	$(BUILD)/bench/ct_bench_build
 
 cross: deps
 	scripts/cross.sh $(BUILD)/cross
