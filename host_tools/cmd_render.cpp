@@ -158,8 +158,12 @@ void write_png_atomic(const std::string &path, const Image &im, const std::strin
     OIIO::ImageSpec spec(im.w, im.h, 3, OIIO::TypeDesc::UINT8);
     spec.attribute("ImageDescription", desc);
     spec.attribute("Software", "conetrace render");
-    bool ok = out->open(tmp, spec) && out->write_image(OIIO::TypeDesc::UINT8, im.px.data());
+    errno = 0;
+    bool opened = out->open(tmp, spec);
+    const int open_errno = errno;
+    bool ok = opened && out->write_image(OIIO::TypeDesc::UINT8, im.px.data());
     std::string err = ok ? "" : out->geterror();
+    if (!opened && open_errno != 0) err = std::strerror(open_errno);  // OIIO's text names the temporary
     ok = out->close() && ok;
     if (ok && std::rename(tmp.c_str(), path.c_str()) != 0) {
         ok = false;
@@ -596,7 +600,7 @@ int cmd_render(int argc, char **argv)
                     for (int b = 0; b < 12; ++b) im.set(x + b, y0 + a, kNone);
         }
     }
-    desc << "; scale " << lo << ".." << hi << " " << unit;
+    if (what != "bitmap") desc << "; scale " << lo << ".." << hi << " " << unit;
     write_png_atomic(out, im, desc.str());
     std::printf("%s: %dx%d px, %d panel%s of %dx%d cells; %s\n", out.c_str(), im.w, im.h, n, n == 1 ? "" : "s", wc, hc,
                 desc.str().c_str());
