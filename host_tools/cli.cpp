@@ -47,8 +47,10 @@ namespace {
                  "       conetrace geoloc PKG --camera C.cameramodel --pixels px.csv [--method M]\n"
                  "                        [--effects curvature,refraction] [--refraction-k K]\n"
                  "                        [--earth-radius M] [--grid-step PX] -o g.csv\n"
-                 "       conetrace render IN --what bitmap|dt|ddt|angles|apex -o OUT.png [--level H]\n"
-                 "                        [--sectors N] [--sector S1,S2,...] [--scale K]\n"
+                 "       conetrace render DEM_or_PKG --what bitmap|dt|ddt|angles|apex -o OUT.png\n"
+                 "                       [--slice H | --level k --slices K] [--reduce r] [--sectors N]\n"
+                 "                       [--sector LIST] [--range LO,HI] [--hillshade] [--zoom Z]\n"
+                 "                       [--columns C] [--no-legend] [--threads T]\n"
                  "methods: incremental, hierarchical, cone, directional (default)\n");
     std::exit(2);
 }

@@ -1,189 +1,608 @@
-// cmd_render.cpp -- `conetrace render`: pictures a person would look at.
+// cmd_render.cpp -- `conetrace render`: PNG pictures of what the PPT builder
+// works with (Paglieroni 1997, Figs. 10-11): a DEM cross-section, its
+// distance transforms, and a package's opening-angle and apex maps.
 //
-//   conetrace render IN --what bitmap|dt|ddt|angles|apex -o OUT.png
-//                    [--level H] [--sectors N] [--sector S1,S2,...] [--scale K]
+//   conetrace render IN --what KIND -o OUT.png [options]
 //
-// IN is a DEM (anything `build` reads) or a terrain package (.ctp); angles
-// and apex need a package.  bitmap: the cross-section at --level H metres
-// (default: halfway between the lowest and highest cell) over a hillshade;
-// dt: its unconstrained Euclidean distance transform; ddt: its directional
-// DTs for the --sector list of --sectors N (default N = 8, every sector),
-// side by side (the paper's Fig. 11); angles: the package's opening angles
-// for the --sector list (N = the omnidirectional plane; default 0); apex: the
-// package's apex heights.  --scale K enlarges K times (nearest neighbour).
+// IN is a DEM (anything `build` reads) or a package (.ctp, recognised by its
+// magic); KIND is one of
+//   bitmap  the cross-section: cells whose top (tallest corner; with
+//           --reduce r the max over r x r cells) is at or above the level
+//   dt      its unconstrained Euclidean DT (ddt::unconstrained), in cells
+//   ddt     directional Euclidean DTs, one panel per sector (--sectors N,
+//           --sector LIST); "no feature in the sector" = infinity
+//   angles  a package's opening-angle planes, one panel per sector
+//           (--sector LIST, "omni" = the omnidirectional plane), degrees
+//           from the upward vertical; code 0 (no cone) is marked
+//   apex    a package's apex heights, grey (dark = low), metres
+// Level (bitmap, dt, ddt): --slice H (metres), or --level k with
+// --slices K (level k of K evenly spaced between the lowest and highest
+// height code, as `build --slices`; K defaults to the package's slices).
+// Options: --reduce r (1..8, bitmap/dt/ddt; packages use their own r),
+//   --sectors N (ddt, 1..64, default 8), --sector LIST ("0,2,5", "all";
+//   default all), --range LO,HI (colour scale: cells for distances, degrees
+//   for angles, metres for apex; default: the data's range over all
+//   panels), --hillshade (shade by the DEM's relief, light from the NW),
+//   --zoom Z (1..16, pixels per cell), --columns C (panels per row),
+//   --no-legend, --threads T.
+//
+// Picture layout (tests rely on it): panels of w*Z x h*Z pixels (cell
+// (x, y) at pixels x*Z.., y*Z.., row 0 = north), laid out C per row, GAP
+// pixels apart; sector panels (ddt, angles) have a STRIP-pixel header above
+// them with the sector's wedge and number; below everything (unless
+// --no-legend) a LEGEND-pixel colour bar with the scale's ends.
+// Background white.  Colours: viridis (perceptual, dark = 0) for distances
+// and angles, grey for apex; infinity / no cone = kNone (light grey,
+// distinct from every palette colour), bitmap features kFeature on white.
+//
+// Errors print one line (file and reason) and exit non-zero; the PNG is
+// written to a temporary file and renamed: never a partial output.
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <map>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include <unistd.h>
+
+#include <OpenImageIO/imageio.h>
+
 #include "conetrace.h"
 #include "ddt.hpp"
 #include "dem_io.hpp"
 #include "host_io.hpp"
-#include "render.hpp"
 #include "terrain.hpp"
 
 using namespace ct_host;
 
 namespace {
 
-[[noreturn]] void render_usage(const std::string &msg)
+constexpr int GAP = 8;      // pixels between panels
+constexpr int STRIP = 28;   // header above each sector panel
+constexpr int LEGEND = 26;  // colour bar below the panels (incl. its gap)
+
+struct Rgb {
+    uint8_t r, g, b;
+};
+constexpr Rgb kWhite{255, 255, 255};
+constexpr Rgb kFeature{38, 38, 46};    // bitmap: terrain at/above the level
+constexpr Rgb kNone{200, 200, 200};    // infinity, no cone (not in viridis)
+constexpr Rgb kInk{20, 20, 20};
+
+// Viridis (matplotlib's), 11 anchors at t = 0, 0.1, ..., 1, linear between.
+Rgb viridis(double t)
 {
-    std::fprintf(stderr, "conetrace: %s\n", msg.c_str());
-    std::fprintf(stderr,
-                 "usage: conetrace render IN --what bitmap|dt|ddt|angles|apex -o OUT.png\n"
-                 "                        [--level H] [--sectors N] [--sector S1,S2,...] [--scale K]\n"
-                 "IN: a DEM or a package (.ctp); angles and apex need a package\n");
-    std::exit(2);
+    static const uint8_t a[11][3] = {{68, 1, 84},    {72, 36, 117},  {65, 68, 135},  {53, 95, 141},
+                                     {42, 120, 142}, {33, 145, 140}, {34, 168, 132}, {68, 191, 112},
+                                     {122, 209, 81}, {189, 223, 38}, {253, 231, 37}};
+    t = std::min(1.0, std::max(0.0, t)) * 10.0;
+    int k = std::min(9, (int)t);
+    double f = t - k;
+    auto mix = [&](int c) { return (uint8_t)std::lround(a[k][c] + f * (a[k + 1][c] - a[k][c])); };
+    return Rgb{mix(0), mix(1), mix(2)};
+}
+// 256-entry palette: index = round(255 * t).
+Rgb palette(bool grey, int idx)
+{
+    if (grey) return Rgb{(uint8_t)idx, (uint8_t)idx, (uint8_t)idx};
+    return viridis(idx / 255.0);
 }
 
-long parse_long(const std::string &opt, const std::string &v, long lo, long hi)
+[[noreturn]] void fail(const std::string &msg) { throw Error("render: " + msg); }
+
+// ------------------------------------------------------------------ image
+struct Image {
+    int w = 0, h = 0;
+    std::vector<uint8_t> px;  // RGB
+    Image(int w_, int h_) : w(w_), h(h_), px((size_t)w_ * h_ * 3, 255) {}
+    void set(int x, int y, Rgb c)
+    {
+        if (x < 0 || y < 0 || x >= w || y >= h) return;
+        uint8_t *p = &px[((size_t)y * w + x) * 3];
+        p[0] = c.r, p[1] = c.g, p[2] = c.b;
+    }
+};
+
+// 3 x 5 digits and a few signs, bit 14 = top-left.
+void draw_text(Image &im, int x, int y, const std::string &s, int scale)
+{
+    auto glyph = [](char ch) -> unsigned {
+        switch (ch) {
+        case '0': return 075557;
+        case '1': return 026227;
+        case '2': return 071747;
+        case '3': return 071717;
+        case '4': return 055711;
+        case '5': return 074717;
+        case '6': return 074757;
+        case '7': return 071111;
+        case '8': return 075757;
+        case '9': return 075717;
+        case '.': return 000002;
+        case '-': return 000700;
+        case 'o': return 000757;  // "omni"
+        default: return 0;
+        }
+    };
+    for (char ch : s) {
+        unsigned g = glyph(ch);
+        for (int r = 0; r < 5; ++r)
+            for (int c = 0; c < 3; ++c)
+                if (g & (1u << (14 - (r * 3 + c))))
+                    for (int a = 0; a < scale; ++a)
+                        for (int b = 0; b < scale; ++b) im.set(x + c * scale + b, y + r * scale + a, kInk);
+        x += 4 * scale;
+    }
+}
+
+std::string fmt_num(double v)
+{
+    char b[32];
+    if (std::fabs(v) >= 100 || v == std::floor(v))
+        std::snprintf(b, sizeof b, "%.0f", v);
+    else
+        std::snprintf(b, sizeof b, "%.1f", v);
+    return b;
+}
+
+void write_png_atomic(const std::string &path, const Image &im, const std::string &desc)
+{
+    const std::string tmp = path + ".tmp." + std::to_string((long)getpid()) + ".png";
+    auto out = OIIO::ImageOutput::create("png");
+    if (!out) throw Error(path + ": cannot write PNG (" + OIIO::geterror() + ")");
+    OIIO::ImageSpec spec(im.w, im.h, 3, OIIO::TypeDesc::UINT8);
+    spec.attribute("ImageDescription", desc);
+    spec.attribute("Software", "conetrace render");
+    errno = 0;
+    bool opened = out->open(tmp, spec);
+    const int open_errno = errno;
+    bool ok = opened && out->write_image(OIIO::TypeDesc::UINT8, im.px.data());
+    std::string err = ok ? "" : out->geterror();
+    if (!opened && open_errno != 0) err = std::strerror(open_errno);  // OIIO's text names the temporary
+    ok = out->close() && ok;
+    if (ok && std::rename(tmp.c_str(), path.c_str()) != 0) {
+        ok = false;
+        err = std::strerror(errno);
+    }
+    if (!ok) {
+        std::remove(tmp.c_str());
+        if (err.empty()) err = out->geterror();
+        // OIIO's messages often repeat the (temporary) file name; keep the reason
+        throw Error(path + ": cannot write (" + (err.empty() ? "unknown error" : err) + ")");
+    }
+}
+
+// ------------------------------------------------------------------ input
+struct Input {
+    Terrain t;
+    bool is_pkg = false;
+    std::vector<uint8_t> bytes;  // package bytes (kept: ct_package points into them)
+    ct_package pkg{};
+};
+
+uint16_t rd16(const uint8_t *p) { return (uint16_t)(p[0] | (p[1] << 8)); }
+
+Input load_input(const std::string &path)
+{
+    Input in;
+    std::vector<uint8_t> head;
+    {
+        std::FILE *f = std::fopen(path.c_str(), "rb");
+        if (!f) throw Error(path + ": " + std::strerror(errno));
+        uint8_t m[4] = {0, 0, 0, 0};
+        size_t n = std::fread(m, 1, 4, f);
+        std::fclose(f);
+        in.is_pkg = n == 4 && std::memcmp(m, CT_PKG_MAGIC, 4) == 0;
+    }
+    if (in.is_pkg) {
+        in.bytes = read_file(path);
+        ct_status st = ct_package_open(&in.pkg, in.bytes.data(), in.bytes.size());
+        if (st != CT_OK) throw Error(path + ": not a valid package (" + status_name(st) + ")");
+        const ct_package &p = in.pkg;
+        Terrain &t = in.t;
+        t.width = (int)p.width;
+        t.height = (int)p.height;
+        t.codes.resize((size_t)p.width * p.height);
+        for (size_t k = 0; k < t.codes.size(); ++k) t.codes[k] = rd16(p.heights + 2 * k);
+        t.geo.origin_e = p.origin_e_nm * 1e-9;
+        t.geo.origin_n = p.origin_n_nm * 1e-9;
+        t.geo.posting_e = p.posting_e_nm * 1e-9;
+        t.geo.posting_n = p.posting_n_nm * 1e-9;
+        t.geo.epsg = (int)p.epsg;
+        t.height_offset_m = p.height_offset_nm * 1e-9;
+        t.height_scale_m = p.height_scale_nm * 1e-9;
+    } else {
+        DemRaster r = read_dem(path);
+        try {
+            in.t = terrain_from_heights(r.width, r.height, r.h, r.valid, r.geo, 0.0);
+        } catch (const Error &e) {
+            throw Error(path + ": " + e.what());
+        }
+    }
+    return in;
+}
+
+// Coarse cell tops (height codes): max of the corners of the r x r fine
+// cells (the builder's cell heights and reduction).
+std::vector<uint16_t> cell_tops(const Terrain &t, int r, int &wc, int &hc)
+{
+    const int cx = t.width - 1, cy = t.height - 1;
+    wc = (cx + r - 1) / r;
+    hc = (cy + r - 1) / r;
+    std::vector<uint16_t> top((size_t)wc * hc, 0);
+    for (int j = 0; j < cy; ++j)
+        for (int i = 0; i < cx; ++i) {
+            uint16_t m = std::max(std::max(t.at(i, j), t.at(i + 1, j)), std::max(t.at(i, j + 1), t.at(i + 1, j + 1)));
+            uint16_t &d = top[(size_t)(j / r) * wc + i / r];
+            d = std::max(d, m);
+        }
+    return top;
+}
+
+// Hillshade in [0, 1] per coarse cell (mean over its fine cells), light from
+// azimuth 315 deg (NW), 45 deg up; gradients from the cell's four posts.
+std::vector<double> hillshade(const Terrain &t, int r, int wc, int hc)
+{
+    const int cx = t.width - 1, cy = t.height - 1;
+    const double post = std::fabs(t.geo.posting_e) > 0 ? std::fabs(t.geo.posting_e) : 1.0;
+    const double alt = M_PI / 4, az = 7 * M_PI / 4;  // from north, clockwise
+    // light vector in (east, south, up)
+    const double lx = std::cos(alt) * std::sin(az), ly = -std::cos(alt) * std::cos(az), lz = std::sin(alt);
+    std::vector<double> sum((size_t)wc * hc, 0.0);
+    std::vector<int> cnt((size_t)wc * hc, 0);
+    for (int j = 0; j < cy; ++j)
+        for (int i = 0; i < cx; ++i) {
+            double z00 = t.at(i, j), z10 = t.at(i + 1, j), z01 = t.at(i, j + 1), z11 = t.at(i + 1, j + 1);
+            double s = t.height_scale_m / post;
+            double gx = 0.5 * ((z10 + z11) - (z00 + z01)) * s, gy = 0.5 * ((z01 + z11) - (z00 + z10)) * s;
+            double nrm = std::sqrt(gx * gx + gy * gy + 1.0);
+            double sh = std::max(0.0, (-gx * lx - gy * ly + lz) / nrm);
+            size_t k = (size_t)(j / r) * wc + i / r;
+            sum[k] += sh;
+            cnt[k] += 1;
+        }
+    for (size_t k = 0; k < sum.size(); ++k) sum[k] = cnt[k] ? sum[k] / cnt[k] : 1.0;
+    return sum;
+}
+
+// ------------------------------------------------------------------ options
+struct Opts {
+    std::vector<std::string> pos;
+    std::map<std::string, std::string> val;
+    bool hillshade = false, legend = true;
+};
+
+Opts parse_opts(int argc, char **argv)
+{
+    static const char *valued[] = {"-o",      "--what",  "--slice",   "--level", "--slices",  "--reduce", "--sectors",
+                                   "--sector", "--range", "--zoom",    "--columns", "--threads"};
+    Opts o;
+    for (int k = 2; k < argc; ++k) {
+        std::string s = argv[k];
+        if (s == "--hillshade") {
+            o.hillshade = true;
+        } else if (s == "--no-legend") {
+            o.legend = false;
+        } else if (s.size() > 1 && s[0] == '-') {
+            bool known = false;
+            for (const char *v : valued) known = known || s == v;
+            if (!known) fail("unknown option " + s);
+            if (k + 1 >= argc) fail("option " + s + " needs a value");
+            if (o.val.count(s)) fail("option " + s + " given twice");
+            o.val[s] = argv[++k];
+        } else {
+            o.pos.push_back(s);
+        }
+    }
+    return o;
+}
+
+long get_int(const Opts &o, const std::string &k, long def, long lo, long hi)
+{
+    auto it = o.val.find(k);
+    if (it == o.val.end()) return def;
+    char *end = nullptr;
+    errno = 0;
+    long v = std::strtol(it->second.c_str(), &end, 10);
+    if (it->second.empty() || *end || errno == ERANGE || v < lo || v > hi)
+        fail(k + " needs an integer in " + std::to_string(lo) + ".." + std::to_string(hi) + ", got '" + it->second + "'");
+    return v;
+}
+
+double parse_real(const std::string &what, const std::string &s)
 {
     char *end = nullptr;
-    long x = std::strtol(v.c_str(), &end, 10);
-    if (v.empty() || *end != '\0' || x < lo || x > hi)
-        render_usage(opt + " needs an integer in " + std::to_string(lo) + ".." + std::to_string(hi) + ", got '" + v + "'");
-    return x;
+    double v = std::strtod(s.c_str(), &end);
+    if (s.empty() || *end || !std::isfinite(v)) fail(what + " needs a number, got '" + s + "'");
+    return v;
 }
 
-std::vector<long> parse_list(const std::string &opt, const std::string &v, long lo, long hi)
+// "all", or a comma-separated list of sector indices (and "omni" if allowed).
+// Returns plane indices; omni = n.
+std::vector<int> parse_sectors(const std::string &s, int n, bool allow_omni)
 {
-    std::vector<long> out;
-    std::stringstream ss(v);
+    std::vector<int> v;
+    if (s == "all") {
+        for (int k = 0; k < n; ++k) v.push_back(k);
+        return v;
+    }
+    std::stringstream ss(s);
     std::string item;
-    while (std::getline(ss, item, ',')) out.push_back(parse_long(opt, item, lo, hi));
-    if (out.empty()) render_usage(opt + " needs at least one number");
-    return out;
+    while (std::getline(ss, item, ',')) {
+        if (item == "omni") {
+            if (!allow_omni) fail("--sector omni: only for --what angles of a package with more than one sector");
+            v.push_back(n);
+            continue;
+        }
+        char *end = nullptr;
+        long k = std::strtol(item.c_str(), &end, 10);
+        if (item.empty() || *end || k < 0 || k >= n)
+            fail("--sector '" + s + "': '" + item + "' is not a sector in 0.." + std::to_string(n - 1) +
+                 (allow_omni ? " or omni" : ""));
+        v.push_back((int)k);
+    }
+    if (v.empty()) fail("--sector '" + s + "': empty list");
+    return v;
+}
+
+// ------------------------------------------------------------------ panels
+// One panel: values per cell (NaN = none/infinity), w x h.
+struct Panel {
+    int w = 0, h = 0;
+    std::vector<double> v;
+    int sector = -1;          // header: sector index (N = omni), -1 = no header
+    std::vector<uint8_t> fg;  // bitmap panels: 1 = feature
+};
+
+void draw_wedge_glyph(Image &im, int cx, int cy, int rad, int n, int s)
+{
+    // ring, then the sector filled (s == n: whole disc, the omni plane)
+    int32_t b0x = 1, b0y = 0, b1x = 0, b1y = 1;
+    if (s < n) {
+        ct_sector_boundary((uint32_t)n, (uint32_t)s, &b0x, &b0y);
+        ct_sector_boundary((uint32_t)n, (uint32_t)s + 1, &b1x, &b1y);
+    }
+    for (int dy = -rad; dy <= rad; ++dy)
+        for (int dx = -rad; dx <= rad; ++dx) {
+            int d2 = dx * dx + dy * dy;
+            if (d2 > rad * rad) continue;
+            bool ring = d2 >= (rad - 1) * (rad - 1);
+            bool in = s >= n || n == 1;
+            if (!in) {
+                // the closed-wedge test with the flight library's convention:
+                // image x = grid x (east), image y = grid y (south)
+                int64_t c0 = (int64_t)b0x * dy - (int64_t)b0y * dx, c1 = (int64_t)dx * b1y - (int64_t)dy * b1x;
+                in = c0 >= 0 && c1 >= 0;
+                // N == 2, 3: wedges wider than 180 deg are not sectors here (N >= 2 has <= 180)
+            }
+            if (ring || in) im.set(cx + dx, cy + dy, ring ? kInk : Rgb{230, 120, 30});
+        }
 }
 
 }  // namespace
 
 int cmd_render(int argc, char **argv)
 {
-    std::string in, out, what;
-    std::map<std::string, std::string> opt;
-    for (int k = 2; k < argc; ++k) {
-        std::string a = argv[k];
-        if (a == "-o" || a == "--what" || a == "--level" || a == "--sectors" || a == "--sector" || a == "--scale") {
-            if (k + 1 >= argc) render_usage(a + " needs a value");
-            opt[a] = argv[++k];
-        } else if (!a.empty() && a[0] == '-') {
-            render_usage("render: unknown option " + a);
-        } else if (in.empty()) {
-            in = a;
-        } else {
-            render_usage("render takes one input file");
-        }
-    }
-    if (in.empty()) render_usage("render needs an input DEM or package");
-    if (!opt.count("-o")) render_usage("render needs -o OUT.png");
-    if (!opt.count("--what")) render_usage("render needs --what bitmap|dt|ddt|angles|apex");
-    out = opt["-o"];
-    what = opt["--what"];
+    Opts o = parse_opts(argc, argv);
+    if (o.pos.size() != 1) fail("needs exactly one input (a DEM or a .ctp package)");
+    if (!o.val.count("--what")) fail("needs --what bitmap|dt|ddt|angles|apex");
+    if (!o.val.count("-o")) fail("needs -o OUT.png");
+    const std::string what = o.val["--what"], out = o.val["-o"], inpath = o.pos[0];
     if (what != "bitmap" && what != "dt" && what != "ddt" && what != "angles" && what != "apex")
-        render_usage("--what " + what + ": expected bitmap, dt, ddt, angles or apex");
-    if (out.size() < 5 || out.compare(out.size() - 4, 4, ".png") != 0) render_usage("-o " + out + ": must end in .png");
-    int scale = (int)(opt.count("--scale") ? parse_long("--scale", opt["--scale"], 1, 16) : 1);
+        fail("--what '" + what + "': expected bitmap, dt, ddt, angles or apex");
+    if (out.size() < 5 || (out.compare(out.size() - 4, 4, ".png") != 0 && out.compare(out.size() - 4, 4, ".PNG") != 0))
+        fail(out + ": the output must be a .png file");
+    const bool sliced = what == "bitmap" || what == "dt" || what == "ddt";
+    // options that do not apply are refused (no silent ignoring)
+    auto refuse = [&](const char *opt, bool applies) {
+        if (!applies && o.val.count(opt)) fail(std::string(opt) + " does not apply to --what " + what);
+    };
+    refuse("--slice", sliced);
+    refuse("--level", sliced);
+    refuse("--slices", sliced);
+    refuse("--reduce", sliced);
+    refuse("--sectors", what == "ddt");
+    refuse("--sector", what == "ddt" || what == "angles");
+    refuse("--range", what != "bitmap");
+    const int zoom = (int)get_int(o, "--zoom", 1, 1, 16);
+    const int threads = (int)get_int(o, "--threads", 0, 0, 256);
 
-    // input: a package (magic) or a DEM
-    std::vector<uint8_t> bytes;
-    ct_package pkg;
-    bool is_pkg = false;
-    {
-        FILE *f = std::fopen(in.c_str(), "rb");
-        char magic[4] = {0, 0, 0, 0};
-        if (f) {
-            size_t got = std::fread(magic, 1, 4, f);
-            std::fclose(f);
-            is_pkg = got == 4 && std::string(magic, 4) == CT_PKG_MAGIC;
-        }
-    }
-    if (is_pkg) {
-        bytes = read_file(in);
-        ct_status st = ct_package_open(&pkg, bytes.data(), bytes.size());
-        if (st != CT_OK) throw Error(in + ": not a valid package (" + status_name(st) + ")");
-    } else if (what == "angles" || what == "apex") {
-        throw Error(in + ": --what " + what + " needs a terrain package (.ctp), not a DEM");
-    }
+    Input in = load_input(inpath);
+    const Terrain &t = in.t;
+    if (!sliced && !in.is_pkg)
+        fail(inpath + ": --what " + what + " needs a package (.ctp; make one with conetrace build)");
 
-    render::Image im;
-    std::string detail;
-    if (what == "angles") {
-        std::vector<long> ss = opt.count("--sector") ? parse_list("--sector", opt["--sector"], 0, (long)pkg.planes - 1)
-                                                     : std::vector<long>{0};
-        std::vector<render::Image> panels;
-        for (long s : ss) panels.push_back(render::angle_image(pkg, (uint32_t)s));
-        im = render::side_by_side(panels, 4);
-        detail = "opening angles, " + std::to_string(pkg.sectors) + " sectors, planes " + opt["--sector"];
-    } else if (what == "apex") {
-        im = render::apex_image(pkg);
-        detail = "apex heights";
-    } else {
-        render::Cells cells;
-        if (is_pkg) {
-            cells = render::cells_from_package(pkg);
+    std::vector<Panel> panels;
+    int reduce = 1, nsec = 0;
+    bool grey = false, distances = false;
+    std::ostringstream desc;
+    std::string unit;
+    int wc = 0, hc = 0;
+    double level_m = 0.0;
+    if (sliced) {
+        reduce = (int)get_int(o, "--reduce", 1, 1, 8);
+        uint16_t hmin = 65535, hmax = 0;
+        for (uint16_t c : t.codes) hmin = std::min(hmin, c), hmax = std::max(hmax, c);
+        // level in code units (double): feature iff cell top >= level
+        double level;
+        if (o.val.count("--slice") && o.val.count("--level")) fail("give --slice H or --level k, not both");
+        if (o.val.count("--slice")) {
+            if (o.val.count("--slices")) fail("--slices goes with --level, not --slice");
+            double hm = parse_real("--slice", o.val["--slice"]);
+            level = (hm - t.height_offset_m) / t.height_scale_m;
+        } else if (o.val.count("--level")) {
+            long kdef = in.is_pkg && in.pkg.slices > 0 ? (long)in.pkg.slices : 0;
+            long k = get_int(o, "--slices", kdef, 1, 65535);
+            if (k == 0) fail("--level needs --slices K (the number of evenly spaced levels)");
+            long l = get_int(o, "--level", 0, 0, k);
+            level = hmin + (double)l * (hmax - hmin) / (double)k;
         } else {
-            DemRaster r = read_dem(in);
-            Georef g = r.has_georef ? r.geo : Georef{};
-            try {
-                cells = render::cells_from_terrain(terrain_from_heights(r.width, r.height, r.h, r.valid, g));
-            } catch (const Error &e) {
-                throw Error(in + ": " + e.what());
-            }
+            fail("--what " + what + " needs a level: --slice H (metres) or --level k --slices K");
         }
-        if (cells.w < 1 || cells.h < 1) throw Error(in + ": too small to render");
-        double lo = cells.top_m[0], hi = lo;
-        for (double v : cells.top_m) lo = std::min(lo, v), hi = std::max(hi, v);
-        double level = (lo + hi) / 2;
-        if (opt.count("--level")) {
-            char *end = nullptr;
-            level = std::strtod(opt["--level"].c_str(), &end);
-            if (opt["--level"].empty() || *end != '\0' || !std::isfinite(level))
-                render_usage("--level needs a height in metres, got '" + opt["--level"] + "'");
-        }
-        std::vector<uint8_t> bits = render::cross_section(cells, level);
-        char lv[64];
-        std::snprintf(lv, sizeof lv, "level %.2f m", level);
+        std::vector<uint16_t> top = cell_tops(t, reduce, wc, hc);
+        std::vector<uint8_t> bits(top.size());
+        size_t nfeat = 0;
+        for (size_t k = 0; k < top.size(); ++k) nfeat += bits[k] = top[k] >= level - 1e-9;
+        level_m = t.height_offset_m + level * t.height_scale_m;
+        desc << "cross-section at " << level_m << " m (cells with top >= level: " << nfeat << " of " << top.size()
+             << "), r=" << reduce;
         if (what == "bitmap") {
-            im = render::bitmap_image(cells, bits);
-            detail = std::string("cross-section at ") + lv;
+            Panel p;
+            p.w = wc, p.h = hc;
+            p.fg = bits;
+            p.v.assign(bits.size(), 0.0);
+            panels.push_back(std::move(p));
         } else {
-            ddt::Prepared bm(cells.w, cells.h, bits.data());
+            distances = true;
+            unit = "cells";
+            ddt::Prepared bm(wc, hc, bits.data());
+            ddt::Options dopt;
+            dopt.threads = threads;
+            std::vector<int64_t> dt;
             std::vector<ddt::Point> ft;
-            ddt::Options o;
-            o.threads = 0;
+            auto to_panel = [&](int sector) {
+                Panel p;
+                p.w = wc, p.h = hc, p.sector = sector;
+                p.v.resize(dt.size());
+                for (size_t k = 0; k < dt.size(); ++k)
+                    p.v[k] = dt[k] == ddt::Inf<int64_t>::value ? NAN : std::sqrt((double)dt[k]);
+                panels.push_back(std::move(p));
+            };
             if (what == "dt") {
-                std::vector<int64_t> d2;
-                ddt::unconstrained(bm, ddt::EuclideanSq(), d2, ft, o);
-                im = render::distance_image(cells.w, cells.h, d2, std::max(1.0, render::max_distance(d2)));
-                detail = std::string("Euclidean DT of the cross-section at ") + lv;
+                ddt::unconstrained(bm, ddt::EuclideanSq(), dt, ft, dopt);
+                to_panel(-1);
+                desc << "; unconstrained Euclidean DT";
             } else {
-                long n = opt.count("--sectors") ? parse_long("--sectors", opt["--sectors"], 1, CT_MAX_SECTORS) : 8;
-                std::vector<long> ss;
-                if (opt.count("--sector")) {
-                    ss = parse_list("--sector", opt["--sector"], 0, n - 1);
-                } else {
-                    for (long s = 0; s < n; ++s) ss.push_back(s);
+                nsec = (int)get_int(o, "--sectors", 8, 1, CT_MAX_SECTORS);
+                std::vector<int> secs = parse_sectors(o.val.count("--sector") ? o.val["--sector"] : "all", nsec, false);
+                for (int s : secs) {
+                    ddt::directional(bm, (uint32_t)nsec, (uint32_t)s, ddt::EuclideanSq(), dt, ft, dopt);
+                    to_panel(s);
                 }
-                std::vector<std::vector<int64_t>> d2s(ss.size());
-                double dmax = 1.0;
-                for (size_t k = 0; k < ss.size(); ++k) {
-                    ddt::directional(bm, (uint32_t)n, (uint32_t)ss[k], ddt::EuclideanSq(), d2s[k], ft, o);
-                    dmax = std::max(dmax, render::max_distance(d2s[k]));
-                }
-                std::vector<render::Image> panels;
-                for (const auto &d2 : d2s) panels.push_back(render::distance_image(cells.w, cells.h, d2, dmax));
-                im = render::side_by_side(panels, 4);
-                detail = "directional DTs, " + std::to_string(n) + " sectors, of the cross-section at " + lv;
+                desc << "; directional Euclidean DT, " << nsec << " sectors, sectors";
+                for (int s : secs) desc << " " << s;
             }
         }
+    } else {
+        const ct_package &p = in.pkg;
+        wc = (int)p.coarse_x, hc = (int)p.coarse_y;
+        reduce = (int)p.reduce;
+        const size_t plane = (size_t)wc * hc;
+        if (what == "apex") {
+            grey = true;
+            unit = "m";
+            Panel pn;
+            pn.w = wc, pn.h = hc;
+            pn.v.resize(plane);
+            for (size_t k = 0; k < plane; ++k) pn.v[k] = t.height_offset_m + rd16(p.apex + 2 * k) * t.height_scale_m;
+            panels.push_back(std::move(pn));
+            desc << "apex heights (m), " << wc << "x" << hc << " coarse cells, r=" << reduce;
+        } else {
+            unit = "deg";
+            nsec = (int)p.sectors;
+            std::vector<int> secs =
+                parse_sectors(o.val.count("--sector") ? o.val["--sector"] : "all", nsec, p.planes > p.sectors);
+            for (int s : secs) {
+                Panel pn;
+                pn.w = wc, pn.h = hc, pn.sector = s;
+                pn.v.resize(plane);
+                const uint8_t *a = p.angles + (size_t)s * plane;
+                for (size_t k = 0; k < plane; ++k) pn.v[k] = a[k] == 0 ? NAN : a[k] * 180.0 / 256.0;
+                panels.push_back(std::move(pn));
+            }
+            desc << "opening angles (deg from the upward vertical; no cone = grey), " << nsec << " sectors, r="
+                 << reduce << ", planes";
+            for (int s : secs) desc << " " << (s == nsec ? std::string("omni") : std::to_string(s));
+        }
     }
-    im = render::enlarge(im, scale);
-    render::write_png(out, im);
-    std::printf("%s: %dx%d, %s\n", out.c_str(), im.w, im.h, detail.c_str());
+
+    // colour scale
+    double lo = INFINITY, hi = -INFINITY;
+    for (const Panel &p : panels)
+        for (double v : p.v)
+            if (!std::isnan(v)) lo = std::min(lo, v), hi = std::max(hi, v);
+    if (distances) lo = 0.0;
+    if (o.val.count("--range")) {
+        const std::string &r = o.val["--range"];
+        size_t c = r.find(',');
+        if (c == std::string::npos) fail("--range needs LO,HI, got '" + r + "'");
+        lo = parse_real("--range", r.substr(0, c));
+        hi = parse_real("--range", r.substr(c + 1));
+        if (!(hi > lo)) fail("--range '" + r + "': HI must exceed LO");
+    }
+    if (!std::isfinite(lo)) lo = 0.0, hi = 1.0;  // nothing finite: all "none"
+    if (!(hi > lo)) hi = lo + 1.0;
+    auto colour = [&](double v) {
+        if (std::isnan(v)) return kNone;
+        double f = (v - lo) / (hi - lo);
+        int idx = (int)std::lround(std::min(1.0, std::max(0.0, f)) * 255.0);
+        return palette(grey, idx);
+    };
+
+    std::vector<double> shade;
+    if (o.hillshade) shade = hillshade(t, reduce, wc, hc);
+
+    // layout
+    const int n = (int)panels.size();
+    const int cols = (int)get_int(o, "--columns", std::min(n, 6), 1, 64);
+    const int rows = (n + cols - 1) / cols;
+    const bool headers = panels[0].sector >= 0;
+    const int strip = headers ? STRIP : 0;
+    const int pw = wc * zoom, ph = hc * zoom;
+    const long W = (long)cols * pw + (long)(cols - 1) * GAP;
+    const long H = (long)rows * (strip + ph) + (long)(rows - 1) * GAP + (o.legend ? LEGEND : 0);
+    if (W * H > (1L << 28)) fail("the picture would be " + std::to_string(W) + "x" + std::to_string(H) + " pixels; use a smaller --zoom");
+    Image im((int)std::max<long>(W, o.legend ? 200 : 1), (int)H);
+    for (int k = 0; k < n; ++k) {
+        const Panel &p = panels[(size_t)k];
+        const int x0 = (k % cols) * (pw + GAP), y0 = (k / cols) * (strip + ph + GAP) + strip;
+        if (headers) {
+            draw_wedge_glyph(im, x0 + 12, y0 - strip + 13, 11, nsec, p.sector);
+            draw_text(im, x0 + 30, y0 - strip + 8, p.sector == nsec && what == "angles" ? "o" : std::to_string(p.sector), 2);
+        }
+        for (int y = 0; y < p.h; ++y)
+            for (int x = 0; x < p.w; ++x) {
+                size_t c = (size_t)y * p.w + x;
+                Rgb col = !p.fg.empty() ? (p.fg[c] ? kFeature : kWhite) : colour(p.v[c]);
+                if (!shade.empty()) {
+                    double f = 0.45 + 0.55 * shade[c];
+                    col = Rgb{(uint8_t)std::lround(col.r * f), (uint8_t)std::lround(col.g * f),
+                              (uint8_t)std::lround(col.b * f)};
+                }
+                for (int a = 0; a < zoom; ++a)
+                    for (int b = 0; b < zoom; ++b) im.set(x0 + x * zoom + b, y0 + y * zoom + a, col);
+            }
+    }
+    if (o.legend) {
+        const int y0 = im.h - LEGEND + 8;  // 8 px gap above the bar
+        if (what == "bitmap") {
+            for (int a = 0; a < 12; ++a)
+                for (int b = 0; b < 12; ++b) im.set(2 + b, y0 + a, kFeature);
+            draw_text(im, 18, y0 + 1, fmt_num(level_m), 2);  // the level, metres
+        } else {
+            const int bw = std::min(256, im.w - 120);
+            std::string ls = fmt_num(lo), hs = fmt_num(hi);
+            int x = 2;
+            draw_text(im, x, y0 + 1, ls, 2);
+            x += (int)ls.size() * 8 + 4;
+            for (int b = 0; b < bw; ++b)
+                for (int a = 0; a < 12; ++a) im.set(x + b, y0 + a, palette(grey, (int)std::lround(b * 255.0 / (bw - 1))));
+            x += bw + 4;
+            draw_text(im, x, y0 + 1, hs, 2);
+            x += (int)hs.size() * 8 + 12;
+            if (!grey)  // the "none" swatch: infinity / no cone
+                for (int a = 0; a < 12; ++a)
+                    for (int b = 0; b < 12; ++b) im.set(x + b, y0 + a, kNone);
+        }
+    }
+    if (what != "bitmap") desc << "; scale " << lo << ".." << hi << " " << unit;
+    write_png_atomic(out, im, desc.str());
+    std::printf("%s: %dx%d px, %d panel%s of %dx%d cells; %s\n", out.c_str(), im.w, im.h, n, n == 1 ? "" : "s", wc, hc,
+                desc.str().c_str());
     return 0;
 }
