@@ -4,7 +4,7 @@
 //
 // Grid: coarse cells G (r x r fine cells, height Hc(G) = max over its fine
 // cells of the tallest corner).  Levels L_0 < L_1 < ... < L_K (integer height
-// codes, L_0 = hmin, L_K = hmax, evenly spaced, duplicates removed).  Apex of
+// codes, L_0 = hmin, L_K = hmax, evenly spaced or given, duplicates removed).  Apex of
 // coarse cell F: a = L_k0, the lowest level not below Hc(F).  Slice k is the
 // bitmap B_k = { G : Hc(G) > L_k }.
 //
@@ -16,7 +16,10 @@
 //          the brute-force builder, builder_common.hpp);
 //  window  q in a coarse cell G = F + v with |v|_inf <= Rw: the column bound
 //          (Hc(G) - a) / max(K_NEAR, min rho over G in W_s), exact geometry,
-//          offsets precomputed per sector;
+//          offsets precomputed per sector; for |v|_inf <= FINE_RING per fine
+//          cell instead of per coarse cell, and the largest such terms (up
+//          to three per cone) refined best-first over 1/8-cell sub-squares
+//          (sub_term: the patch's maximum over a sub-square is at a corner);
 //  far     q in G with |v|_inf > Rw.  Let S(q) be in (L_k, L_k+1] (k >= k0);
 //          then G is in B_k, and
 //            rho_s(q) >= r * (|v| - sqrt2)          (p, q anywhere in F, G)
@@ -35,8 +38,8 @@
 // sectors run on the worker threads (one sector per thread at a time).
 #include <atomic>
 #include <chrono>
-#include <map>
 #include <cmath>
+#include <map>
 #include <thread>
 
 #include "builder_common.hpp"
