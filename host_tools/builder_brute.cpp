@@ -251,7 +251,7 @@ std::vector<uint8_t> build_package(const Terrain &t, const BuildOptions &opt, Bu
     int wc = (c.cx + c.r - 1) / c.r, hc = (c.cy + c.r - 1) / c.r;
     size_t plane = (size_t)wc * hc;
     int nthreads = opt.threads > 0 ? opt.threads : (int)std::max(1u, std::thread::hardware_concurrency());
-    std::vector<int> apex(plane);
+    std::vector<uint16_t> apex(plane);  // height codes
     // the angle planes, written in place in the package (sector-major, then
     // the omnidirectional plane when N > 1)
     uint8_t *codes = &b[so[CT_SEC_ANGLES]];
@@ -261,7 +261,7 @@ std::vector<uint8_t> build_package(const Terrain &t, const BuildOptions &opt, Bu
             int m = 0;
             for (int j = cj * c.r; j < std::min(c.cy, (cj + 1) * c.r); ++j)
                 for (int i = ci * c.r; i < std::min(c.cx, (ci + 1) * c.r); ++i) m = std::max<int>(m, c.fm[(size_t)j * c.cx + i]);
-            apex[(size_t)cj * wc + ci] = m;
+            apex[(size_t)cj * wc + ci] = (uint16_t)m;
         }
     if (opt.builder == PptBuilder::Slices) {
         int K = opt.slices > 0 ? opt.slices : BuildOptions::DEFAULT_SLICES;
@@ -289,12 +289,12 @@ std::vector<uint8_t> build_package(const Terrain &t, const BuildOptions &opt, Bu
                 if (lv.empty() || l > lv.back()) lv.push_back(l);
             }
         }
-        std::vector<int> k0(plane);
+        std::vector<uint16_t> k0(plane);  // < lv.size() <= 65536
         for (size_t f = 0; f < plane; ++f) {
             // the paper's apex: the lowest level not below the cell's top
             // (measured: 7% fewer steps than exact apexes with K = 64)
-            k0[f] = (int)(std::lower_bound(lv.begin(), lv.end(), apex[f]) - lv.begin());
-            apex[f] = lv[(size_t)k0[f]];
+            k0[f] = (uint16_t)(std::lower_bound(lv.begin(), lv.end(), (int)apex[f]) - lv.begin());
+            apex[f] = (uint16_t)lv[(size_t)k0[f]];
         }
         bld::SliceInput in;
         in.levels = &lv;
@@ -315,12 +315,13 @@ std::vector<uint8_t> build_package(const Terrain &t, const BuildOptions &opt, Bu
         }
     } else {
         if (opt.slices > 0 && hmax > hmin) {
-            for (int &m : apex) {
+            for (uint16_t &am : apex) {
+                int m = am;
                 // smallest level hmin + k*(hmax-hmin)/K >= m, as an integer code
                 double step = (double)(hmax - hmin) / opt.slices;
                 int k = (int)std::ceil((m - hmin) / step - 1e-12);
                 int lvl = (int)std::ceil(hmin + k * step - 1e-9);
-                m = std::min<int>(hmax, std::max(m, lvl));
+                am = (uint16_t)std::min<int>(hmax, std::max(m, lvl));
             }
         }
         std::atomic<int> next_row{0};

@@ -156,8 +156,8 @@ void slice_angles(const Ctx &c, const SliceInput &in, uint8_t *codes, SliceStats
             d = std::max(d, c.fm[(size_t)j * c.cx + i]);
         }
     const std::vector<int> &lv = *in.levels;
-    const std::vector<int> &k0 = *in.apex_level;
-    const std::vector<int> &apex = *in.apex;
+    const std::vector<uint16_t> &k0 = *in.apex_level;
+    const std::vector<uint16_t> &apex = *in.apex;
     const int K = (int)lv.size() - 1;
 
     // cot of each code as a double lower bound, for the monotone update
@@ -326,7 +326,7 @@ void slice_angles(const Ctx &c, const SliceInput &in, uint8_t *codes, SliceStats
     std::vector<std::vector<ddt::Wedge>> pieces((size_t)c.n);
     for (int s = 0; s < c.n; ++s) pieces[(size_t)s] = widened_pieces(c, s, delta);
     int kmin = K;
-    for (int v : k0) kmin = std::min(kmin, v);
+    for (uint16_t v : k0) kmin = std::min(kmin, (int)v);
     std::vector<uint8_t> bits(plane);
     struct Scratch {  // one DT's arrays per thread, kept across slices
         std::vector<int64_t> dt, dmin;

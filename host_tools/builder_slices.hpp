@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <functional>
 #include <vector>
 
@@ -13,8 +14,8 @@ namespace bld {
 
 struct SliceInput {
     const std::vector<int> *levels = nullptr;      // L_0 < ... < L_K, height codes
-    const std::vector<int> *apex = nullptr;        // per coarse cell: apex height a >= Hc
-    const std::vector<int> *apex_level = nullptr;  // per coarse cell: k0, the largest k with L_k <= a
+    const std::vector<uint16_t> *apex = nullptr;        // per coarse cell: apex height code a >= Hc
+    const std::vector<uint16_t> *apex_level = nullptr;  // per coarse cell: k0, the largest k with L_k <= a
     int window = 12;                               // Rw, coarse cells (>= 1)
     int threads = 1;
     std::function<void(size_t, size_t)> progress;
