@@ -334,6 +334,7 @@ void slice_angles(const Ctx &c, const SliceInput &in, uint8_t *codes, SliceStats
         ddt::Options opt;
     };
     std::vector<Scratch> scratch((size_t)nthreads);
+    for (Scratch &sc : scratch) sc.opt.feature_transform = false;  // distances only
     std::vector<size_t> narrowed((size_t)nthreads, 0), skipped((size_t)nthreads, 0);
     for (int k = kmin; k < K; ++k) {
         size_t nfeat = 0;

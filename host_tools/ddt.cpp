@@ -406,10 +406,10 @@ private:
             }
             if (bc >= 0) {
                 dt_[idx] = best;
-                ft_[idx] = to_orig(bc, br);
+                if (ft_) ft_[idx] = to_orig(bc, br);
             } else if (first_) {
                 dt_[idx] = Inf<V>::value;
-                ft_[idx] = Point();
+                if (ft_) ft_[idx] = Point();
             }
         }
     }
@@ -459,18 +459,24 @@ void run_pieces(const Prepared &bm, const std::vector<Piece> &pieces, const D &d
 {
     const size_t n = (size_t)bm.width() * (size_t)bm.height();
     dt.resize(n);  // the first piece writes every pixel
-    ft.resize(n);
+    Point *ftp = nullptr;
+    if (opt.feature_transform) {
+        ft.resize(n);
+        ftp = ft.data();
+    } else {
+        ft.clear();
+    }
     bool first = true;
     for (const Piece &p : pieces) {
         const Frame f = make_frame(bm.width(), bm.height(), p);
         if (f.transpose && stats)
-            run_frame<D, true, true>(bm, f, dist, dt.data(), ft.data(), opt, first, stats);
+            run_frame<D, true, true>(bm, f, dist, dt.data(), ftp, opt, first, stats);
         else if (f.transpose)
-            run_frame<D, true, false>(bm, f, dist, dt.data(), ft.data(), opt, first, stats);
+            run_frame<D, true, false>(bm, f, dist, dt.data(), ftp, opt, first, stats);
         else if (stats)
-            run_frame<D, false, true>(bm, f, dist, dt.data(), ft.data(), opt, first, stats);
+            run_frame<D, false, true>(bm, f, dist, dt.data(), ftp, opt, first, stats);
         else
-            run_frame<D, false, false>(bm, f, dist, dt.data(), ft.data(), opt, first, stats);
+            run_frame<D, false, false>(bm, f, dist, dt.data(), ftp, opt, first, stats);
         first = false;
     }
 }

@@ -225,6 +225,7 @@ struct Options {
     int threads = 1;    // lines are independent; 0 = hardware concurrency
     bool rule1 = true;  // propagation rule (see above)
     bool rule2 = true;  // dominance rule
+    bool feature_transform = true;  // false: the DT only, ft left empty
 };
 // Operation counts, summed over pieces and threads.
 struct Stats {

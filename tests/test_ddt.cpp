@@ -443,6 +443,28 @@ void test_rules_off_same_result(void)
                     (unsigned long long)on.comparisons, (unsigned long long)off.comparisons);
 }
 
+// Options::feature_transform = false (the PPT builder's mode): the same
+// distances, no feature array.
+void test_distances_only(void)
+{
+    ct_rng r;
+    ct_rng_seed(&r, g_seed * 1000003u + 11);
+    for (int c = 0; c < g_cases / 4; ++c) {
+        const Bits m = random_bits(&r, 24);
+        const Prepared bm(m.w, m.h, m.b.data());
+        const uint32_t n = (uint32_t)ct_rng_range(&r, 1, 32), s = (uint32_t)ct_rng_range(&r, 0, (int)n - 1);
+        Options full, lean;
+        lean.feature_transform = false;
+        std::vector<int64_t> a, b;
+        std::vector<Point> fa, fb(3);
+        directional(bm, n, s, EuclideanSq(), a, fa, full);
+        directional(bm, n, s, EuclideanSq(), b, fb, lean);
+        TEST_ASSERT_MSG(a == b, "case %d (N=%u s=%u): distances differ without the feature transform", c, n, s);
+        TEST_ASSERT_MSG(fb.empty() && fa.size() == a.size(), "case %d: feature array sizes %zu / %zu", c, fa.size(),
+                        fb.size());
+    }
+}
+
 // Self-tests of the comparison: a wrong sector, an open wedge and a wrong FT
 // must each be caught on some case.
 void test_checker_catches_errors(void)
@@ -587,5 +609,6 @@ int main(void)
     RUN_TEST(test_unconstrained);
     RUN_TEST(test_large_bitmaps);
     RUN_TEST(test_rules_off_same_result);
+    RUN_TEST(test_distances_only);
     return TEST_END();
 }
