@@ -10,7 +10,8 @@
 // with --brute-2048.  Also the package's sections for N = 24, r = 3 (the
 // paper: the PPT is about 1.4x the DEM).
 //
-// Options: --quick (fixture only), --brute-2048, --slices K (default 80).
+// Options: --quick (fixture only), --brute-2048, --slices K (default 80),
+// --big-only (2048^2 only), --r R (2048^2 at reduction R only).
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -40,7 +41,7 @@ double status_kib(const char *key)
 
 struct Result {
     double seconds = -1, work_bytes = 0, local_s = 0, dt_s = 0;
-    size_t bytes = 0, degenerate = 0, cones = 0;
+    size_t bytes = 0, degenerate = 0, cones = 0, queries = 0, full_dts = 0;
     int slices = 0;
     uint32_t sec[CT_SEC_COUNT] = {0, 0, 0, 0, 0};
 };
@@ -60,6 +61,7 @@ Result build_in_child(const ct_host::Terrain &t, ct_host::PptBuilder b, int r, i
         o.slices = slices;
         o.threads = 2;
         o.builder = b;
+        if (getenv("CT_FULL_DT_ROWS")) o.full_dt_rows = atof(getenv("CT_FULL_DT_ROWS"));
         double rss0 = status_kib("VmRSS") * 1024.0;
         {
             std::ofstream cr("/proc/self/clear_refs");
@@ -76,6 +78,8 @@ Result build_in_child(const ct_host::Terrain &t, ct_host::PptBuilder b, int r, i
         out.slices = st.slices_transformed;
         out.local_s = st.seconds_local;
         out.dt_s = st.seconds_dt;
+        out.queries = st.dt_queries;
+        out.full_dts = st.full_dts;
         uint32_t off[CT_SEC_COUNT], levels, total;
         ct_package_layout((uint32_t)t.width, (uint32_t)t.height, (uint32_t)r, 24, t.void_post.empty() ? 0u : 1u, off,
                           out.sec, &levels, &total);
@@ -105,7 +109,9 @@ void row(const char *dem, const ct_host::Terrain &t, ct_host::PptBuilder b, int 
                 dem, bn, r, x.seconds, x.work_bytes / 1e6, x.work_bytes / dem_bytes, x.bytes / dem_bytes,
                 ppt / dem_bytes, 100.0 * x.degenerate / std::max<size_t>(1, x.cones));
     if (b == ct_host::PptBuilder::Slices)
-        std::printf(" | %d slices x 24 DTs, near %.2f s, slices %.2f s", x.slices, x.local_s, x.dt_s);
+        std::printf(" | %d slices x 24 sectors: %.3f queries per cell, %zu full DTs; near %.2f s, slices %.2f s",
+                    x.slices, (double)x.queries / std::max(1.0, (double)x.slices * (double)x.cones), x.full_dts,
+                    x.local_s, x.dt_s);
     std::printf("\n");
     std::fflush(stdout);
 }
@@ -114,14 +120,16 @@ void row(const char *dem, const ct_host::Terrain &t, ct_host::PptBuilder b, int 
 
 int main(int argc, char **argv)
 {
-    bool quick = false, brute_big = false;
-    int slices = 80;
+    bool quick = false, brute_big = false, big_only = false;
+    int slices = 80, big_r = 0;
     for (int k = 1; k < argc; ++k) {
         if (!std::strcmp(argv[k], "--quick")) quick = true;
         else if (!std::strcmp(argv[k], "--brute-2048")) brute_big = true;
         else if (!std::strcmp(argv[k], "--slices") && k + 1 < argc) slices = std::atoi(argv[++k]);
+        else if (!std::strcmp(argv[k], "--big-only")) big_only = true;
+        else if (!std::strcmp(argv[k], "--r") && k + 1 < argc) big_r = std::atoi(argv[++k]);
         else {
-            std::fprintf(stderr, "usage: ct_bench_build [--quick] [--brute-2048] [--slices K]\n");
+            std::fprintf(stderr, "usage: ct_bench_build [--quick] [--brute-2048] [--slices K] [--big-only] [--r R]\n");
             return 2;
         }
     }
@@ -135,6 +143,7 @@ int main(int argc, char **argv)
                 "build above RSS before it (package included) ===\n", slices);
     std::printf("(package = whole file incl. the DEM's heights and the mipmap; PPT = apexes + angle planes)\n");
     for (int r : {1, 3}) {
+        if (big_only) break;
         row("fixture 403x344", t, B::Slices, r, slices);
         row("fixture 403x344", t, B::Brute, r, slices);
     }
@@ -150,6 +159,7 @@ int main(int argc, char **argv)
                 big.codes[(size_t)j * 2048 + i] = t.at(pi, pj);
             }
         for (int r : {3, 1}) {
+            if (big_r && r != big_r) continue;
             row("mirror-tiled 2048x2048", big, B::Slices, r, slices);
             if (brute_big) row("mirror-tiled 2048x2048", big, B::Brute, r, slices);
         }

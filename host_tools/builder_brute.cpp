@@ -301,6 +301,7 @@ std::vector<uint8_t> build_package(const Terrain &t, const BuildOptions &opt, Bu
         in.apex_level = &k0;
         in.apex = &apex;
         in.window = opt.window;
+        in.full_dt_rows = opt.full_dt_rows;
         in.threads = nthreads;
         in.progress = opt.progress;
         bld::SliceStats sst;
@@ -311,6 +312,9 @@ std::vector<uint8_t> build_package(const Terrain &t, const BuildOptions &opt, Bu
             stats->seconds_local = sst.seconds_local;
             stats->far_narrowed = sst.far_narrowed;
             stats->dts_skipped = sst.dts_skipped;
+            stats->dt_queries = sst.queries;
+            stats->dt_query_rows = sst.query_rows;
+            stats->full_dts = sst.full_dts;
             stats->seconds_dt = sst.seconds_dt;
         }
     } else {

@@ -34,12 +34,26 @@
 //          paper prescribes.
 // The code stored is the widest angle whose tracer cot covers max(0, near,
 // window, far_k for all k >= k0), rounded down (code_for).  Slices are done
-// bottom-up with one slice's bitmap and DT arrays in memory; each slice's
-// sectors run on the worker threads (one sector per thread at a time).
+// bottom-up with one slice in memory; each slice's sectors run on the worker
+// threads (one sector per thread at a time).
+//
+// DT_k is needed only where a far term could narrow the current code, i.e.
+// for cells with X = (L_k+1 - a) / cot > r Rw, and only below the cap
+// (X / r + sqrt2)^2: about 10% of the cells per slice and sector on the real
+// DEM, with caps of ~30 cells.  So each such cell asks a capped query
+// (ddt::CappedQuery: the same canonical frames and exact wedge intervals as
+// the line traversal, one bitset lookup per row); a (slice, sector) whose
+// queries visit more than full_dt_rows rows per cell finishes with one full
+// line-traversal DT (ddt::directional), and so does the same sector of the
+// next slice.  Both give the exact DT below the cap: the packages are
+// byte-identical whichever runs (test_promise), and identical to computing
+// every DT in full (the paper's way), which is 2-3x slower at 2048^2.
 #include <atomic>
 #include <chrono>
 #include <cmath>
 #include <map>
+#include <memory>
+#include <mutex>
 #include <thread>
 
 #include "builder_common.hpp"
@@ -61,6 +75,7 @@ struct WinOffset {
 // top-left fine cell; the column bound per fine cell is far tighter than
 // per coarse cell next to F), the rest to `coarse`.
 constexpr int FINE_RING = 2;
+
 // `near`: the fine cells of near_term() (builder_common.hpp) for a whole
 // footprint, as offsets from F's top-left fine cell (a superset of a partial
 // edge cell's: distances to a subset of F are no shorter).
@@ -320,6 +335,7 @@ void slice_angles(const Ctx &c, const SliceInput &in, uint8_t *codes, SliceStats
     }
 
     auto t_local = std::chrono::steady_clock::now();
+    hcm = std::vector<uint16_t>();  // not needed below: B_k comes from the apex levels
     // ---- far terms, slice by slice, bottom-up
     constexpr double SQRT2 = 1.41421356237309515;  // rounded up
     const double delta = std::asin(std::min(1.0, SQRT2 / (rw + 1))) + 1e-7;
@@ -327,76 +343,112 @@ void slice_angles(const Ctx &c, const SliceInput &in, uint8_t *codes, SliceStats
     for (int s = 0; s < c.n; ++s) pieces[(size_t)s] = widened_pieces(c, s, delta);
     int kmin = K;
     for (uint16_t v : k0) kmin = std::min(kmin, (int)v);
-    std::vector<uint8_t> bits(plane);
-    struct Scratch {  // one DT's arrays per thread, kept across slices
+    std::vector<size_t> narrowed((size_t)nthreads, 0), skipped((size_t)nthreads, 0), queries((size_t)nthreads, 0),
+        full((size_t)nthreads, 0);
+    std::vector<uint64_t> rows((size_t)nthreads, 0);
+    struct Scratch {  // a full DT's arrays per thread, allocated on first use
         std::vector<int64_t> dt, dmin;
         std::vector<ddt::Point> ft;
-        ddt::Options opt;
     };
     std::vector<Scratch> scratch((size_t)nthreads);
-    for (Scratch &sc : scratch) sc.opt.feature_transform = false;  // distances only
-    std::vector<size_t> narrowed((size_t)nthreads, 0), skipped((size_t)nthreads, 0);
+    // per sector: did the previous slice switch to a full DT?  Then this one
+    // starts with it (the needed cells change slowly from slice to slice).
+    std::vector<uint8_t> went_full((size_t)c.n, 0);
+    // A far term is at most (top - a) / (r Rw): it cannot narrow code k
+    // unless top - a > r Rw cot(k) (checked exactly below; a hair lower
+    // here).  Code 0 (degenerate) cannot narrow at all.
+    double skip_rise[256];
+    for (int k = 0; k < 256; ++k)
+        skip_rise[k] = k == 0 ? INF : cot_of[k] > 0.0 ? r * (double)rw * cot_of[k] * (1.0 - 1e-12) : -INF;
+    // a query row costs ~2 ns, a full DT ~10-20 ns per cell (measured)
+    const double row_budget = in.full_dt_rows * (double)plane;
     for (int k = kmin; k < K; ++k) {
+        // slice k: B_k = { G : Hc(G) > L_k } = { G : k0(G) > k } (levels increase)
         size_t nfeat = 0;
-        for (size_t f = 0; f < plane; ++f) {
-            bits[f] = hcm[f] > lv[(size_t)k];
-            nfeat += bits[f];
-        }
+        const ddt::BitLines bl = ddt::BitLines::from(wc, hc, [&](int x, int y) {
+            bool b = k0[(size_t)y * wc + x] > k;
+            nfeat += b;
+            return b;
+        });
         if (in.progress) in.progress((size_t)(k - kmin), (size_t)(K - kmin));
         if (nfeat == 0) break;  // and every higher slice is empty too
         if (st) st->slices++;
-        ddt::Prepared bm(wc, hc, bits.data());
         const double top = lv[(size_t)k + 1];
+        // the line-traversal tables, built when a sector first needs a full DT
+        std::once_flag prepared_once;
+        std::unique_ptr<ddt::Prepared> prepared;
         std::atomic<int> next{0};
         auto worker = [&](int tid) {
-            Scratch &sc = scratch[(size_t)tid];
             for (;;) {
                 int s = next.fetch_add(1);
                 if (s >= c.n) break;
-                const auto &ps = pieces[(size_t)s];
+                const ddt::CappedQuery<ddt::EuclideanSq> q(bl, pieces[(size_t)s], ddt::EuclideanSq());
                 uint8_t *cs = &codes[(size_t)s * plane];
-                // Skip the DT when no active cell could be narrowed by it:
-                // every far term is at most (top - a) / (r Rw).
-                bool useful = false;
-                for (size_t f = 0; f < plane && !useful; ++f)
-                    useful = k0[f] <= k && cs[f] != 0 && top - apex[f] > cot_of[cs[f]] * (r * (double)rw);
-                if (!useful) {
-                    skipped[(size_t)tid]++;
-                    continue;
-                }
-                if (ps.empty()) {
-                    ddt::unconstrained(bm, ddt::EuclideanSq(), sc.dmin, sc.ft, sc.opt);
-                } else {
-                    for (size_t p = 0; p < ps.size(); ++p) {
-                        ddt::directional(bm, ps[p], ddt::EuclideanSq(), p == 0 ? sc.dmin : sc.dt, sc.ft, sc.opt);
-                        if (p > 0)
-                            for (size_t f = 0; f < plane; ++f) sc.dmin[f] = std::min(sc.dmin[f], sc.dt[f]);
-                    }
-                }
-                // term = (top - a) / (r max(Rw, sqrt(D2) - sqrt2)) > cot  <=>
-                // X = (top - a) / cot > r Rw  and  D2 < (X / r + sqrt2)^2
-                const int64_t *dm = sc.dmin.data();
+                size_t nq = 0;
+                const int64_t *dtf = nullptr;  // the full DT, once switched to it
                 for (size_t f = 0; f < plane; ++f) {
-                    if (k0[f] > k || cs[f] == 0 || dm[f] == ddt::Inf<int64_t>::value) continue;
-                    double rise = top - apex[f], cot = cot_of[cs[f]];
-                    if (rise <= 0.0) continue;
+                    if (k0[f] > k) continue;
+                    const uint8_t code = cs[f];
+                    const double rise = top - apex[f];
+                    if (rise <= 0.0 || rise < skip_rise[code]) continue;
+                    const double cot = cot_of[code];
+                    // term = (top - a) / (r max(Rw, sqrt(D2) - sqrt2)) > cot
+                    // needs X = (top - a) / cot > r Rw and D2 < (X / r + sqrt2)^2:
+                    // only distances below that cap are asked for (exactly)
+                    int64_t cap = ddt::Inf<int64_t>::value;
                     if (cot > 0.0) {
-                        double x = rise / cot;
+                        const double x = rise / cot;
                         if (x <= r * (double)rw) continue;
-                        double lim = x / r + SQRT2;
-                        if ((double)dm[f] >= lim * lim * (1.0 + 1e-12)) continue;
+                        const double lim = x / r + SQRT2, l2 = lim * lim * (1.0 + 1e-12) + 1.0;
+                        if (l2 < 4.0e18) cap = (int64_t)l2 + 1;
                     }
-                    double d = std::sqrt((double)dm[f]) * (1.0 - 1e-15) - SQRT2;
-                    double rho = r * std::max((double)rw, d);
-                    double term = rise / rho;
+                    if (!dtf && (went_full[(size_t)s] || row_budget <= 0.0 || (double)q.rows_visited() > row_budget)) {
+                        // the queries cost more than a full transform would:
+                        // finish this slice and sector with one (the same values)
+                        std::call_once(prepared_once, [&] {
+                            std::vector<uint8_t> bits(plane);
+                            for (size_t g = 0; g < plane; ++g) bits[g] = k0[g] > k;
+                            prepared.reset(new ddt::Prepared(wc, hc, bits.data()));
+                        });
+                        Scratch &sc = scratch[(size_t)tid];
+                        ddt::Options opt;
+                        opt.feature_transform = false;
+                        const auto &ps = pieces[(size_t)s];
+                        if (ps.empty()) {
+                            ddt::unconstrained(*prepared, ddt::EuclideanSq(), sc.dmin, sc.ft, opt);
+                        } else {
+                            for (size_t p = 0; p < ps.size(); ++p) {
+                                ddt::directional(*prepared, ps[p], ddt::EuclideanSq(), p == 0 ? sc.dmin : sc.dt,
+                                                 sc.ft, opt);
+                                if (p > 0)
+                                    for (size_t g = 0; g < plane; ++g) sc.dmin[g] = std::min(sc.dmin[g], sc.dt[g]);
+                            }
+                        }
+                        dtf = sc.dmin.data();
+                        full[(size_t)tid]++;
+                    }
+                    int64_t d2;
+                    if (dtf) {
+                        d2 = dtf[f];
+                    } else {
+                        ++nq;
+                        d2 = q.query((int)(f % (size_t)wc), (int)(f / (size_t)wc), cap);
+                    }
+                    if (d2 >= cap) continue;
+                    const double d = std::sqrt((double)d2) * (1.0 - 1e-15) - SQRT2;
+                    const double term = rise / (r * std::max((double)rw, d));
                     if (term > cot) {
-                        uint8_t nc = code_for(c, term);
+                        const uint8_t nc = code_for(c, term);
                         if (nc < cs[f]) {
                             cs[f] = nc;
                             narrowed[(size_t)tid]++;
                         }
                     }
                 }
+                if (nq == 0 && !dtf) skipped[(size_t)tid]++;
+                went_full[(size_t)s] = dtf != nullptr;
+                queries[(size_t)tid] += nq;
+                rows[(size_t)tid] += q.rows_visited();
             }
         };
         std::vector<std::thread> pool;
@@ -408,6 +460,9 @@ void slice_angles(const Ctx &c, const SliceInput &in, uint8_t *codes, SliceStats
         auto t_end = std::chrono::steady_clock::now();
         for (size_t v : narrowed) st->far_narrowed += v;
         for (size_t v : skipped) st->dts_skipped += v;
+        for (size_t v : queries) st->queries += v;
+        for (size_t v : full) st->full_dts += v;
+        for (uint64_t v : rows) st->query_rows += v;
         st->seconds_local = std::chrono::duration<double>(t_local - t_start).count();
         st->seconds_dt = std::chrono::duration<double>(t_end - t_local).count();
     }

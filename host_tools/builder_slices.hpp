@@ -17,14 +17,18 @@ struct SliceInput {
     const std::vector<uint16_t> *apex = nullptr;        // per coarse cell: apex height code a >= Hc
     const std::vector<uint16_t> *apex_level = nullptr;  // per coarse cell: k0, the largest k with L_k <= a
     int window = 12;                               // Rw, coarse cells (>= 1)
+    double full_dt_rows = 12.0;  // see BuildOptions::full_dt_rows
     int threads = 1;
     std::function<void(size_t, size_t)> progress;
 };
 
 struct SliceStats {
-    int slices = 0;  // slices whose DTs were computed
-    size_t far_narrowed = 0;
-    size_t dts_skipped = 0;   // (slice, sector) DTs skipped: no active cone could narrow  // (cell, sector) codes narrowed by a far (DT) term
+    int slices = 0;           // slices transformed (non-empty cross-sections)
+    size_t far_narrowed = 0;  // (cell, sector) codes narrowed by a far (DT) term
+    size_t dts_skipped = 0;   // (slice, sector) pairs where no cone could narrow: no query
+    size_t queries = 0;       // capped directional DT queries (cell, slice, sector)
+    uint64_t query_rows = 0;  // rows those queries visited
+    size_t full_dts = 0;      // (slice, sector) pairs finished with a full line-traversal DT
     double seconds_local = 0.0;   // near + window terms
     double seconds_dt = 0.0;      // the slices' DTs and far terms
 };

@@ -212,9 +212,14 @@ int cmd_build(int argc, char **argv)
     size_t dem_bytes = (size_t)t.width * t.height * 2;
     std::string how = "brute-force builder";
     if (o.builder == PptBuilder::Slices) {
-        char buf[200];
-        std::snprintf(buf, sizeof buf, "slice builder: %d levels, %d slices x %d sectors, %zu DTs skipped; %.2f s near, %.2f s slices",
-                      st.slices, st.slices_transformed, o.sectors, st.dts_skipped, st.seconds_local, st.seconds_dt);
+        char buf[300];
+        std::snprintf(buf, sizeof buf,
+                      "slice builder: %d levels, %d slices x %d sectors, %.2f DT queries per cell and slice-sector "
+                      "(%.1f rows each), %zu full DTs; %.2f s near, %.2f s slices",
+                      st.slices, st.slices_transformed, o.sectors,
+                      (double)st.dt_queries / std::max(1.0, (double)st.slices_transformed * (double)st.cones),
+                      (double)st.dt_query_rows / std::max<double>(1.0, (double)st.dt_queries), st.full_dts, st.seconds_local,
+                      st.seconds_dt);
         how = buf;
     }
     std::printf("%s: %dx%d posts, %d sectors, r=%d, package %zu bytes (%.2fx the 16-bit DEM), "

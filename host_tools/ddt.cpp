@@ -568,6 +568,164 @@ void unconstrained(const Prepared &bm, const D &dist, std::vector<typename D::va
     run_pieces(bm, quadrants, dist, dt, ft, opt, stats);
 }
 
+// ------------------------------------------------------------ capped queries
+
+void BitLines::alloc(int width, int height)
+{
+    if (width < 1 || height < 1 || width > kMaxSide || height > kMaxSide)
+        throw Error("ddt: bitmap size out of range");
+    w_ = width;
+    h_ = height;
+    const int64_t len[2] = {width, height}, nl[2] = {height, width};
+    for (int o = 0; o < 2; ++o) {
+        Lines &L = l_[o];
+        L.len = len[o];
+        L.wpl = (len[o] + 63) / 64;
+        L.w.assign((size_t)(nl[o] * L.wpl), 0);
+    }
+}
+
+void BitLines::set(int x, int y)
+{
+    l_[0].w[(size_t)(y * l_[0].wpl + (x >> 6))] |= UINT64_C(1) << (x & 63);
+    l_[1].w[(size_t)(x * l_[1].wpl + (y >> 6))] |= UINT64_C(1) << (y & 63);
+}
+
+void BitLines::finish()
+{
+    for (Lines &L : l_) {
+        const size_t n = L.w.size(), wpl = (size_t)L.wpl;
+        L.nz_up.assign(n, -1);
+        L.nz_down.assign(n, -1);
+        for (size_t base = 0; base < n; base += wpl) {
+            int32_t last = -1;
+            for (size_t k = wpl; k-- > 0;) {
+                if (L.w[base + k]) last = (int32_t)k;
+                L.nz_up[base + k] = last;
+            }
+            last = -1;
+            for (size_t k = 0; k < wpl; ++k) {
+                if (L.w[base + k]) last = (int32_t)k;
+                L.nz_down[base + k] = last;
+            }
+        }
+    }
+}
+
+BitLines::BitLines(int width, int height, const uint8_t *bits)
+{
+    if (bits == nullptr) throw Error("ddt: null bitmap");
+    alloc(width, height);
+    for (int y = 0; y < height; ++y)
+        for (int x = 0; x < width; ++x)
+            if (bits[(size_t)y * (size_t)width + (size_t)x]) set(x, y);
+    finish();
+}
+
+int64_t BitLines::next(int o, int64_t l, int64_t p, bool fwd) const
+{
+    const Lines &L = l_[o];
+    const size_t base = (size_t)(l * L.wpl);
+    const uint64_t *row = &L.w[base];
+    const int64_t w = p >> 6;
+    const int b = (int)(p & 63);
+    if (fwd) {
+        const uint64_t m = row[w] & (~UINT64_C(0) << b);
+        if (m) return (w << 6) + __builtin_ctzll(m);
+        if (w + 1 >= L.wpl) return -1;
+        const int32_t w2 = L.nz_up[base + (size_t)w + 1];
+        return w2 < 0 ? -1 : ((int64_t)w2 << 6) + __builtin_ctzll(row[w2]);
+    }
+    const uint64_t m = row[w] & (~UINT64_C(0) >> (63 - b));
+    if (m) return (w << 6) + 63 - __builtin_clzll(m);
+    if (w == 0) return -1;
+    const int32_t w2 = L.nz_down[base + (size_t)w - 1];
+    return w2 < 0 ? -1 : ((int64_t)w2 << 6) + 63 - __builtin_clzll(row[w2]);
+}
+
+template <class D>
+CappedQuery<D>::CappedQuery(const BitLines &bl, const std::vector<Wedge> &wedges, const D &dist)
+    : bl_(bl), dist_(dist)
+{
+    std::vector<Piece> pieces;
+    if (wedges.empty()) {
+        static const Piece quadrants[4] = {{1, 0, 0, 1}, {0, 1, -1, 0}, {-1, 0, 0, -1}, {0, -1, 1, 0}};
+        for (const Piece &p : quadrants) pieces.push_back(p);
+    } else {
+        for (const Wedge &w : wedges)
+            for (const Piece &p : split_wedge(w)) pieces.push_back(p);
+    }
+    const int W = bl.width(), H = bl.height();
+    for (const Piece &p : pieces) {
+        // canonical first-quadrant boundaries u (near +x), v (near +y), as
+        // in make_frame; then the frame whose far boundary is nearer the
+        // scan axis (larger t2 = a2 / c2: fewer rows before rule 1 stops)
+        const int64_t mx = p.b1x + p.b2x, my = p.b1y + p.b2y;
+        QFrame q;
+        q.fx = mx < 0;
+        q.fy = my < 0;
+        const int64_t sx = q.fx ? -1 : 1, sy = q.fy ? -1 : 1;
+        int64_t ux = sx * p.b1x, uy = sy * p.b1y, vx = sx * p.b2x, vy = sy * p.b2y;
+        if (sx * sy < 0) {
+            std::swap(ux, vx);
+            std::swap(uy, vy);
+        }
+        if (ux < 0 || uy < 0 || vx < 0 || vy < 0 || cross(ux, uy, vx, vy) <= 0)
+            throw Error("ddt: internal error: piece not in one quadrant");
+        // frame A: a2/c2 = vx/vy; frame B (transposed): uy/ux
+        q.transpose = (i128)uy * vy > (i128)vx * ux;
+        int64_t a1, c1, a2, c2;
+        if (!q.transpose) {
+            a1 = ux, c1 = uy, a2 = vx, c2 = vy;
+        } else {
+            a1 = vy, c1 = vx, a2 = uy, c2 = ux;
+        }
+        const int64_t Wc = q.transpose ? H : W, Hc = q.transpose ? W : H;
+        for (int64_t j = 0; j < Hc; ++j) {
+            const int64_t L = (j * a2 + c2 - 1) / c2;  // < 2^20 * 2^31
+            if (L >= Wc) break;                          // and every deeper row
+            q.L.push_back(L);
+            q.R.push_back(c1 == 0 ? INT64_MAX : j * a1 / c1);
+            q.lb.push_back(q.transpose ? dist_(j, L) : dist_(L, j));
+        }
+        frames_.push_back(std::move(q));
+    }
+}
+
+template <class D>
+typename D::value_type CappedQuery<D>::query(int x, int y, V cap) const
+{
+    const int64_t W = bl_.width(), H = bl_.height();
+    V best = cap;
+    uint64_t rows = 0;
+    for (const QFrame &q : frames_) {
+        const int64_t xf = q.fx ? W - 1 - x : x, yf = q.fy ? H - 1 - y : y;
+        const int64_t xc = q.transpose ? yf : xf, yc = q.transpose ? xf : yf;
+        const int64_t Wc = q.transpose ? H : W, Hc = q.transpose ? W : H;
+        const int64_t jmax = std::min<int64_t>((int64_t)q.L.size(), Hc - yc);
+        // the line for canonical row yc + j, positions in canonical x
+        const int o = q.transpose ? 1 : 0;
+        const bool flip_pos = q.transpose ? q.fy : q.fx, flip_line = q.transpose ? q.fx : q.fy;
+        const int64_t lenl = q.transpose ? W : H, lenp = Wc;
+        for (int64_t j = 0; j < jmax; ++j) {
+            if (!(q.lb[(size_t)j] < best)) break;
+            const int64_t lo = xc + q.L[(size_t)j];
+            if (lo >= Wc) break;  // L nondecreasing: no deeper row either
+            ++rows;
+            const int64_t hi = q.R[(size_t)j] == INT64_MAX ? Wc - 1 : std::min(Wc - 1, xc + q.R[(size_t)j]);
+            const int64_t line = flip_line ? lenl - 1 - (yc + j) : yc + j;
+            const int64_t f = bl_.next(o, line, flip_pos ? lenp - 1 - lo : lo, !flip_pos);
+            if (f < 0) continue;
+            const int64_t pc = flip_pos ? lenp - 1 - f : f;
+            if (pc > hi) continue;
+            const V d = q.transpose ? dist_(j, pc - xc) : dist_(pc - xc, j);
+            if (d < best) best = d;
+        }
+    }
+    rows_ += rows;
+    return best;
+}
+
 #define CT_DDT_INSTANTIATE(D)                                                                              \
     template void directional<D>(const Prepared &, const Wedge &, const D &,                              \
                                  std::vector<D::value_type> &, std::vector<Point> &, const Options &,     \
@@ -576,7 +734,8 @@ void unconstrained(const Prepared &bm, const D &dist, std::vector<typename D::va
                                  std::vector<D::value_type> &, std::vector<Point> &, const Options &,     \
                                  Stats *);                                                                 \
     template void unconstrained<D>(const Prepared &, const D &, std::vector<D::value_type> &,             \
-                                   std::vector<Point> &, const Options &, Stats *);
+                                   std::vector<Point> &, const Options &, Stats *);              \
+    template class CappedQuery<D>;
 CT_DDT_INSTANTIATE(EuclideanSq)
 CT_DDT_INSTANTIATE(CityBlock)
 CT_DDT_INSTANTIATE(Chessboard)

@@ -272,5 +272,88 @@ void unconstrained(const Prepared &bm, const D &dist,
                    std::vector<typename D::value_type> &dt, std::vector<Point> &ft,
                    const Options &opt = Options(), Stats *stats = nullptr);
 
+// ------------------------------------------------------- capped queries
+// The PPT builder (builder_slices.cpp) needs a slice's directional DT only at
+// some pixels (measured: about 10% of them per slice and sector on the real
+// DEM) and only where it is below a per-pixel cap (a radius of ~30 pixels on
+// average).  A full transform computes every pixel; a capped query computes
+// one pixel by walking the rows of the same canonical frame as the traversal
+// (depth j = 0, 1, ... away from p; ddt.hpp's L(j), R(j) give row j's exact
+// wedge interval), with the same exactness argument as pass 2: the nearest
+// in-sector feature of row j is the first feature at or after x + L(j) when
+// it is <= x + R(j) (D nondecreasing in |dx|), and rows stop at the first
+// depth j with D(L(j), j) >= min(best, cap) (rule 1's bound).  Each row costs
+// one "first set bit at or after" on 64-bit words with a skip table over
+// empty words, O(1).  Per piece, the frame with the fewer rows to visit is
+// taken: rows ~ distance * sin(angle between the piece's far boundary and the
+// scan axis).
+//
+// BitLines: a bitmap's rows and columns as bitsets (2 bits per pixel plus
+// 1/16 for the skip tables), built once per bitmap, shared by every sector
+// and thread.
+class BitLines {
+public:
+    // bits: W*H bytes, nonzero = feature; 1 <= W, H <= 2^20.  Throws.
+    BitLines(int width, int height, const uint8_t *bits);
+    // The same from a predicate feature(x, y) evaluated once per pixel.
+    template <class F>
+    static BitLines from(int width, int height, const F &feature);
+    int width() const { return w_; }
+    int height() const { return h_; }
+    // First feature at or after position p (0 <= p < len) along line l of
+    // orientation o (0: rows, position = x; 1: columns, position = y) in
+    // increasing (fwd) or decreasing (!fwd) position; -1 if none.
+    int64_t next(int o, int64_t l, int64_t p, bool fwd) const;
+
+private:
+    BitLines() = default;
+    void alloc(int width, int height);
+    void set(int x, int y);
+    void finish();
+    struct Lines {
+        int64_t len = 0, wpl = 0;        // line length, 64-bit words per line
+        std::vector<uint64_t> w;          // lines x wpl
+        std::vector<int32_t> nz_up, nz_down;  // next nonzero word at or after / at or before (-1: none)
+    };
+    int w_ = 0, h_ = 0;
+    Lines l_[2];
+};
+
+template <class F>
+BitLines BitLines::from(int width, int height, const F &feature)
+{
+    BitLines b;
+    b.alloc(width, height);
+    for (int y = 0; y < height; ++y)
+        for (int x = 0; x < width; ++x)
+            if (feature(x, y)) b.set(x, y);
+    b.finish();
+    return b;
+}
+
+// Capped directional DT queries for one wedge (a union of closed pieces)
+// over one BitLines.  The wedges: each 0 < opening <= 180 degrees (ddt.hpp's
+// convention), their union the sector; an empty list = every direction.
+template <class D>
+class CappedQuery {
+public:
+    using V = typename D::value_type;
+    CappedQuery(const BitLines &bl, const std::vector<Wedge> &wedges, const D &dist);
+    // min(cap, the directional DT at (x, y)): exact when the DT is below cap.
+    V query(int x, int y, V cap) const;
+    uint64_t rows_visited() const { return rows_; }  // statistics, summed over queries
+
+private:
+    struct QFrame {
+        bool fx, fy, transpose;
+        std::vector<int64_t> L, R;  // per depth j: wedge interval (R: INT64_MAX = unbounded)
+        std::vector<V> lb;          // D(L(j), j) in the original orientation
+    };
+    const BitLines &bl_;
+    D dist_;
+    std::vector<QFrame> frames_;
+    mutable uint64_t rows_ = 0;
+};
+
 }  // namespace ddt
 }  // namespace ct_host

@@ -45,6 +45,10 @@ struct BuildOptions {
     int threads = 0;       // 0 = hardware concurrency
     PptBuilder builder = PptBuilder::Slices;
     int window = 12;       // Slices: near window Rw in coarse cells (>= 1)
+    // Slices: a (slice, sector) whose capped DT queries visit more than this
+    // many rows per coarse cell finishes with one full line-traversal DT
+    // (the same values; 0 = always full DTs, a huge value = queries only)
+    double full_dt_rows = 12.0;
     std::vector<double> levels_m;  // Slices: given levels (metres) instead of K even ones;
                                    // the DEM's lowest and highest heights are always levels
     static constexpr int DEFAULT_SLICES = 64;
@@ -59,7 +63,10 @@ struct BuildStats {
     int slices = 0;                // Slices: levels K used / slices transformed
     int slices_transformed = 0;
     size_t far_narrowed = 0;       // Slices: codes narrowed by a far (DT) term
-    size_t dts_skipped = 0;        // Slices: (slice, sector) DTs found useless and skipped
+    size_t dts_skipped = 0;        // Slices: (slice, sector) pairs where no cone could narrow
+    size_t dt_queries = 0;         // Slices: capped directional DT queries (cell, slice, sector)
+    uint64_t dt_query_rows = 0;    // Slices: rows those queries visited
+    size_t full_dts = 0;           // Slices: (slice, sector) pairs finished with a full DT
     double seconds_local = 0.0;    // Slices: near + window terms
     double seconds_dt = 0.0;       // Slices: slice DTs and far terms
 };

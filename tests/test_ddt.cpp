@@ -465,6 +465,108 @@ void test_distances_only(void)
     }
 }
 
+// Capped queries (the PPT builder's mode): min(cap, DT) at every pixel equals
+// the brute force's, for unions of random wedges (or all directions), every
+// metric, caps from 0 through the exact DT values to infinity, on bitmaps
+// wide enough to span several 64-bit words per row and column.
+template <class D>
+bool check_capped(ct_rng *r, const Bits &m, const BitLines &bl, const std::vector<Wedge> &ws, const D &d,
+                  const char *label, std::string *what)
+{
+    using V = typename D::value_type;
+    CappedQuery<D> q(bl, ws, d);
+    std::vector<std::array<int, 2>> feats;
+    for (int y = 0; y < m.h; ++y)
+        for (int x = 0; x < m.w; ++x)
+            if (m.at(x, y)) feats.push_back({x, y});
+    for (int y = 0; y < m.h; ++y)
+        for (int x = 0; x < m.w; ++x) {
+            V best = Inf<V>::value;
+            for (const auto &f : feats) {
+                const int64_t dx = f[0] - x, dy = f[1] - y;
+                bool in = ws.empty();
+                for (const Wedge &w : ws) in = in || XSector{w, false}(dx, dy);
+                if (!in) continue;
+                const V v = d(dx < 0 ? -dx : dx, dy < 0 ? -dy : dy);
+                if (v < best) best = v;
+            }
+            V caps[4] = {Inf<V>::value, best, (V)0, (V)ct_rng_range(r, 0, 40)};
+            if (best != Inf<V>::value) caps[2] = best + (V)1;
+            for (V cap : caps) {
+                const V got = q.query(x, y, cap), want = best < cap ? best : cap;
+                if (!(got == want)) {
+                    char buf[256];
+                    snprintf(buf, sizeof buf, "%s: %dx%d pixel (%d,%d) cap %s: query %s, brute force %s", label, m.w,
+                             m.h, x, y, vstr(cap).c_str(), vstr(got).c_str(), vstr(want).c_str());
+                    *what = buf;
+                    return false;
+                }
+            }
+        }
+    return true;
+}
+
+void test_capped_queries(void)
+{
+    ct_rng r;
+    ct_rng_seed(&r, g_seed * 1000003u + 313);
+    int unions = 0, alldir = 0;
+    uint64_t rows = 0;
+    for (int c = 0; c < g_cases / 4; ++c) {
+        const Bits m = random_bits(&r, c % 16 == 0 ? 130 : 40);
+        const BitLines bl(m.w, m.h, m.b.data());
+        std::vector<Wedge> ws;
+        const int kind = (int)ct_rng_range(&r, 0, 9);
+        if (kind == 0) {
+            alldir++;
+        } else if (kind <= 3) {
+            const uint32_t n = (uint32_t)ct_rng_range(&r, 2, 64);
+            ws.push_back(sector_wedge(n, (uint32_t)ct_rng_range(&r, 0, (int)n - 1)));
+        } else {
+            const int nw = (int)ct_rng_range(&r, 1, 3);
+            for (int k = 0; k < nw; ++k) ws.push_back(random_wedge(&r));
+            unions += nw > 1;
+        }
+        char label[64];
+        snprintf(label, sizeof label, "case %d (%zu wedges)", c, ws.size());
+        const Metrics me(&r, m.w, m.h);
+        std::string what;
+        bool ok = check_capped(&r, m, bl, ws, me.e, label, &what) && check_capped(&r, m, bl, ws, me.c, label, &what) &&
+                  check_capped(&r, m, bl, ws, me.k, label, &what) && check_capped(&r, m, bl, ws, me.cr, label, &what) &&
+                  check_capped(&r, m, bl, ws, me.t, label, &what);
+        if (!ok) TEST_FAIL_MSG("%s", what.c_str());
+        // the same bitmap from a predicate gives the same bitsets' answers
+        const BitLines bp = BitLines::from(m.w, m.h, [&](int x, int y) { return m.at(x, y) != 0; });
+        CappedQuery<EuclideanSq> q1(bl, ws, EuclideanSq()), q2(bp, ws, EuclideanSq());
+        for (int y = 0; y < m.h; ++y)
+            for (int x = 0; x < m.w; ++x)
+                TEST_ASSERT_MSG(q1.query(x, y, Inf<int64_t>::value) == q2.query(x, y, Inf<int64_t>::value),
+                                "case %d: BitLines::from differs at (%d,%d)", c, x, y);
+        rows += q1.rows_visited();
+    }
+    // a few features on wide bitmaps: nearest features many rows and words away
+    for (int c = 0; c < 24; ++c) {
+        Bits m;
+        m.w = (int)ct_rng_range(&r, 1, 300);
+        m.h = (int)ct_rng_range(&r, 1, 300);
+        m.b.assign((size_t)m.w * (size_t)m.h, 0);
+        for (int k = (int)ct_rng_range(&r, 1, 6); k-- > 0;)
+            m.b[(size_t)ct_rng_range(&r, 0, m.w * m.h - 1)] = 1;
+        const BitLines bl(m.w, m.h, m.b.data());
+        std::vector<Wedge> ws;
+        if (c % 6 != 0) ws.push_back(c % 2 ? random_wedge(&r) : sector_wedge(24, (uint32_t)(c % 24)));
+        char label[64];
+        snprintf(label, sizeof label, "sparse case %d", c);
+        std::string what;
+        if (!check_capped(&r, m, bl, ws, EuclideanSq(), label, &what) ||
+            !check_capped(&r, m, bl, ws, Chessboard(), label, &what))
+            TEST_FAIL_MSG("%s", what.c_str());
+    }
+    TEST_ASSERT_MSG(unions > 0 && alldir > 0, "no union of wedges (%d) or all-directions case (%d) drawn", unions,
+                    alldir);
+    TEST_ASSERT(rows > 0);
+}
+
 // Self-tests of the comparison: a wrong sector, an open wedge and a wrong FT
 // must each be caught on some case.
 void test_checker_catches_errors(void)
@@ -610,5 +712,6 @@ int main(void)
     RUN_TEST(test_large_bitmaps);
     RUN_TEST(test_rules_off_same_result);
     RUN_TEST(test_distances_only);
+    RUN_TEST(test_capped_queries);
     return TEST_END();
 }

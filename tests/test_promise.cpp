@@ -513,6 +513,48 @@ void test_promise_slice_builder()
     }
 }
 
+// The slice builder's far terms come from capped directional DT queries, or,
+// where those would visit too many rows, from full line-traversal DTs: two
+// independent implementations that must give byte-identical packages.  Run
+// both ways on every (N, r) of the slice-builder grid and on the real DEM.
+void test_slice_dt_paths_agree()
+{
+    struct Case {
+        const char *name;
+        ct_host::Terrain t;
+        int n, r, window;
+    };
+    std::vector<Case> cases;
+    ct_host::Terrain ts[3] = {small(1, 19, 17), small(2, 18, 18), small(0, 17, 15)};
+    int k = 0;
+    for (int n : {1, 2, 4, 8, 16, 24, 32, 64})
+        for (int r = 1; r <= 4; ++r, ++k) cases.push_back({"small", ts[k % 3], n, r, 1 + k % 2});
+    cases.push_back({"jacksboro", dem_cases::real_terrain(), 24, 3, 12});
+    cases.push_back({"jacksboro", dem_cases::real_terrain(), 8, 2, 4});
+    size_t queried = 0, full = 0;
+    for (const Case &c : cases) {
+        ct_host::BuildOptions o;
+        o.sectors = c.n;
+        o.reduce = c.r;
+        o.window = c.window;
+        ct_host::BuildStats sq, sf;
+        o.full_dt_rows = 1e30;  // queries only
+        const std::vector<uint8_t> a = ct_host::build_package(c.t, o, &sq);
+        o.full_dt_rows = 0.0;  // full DTs only
+        const std::vector<uint8_t> b = ct_host::build_package(c.t, o, &sf);
+        TEST_ASSERT_MSG(a == b, "%s N=%d r=%d window %d: capped queries and full DTs give different packages", c.name,
+                        c.n, c.r, c.window);
+        TEST_ASSERT_MSG(sq.full_dts == 0 && sf.dt_queries == 0, "%s N=%d r=%d: paths not separated (%zu full, %zu "
+                        "queries)", c.name, c.n, c.r, sq.full_dts, sf.dt_queries);
+        queried += sq.dt_queries;
+        full += sf.full_dts;
+        if (ct_harness_g.current_failed) return;
+    }
+    std::printf("  %zu capped queries and %zu full DTs gave the same packages in %zu builds\n", queried, full,
+                cases.size());
+    TEST_ASSERT_MSG(queried > 1000 && full > 100, "too little exercised: %zu queries, %zu full DTs", queried, full);
+}
+
 }  // namespace
 
 int main()
@@ -521,5 +563,6 @@ int main()
     RUN_TEST(test_promise_sectors);
     RUN_TEST(test_promise_reduce_and_slices);
     RUN_TEST(test_promise_slice_builder);
+    RUN_TEST(test_slice_dt_paths_agree);
     return TEST_END();
 }
