@@ -157,6 +157,13 @@ inline double dist_max(const Wedge &w, int s, const Rect &r)
     return best * (1.0 + 1e-12) + 1e-12;
 }
 
+// A fine cell's height: the tallest of its four posts.
+inline uint16_t fine_max(const Terrain &t, int i, int j)
+{
+    const size_t k = (size_t)j * (size_t)t.width + (size_t)i, w = (size_t)t.width;
+    return std::max(std::max(t.codes[k], t.codes[k + 1]), std::max(t.codes[k + w], t.codes[k + w + 1]));
+}
+
 // Max pyramid of fine-cell maxima: level 0 = fine cells.
 // Max pyramid: level 0 is the fine-cell maxima themselves (not copied: the
 // pyramid must not outlive `fm`), levels 1.. are 2x2 maxima.
@@ -194,8 +201,8 @@ struct Ctx {
     const Terrain *t;
     int cx, cy, r, n;
     Wedge wedge;
-    std::vector<uint16_t> fm;          // fine-cell tallest corner
-    Pyramid pyr;
+    std::vector<uint16_t> fm;          // fine-cell tallest corner (brute-force builder only)
+    Pyramid pyr;                       // its max pyramid (brute-force builder only)
     int64_t cot_q16[256];
     uint8_t cot_ok[256];
     // code_for's search: the usable codes 1..255 by cot, descending, with the

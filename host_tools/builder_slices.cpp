@@ -163,16 +163,15 @@ void slice_angles(const Ctx &c, const SliceInput &in, uint8_t *codes, SliceStats
     const int nthreads = std::max(1, in.threads);
     std::fill(codes, codes + plane * (size_t)c.n, (uint8_t)0);
 
-    // coarse heights
-    std::vector<uint16_t> hcm(plane, 0);
-    for (int j = 0; j < c.cy; ++j)
-        for (int i = 0; i < c.cx; ++i) {
-            uint16_t &d = hcm[(size_t)(j / r) * wc + i / r];
-            d = std::max(d, c.fm[(size_t)j * c.cx + i]);
-        }
+    // coarse heights (taken over: freed after the window terms)
+    std::vector<uint16_t> hcm;
+    hcm.swap(*in.coarse_max);
+    if (hcm.size() != plane) throw Error("slice builder: coarse heights missing");
     const std::vector<int> &lv = *in.levels;
     const std::vector<uint16_t> &k0 = *in.apex_level;
-    const std::vector<uint16_t> &apex = *in.apex;
+    // apex of a cell: its level (one table, no per-cell array)
+    std::vector<double> lvd(lv.begin(), lv.end());
+    auto apex_of = [&](size_t f) { return lvd[k0[f]]; };
     const int K = (int)lv.size() - 1;
 
     // cot of each code as a double lower bound, for the monotone update
@@ -236,7 +235,17 @@ void slice_angles(const Ctx &c, const SliceInput &in, uint8_t *codes, SliceStats
                 v[k] = x, qi[k] = i, qj[k] = j;
             }
         };
+        // each fine-ring offset's coarse cell, as an index into alive[]
+        constexpr int RING_SIDE = 2 * FINE_RING + 1, RING_GROUPS = RING_SIDE * RING_SIDE;
+        std::vector<uint8_t> fine_group(mfine.offs.size());
+        for (size_t m = 0; m < mfine.offs.size(); ++m) {
+            auto fdiv = [r](int v) { return v >= 0 ? v / r : -((-v + r - 1) / r); };
+            int gx = fdiv(mfine.offs[m].dx) + FINE_RING, gy = fdiv(mfine.offs[m].dy) + FINE_RING;
+            if (gx < 0 || gy < 0 || gx >= RING_SIDE || gy >= RING_SIDE) throw Error("slice builder: fine ring offset");
+            fine_group[m] = (uint8_t)(gy * RING_SIDE + gx);
+        }
         auto worker = [&]() {
+            bool alive[RING_GROUPS];
             std::vector<double> need((size_t)c.n);
             std::vector<Top> top((size_t)c.n);
             struct Sub {
@@ -249,8 +258,13 @@ void slice_angles(const Ctx &c, const SliceInput &in, uint8_t *codes, SliceStats
                 if (cj >= hc) break;
                 for (int ci = 0; ci < wc; ++ci) {
                     size_t f = (size_t)cj * wc + ci;
-                    double a = apex[f];
+                    double a = apex_of(f);
                     int fx0 = ci * r, fy0 = cj * r;
+                    // the coarse cells of the fine ring that rise above a
+                    for (int g = 0; g < RING_GROUPS; ++g) {
+                        int gi = ci + g % RING_SIDE - FINE_RING, gj = cj + g / RING_SIDE - FINE_RING;
+                        alive[g] = gi >= 0 && gj >= 0 && gi < wc && gj < hc && hcm[(size_t)gj * wc + gi] > a;
+                    }
                     std::fill(need.begin(), need.end(), 0.0);
                     for (Top &tp : top) tp.reset();
                     for (const Merged &o : mnear.offs) {
@@ -261,10 +275,12 @@ void slice_angles(const Ctx &c, const SliceInput &in, uint8_t *codes, SliceStats
                             need[(size_t)s] = std::max(need[(size_t)s], max_slope(c, s, qi, qj));
                         }
                     }
-                    for (const Merged &o : mfine.offs) {
+                    for (size_t m = 0; m < mfine.offs.size(); ++m) {
+                        const Merged &o = mfine.offs[m];
+                        if (!alive[fine_group[m]]) continue;  // its coarse cell is not above a
                         int qi = fx0 + o.dx, qj = fy0 + o.dy;
                         if (qi < 0 || qj < 0 || qi >= c.cx || qj >= c.cy) continue;
-                        double rise = c.fm[(size_t)qj * c.cx + qi] - a;
+                        double rise = fine_max(*c.t, qi, qj) - a;
                         if (rise <= 0.0) continue;
                         for (size_t e = o.first; e < o.first + o.count; ++e)
                             top[(size_t)mfine.secs[e]].add(rise / mfine.rhos[e], qi, qj);
@@ -387,9 +403,10 @@ void slice_angles(const Ctx &c, const SliceInput &in, uint8_t *codes, SliceStats
                 size_t nq = 0;
                 const int64_t *dtf = nullptr;  // the full DT, once switched to it
                 for (size_t f = 0; f < plane; ++f) {
-                    if (k0[f] > k) continue;
+                    const uint16_t kf = k0[f];
+                    if (kf > k) continue;
                     const uint8_t code = cs[f];
-                    const double rise = top - apex[f];
+                    const double rise = top - lvd[kf];
                     if (rise <= 0.0 || rise < skip_rise[code]) continue;
                     const double cot = cot_of[code];
                     // term = (top - a) / (r max(Rw, sqrt(D2) - sqrt2)) > cot

@@ -191,18 +191,17 @@ int cmd_build(int argc, char **argv)
     Progress bar("building cones");
     o.progress = [&](size_t d, size_t n) { bar.update(d, n); };
     BuildStats st;
-    // working memory of the build: the peak resident size during
-    // build_package (including the package it returns) above the resident
-    // size before it (the DEM and the libraries)
+    // working memory of the build: the peak resident size while the
+    // package is built and written (streamed to the file) above the
+    // resident size before it (the DEM and the libraries)
     double rss0 = proc_status_kib("VmRSS") * 1024.0;
     reset_peak_rss();
-    std::vector<uint8_t> pkg = build_package(t, o, &st);
+    build_package_file(t, o, out, &st);
     double work = std::max(0.0, proc_status_kib("VmHWM") * 1024.0 - rss0);
     bar.finish();
-    write_file_atomic(out, pkg);
     if (a.opt.count("--emit-c")) {
         try {
-            emit_c_array(out, a.opt["--emit-c"], pkg);
+            emit_c_array(out, a.opt["--emit-c"]);
         } catch (...) {
             std::remove(out.c_str());  // all outputs or none
             throw;
@@ -224,7 +223,7 @@ int cmd_build(int argc, char **argv)
     }
     std::printf("%s: %dx%d posts, %d sectors, r=%d, package %zu bytes (%.2fx the 16-bit DEM), "
                 "%.1f%% degenerate cones, built in %.2f s (%s), working memory %.1f MB (%.2fx the DEM)\n",
-                out.c_str(), t.width, t.height, o.sectors, o.reduce, pkg.size(), (double)pkg.size() / dem_bytes,
+                out.c_str(), t.width, t.height, o.sectors, o.reduce, st.bytes, (double)st.bytes / dem_bytes,
                 100.0 * st.degenerate_cones / std::max<size_t>(1, st.cones), secs, how.c_str(), work / 1e6,
                 work / dem_bytes);
     return 0;

@@ -9,10 +9,11 @@
 
 namespace ct_host {
 
-// Writes <dir>/NAME.c and <dir>/NAME.h, dir = the directory of package_path.
-// NAME must be a C identifier.  Throws Error (file, reason); each file is
-// written atomically (never a partial file).
-void emit_c_array(const std::string &package_path, const std::string &name, const std::vector<uint8_t> &bytes);
+// Writes <dir>/NAME.c and <dir>/NAME.h, dir = the directory of package_path,
+// from the package file (read in chunks).  NAME must be a C identifier.
+// Throws Error (file, reason); each file is written atomically (never a
+// partial file), and both or neither.
+void emit_c_array(const std::string &package_path, const std::string &name);
 
 // true when s is a valid C identifier (and not too long for C99's 31
 // significant characters of external names)

@@ -58,6 +58,7 @@ struct BuildOptions {
 
 struct BuildStats {
     double seconds = 0.0;
+    size_t bytes = 0;              // package size
     size_t degenerate_cones = 0;   // (cell, sector) pairs with code 0
     size_t cones = 0;              // (cell, sector) pairs
     int slices = 0;                // Slices: levels K used / slices transformed
@@ -82,9 +83,25 @@ Terrain terrain_from_heights(int width, int height, const std::vector<double> &h
                              const std::vector<uint8_t> &valid, const Georef &geo,
                              double scale_m = 0.0);
 
-// The package bytes (header, heights, mipmap, apex, angles, voids, CRC).
+// Where a package goes: its bytes in file order, then one patch (the CRC).
+class PackageSink {
+public:
+    virtual ~PackageSink() = default;
+    virtual void write(const uint8_t *p, size_t n) = 0;
+    virtual void patch(size_t offset, const uint8_t *p, size_t n) = 0;
+};
+
+// The package (header, heights, mipmap, apex, angles, voids, CRC), streamed
+// to `sink` (package_build.cpp); only the angle planes are held whole.
+void build_package_to(const Terrain &t, const BuildOptions &opt, PackageSink &sink,
+                      BuildStats *stats = nullptr);
+// The same into memory.
 std::vector<uint8_t> build_package(const Terrain &t, const BuildOptions &opt,
                                    BuildStats *stats = nullptr);
+// The same into a file, atomically ("<path>.tmp.<pid>" then rename): no
+// partial file is left on any error.  Throws Error("<path>: ...").
+void build_package_file(const Terrain &t, const BuildOptions &opt, const std::string &path,
+                        BuildStats *stats = nullptr);
 
 // Georeference as the package stores it (integer nanometres).
 int64_t metres_to_nm(double m);

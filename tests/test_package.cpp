@@ -3,6 +3,10 @@
 // spirit of littlefs's test_evil); random corruption never crashes, and a
 // corrupted package that still opens never makes the tracer read outside
 // the buffer (run under AddressSanitizer + UBSan as test_package_san).
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <functional>
 #include <string>
@@ -250,6 +254,64 @@ void test_prepared_ray_tampering()
     TEST_ASSERT_EQUAL_INT(CT_ERR_RAY, ct_trace(&p, &huge, CT_METHOD_INCREMENTAL, &h));
 }
 
+// build_package_file streams the same bytes as build_package (voids and
+// both builders included); a path that cannot be written throws and leaves
+// neither the file nor its temporary behind.
+void test_streamed_file_same_bytes()
+{
+    auto z = dem_cases::smooth(41, 37, 5, 100, 9000);
+    ct_host::Terrain t = dem_cases::make_terrain(41, 37, z, 0.5);
+    t.void_post.assign(z.size(), 0);
+    t.void_post[5 * 41 + 7] = 1;
+    const std::string path = "/tmp/ct_test_stream." + std::to_string((long)getpid()) + ".ctp";
+    for (ct_host::PptBuilder b : {ct_host::PptBuilder::Slices, ct_host::PptBuilder::Brute})
+        for (int n : {1, 8, 24}) {
+            ct_host::BuildOptions o;
+            o.sectors = n;
+            o.reduce = 2;
+            o.builder = b;
+            const std::vector<uint8_t> mem = ct_host::build_package(t, o);
+            ct_host::BuildStats st;
+            ct_host::build_package_file(t, o, path, &st);
+            FILE *f = fopen(path.c_str(), "rb");
+            TEST_ASSERT(f != nullptr);
+            std::vector<uint8_t> disk(mem.size() + 16);
+            size_t got = fread(disk.data(), 1, disk.size(), f);
+            fclose(f);
+            disk.resize(got);
+            std::remove(path.c_str());
+            TEST_ASSERT_MSG(disk == mem, "N=%d: file (%zu bytes) differs from memory (%zu bytes)", n, got, mem.size());
+            TEST_ASSERT_EQUAL_INT((int)mem.size(), (int)st.bytes);
+            ct_package p;
+            TEST_ASSERT_EQUAL_INT(CT_OK, ct_package_open(&p, mem.data(), mem.size()));
+            TEST_ASSERT_EQUAL_INT(CT_OK, ct_package_verify(&p));
+            TEST_ASSERT(p.voids != 0);
+        }
+    const std::string bad = "/tmp/ct_no_such_dir_" + std::to_string((long)getpid()) + "/x.ctp";
+    bool threw = false;
+    try {
+        ct_host::build_package_file(t, ct_host::BuildOptions(), bad);
+    } catch (const ct_host::Error &e) {
+        threw = std::string(e.what()).find(bad) != std::string::npos;
+    }
+    TEST_ASSERT_MSG(threw, "an unwritable path did not throw an error naming it");
+    // a build that fails after the file was opened leaves nothing behind
+    ct_host::Terrain broken = t;
+    broken.geo.posting_n = 2 * broken.geo.posting_e;  // non-square posting
+    threw = false;
+    try {
+        ct_host::build_package_file(broken, ct_host::BuildOptions(), path);
+    } catch (const ct_host::Error &) {
+        threw = true;
+    }
+    TEST_ASSERT(threw);
+    FILE *f = fopen(path.c_str(), "rb");
+    TEST_ASSERT_MSG(f == nullptr, "a failed build left %s", path.c_str());
+    if (f) fclose(f);
+    const std::string cmd = "ls " + path + ".tmp.* >/dev/null 2>&1";
+    TEST_ASSERT_MSG(std::system(cmd.c_str()) != 0, "a failed build left a temporary file");
+}
+
 }  // namespace
 
 int main()
@@ -260,5 +322,6 @@ int main()
     RUN_TEST(test_verify_catches_bad_content);
     RUN_TEST(test_random_corruption);
     RUN_TEST(test_prepared_ray_tampering);
+    RUN_TEST(test_streamed_file_same_bytes);
     return TEST_END();
 }

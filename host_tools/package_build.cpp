@@ -1,0 +1,396 @@
+// package_build.cpp -- builds a terrain package (format: lib/include/
+// conetrace.h) and streams it to a sink in file order: header, heights,
+// max-mipmap, apexes, angle planes, voids, then one patch of the CRC field.
+//
+// Memory: the caller's DEM, the angle planes (the only package section held
+// whole), one 16-bit array per coarse cell (apex levels) and, while the
+// builder runs, its working arrays (builder_slices.cpp: one more array per
+// coarse cell and one slice's bitsets).  The heights are written from the
+// DEM, the mipmap level by level before the cones are built, the voids in
+// chunks: none of them is held whole while the angle planes are.
+#include <algorithm>
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <sstream>
+#include <thread>
+#include <unistd.h>
+
+#include "builder_common.hpp"
+#include "builder_slices.hpp"
+#include "conetrace.h"
+#include "terrain.hpp"
+
+namespace ct_host {
+namespace {
+
+using namespace bld;
+
+// Sequential writes through a staging buffer, with the running CRC.
+class Writer {
+public:
+    explicit Writer(PackageSink &s) : sink_(s) { buf_.reserve(kBuf); }
+    void byte(uint8_t v)
+    {
+        buf_.push_back(v);
+        if (buf_.size() >= kBuf) flush();
+    }
+    void u16(uint32_t v)
+    {
+        byte((uint8_t)v);
+        byte((uint8_t)(v >> 8));
+    }
+    void bytes(const uint8_t *p, size_t n)
+    {
+        flush();
+        ct_crc32(crc_, p, n, &crc_);
+        sink_.write(p, n);
+        pos_ += n;
+    }
+    // zero padding up to a section's offset
+    void pad_to(size_t off)
+    {
+        if (position() > off) throw Error("package writer: section overlap (internal error)");
+        while (position() < off) byte(0);
+    }
+    size_t position() const { return pos_ + buf_.size(); }
+    void flush()
+    {
+        if (buf_.empty()) return;
+        ct_crc32(crc_, buf_.data(), buf_.size(), &crc_);
+        sink_.write(buf_.data(), buf_.size());
+        pos_ += buf_.size();
+        buf_.clear();
+    }
+    uint32_t crc() const { return crc_; }
+
+private:
+    static constexpr size_t kBuf = 1 << 16;
+    PackageSink &sink_;
+    std::vector<uint8_t> buf_;
+    size_t pos_ = 0;
+    uint32_t crc_ = 0;
+};
+
+void put16(std::vector<uint8_t> &b, size_t off, uint32_t v)
+{
+    b[off] = (uint8_t)v;
+    b[off + 1] = (uint8_t)(v >> 8);
+}
+void put32(std::vector<uint8_t> &b, size_t off, uint32_t v)
+{
+    for (int k = 0; k < 4; ++k) b[off + k] = (uint8_t)(v >> (8 * k));
+}
+void put64(std::vector<uint8_t> &b, size_t off, int64_t v)
+{
+    for (int k = 0; k < 8; ++k) b[off + k] = (uint8_t)((uint64_t)v >> (8 * k));
+}
+
+// The mipmap levels 1..levels of the fine cells' max pyramid (level l: 2x2
+// maxima of level l-1; level 0 = fine cells, not stored), one level in memory
+// besides the one being made.
+void write_mipmap(Writer &w, const Terrain &t, int cx, int cy, uint32_t levels)
+{
+    std::vector<uint16_t> prev, cur;
+    int pw = cx, ph = cy;
+    for (uint32_t l = 1; l <= levels; ++l) {
+        const int nw = (pw + 1) / 2, nh = (ph + 1) / 2;
+        cur.assign((size_t)nw * nh, 0);
+        for (int j = 0; j < ph; ++j)
+            for (int i = 0; i < pw; ++i) {
+                const uint16_t v = l == 1 ? fine_max(t, i, j) : prev[(size_t)j * pw + i];
+                uint16_t &d = cur[(size_t)(j / 2) * nw + i / 2];
+                d = std::max(d, v);
+            }
+        for (uint16_t v : cur) w.u16(v);
+        prev.swap(cur);
+        pw = nw;
+        ph = nh;
+    }
+}
+
+class VectorSink : public PackageSink {
+public:
+    explicit VectorSink(std::vector<uint8_t> &b) : b_(b) {}
+    void write(const uint8_t *p, size_t n) override { b_.insert(b_.end(), p, p + n); }
+    void patch(size_t off, const uint8_t *p, size_t n) override { std::memcpy(&b_[off], p, n); }
+
+private:
+    std::vector<uint8_t> &b_;
+};
+
+class FileSink : public PackageSink {
+public:
+    FileSink(const std::string &path, const std::string &tmp) : path_(path), tmp_(tmp)
+    {
+        f_ = std::fopen(tmp.c_str(), "wb");
+        if (!f_) fail();
+    }
+    ~FileSink() override
+    {
+        if (f_) std::fclose(f_);
+        if (!done_) std::remove(tmp_.c_str());
+    }
+    void write(const uint8_t *p, size_t n) override
+    {
+        if (std::fwrite(p, 1, n, f_) != n) fail();
+    }
+    void patch(size_t off, const uint8_t *p, size_t n) override
+    {
+        if (std::fseek(f_, (long)off, SEEK_SET) != 0 || std::fwrite(p, 1, n, f_) != n) fail();
+    }
+    void commit()
+    {
+        bool ok = std::fflush(f_) == 0;
+        ok = std::fclose(f_) == 0 && ok;
+        f_ = nullptr;
+        if (!ok || std::rename(tmp_.c_str(), path_.c_str()) != 0) fail();
+        done_ = true;
+    }
+
+private:
+    [[noreturn]] void fail() { throw Error(path_ + ": cannot write (" + std::strerror(errno) + ")"); }
+    std::string path_, tmp_;
+    std::FILE *f_ = nullptr;
+    bool done_ = false;
+};
+
+}  // namespace
+
+void build_package_to(const Terrain &t, const BuildOptions &opt, PackageSink &sink, BuildStats *stats)
+{
+    auto t0 = std::chrono::steady_clock::now();
+    if (opt.sectors < 1 || opt.sectors > CT_MAX_SECTORS) throw Error("sectors must be in 1..64");
+    if (opt.reduce < 1 || opt.reduce > CT_MAX_REDUCE) throw Error("reduce must be in 1..8");
+    if (opt.slices < 0) throw Error("slices must be >= 0");
+    if (t.width < 2 || t.height < 2 || t.width > CT_MAX_POSTS || t.height > CT_MAX_POSTS)
+        throw Error("DEM dimensions outside 2..32768 posts");
+    if ((size_t)t.width * t.height != t.codes.size()) throw Error("terrain codes size mismatch");
+
+    Ctx c;
+    c.t = &t;
+    c.cx = t.width - 1;
+    c.cy = t.height - 1;
+    c.r = opt.reduce;
+    c.n = opt.sectors;
+    c.wedge = make_wedge(opt.sectors);
+
+    // georeference as stored
+    int64_t pe = metres_to_nm(t.geo.posting_e), pn = metres_to_nm(t.geo.posting_n);
+    int64_t sc = metres_to_nm(t.height_scale_m);
+    if (pe == 0 || pn == 0 || std::llabs(pe) != std::llabs(pn)) {
+        std::ostringstream os;
+        os << "non-square posting (" << t.geo.posting_e << " x " << t.geo.posting_n << " m)";
+        throw Error(os.str());
+    }
+    if (sc <= 0) throw Error("height scale must be positive");
+    if (ct_cot_table(pe, sc, c.cot_q16, c.cot_ok) != CT_OK) throw Error("posting or height scale out of range");
+    prepare_codes(c);
+
+    const bool voids = !t.void_post.empty();
+    uint32_t so[CT_SEC_COUNT], ss[CT_SEC_COUNT], levels, total;
+    if (ct_package_layout((uint32_t)t.width, (uint32_t)t.height, (uint32_t)c.r, (uint32_t)c.n, voids ? 1u : 0u, so, ss,
+                          &levels, &total) != CT_OK)
+        throw Error("package layout failed (size limits)");
+    uint16_t hmin = 65535, hmax = 0;
+    for (uint16_t v : t.codes) {
+        hmin = std::min(hmin, v);
+        hmax = std::max(hmax, v);
+    }
+    const int wc = (c.cx + c.r - 1) / c.r, hc = (c.cy + c.r - 1) / c.r;
+    const size_t plane = (size_t)wc * hc;
+    const int nthreads = opt.threads > 0 ? opt.threads : (int)std::max(1u, std::thread::hardware_concurrency());
+
+    // slice levels (slice builder): L_k = ceil(hmin + k (hmax - hmin) / K),
+    // duplicates removed, or the given ones plus the extremes
+    int slices_header = opt.slices;
+    std::vector<int> lv;
+    if (opt.builder == PptBuilder::Slices) {
+        const int K = opt.slices > 0 ? opt.slices : BuildOptions::DEFAULT_SLICES;
+        slices_header = K;
+        if (!opt.levels_m.empty()) {
+            // given levels in metres -> codes (rounded up: a level is only a
+            // height at which a slice is cut), plus the extremes
+            lv.push_back(hmin);
+            lv.push_back(hmax);
+            for (double m : opt.levels_m) {
+                if (!std::isfinite(m)) throw Error("slice level is not a number");
+                double code = std::ceil((m - t.height_offset_m) / t.height_scale_m - 1e-9);
+                if (code > hmin && code < hmax) lv.push_back((int)code);
+            }
+            std::sort(lv.begin(), lv.end());
+            lv.erase(std::unique(lv.begin(), lv.end()), lv.end());
+            slices_header = (int)lv.size() - 1;
+        } else {
+            for (int k = 0; k <= K; ++k) {
+                int l = (int)std::ceil(hmin + (double)k * (hmax - hmin) / K - 1e-9);
+                l = std::clamp<int>(l, hmin, hmax);
+                if (k == K) l = hmax;
+                if (lv.empty() || l > lv.back()) lv.push_back(l);
+            }
+        }
+    }
+
+    // ---- header (CRC field zero), heights, mipmap: from the DEM alone
+    Writer w(sink);
+    {
+        std::vector<uint8_t> h(so[CT_SEC_HEIGHTS], 0);
+        if (h.size() < (size_t)CT_HDR_SECTION_TABLE + 8 * CT_SEC_COUNT) throw Error("package layout: short header");
+        std::memcpy(&h[0], CT_PKG_MAGIC, 4);
+        put16(h, 4, CT_PKG_VERSION);
+        put16(h, 6, CT_PKG_HEADER_SIZE);
+        put32(h, 8, total);
+        put16(h, 16, (uint32_t)t.width);
+        put16(h, 18, (uint32_t)t.height);
+        h[20] = (uint8_t)c.r;
+        h[21] = (uint8_t)c.n;
+        h[22] = (uint8_t)levels;
+        h[23] = voids ? CT_PKG_FLAG_VOIDS : 0;
+        put16(h, 24, hmin);
+        put16(h, 26, hmax);
+        put32(h, 28, (uint32_t)slices_header);
+        put64(h, 32, metres_to_nm(t.geo.origin_e));
+        put64(h, 40, metres_to_nm(t.geo.origin_n));
+        put64(h, 48, pe);
+        put64(h, 56, pn);
+        put64(h, 64, metres_to_nm(t.height_offset_m));
+        put64(h, 72, sc);
+        put32(h, 80, (uint32_t)std::max(0, t.geo.epsg));
+        for (int k = 0; k < CT_SEC_COUNT; ++k) {
+            put32(h, CT_HDR_SECTION_TABLE + 8 * k, so[k]);
+            put32(h, CT_HDR_SECTION_TABLE + 8 * k + 4, ss[k]);
+        }
+        w.bytes(h.data(), h.size());
+    }
+    w.pad_to(so[CT_SEC_HEIGHTS]);
+    for (uint16_t v : t.codes) w.u16(v);
+    w.pad_to(so[CT_SEC_MIPMAP]);
+    write_mipmap(w, t, c.cx, c.cy, levels);
+    w.flush();
+
+    // ---- the PPT: apexes and the angle planes (sector-major, then the
+    // omnidirectional plane when N > 1)
+    // the N sector planes; the omnidirectional plane (N > 1) is made while
+    // it is written
+    std::vector<uint8_t> codes(plane * (size_t)c.n, 0);
+    std::vector<uint16_t> apex_out;  // brute force: apex codes; slices: apex levels k0
+    {
+        // coarse heights: the tallest post of the coarse cell's fine cells
+        std::vector<uint16_t> hcm(plane, 0);
+        for (int j = 0; j < c.cy; ++j)
+            for (int i = 0; i < c.cx; ++i) {
+                uint16_t &d = hcm[(size_t)(j / c.r) * wc + i / c.r];
+                d = std::max(d, fine_max(t, i, j));
+            }
+        if (opt.builder == PptBuilder::Slices) {
+            std::vector<uint16_t> &k0 = apex_out;  // < lv.size() <= 65536
+            k0.resize(plane);
+            // the paper's apex: the lowest level not below the cell's top
+            // (measured: 7% fewer steps than exact apexes with K = 64)
+            for (size_t f = 0; f < plane; ++f)
+                k0[f] = (uint16_t)(std::lower_bound(lv.begin(), lv.end(), (int)hcm[f]) - lv.begin());
+            SliceInput in;
+            in.levels = &lv;
+            in.apex_level = &k0;
+            in.coarse_max = &hcm;  // taken over
+            in.window = opt.window;
+            in.full_dt_rows = opt.full_dt_rows;
+            in.threads = nthreads;
+            in.progress = opt.progress;
+            SliceStats sst;
+            slice_angles(c, in, codes.data(), &sst);
+            if (stats) {
+                stats->slices = (int)lv.size() - 1;
+                stats->slices_transformed = sst.slices;
+                stats->seconds_local = sst.seconds_local;
+                stats->far_narrowed = sst.far_narrowed;
+                stats->dts_skipped = sst.dts_skipped;
+                stats->dt_queries = sst.queries;
+                stats->dt_query_rows = sst.query_rows;
+                stats->full_dts = sst.full_dts;
+                stats->seconds_dt = sst.seconds_dt;
+            }
+        } else {
+            std::vector<uint16_t> &apex = apex_out;
+            apex.swap(hcm);
+            if (opt.slices > 0 && hmax > hmin) {
+                for (uint16_t &am : apex) {
+                    int m = am;
+                    // smallest level hmin + k*(hmax-hmin)/K >= m, as an integer code
+                    double step = (double)(hmax - hmin) / opt.slices;
+                    int k = (int)std::ceil((m - hmin) / step - 1e-12);
+                    int lvl = (int)std::ceil(hmin + k * step - 1e-9);
+                    am = (uint16_t)std::min<int>(hmax, std::max(m, lvl));
+                }
+            }
+            c.fm.resize((size_t)c.cx * c.cy);
+            for (int j = 0; j < c.cy; ++j)
+                for (int i = 0; i < c.cx; ++i) c.fm[(size_t)j * c.cx + i] = fine_max(t, i, j);
+            c.pyr = make_pyramid(c.fm, c.cx, c.cy);
+            brute_angles(c, apex, codes.data(), nthreads, opt.progress);
+            c.pyr = Pyramid();
+            c.fm = std::vector<uint16_t>();
+        }
+    }
+    if (stats) stats->cones = plane * (size_t)c.n;
+    size_t degenerate = 0;
+    for (size_t k = 0; k < plane * (size_t)c.n; ++k) degenerate += codes[k] == 0;
+
+    // ---- apexes, angles, voids
+    w.pad_to(so[CT_SEC_APEX]);
+    for (size_t f = 0; f < plane; ++f)
+        w.u16(opt.builder == PptBuilder::Slices ? (uint32_t)lv[apex_out[f]] : (uint32_t)apex_out[f]);
+    w.pad_to(so[CT_SEC_ANGLES]);
+    w.bytes(codes.data(), codes.size());
+    if (c.n > 1) {
+        for (size_t k = 0; k < plane; ++k) {
+            uint8_t m = 255;
+            for (int s = 0; s < c.n; ++s) m = std::min(m, codes[(size_t)s * plane + k]);
+            w.byte(m);
+        }
+    }
+    if (voids) {
+        w.pad_to(so[CT_SEC_VOIDS]);
+        // bit k = fine cell k (row-major) touches a void post
+        const size_t cells = (size_t)c.cx * c.cy;
+        for (size_t k0 = 0; k0 < cells; k0 += 8) {
+            uint8_t byte = 0;
+            for (size_t k = k0; k < std::min(cells, k0 + 8); ++k) {
+                const size_t i = k % (size_t)c.cx, j = k / (size_t)c.cx, p00 = j * (size_t)t.width + i;
+                if (t.void_post[p00] || t.void_post[p00 + 1] || t.void_post[p00 + t.width] ||
+                    t.void_post[p00 + t.width + 1])
+                    byte |= (uint8_t)(1u << (k - k0));
+            }
+            w.byte(byte);
+        }
+    }
+    w.pad_to(total);
+    w.flush();
+    uint8_t crc[4];
+    for (int k = 0; k < 4; ++k) crc[k] = (uint8_t)(w.crc() >> (8 * k));
+    sink.patch(12, crc, 4);
+    if (stats) {
+        stats->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        stats->degenerate_cones = degenerate;
+        stats->bytes = total;
+    }
+}
+
+std::vector<uint8_t> build_package(const Terrain &t, const BuildOptions &opt, BuildStats *stats)
+{
+    std::vector<uint8_t> b;
+    VectorSink s(b);
+    build_package_to(t, opt, s, stats);
+    return b;
+}
+
+void build_package_file(const Terrain &t, const BuildOptions &opt, const std::string &path, BuildStats *stats)
+{
+    FileSink s(path, path + ".tmp." + std::to_string((long)getpid()));
+    build_package_to(t, opt, s, stats);
+    s.commit();
+}
+
+}  // namespace ct_host
