@@ -230,35 +230,52 @@ inline void prepare_codes(Ctx &c)
     }
 }
 
-// Max over u in W_s of the directional derivative of cell (i, j)'s patch
-// (LSB per cell); gradient extremes are at the corners.
-inline double max_slope(const Ctx &c, int s, int i, int j)
+// The bilinear patch of cell (i, j): its gradient at the four corners
+// (gradient extremes of a bilinear patch are at the corners).  gx, gy:
+// integers below 2^18, exact; g1 = |gx| + |gy| >= |g| widens the
+// tolerances below (conservative: "inside" takes |g|).
+struct PatchGrad {
+    double gx[4], gy[4], g1[4], norm[4];
+};
+inline PatchGrad patch_grad(const Terrain &t, int i, int j)
 {
-    const Terrain &t = *c.t;
     double h00 = t.at(i, j), h10 = t.at(i + 1, j), h01 = t.at(i, j + 1), h11 = t.at(i + 1, j + 1);
     double a = h10 - h00, b = h01 - h00, cc = h11 - h10 - h01 + h00;
-    double best = -INF;
+    PatchGrad g;
     for (int v = 0; v < 2; ++v)
         for (int u = 0; u < 2; ++u) {
-            // gx, gy: integers below 2^18, exact; g1 = |gx| + |gy| >= |g|
-            // widens the tolerances (conservative: "inside" takes |g|)
-            double gx = a + cc * v, gy = b + cc * u, m;
-            double g1 = std::fabs(gx) + std::fabs(gy);
-            bool inside = c.wedge.n == 1;
-            if (!inside) {
-                double c0 = c.wedge.ux[s] * gy - c.wedge.uy[s] * gx;
-                double c1 = gx * c.wedge.uy[s + 1] - gy * c.wedge.ux[s + 1];
-                inside = c0 >= -1e-12 * g1 && c1 >= -1e-12 * g1;
-            }
-            if (inside) {
-                m = std::sqrt(gx * gx + gy * gy);
-            } else {
-                m = std::max(gx * c.wedge.ux[s] + gy * c.wedge.uy[s], gx * c.wedge.ux[s + 1] + gy * c.wedge.uy[s + 1]);
-            }
-            best = std::max(best, m + 1e-9 * (g1 + 1.0));
+            const int k = 2 * v + u;
+            g.gx[k] = a + cc * v;
+            g.gy[k] = b + cc * u;
+            g.g1[k] = std::fabs(g.gx[k]) + std::fabs(g.gy[k]);
+            g.norm[k] = std::sqrt(g.gx[k] * g.gx[k] + g.gy[k] * g.gy[k]);
         }
+    return g;
+}
+
+// Max over u in W_s of the directional derivative of a patch (LSB per cell).
+inline double max_slope(const Ctx &c, int s, const PatchGrad &g)
+{
+    double best = -INF;
+    for (int k = 0; k < 4; ++k) {
+        const double gx = g.gx[k], gy = g.gy[k], g1 = g.g1[k];
+        double m;
+        bool inside = c.wedge.n == 1;
+        if (!inside) {
+            double c0 = c.wedge.ux[s] * gy - c.wedge.uy[s] * gx;
+            double c1 = gx * c.wedge.uy[s + 1] - gy * c.wedge.ux[s + 1];
+            inside = c0 >= -1e-12 * g1 && c1 >= -1e-12 * g1;
+        }
+        if (inside) {
+            m = g.norm[k];
+        } else {
+            m = std::max(gx * c.wedge.ux[s] + gy * c.wedge.uy[s], gx * c.wedge.ux[s + 1] + gy * c.wedge.uy[s + 1]);
+        }
+        best = std::max(best, m + 1e-9 * (g1 + 1.0));
+    }
     return best;
 }
+inline double max_slope(const Ctx &c, int s, int i, int j) { return max_slope(c, s, patch_grad(*c.t, i, j)); }
 
 
 inline Rect block_rect(const Ctx &c, int l, int bi, int bj, int fx0, int fx1, int fy0, int fy1)

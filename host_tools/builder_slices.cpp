@@ -208,6 +208,11 @@ void slice_angles(const Ctx &c, const SliceInput &in, uint8_t *codes, SliceStats
         return out;
     };
     const MergedList mnear = merge(wnear), mfine = merge(wfine), mcoarse = merge(win);
+    // 1 / rho of the coarse window's offsets: a product instead of a
+    // division per term (within an ulp of the quotient, far inside
+    // code_for's margin)
+    std::vector<double> inv_rho(mcoarse.rhos.size());
+    for (size_t e = 0; e < inv_rho.size(); ++e) inv_rho[e] = 1.0 / mcoarse.rhos[e];
     {
         std::atomic<int> next{0};
         // the fine window's three largest terms per sector (value, cell),
@@ -244,7 +249,20 @@ void slice_angles(const Ctx &c, const SliceInput &in, uint8_t *codes, SliceStats
             if (gx < 0 || gy < 0 || gx >= RING_SIDE || gy >= RING_SIDE) throw Error("slice builder: fine ring offset");
             fine_group[m] = (uint8_t)(gy * RING_SIDE + gx);
         }
+        // the coarse window per sector, by increasing rho (for r > 1)
+        struct SecOffset {
+            int dx, dy;
+            double inv_rho;
+        };
+        std::vector<std::vector<SecOffset>> by_sector((size_t)c.n);
+        for (const Merged &o : mcoarse.offs)
+            for (size_t e = o.first; e < o.first + o.count; ++e)
+                by_sector[(size_t)mcoarse.secs[e]].push_back(SecOffset{o.dx, o.dy, inv_rho[e]});
+        for (auto &l : by_sector)
+            std::stable_sort(l.begin(), l.end(),
+                             [](const SecOffset &x, const SecOffset &y) { return x.inv_rho > y.inv_rho; });
         auto worker = [&]() {
+            std::vector<uint16_t> colmax((size_t)wc), winmax((size_t)wc);
             bool alive[RING_GROUPS];
             std::vector<double> need((size_t)c.n);
             std::vector<Top> top((size_t)c.n);
@@ -256,6 +274,19 @@ void slice_angles(const Ctx &c, const SliceInput &in, uint8_t *codes, SliceStats
             for (;;) {
                 int cj = next.fetch_add(1);
                 if (cj >= hc) break;
+                if (r > 1) {  // the window's max height around each cell of the row
+                    const int rww = std::max(rw, FINE_RING);
+                    std::fill(colmax.begin(), colmax.end(), (uint16_t)0);
+                    for (int gj = std::max(0, cj - rww); gj <= std::min(hc - 1, cj + rww); ++gj)
+                        for (int gi = 0; gi < wc; ++gi)
+                            colmax[(size_t)gi] = std::max(colmax[(size_t)gi], hcm[(size_t)gj * wc + gi]);
+                    for (int ci = 0; ci < wc; ++ci) {
+                        uint16_t m = 0;
+                        for (int gi = std::max(0, ci - rww); gi <= std::min(wc - 1, ci + rww); ++gi)
+                            m = std::max(m, colmax[(size_t)gi]);
+                        winmax[(size_t)ci] = m;
+                    }
+                }
                 for (int ci = 0; ci < wc; ++ci) {
                     size_t f = (size_t)cj * wc + ci;
                     double a = apex_of(f);
@@ -270,9 +301,10 @@ void slice_angles(const Ctx &c, const SliceInput &in, uint8_t *codes, SliceStats
                     for (const Merged &o : mnear.offs) {
                         int qi = fx0 + o.dx, qj = fy0 + o.dy;
                         if (qi < 0 || qj < 0 || qi >= c.cx || qj >= c.cy) continue;
+                        const PatchGrad g = patch_grad(*c.t, qi, qj);
                         for (size_t e = o.first; e < o.first + o.count; ++e) {
                             int s = mnear.secs[e];
-                            need[(size_t)s] = std::max(need[(size_t)s], max_slope(c, s, qi, qj));
+                            need[(size_t)s] = std::max(need[(size_t)s], max_slope(c, s, g));
                         }
                     }
                     for (size_t m = 0; m < mfine.offs.size(); ++m) {
@@ -285,19 +317,30 @@ void slice_angles(const Ctx &c, const SliceInput &in, uint8_t *codes, SliceStats
                         for (size_t e = o.first; e < o.first + o.count; ++e)
                             top[(size_t)mfine.secs[e]].add(rise / mfine.rhos[e], qi, qj);
                     }
-                    for (const Merged &o : mcoarse.offs) {
-                        int gi = ci + o.dx, gj = cj + o.dy;
-                        if (gi < 0 || gj < 0 || gi >= wc || gj >= hc) continue;
-                        double rise = hcm[(size_t)gj * wc + gi] - a;
-                        if (rise <= 0.0) continue;
-                        if (r == 1) {  // a coarse cell is a fine cell: refinable too
+                    if (r == 1) {  // a coarse cell is a fine cell: refinable too
+                        for (const Merged &o : mcoarse.offs) {
+                            int gi = ci + o.dx, gj = cj + o.dy;
+                            if (gi < 0 || gj < 0 || gi >= wc || gj >= hc) continue;
+                            double rise = hcm[(size_t)gj * wc + gi] - a;
+                            if (rise <= 0.0) continue;
                             for (size_t e = o.first; e < o.first + o.count; ++e)
                                 top[(size_t)mcoarse.secs[e]].add(rise / mcoarse.rhos[e], gi, gj);
-                        } else {
-                            for (size_t e = o.first; e < o.first + o.count; ++e) {
-                                double &nd = need[(size_t)mcoarse.secs[e]];
-                                nd = std::max(nd, rise / mcoarse.rhos[e]);
+                        }
+                    } else if (winmax[(size_t)ci] > a) {
+                        // per sector, nearest offsets first; no term beyond
+                        // rho can exceed (window max - a) / rho, so stop once
+                        // that is no more than what the sector needs already
+                        const double hw = winmax[(size_t)ci] - a;
+                        for (int s = 0; s < c.n; ++s) {
+                            double nd = need[(size_t)s];
+                            for (const SecOffset &o : by_sector[(size_t)s]) {
+                                if (hw * o.inv_rho <= nd) break;
+                                int gi = ci + o.dx, gj = cj + o.dy;
+                                if (gi < 0 || gj < 0 || gi >= wc || gj >= hc) continue;
+                                double rise = hcm[(size_t)gj * wc + gi] - a;
+                                if (rise > 0.0) nd = std::max(nd, rise * o.inv_rho);
                             }
+                            need[(size_t)s] = nd;
                         }
                     }
                     const int fx1 = std::min(fx0 + r, c.cx), fy1 = std::min(fy0 + r, c.cy);
