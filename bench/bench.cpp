@@ -233,17 +233,7 @@ int main(int argc, char **argv)
     else
         bench_dem("jacksboro_fault_dem (fixture)", t, n, {1, 3}, {B::Slices, B::Brute});
     if (big && !quick) {
-        // mirror-tile the fixture to 2048 x 2048
-        ct_host::Terrain b = t;
-        b.width = b.height = 2048;
-        b.codes.resize((size_t)2048 * 2048);
-        for (int j = 0; j < 2048; ++j)
-            for (int i = 0; i < 2048; ++i) {
-                int pi = i % (2 * t.width), pj = j % (2 * t.height);
-                if (pi >= t.width) pi = 2 * t.width - 1 - pi;
-                if (pj >= t.height) pj = 2 * t.height - 1 - pj;
-                b.codes[(size_t)j * 2048 + i] = t.at(pi, pj);
-            }
+        const ct_host::Terrain b = dem_cases::mirror_tiled(t, 2048, 2048);
         if (brute_big)
             bench_dem("jacksboro mirror-tiled", b, n, {3}, {B::Slices, B::Brute});
         else

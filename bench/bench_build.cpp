@@ -26,19 +26,12 @@
 
 #include "conetrace.h"
 #include "dem_cases.hpp"
+#include "host_io.hpp"
 #include "terrain.hpp"
 
 namespace {
 
-double status_kib(const char *key)
-{
-    std::ifstream f("/proc/self/status");
-    std::string line;
-    size_t n = std::strlen(key);
-    while (std::getline(f, line))
-        if (line.compare(0, n, key) == 0 && line.size() > n && line[n] == ':') return std::atof(line.c_str() + n + 1);
-    return 0.0;
-}
+using ct_host::proc_status_kib;
 
 struct Result {
     double seconds = -1, work_bytes = 0, file_bytes = 0, local_s = 0, dt_s = 0;
@@ -67,30 +60,22 @@ Result build_in_child(const ct_host::Terrain &t, ct_host::PptBuilder b, int r, i
         // runs are resident before the measurement (they are not working
         // memory); RssFile's growth during the measured build is reported
         {
-            ct_host::Terrain tiny = t;
-            tiny.width = tiny.height = 64;
-            tiny.codes.assign((size_t)64 * 64, 0);
-            tiny.void_post.clear();
-            for (int j = 0; j < 64; ++j)
-                for (int i = 0; i < 64; ++i) tiny.codes[(size_t)j * 64 + i] = t.at(i % t.width, j % t.height);
+            const ct_host::Terrain tiny = dem_cases::mirror_tiled(t, 64, 64);
             const std::string wpath = "/tmp/ct_bench_build_warm." + std::to_string((long)getpid()) + ".ctp";
             ct_host::BuildOptions wo = o;
             wo.full_dt_rows = 1.0;  // the full-DT path too
             ct_host::build_package_file(tiny, wo, wpath);
             std::remove(wpath.c_str());
         }
-        double rss0 = status_kib("VmRSS") * 1024.0, file0 = status_kib("RssFile") * 1024.0;
-        {
-            std::ofstream cr("/proc/self/clear_refs");
-            cr << "5";
-        }
+        double rss0 = proc_status_kib("VmRSS") * 1024.0, file0 = proc_status_kib("RssFile") * 1024.0;
+        ct_host::reset_peak_rss();
         ct_host::BuildStats st;
         auto t0 = std::chrono::steady_clock::now();
         const std::string path = "/tmp/ct_bench_build." + std::to_string((long)getpid()) + ".ctp";
         ct_host::build_package_file(t, o, path, &st);
         out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        out.work_bytes = status_kib("VmHWM") * 1024.0 - rss0;
-        out.file_bytes = status_kib("RssFile") * 1024.0 - file0;
+        out.work_bytes = proc_status_kib("VmHWM") * 1024.0 - rss0;
+        out.file_bytes = proc_status_kib("RssFile") * 1024.0 - file0;
         std::remove(path.c_str());
         out.bytes = st.bytes;
         out.degenerate = st.degenerate_cones;
@@ -171,16 +156,7 @@ int main(int argc, char **argv)
         row("fixture 403x344", t, B::Brute, r, slices);
     }
     if (!quick) {
-        ct_host::Terrain big = t;
-        big.width = big.height = 2048;
-        big.codes.resize((size_t)2048 * 2048);
-        for (int j = 0; j < 2048; ++j)
-            for (int i = 0; i < 2048; ++i) {
-                int pi = i % (2 * t.width), pj = j % (2 * t.height);
-                if (pi >= t.width) pi = 2 * t.width - 1 - pi;
-                if (pj >= t.height) pj = 2 * t.height - 1 - pj;
-                big.codes[(size_t)j * 2048 + i] = t.at(pi, pj);
-            }
+        const ct_host::Terrain big = dem_cases::mirror_tiled(t, 2048, 2048);
         for (int r : {3, 1}) {
             if (big_r && r != big_r) continue;
             row("mirror-tiled 2048x2048", big, B::Slices, r, slices);

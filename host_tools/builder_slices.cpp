@@ -208,11 +208,6 @@ void slice_angles(const Ctx &c, const SliceInput &in, uint8_t *codes, SliceStats
         return out;
     };
     const MergedList mnear = merge(wnear), mfine = merge(wfine), mcoarse = merge(win);
-    // 1 / rho of the coarse window's offsets: a product instead of a
-    // division per term (within an ulp of the quotient, far inside
-    // code_for's margin)
-    std::vector<double> inv_rho(mcoarse.rhos.size());
-    for (size_t e = 0; e < inv_rho.size(); ++e) inv_rho[e] = 1.0 / mcoarse.rhos[e];
     {
         std::atomic<int> next{0};
         // the fine window's three largest terms per sector (value, cell),
@@ -249,7 +244,9 @@ void slice_angles(const Ctx &c, const SliceInput &in, uint8_t *codes, SliceStats
             if (gx < 0 || gy < 0 || gx >= RING_SIDE || gy >= RING_SIDE) throw Error("slice builder: fine ring offset");
             fine_group[m] = (uint8_t)(gy * RING_SIDE + gx);
         }
-        // the coarse window per sector, by increasing rho (for r > 1)
+        // the coarse window per sector, by increasing rho (for r > 1), with
+        // 1 / rho: a product instead of a division per term (within an ulp
+        // of the quotient, far inside code_for's margin)
         struct SecOffset {
             int dx, dy;
             double inv_rho;
@@ -257,7 +254,7 @@ void slice_angles(const Ctx &c, const SliceInput &in, uint8_t *codes, SliceStats
         std::vector<std::vector<SecOffset>> by_sector((size_t)c.n);
         for (const Merged &o : mcoarse.offs)
             for (size_t e = o.first; e < o.first + o.count; ++e)
-                by_sector[(size_t)mcoarse.secs[e]].push_back(SecOffset{o.dx, o.dy, inv_rho[e]});
+                by_sector[(size_t)mcoarse.secs[e]].push_back(SecOffset{o.dx, o.dy, 1.0 / mcoarse.rhos[e]});
         for (auto &l : by_sector)
             std::stable_sort(l.begin(), l.end(),
                              [](const SecOffset &x, const SecOffset &y) { return x.inv_rho > y.inv_rho; });
@@ -402,8 +399,7 @@ void slice_angles(const Ctx &c, const SliceInput &in, uint8_t *codes, SliceStats
     for (int s = 0; s < c.n; ++s) pieces[(size_t)s] = widened_pieces(c, s, delta);
     int kmin = K;
     for (uint16_t v : k0) kmin = std::min(kmin, (int)v);
-    std::vector<size_t> narrowed((size_t)nthreads, 0), skipped((size_t)nthreads, 0), queries((size_t)nthreads, 0),
-        full((size_t)nthreads, 0);
+    std::vector<size_t> narrowed((size_t)nthreads, 0), queries((size_t)nthreads, 0), full((size_t)nthreads, 0);
     std::vector<uint64_t> rows((size_t)nthreads, 0);
     struct Scratch {  // a full DT's arrays per thread, allocated on first use
         std::vector<int64_t> dt, dmin;
@@ -505,7 +501,6 @@ void slice_angles(const Ctx &c, const SliceInput &in, uint8_t *codes, SliceStats
                         }
                     }
                 }
-                if (nq == 0 && !dtf) skipped[(size_t)tid]++;
                 went_full[(size_t)s] = dtf != nullptr;
                 queries[(size_t)tid] += nq;
                 rows[(size_t)tid] += q.rows_visited();
@@ -519,7 +514,6 @@ void slice_angles(const Ctx &c, const SliceInput &in, uint8_t *codes, SliceStats
     if (st) {
         auto t_end = std::chrono::steady_clock::now();
         for (size_t v : narrowed) st->far_narrowed += v;
-        for (size_t v : skipped) st->dts_skipped += v;
         for (size_t v : queries) st->queries += v;
         for (size_t v : full) st->full_dts += v;
         for (uint64_t v : rows) st->query_rows += v;

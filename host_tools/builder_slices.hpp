@@ -28,7 +28,6 @@ struct SliceInput {
 struct SliceStats {
     int slices = 0;           // slices transformed (non-empty cross-sections)
     size_t far_narrowed = 0;  // (cell, sector) codes narrowed by a far (DT) term
-    size_t dts_skipped = 0;   // (slice, sector) pairs where no cone could narrow: no query
     size_t queries = 0;       // capped directional DT queries (cell, slice, sector)
     uint64_t query_rows = 0;  // rows those queries visited
     size_t full_dts = 0;      // (slice, sector) pairs finished with a full line-traversal DT

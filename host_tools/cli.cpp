@@ -131,23 +131,6 @@ Terrain load_terrain(const std::string &path, double posting, double hscale)
     }
 }
 
-// A field of /proc/self/status in KiB (0 when unavailable).
-double proc_status_kib(const char *key)
-{
-    std::ifstream f("/proc/self/status");
-    std::string line;
-    size_t n = std::strlen(key);
-    while (std::getline(f, line))
-        if (line.compare(0, n, key) == 0 && line.size() > n && line[n] == ':') return std::atof(line.c_str() + n + 1);
-    return 0.0;
-}
-// Reset VmHWM to the current resident size (Linux >= 4.0; harmless elsewhere).
-void reset_peak_rss()
-{
-    std::ofstream f("/proc/self/clear_refs");
-    f << "5";
-}
-
 int cmd_build(int argc, char **argv)
 {
     Args a = parse(argc, argv, 2,

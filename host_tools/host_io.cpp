@@ -26,19 +26,66 @@ std::vector<uint8_t> read_file(const std::string &path)
     return b;
 }
 
+AtomicFile::AtomicFile(const std::string &path) : path_(path), tmp_(path + ".tmp." + std::to_string((long)getpid()))
+{
+    f_ = std::fopen(tmp_.c_str(), "wb");
+    if (!f_) fail(errno);
+}
+
+AtomicFile::~AtomicFile()
+{
+    if (f_) std::fclose(f_);
+    if (!done_) std::remove(tmp_.c_str());
+}
+
+void AtomicFile::fail(int err) const { throw Error(path_ + ": cannot write (" + std::strerror(err) + ")"); }
+
+void AtomicFile::write(const void *p, size_t n)
+{
+    if (std::fwrite(p, 1, n, f_) != n) fail(errno);
+}
+
+void AtomicFile::patch(size_t offset, const void *p, size_t n)
+{
+    const long here = std::ftell(f_);
+    if (here < 0 || std::fseek(f_, (long)offset, SEEK_SET) != 0 || std::fwrite(p, 1, n, f_) != n ||
+        std::fseek(f_, here, SEEK_SET) != 0)
+        fail(errno);
+}
+
+void AtomicFile::commit()
+{
+    bool ok = std::fflush(f_) == 0;
+    int e = errno;
+    ok = std::fclose(f_) == 0 && ok;
+    if (ok) e = errno;
+    f_ = nullptr;
+    if (!ok) fail(e);
+    if (std::rename(tmp_.c_str(), path_.c_str()) != 0) fail(errno);
+    done_ = true;
+}
+
 void write_file_atomic(const std::string &path, const std::vector<uint8_t> &bytes)
 {
-    std::string tmp = path + ".tmp." + std::to_string((long)getpid());
-    std::FILE *f = std::fopen(tmp.c_str(), "wb");
-    if (!f) throw Error(path + ": cannot write (" + std::strerror(errno) + ")");
-    bool ok = std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size();
-    ok = (std::fflush(f) == 0) && ok;
-    ok = (std::fclose(f) == 0) && ok;
-    if (!ok || std::rename(tmp.c_str(), path.c_str()) != 0) {
-        int e = errno;
-        std::remove(tmp.c_str());
-        throw Error(path + ": cannot write (" + std::strerror(e) + ")");
-    }
+    AtomicFile f(path);
+    f.write(bytes.data(), bytes.size());
+    f.commit();
+}
+
+double proc_status_kib(const char *key)
+{
+    std::ifstream f("/proc/self/status");
+    std::string line;
+    const size_t n = std::strlen(key);
+    while (std::getline(f, line))
+        if (line.compare(0, n, key) == 0 && line.size() > n && line[n] == ':') return std::atof(line.c_str() + n + 1);
+    return 0.0;
+}
+
+void reset_peak_rss()
+{
+    std::ofstream f("/proc/self/clear_refs");
+    f << "5";
 }
 
 std::string status_name(ct_status s)

@@ -3,6 +3,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -13,8 +14,34 @@ namespace ct_host {
 
 // Whole-file read; throws Error("<path>: <reason>").
 std::vector<uint8_t> read_file(const std::string &path);
-// Write to "<path>.tmp.<pid>" then rename: never a partial output file.
+
+// An output file written atomically: bytes go to "<path>.tmp.<pid>", which
+// commit() renames to path; destroyed without commit() (an error on the
+// way), the temporary is removed.  Never a partial output file.  Every
+// failure throws Error("<path>: cannot write (<reason>)").
+class AtomicFile {
+public:
+    explicit AtomicFile(const std::string &path);
+    ~AtomicFile();
+    AtomicFile(const AtomicFile &) = delete;
+    AtomicFile &operator=(const AtomicFile &) = delete;
+    void write(const void *p, size_t n);
+    void patch(size_t offset, const void *p, size_t n);  // overwrite bytes already written
+    void commit();
+
+private:
+    [[noreturn]] void fail(int err) const;
+    std::string path_, tmp_;
+    std::FILE *f_ = nullptr;
+    bool done_ = false;
+};
+// The whole file at once, through AtomicFile.
 void write_file_atomic(const std::string &path, const std::vector<uint8_t> &bytes);
+
+// A field of /proc/self/status in KiB (0 when unavailable), e.g. "VmHWM".
+double proc_status_kib(const char *key);
+// Reset VmHWM to the current resident size (Linux >= 4.0; harmless elsewhere).
+void reset_peak_rss();
 
 std::string status_name(ct_status s);
 

@@ -9,18 +9,16 @@
 // DEM, the mipmap level by level before the cones are built, the voids in
 // chunks: none of them is held whole while the angle planes are.
 #include <algorithm>
-#include <cerrno>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
 #include <cstring>
 #include <sstream>
 #include <thread>
-#include <unistd.h>
 
 #include "builder_common.hpp"
 #include "builder_slices.hpp"
 #include "conetrace.h"
+#include "host_io.hpp"
 #include "terrain.hpp"
 
 namespace ct_host {
@@ -123,38 +121,12 @@ private:
 
 class FileSink : public PackageSink {
 public:
-    FileSink(const std::string &path, const std::string &tmp) : path_(path), tmp_(tmp)
-    {
-        f_ = std::fopen(tmp.c_str(), "wb");
-        if (!f_) fail();
-    }
-    ~FileSink() override
-    {
-        if (f_) std::fclose(f_);
-        if (!done_) std::remove(tmp_.c_str());
-    }
-    void write(const uint8_t *p, size_t n) override
-    {
-        if (std::fwrite(p, 1, n, f_) != n) fail();
-    }
-    void patch(size_t off, const uint8_t *p, size_t n) override
-    {
-        if (std::fseek(f_, (long)off, SEEK_SET) != 0 || std::fwrite(p, 1, n, f_) != n) fail();
-    }
-    void commit()
-    {
-        bool ok = std::fflush(f_) == 0;
-        ok = std::fclose(f_) == 0 && ok;
-        f_ = nullptr;
-        if (!ok || std::rename(tmp_.c_str(), path_.c_str()) != 0) fail();
-        done_ = true;
-    }
+    explicit FileSink(AtomicFile &f) : f_(f) {}
+    void write(const uint8_t *p, size_t n) override { f_.write(p, n); }
+    void patch(size_t off, const uint8_t *p, size_t n) override { f_.patch(off, p, n); }
 
 private:
-    [[noreturn]] void fail() { throw Error(path_ + ": cannot write (" + std::strerror(errno) + ")"); }
-    std::string path_, tmp_;
-    std::FILE *f_ = nullptr;
-    bool done_ = false;
+    AtomicFile &f_;
 };
 
 }  // namespace
@@ -275,7 +247,7 @@ void build_package_to(const Terrain &t, const BuildOptions &opt, PackageSink &si
     // the N sector planes; the omnidirectional plane (N > 1) is made while
     // it is written
     std::vector<uint8_t> codes(plane * (size_t)c.n, 0);
-    std::vector<uint16_t> apex_out;  // brute force: apex codes; slices: apex levels k0
+    std::vector<uint16_t> apex;  // per coarse cell: apex height code
     {
         // coarse heights: the tallest post of the coarse cell's fine cells
         std::vector<uint16_t> hcm(plane, 0);
@@ -285,8 +257,7 @@ void build_package_to(const Terrain &t, const BuildOptions &opt, PackageSink &si
                 d = std::max(d, fine_max(t, i, j));
             }
         if (opt.builder == PptBuilder::Slices) {
-            std::vector<uint16_t> &k0 = apex_out;  // < lv.size() <= 65536
-            k0.resize(plane);
+            std::vector<uint16_t> k0(plane);  // apex levels, < lv.size() <= 65536
             // the paper's apex: the lowest level not below the cell's top
             // (measured: 7% fewer steps than exact apexes with K = 64)
             for (size_t f = 0; f < plane; ++f)
@@ -301,19 +272,19 @@ void build_package_to(const Terrain &t, const BuildOptions &opt, PackageSink &si
             in.progress = opt.progress;
             SliceStats sst;
             slice_angles(c, in, codes.data(), &sst);
+            apex.resize(plane);
+            for (size_t f = 0; f < plane; ++f) apex[f] = (uint16_t)lv[k0[f]];
             if (stats) {
                 stats->slices = (int)lv.size() - 1;
                 stats->slices_transformed = sst.slices;
                 stats->seconds_local = sst.seconds_local;
                 stats->far_narrowed = sst.far_narrowed;
-                stats->dts_skipped = sst.dts_skipped;
                 stats->dt_queries = sst.queries;
                 stats->dt_query_rows = sst.query_rows;
                 stats->full_dts = sst.full_dts;
                 stats->seconds_dt = sst.seconds_dt;
             }
         } else {
-            std::vector<uint16_t> &apex = apex_out;
             apex.swap(hcm);
             if (opt.slices > 0 && hmax > hmin) {
                 for (uint16_t &am : apex) {
@@ -340,8 +311,7 @@ void build_package_to(const Terrain &t, const BuildOptions &opt, PackageSink &si
 
     // ---- apexes, angles, voids
     w.pad_to(so[CT_SEC_APEX]);
-    for (size_t f = 0; f < plane; ++f)
-        w.u16(opt.builder == PptBuilder::Slices ? (uint32_t)lv[apex_out[f]] : (uint32_t)apex_out[f]);
+    for (uint16_t v : apex) w.u16(v);
     w.pad_to(so[CT_SEC_ANGLES]);
     w.bytes(codes.data(), codes.size());
     if (c.n > 1) {
@@ -388,9 +358,10 @@ std::vector<uint8_t> build_package(const Terrain &t, const BuildOptions &opt, Bu
 
 void build_package_file(const Terrain &t, const BuildOptions &opt, const std::string &path, BuildStats *stats)
 {
-    FileSink s(path, path + ".tmp." + std::to_string((long)getpid()));
+    AtomicFile f(path);
+    FileSink s(f);
     build_package_to(t, opt, s, stats);
-    s.commit();
+    f.commit();
 }
 
 }  // namespace ct_host

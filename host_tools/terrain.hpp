@@ -64,7 +64,6 @@ struct BuildStats {
     int slices = 0;                // Slices: levels K used / slices transformed
     int slices_transformed = 0;
     size_t far_narrowed = 0;       // Slices: codes narrowed by a far (DT) term
-    size_t dts_skipped = 0;        // Slices: (slice, sector) pairs where no cone could narrow
     size_t dt_queries = 0;         // Slices: capped directional DT queries (cell, slice, sector)
     uint64_t dt_query_rows = 0;    // Slices: rows those queries visited
     size_t full_dts = 0;           // Slices: (slice, sector) pairs finished with a full DT

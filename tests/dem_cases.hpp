@@ -141,6 +141,47 @@ inline std::vector<Case> adversarial_cases()
 std::vector<Case> real_cases();
 ct_host::Terrain real_terrain();
 
+// grid <-> map in long double, from a package's exact nm georeference
+struct Geo {
+    long double e0, n0, pe, pn, off, sc;
+    explicit Geo(const ct_package &p)
+        : e0(p.origin_e_nm * 1e-9L), n0(p.origin_n_nm * 1e-9L), pe(p.posting_e_nm * 1e-9L),
+          pn(p.posting_n_nm * 1e-9L), off(p.height_offset_nm * 1e-9L), sc(p.height_scale_nm * 1e-9L)
+    {
+    }
+    void to_map(long double x, long double y, long double z, long double m[3]) const
+    {
+        m[0] = e0 + (x + 0.5L) * pe;
+        m[1] = n0 + (y + 0.5L) * pn;
+        m[2] = off + z * sc;
+    }
+    void to_grid(const long double m[3], long double g[3]) const
+    {
+        g[0] = (m[0] - e0) / pe - 0.5L;
+        g[1] = (m[1] - n0) / pn - 0.5L;
+        g[2] = (m[2] - off) / sc;
+    }
+};
+
+// t mirror-tiled to w x h posts (every other copy flipped, so heights stay
+// continuous across the seams); the voids are dropped.
+inline ct_host::Terrain mirror_tiled(const ct_host::Terrain &t, int w, int h)
+{
+    ct_host::Terrain b = t;
+    b.width = w;
+    b.height = h;
+    b.codes.resize((size_t)w * h);
+    b.void_post.clear();
+    for (int j = 0; j < h; ++j)
+        for (int i = 0; i < w; ++i) {
+            int pi = i % (2 * t.width), pj = j % (2 * t.height);
+            if (pi >= t.width) pi = 2 * t.width - 1 - pi;
+            if (pj >= t.height) pj = 2 * t.height - 1 - pj;
+            b.codes[(size_t)j * w + i] = t.at(pi, pj);
+        }
+    return b;
+}
+
 // ---- ray families ---------------------------------------------------------
 
 enum Family {

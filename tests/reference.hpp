@@ -24,6 +24,21 @@ struct Dem {
     int32_t at(int i, int j) const { return z[(size_t)j * w + i]; }
 };
 
+// Narrows [*lo, *hi] to the t where (ox, oy) + t (dx, dy) lies in the box
+// [0, W] x [0, H]; false when the line misses the box (or *hi < *lo).
+inline bool clip_box(ld ox, ld oy, ld dx, ld dy, ld W, ld H, ld *lo, ld *hi)
+{
+    auto axis = [&](ld o, ld u, ld top) {
+        if (u == 0) return o >= 0 && o <= top;
+        ld a = (0 - o) / u, b = (top - o) / u;
+        if (a > b) std::swap(a, b);
+        *lo = std::max(*lo, a);
+        *hi = std::min(*hi, b);
+        return true;
+    };
+    return axis(ox, dx, W) && axis(oy, dy, H) && *hi >= *lo;
+}
+
 struct Ray {
     ld ox, oy, oz;  // cells, cells, LSB
     ld dx, dy, dz;  // per unit t

@@ -209,41 +209,10 @@ inline ct_host::Terrain load_terrain(const Scene &s)
     ct_host::DemRaster r = ct_host::read_dem(p);
     ct_host::Terrain t = ct_host::terrain_from_heights(r.width, r.height, r.h, r.valid, r.geo, 0.0);
     if (s.tile_x == 1 && s.tile_y == 1) return t;
-    ct_host::Terrain b = t;
-    b.width = t.width * s.tile_x;
-    b.height = t.height * s.tile_y;
-    b.codes.resize((size_t)b.width * b.height);
-    b.void_post.clear();
-    for (int j = 0; j < b.height; ++j)
-        for (int i = 0; i < b.width; ++i) {
-            int ti = i / t.width, tj = j / t.height, pi = i % t.width, pj = j % t.height;
-            if (ti & 1) pi = t.width - 1 - pi;
-            if (tj & 1) pj = t.height - 1 - pj;
-            b.codes[(size_t)j * b.width + i] = t.at(pi, pj);
-        }
-    return b;
+    return dem_cases::mirror_tiled(t, t.width * s.tile_x, t.height * s.tile_y);
 }
 
-struct Geo {
-    ld e0, n0, pe, pn, off, sc;
-    explicit Geo(const ct_package &p)
-        : e0(p.origin_e_nm * 1e-9L), n0(p.origin_n_nm * 1e-9L), pe(p.posting_e_nm * 1e-9L),
-          pn(p.posting_n_nm * 1e-9L), off(p.height_offset_nm * 1e-9L), sc(p.height_scale_nm * 1e-9L)
-    {
-    }
-    void to_map(ld x, ld y, ld z, ld m[3]) const
-    {
-        m[0] = e0 + (x + 0.5L) * pe;
-        m[1] = n0 + (y + 0.5L) * pn;
-        m[2] = off + z * sc;
-    }
-    void to_grid(const ld m[3], ld g[3]) const
-    {
-        g[0] = (m[0] - e0) / pe - 0.5L;
-        g[1] = (m[1] - n0) / pn - 0.5L;
-        g[2] = (m[2] - off) / sc;
-    }
-};
+using dem_cases::Geo;
 
 struct World {
     Scene s;
@@ -328,15 +297,7 @@ inline bool ref_ray(const World &w, const Geo &g, const ld C[3], const ld A[3], 
     ld dz = ag[2] - cg[2] - kz;
     const ld W = w.d.w - 1, H = w.d.h - 1;
     ld lo = 0, hi = 4;
-    auto axis = [&](ld o, ld u, ld top) {
-        if (u == 0) return o >= 0 && o <= top;
-        ld a = (0 - o) / u, b = (top - o) / u;
-        if (a > b) std::swap(a, b);
-        lo = std::max(lo, a);
-        hi = std::min(hi, b);
-        return true;
-    };
-    if (!axis(cg[0], dx, W) || !axis(cg[1], dy, H) || hi < lo) return false;
+    if (!ref::clip_box(cg[0], cg[1], dx, dy, W, H, &lo, &hi)) return false;
     ref::Ray r;
     r.ox = std::min(W, std::max<ld>(0, cg[0] + lo * dx));
     r.oy = std::min(H, std::max<ld>(0, cg[1] + lo * dy));

@@ -40,15 +40,7 @@ ld ref_t(const ref::Dem &d, ld ox, ld oy, ld oz, ld dx, ld dy, ld dz, ld kz, ld 
 {
     const ld W = d.w - 1, H = d.h - 1;
     ld lo = 0, hi = INFINITY;
-    auto axis = [&](ld o, ld u, ld top) {
-        if (u == 0) return o >= 0 && o <= top;
-        ld a = (0 - o) / u, b = (top - o) / u;
-        if (a > b) std::swap(a, b);
-        lo = std::max(lo, a);
-        hi = std::min(hi, b);
-        return true;
-    };
-    if (!axis(ox, dx, W) || !axis(oy, dy, H) || hi < lo) return INFINITY;
+    if (!ref::clip_box(ox, oy, dx, dy, W, H, &lo, &hi)) return INFINITY;
     ref::Ray r;
     // the entry point, kept on the tile against rounding (so the
     // reference's start-point test applies to it)

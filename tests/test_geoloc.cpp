@@ -70,27 +70,7 @@ World *world()
     return w;
 }
 
-// grid <-> map in long double, from the package's exact nm georeference
-struct Geo {
-    ld e0, n0, pe, pn, off, sc;
-    explicit Geo(const ct_package &p)
-        : e0(p.origin_e_nm * 1e-9L), n0(p.origin_n_nm * 1e-9L), pe(p.posting_e_nm * 1e-9L),
-          pn(p.posting_n_nm * 1e-9L), off(p.height_offset_nm * 1e-9L), sc(p.height_scale_nm * 1e-9L)
-    {
-    }
-    void to_map(ld x, ld y, ld z, ld m[3]) const
-    {
-        m[0] = e0 + (x + 0.5L) * pe;
-        m[1] = n0 + (y + 0.5L) * pn;
-        m[2] = off + z * sc;
-    }
-    void to_grid(const ld m[3], ld g[3]) const
-    {
-        g[0] = (m[0] - e0) / pe - 0.5L;
-        g[1] = (m[1] - n0) / pn - 0.5L;
-        g[2] = (m[2] - off) / sc;
-    }
-};
+using dem_cases::Geo;
 
 // quaternion (w, x, y, z) helpers: rotations are composed here and turned
 // into Rodrigues vectors directly (atan2, well conditioned at pi), never by
