@@ -159,9 +159,16 @@ struct CanonDist {
     typename D::value_type operator()(int64_t ax, int64_t ay) const { return kT ? d(ay, ax) : d(ax, ay); }
 };
 
+// A list entry: a feature of row r at column col with its keys (V1 - c1*k
+// and V2 - c2*k, see ddt.hpp).  A feature pixel on the line itself (q0) also
+// carries its row's secondary, the first feature after it (column scol, key1
+// skey1; kNoKey: none or not needed): the row's candidate for the pixels
+// where q0 lies left of the wedge (key2 < psi(Y)); a secondary is always on
+// the valid side of the left boundary.
+constexpr int64_t kNoKey = std::numeric_limits<int64_t>::max();
 struct Cand {
-    int32_t r, col;      // canonical row and column of the feature
-    int64_t key1, key2;  // V1 - c1*k and V2 - c2*k (see ddt.hpp)
+    int32_t r, col, scol;
+    int64_t key1, key2, skey1;
 };
 struct Node {
     Cand c;
@@ -199,6 +206,8 @@ public:
         tau_ = (double)f.c1 * (double)f.c2 / (double)x12;
         kmax_ = f.Wc - 1;
         kmin_ = -L_[(size_t)Hc - 1];
+        for (const Row &w : rows_)
+            sec_ = sec_ || w.psi != rows_[0].psi;
     }
 
     int64_t line_count() const { return kmax_ - kmin_ + 1; }
@@ -213,8 +222,12 @@ public:
         for (int64_t ch = tid; ch < nchunks; ch += nth) {
             const int64_t hi = kmax_ - ch * kLineChunk;
             const int64_t lo = std::max(kmin_, hi - kLineChunk + 1);
-            for (int64_t k = hi; k >= lo; --k)
-                line(k, st);
+            for (int64_t k = hi; k >= lo; --k) {
+                if (sec_)
+                    line<true>(k, st);
+                else
+                    line<false>(k, st);
+            }
         }
     }
 
@@ -236,6 +249,7 @@ private:
     std::vector<V> lb_;  // lb_[dy] = D(L(dy), dy): no candidate dy rows deeper is nearer (rule 1)
     double tau_ = 0.0;
     int64_t kmax_ = 0, kmin_ = 0;
+    bool sec_ = false;  // psi varies along a line (non-integer slope): secondaries exist
     // per-thread scratch (one Kernel per thread); a line creates at most two
     // candidates per pixel, so pool and list never exceed 2 * Hc entries
     std::vector<int32_t> head_;
@@ -260,6 +274,7 @@ private:
     // One rasterized line k, bottom to top.  The hot state lives in locals
     // (the list, the pool, the current row's rule-2 thresholds) so that the
     // compiler keeps it in registers across the list's stores.
+    template <bool kSec>
     void line(int64_t k, Stats &st)
     {
         const int Wc = f_.Wc, Hc = f_.Hc;
@@ -282,18 +297,30 @@ private:
         size_t ln = 0, pn = 0;  // used entries of list and pool
         int64_t pmn = 0, psx = 0;  // phimin, psimax of the current row
 
+        // Rule 2.  E covers one part of an older entry A (column ca, keys ka,
+        // kb; kb = kNoKey for a secondary) when, at every row still to come
+        // where that part is A's candidate and valid, E's candidate is valid
+        // and no farther right: E.col <= ca, E.key1 <= max(ka, pmn) (so E is
+        // valid on the right wherever the part is), and either E.key2 >=
+        // min(kb, psx) (E stays valid on the left there) or E's secondary
+        // qualifies too (it takes over where E's q0 falls out on the left).
+        // The rows still to come are <= Y: pmn <= phi and psx >= psi there.
+        auto covers_part = [&](const Cand &e, int64_t ca, int64_t ka, int64_t kb) __attribute__((always_inline)) {
+            const int64_t t1 = std::max(ka, pmn);
+            return e.col <= ca && e.key1 <= t1 &&
+                   (e.key2 >= std::min(kb, psx) || (kSec && e.scol <= ca && e.skey1 <= t1));
+        };
+        auto covers = [&](const Cand &e, const Cand &a) __attribute__((always_inline)) {
+            return covers_part(e, a.col, a.key1, a.key2) &&
+                   (!kSec || a.skey1 == kNoKey || covers_part(e, a.scol, a.skey1, kNoKey));
+        };
         // Insert a into the row-sorted list (top = back = newest row), rule 2.
-        // E covers A (E is in the sector whenever A is, at every row still to
-        // come): (E.key1 <= A.key1 or E.key1 <= pmn) and (E.key2 >= A.key2 or
-        // E.key2 >= psx), i.e. E.key1 <= max(A.key1, pmn), E.key2 >= min(A.key2, psx).
         auto insert = [&](const Cand &a) __attribute__((always_inline)) {
             size_t i = ln;
             if (rule2) {
-                const int64_t t1 = std::max(a.key1, pmn), t2 = std::min(a.key2, psx);
                 while (i > 0 && list[i - 1].r <= a.r) {  // newer (or same row): may dominate a
-                    const Cand &e = list[i - 1];
                     count(st.comparisons);
-                    if (e.col <= a.col && e.key1 <= t1 && e.key2 >= t2) {
+                    if (covers(list[i - 1], a)) {
                         count(st.dominated);
                         return;
                     }
@@ -305,16 +332,12 @@ private:
             }
             count(st.activated);
             size_t j = i;  // older entries a dominates: the run just below i
-            if (rule2) {
-                const bool k1 = a.key1 <= pmn, k2 = a.key2 >= psx;
-                while (j > 0) {
-                    const Cand &b = list[j - 1];
-                    count(st.comparisons);
-                    if (!(b.col >= a.col && (k1 || a.key1 <= b.key1) && (k2 || a.key2 >= b.key2)))
-                        break;
-                    --j;
-                    count(st.dominated);
-                }
+            while (rule2 && j > 0) {
+                count(st.comparisons);
+                if (!covers(a, list[j - 1]))
+                    break;
+                --j;
+                count(st.dominated);
             }
             if (i == ln) {  // the usual case: a is the newest
                 list[j] = a;
@@ -332,9 +355,12 @@ private:
 
         // A candidate of row Y (its own row) at column col, h = col - col(Y).
         auto create = [&](int Y, const Row &w, int64_t col, int64_t h) __attribute__((always_inline)) {
-            const Cand c{Y, (int32_t)col, w.phi + c1 * h, w.psi + c2 * h};
+            const Cand c{Y, (int32_t)col, (int32_t)col, w.phi + c1 * h, w.psi + c2 * h, kNoKey};
             count(st.candidates);
-            if (!rule1) {
+            // h <= 1: valid from its own row or the next (one walk step at
+            // most); inserting it at once is exact too (the scan checks
+            // validity) and measured cheaper than a walk and an activation.
+            if (!rule1 || h <= 1) {
                 insert(c);
                 return;
             }
@@ -379,30 +405,33 @@ private:
             count(st.pixels);
             // candidates of row Y
             if (feat) {
-                // q0 = (Y, col(Y)): newer than every entry (their rows are > Y)
-                // and no farther right (their columns are >= col(r) >= col(Y)),
-                // so only the older run it dominates goes (insert's second loop)
+                // q0 = (Y, col(Y)) and its row's secondary, one entry.  It is
+                // newer than every entry (their rows are > Y) and no farther
+                // right (their columns are >= col(r) >= col(Y)), so only the
+                // older run it covers goes.  The secondary is not needed when
+                // q0 stays on the left side for all rows to come (then the
+                // left start of row Y is col(Y) for every pixel above).
                 count(st.candidates);
                 count(st.activated);
-                const bool k1 = w.phi <= pmn, k2 = w.psi >= psx;
+                Cand q{Y, (int32_t)col, (int32_t)col, w.phi, w.psi, kNoKey};
+                if (kSec && col + 1 < Wc && !(rule2 && w.psi >= w.psimax)) {
+                    const int32_t d1 = nx[idx + stepx];
+                    if (d1 < Prepared::kNone) {
+                        count(st.candidates);
+                        q.scol = (int32_t)(col + 1 + d1);
+                        q.skey1 = w.phi + c1 * (1 + d1);
+                    }
+                }
                 size_t j = ln;
                 while (rule2 && j > 0) {
-                    const Cand &b = list[j - 1];
                     count(st.comparisons);
-                    if (!((k1 || w.phi <= b.key1) && (k2 || w.psi >= b.key2)))
+                    if (!covers(q, list[j - 1]))
                         break;
                     --j;
                     count(st.dominated);
                 }
-                list[j] = Cand{Y, (int32_t)col, w.phi, w.psi};
+                list[j] = q;
                 ln = j + 1;
-                // secondary: needed unless q0 stays on the left side for all
-                // rows to come (then the left start of row Y is col(Y))
-                if (col + 1 < Wc && !(rule2 && w.psi >= w.psimax)) {
-                    const int32_t d1 = nx[idx + stepx];
-                    if (d1 < Prepared::kNone)
-                        create(Y, w, col + 1 + d1, 1 + d1);
-                }
             } else if (d0 < Prepared::kNone) {
                 create(Y, w, col + d0, d0);
             }
@@ -428,11 +457,15 @@ private:
                     if (rule1 && !(lb[dy] < best))
                         break;
                     count(st.comparisons);
-                    if (e.key1 <= phiY && e.key2 >= psiY) {
-                        const V d = dist_(e.col - col, dy);
+                    // q0 where it is on the valid side of the left boundary,
+                    // else the secondary (if any); either valid on the right
+                    const bool left = !kSec || e.key2 >= psiY;
+                    if ((left ? e.key1 : e.skey1) <= phiY) {
+                        const int64_t cc = left ? e.col : e.scol;
+                        const V d = dist_(cc - col, dy);
                         if (d < best) {
                             best = d;
-                            bc = e.col;
+                            bc = cc;
                             br = e.r;
                         }
                     }
