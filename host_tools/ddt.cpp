@@ -36,6 +36,7 @@ i128 cross(int64_t ux, int64_t uy, int64_t vx, int64_t vy) { return (i128)ux * v
 
 constexpr int64_t kMaxSide = INT64_C(1) << 20;  // pixels per side (keys stay < 2^53)
 constexpr int kLineChunk = 64;                   // lines per work unit
+constexpr int kPrefetchRows = 16;                // pass 2 prefetches this many rows ahead
 
 bool int32_range(int64_t v) { return v >= INT32_MIN && v <= INT32_MAX; }
 
@@ -400,6 +401,16 @@ private:
             psx = w.psimax;
             const int64_t col = k + w.L;
             const int64_t idx = base + w.off;
+            // a line steps through memory by a row per pixel: ask for the
+            // pixel kPrefetchRows further up now (measured at 2048^2: 15 -> 12
+            // ns per pixel on dense cross-sections; no change at 403 x 344)
+            if (Y - kPrefetchRows >= Ytop) {
+                const int64_t ahead = base + rows[Y - kPrefetchRows].off;
+                __builtin_prefetch(nx + ahead);
+                __builtin_prefetch(dt + ahead, 1);
+                if (ft)
+                    __builtin_prefetch(ft + ahead, 1);
+            }
             const int32_t d0 = nx[idx];
             const bool feat = d0 == 0;
             count(st.pixels);
