@@ -87,7 +87,7 @@ struct Frame {
     int64_t a1 = 1, c1 = 0, a2 = 0, c2 = 1;  // canonical boundaries
 };
 
-Frame make_frame(int W, int H, const Piece &p)
+Frame make_frame(int W, int H, const Piece &p, int force)
 {
     Frame f;
     f.W = W;
@@ -135,6 +135,8 @@ Frame make_frame(int W, int H, const Piece &p)
         useb = true;                        // of memory as lines (measured faster)
     else
         useb = (t1b - t2b) > (t1a - t2a);
+    if (force == 1 || force == 2)
+        useb = force == 2;
     f.transpose = useb;
     if (!useb) {
         f.a1 = ux;
@@ -540,6 +542,8 @@ void run_pieces(const Prepared &bm, const std::vector<Piece> &pieces, const D &d
                 std::vector<typename D::value_type> &dt, std::vector<Point> &ft, const Options &opt,
                 Stats *stats)
 {
+    if (opt.frame < 0 || opt.frame > 2)
+        throw Error("ddt: Options::frame must be 0 (automatic), 1 or 2");
     const size_t n = (size_t)bm.width() * (size_t)bm.height();
     dt.resize(n);  // the first piece writes every pixel
     Point *ftp = nullptr;
@@ -551,7 +555,7 @@ void run_pieces(const Prepared &bm, const std::vector<Piece> &pieces, const D &d
     }
     bool first = true;
     for (const Piece &p : pieces) {
-        const Frame f = make_frame(bm.width(), bm.height(), p);
+        const Frame f = make_frame(bm.width(), bm.height(), p, opt.frame);
         if (f.transpose && stats)
             run_frame<D, true, true>(bm, f, dist, dt.data(), ftp, opt, first, stats);
         else if (f.transpose)

@@ -243,6 +243,10 @@ struct Options {
     bool rule1 = true;  // propagation rule (see above)
     bool rule2 = true;  // dominance rule
     bool feature_transform = true;  // false: the DT only, ft left empty
+    // Canonical frame per piece: 0 = the measured-fastest choice (above);
+    // 1 = never transposed, 2 = always transposed.  Every frame is exact (the
+    // tests sweep all three); only speed differs.
+    int frame = 0;
 };
 // Operation counts, summed over pieces and threads.
 struct Stats {

@@ -244,6 +244,7 @@ Options opts_for(ct_rng *r)
 {
     Options o;
     o.threads = ct_rng_range(r, 0, 3) == 0 ? 2 : 1;
+    o.frame = (int)ct_rng_range(r, 0, 2);  // the automatic frame, or either one forced
     return o;
 }
 
