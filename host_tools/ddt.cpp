@@ -322,6 +322,19 @@ private:
             return covers_part(e, a.col, a.key1, a.key2) &&
                    (!kSec || a.skey1 == kNoKey || covers_part(e, a.scol, a.skey1, kNoKey));
         };
+        // The run of entries just below position i that a covers (rule 2):
+        // returns where it starts.
+        auto covered_run = [&](const Cand &a, size_t i) __attribute__((always_inline)) {
+            size_t j = i;
+            while (rule2 && j > 0) {
+                count(st.comparisons);
+                if (!covers(a, list[j - 1]))
+                    break;
+                --j;
+                count(st.dominated);
+            }
+            return j;
+        };
         // Insert a into the row-sorted list (top = back = newest row), rule 2.
         auto insert = [&](const Cand &a) __attribute__((always_inline)) {
             size_t i = ln;
@@ -339,14 +352,7 @@ private:
                     --i;
             }
             count(st.activated);
-            size_t j = i;  // older entries a dominates: the run just below i
-            while (rule2 && j > 0) {
-                count(st.comparisons);
-                if (!covers(a, list[j - 1]))
-                    break;
-                --j;
-                count(st.dominated);
-            }
+            const size_t j = covered_run(a, i);  // older entries a dominates
             if (i == ln) {  // the usual case: a is the newest
                 list[j] = a;
                 ln = j + 1;
@@ -365,9 +371,9 @@ private:
         auto create = [&](int Y, const Row &w, int64_t col, int64_t h) __attribute__((always_inline)) {
             const Cand c{Y, (int32_t)col, (int32_t)col, w.phi + c1 * h, w.psi + c2 * h, kNoKey};
             count(st.candidates);
-            // h <= 1: valid from its own row or the next (one walk step at
-            // most); inserting it at once is exact too (the scan checks
-            // validity) and measured cheaper than a walk and an activation.
+            // h <= 1 (the feature next to the line): inserting it at once,
+            // before it is valid, is exact too (the scan checks validity) and
+            // measured cheaper than a walk and an activation for these.
             if (!rule1 || h <= 1) {
                 insert(c);
                 return;
@@ -378,7 +384,7 @@ private:
             // (Activating at that bound without the walk is also exact -- queries
             // check validity -- but measured no faster: more invalid entries.)
             int64_t Y1 = Y;
-            if (c1 != 0 && h >= 1) {
+            if (c1 != 0) {
                 const double est = (double)(h - 1) * tau;  // >= 0: truncation is floor
                 if (est > (double)(Y - Ytop) + 1.0) {
                     count(st.never_valid);
@@ -440,14 +446,7 @@ private:
                         q.skey1 = w.phi + c1 * (1 + d1);
                     }
                 }
-                size_t j = ln;
-                while (rule2 && j > 0) {
-                    count(st.comparisons);
-                    if (!covers(q, list[j - 1]))
-                        break;
-                    --j;
-                    count(st.dominated);
-                }
+                const size_t j = covered_run(q, ln);
                 list[j] = q;
                 ln = j + 1;
             } else if (d0 < Prepared::kNone) {

@@ -109,9 +109,8 @@
 // Rule 1 (propagation): a primary with h >= 2 waits until its activation row
 //   and is dropped if that row lies above the line's top (it can never be in
 //   the sector of a pixel further along the line); a primary with h = 1
-//   (valid from the next row or the one after) and the (q0, secondary)
-//   entries enter at once, which measured cheaper than walking (the scan
-//   checks validity anyway).  The scan stops at the first depth dy with
+//   (next to the line) and the (q0, secondary) entries enter at once, which
+//   measured cheaper than walking for them (the scan checks validity anyway).  The scan stops at the first depth dy with
 //   D(L(dy), dy) >= best (no deeper candidate can be nearer).
 // Rule 2 (dominance): an entry B is dropped once a newer entry A (row(A) <=
 //   row(B)) covers it: at every pixel further along the line where B's
