@@ -429,6 +429,26 @@ void slice_angles(const Ctx &c, const SliceInput &in, uint8_t *codes, SliceStats
         if (nfeat == 0) break;  // and every higher slice is empty too
         if (st) st->slices++;
         const double top = lv[(size_t)k + 1];
+        // A cell can be narrowed only if its code is one whose skip test
+        // passes: rise >= skip_rise[code], rise = top - its apex level, the
+        // same for every sector.  thr[f] = (the least such code) - 1, 255 when
+        // none: every cell the tests below accept has code > thr[f], so the
+        // sectors' loops first compare one byte (same result, ~10x fewer
+        // instructions for the ~90% of cells that fail).
+        std::vector<uint8_t> thr_of_level((size_t)K + 1);
+        for (int kf = 0; kf <= K; ++kf) {
+            int t = 255;
+            const double rise = top - lvd[(size_t)kf];
+            if (kf <= k && rise > 0.0)
+                for (int code = 1; code < 256; ++code)
+                    if (!(rise < skip_rise[code])) {
+                        t = code - 1;
+                        break;
+                    }
+            thr_of_level[(size_t)kf] = (uint8_t)t;
+        }
+        std::vector<uint8_t> thr(plane);
+        for (size_t f = 0; f < plane; ++f) thr[f] = thr_of_level[k0[f]];
         // the line-traversal tables, built when a sector first needs a full DT
         std::once_flag prepared_once;
         std::unique_ptr<ddt::Prepared> prepared;
@@ -442,6 +462,7 @@ void slice_angles(const Ctx &c, const SliceInput &in, uint8_t *codes, SliceStats
                 size_t nq = 0;
                 const int64_t *dtf = nullptr;  // the full DT, once switched to it
                 for (size_t f = 0; f < plane; ++f) {
+                    if (cs[f] <= thr[f]) continue;
                     const uint16_t kf = k0[f];
                     if (kf > k) continue;
                     const uint8_t code = cs[f];
