@@ -150,10 +150,11 @@
 // stopping depth -- any D-oblivious exact method must evaluate D on each
 // Pareto-minimal in-sector feature, since any of them can be the unique
 // nearest for some monotone D.  Measured on cross-sections of the real DEM
-// (bench/bench_ddt.cpp, N = 24): 1.2 - 4.6 comparisons, 0.3 - 1.4
-// candidates and 0.3 - 1.5 walk steps per pixel per sector; one thread:
-// 9 - 19 ns per pixel per sector at 403 x 344, 23 - 29 ns at 2048^2 (two
-// threads at 2048^2: 13 - 16 ns); OpenCV's exact unconstrained EDT: 6 - 15.
+// (bench/bench_ddt.cpp, N = 24): 0.9 - 3.8 comparisons, 0.3 - 1.3
+// candidates and 0.25 - 1.8 walk steps per pixel per sector; distances only,
+// one thread: 7 - 15 ns per pixel per sector at 403 x 344 and 11 - 23 ns at
+// 2048^2 (two threads at 2048^2: 7 - 14 ns); OpenCV's exact unconstrained
+// EDT in the same runs: 6.5 - 12.5 ns per pixel.
 // Unconstrained: the minimum over the four closed quadrants [0,90], [90,180],
 // [180,270], [270,360] degrees (every offset lies in one), same traversal.
 #pragma once
