@@ -433,8 +433,8 @@ void slice_angles(const Ctx &c, const SliceInput &in, uint8_t *codes, SliceStats
         // passes: rise >= skip_rise[code], rise = top - its apex level, the
         // same for every sector.  thr[f] = (the least such code) - 1, 255 when
         // none: every cell the tests below accept has code > thr[f], so the
-        // sectors' loops first compare one byte (same result, ~10x fewer
-        // instructions for the ~90% of cells that fail).
+        // sectors' loops first compare one byte (same result; most cells stop
+        // there; the slice phase at 2048^2, r = 3 measured 5-10% faster).
         std::vector<uint8_t> thr_of_level((size_t)K + 1);
         for (int kf = 0; kf <= K; ++kf) {
             int t = 255;
