@@ -196,13 +196,12 @@ public:
           first_(first)
     {
         const int Hc = f.Hc;
-        L_.resize(Hc);
         rows_.resize(Hc);
         lb_.resize(Hc);
         // Y*a2 < 2^20 * 2^32; c1*L <= a1*Y + c1 (theta1 < theta2): all < 2^53.
         for (int Y = 0; Y < Hc; ++Y) {
             Row &w = rows_[(size_t)Y];
-            w.L = L_[(size_t)Y] = (Y * f.a2 + f.c2 - 1) / f.c2;
+            w.L = (Y * f.a2 + f.c2 - 1) / f.c2;
             w.off = w.L * f.stepx + (int64_t)Y * f.stepy;
             w.phi = f.c1 * w.L - f.a1 * Y;
             w.psi = f.c2 * w.L - f.a2 * Y;
@@ -213,9 +212,8 @@ public:
         const i128 x12 = (i128)f.a1 * f.c2 - (i128)f.c1 * f.a2;
         tau_ = (double)f.c1 * (double)f.c2 / (double)x12;
         kmax_ = f.Wc - 1;
-        kmin_ = -L_[(size_t)Hc - 1];
-        for (const Row &w : rows_)
-            sec_ = sec_ || w.psi != rows_[0].psi;
+        kmin_ = -rows_[(size_t)Hc - 1].L;
+        sec_ = f.a2 % f.c2 != 0;  // else psi = c2*L(Y) - a2*Y = 0 on every row
     }
 
     int64_t line_count() const { return kmax_ - kmin_ + 1; }
@@ -252,12 +250,11 @@ private:
     Point *ft_;
     const int32_t *next_;
     const bool rule1_, rule2_, first_;
-    std::vector<int64_t> L_;
     std::vector<Row> rows_;
     std::vector<V> lb_;  // lb_[dy] = D(L(dy), dy): no candidate dy rows deeper is nearer (rule 1)
     double tau_ = 0.0;
     int64_t kmax_ = 0, kmin_ = 0;
-    bool sec_ = false;  // psi varies along a line (non-integer slope): secondaries exist
+    bool sec_ = false;  // psi varies along a line (non-integer slope a2/c2): secondaries exist
     // per-thread scratch (one Kernel per thread); a line creates at most two
     // candidates per pixel, so pool and list never exceed 2 * Hc entries
     std::vector<int32_t> head_;
@@ -286,8 +283,12 @@ private:
     void line(int64_t k, Stats &st)
     {
         const int Wc = f_.Wc, Hc = f_.Hc;
-        const int Ytop = (int)(std::lower_bound(L_.begin(), L_.end(), -k) - L_.begin());
-        const int Ybot = (int)(std::upper_bound(L_.begin(), L_.end(), (int64_t)(Wc - 1) - k) - L_.begin()) - 1;
+        // the line's rows: 0 <= k + L(Y) <= Wc - 1 (L nondecreasing)
+        const auto L_below = [](const Row &w, int64_t v) { return w.L < v; };
+        const auto below_L = [](int64_t v, const Row &w) { return v < w.L; };
+        const int Ytop = (int)(std::lower_bound(rows_.begin(), rows_.end(), -k, L_below) - rows_.begin());
+        const int Ybot =
+            (int)(std::upper_bound(rows_.begin(), rows_.end(), (int64_t)(Wc - 1) - k, below_L) - rows_.begin()) - 1;
         if (Ytop > Ybot || Ytop >= Hc)
             return;
         count(st.lines);
