@@ -81,7 +81,7 @@ struct Row {
     int w, h;
     double density;
     double full_ms_1t, full_ft_ms_1t, full_ms, ns_pix_sector_1t, ns_pix_sector_ft_1t, ns_pix_sector, prep_ms;
-    double ops_rules, ops_none, ops_r1, ops_r2, walk_per_pix, cand_per_pix;
+    double ops_rules, ops_none, ops_r1, ops_r2, ops_r12, walk_per_pix, cand_per_pix;
     double unc_ms_1t, unc_ms, unc_ns_pix_1t;
     double cv_ns_1t = -1, cv_ns_nt = -1, cv_diff = -1;
 };
@@ -338,15 +338,24 @@ int main(int argc, char **argv)
         row.walk_per_pix = (double)st.walk_steps / (npix * N);
         row.cand_per_pix = (double)st.candidates / (npix * N);
         row.ops_none = row.ops_r1 = row.ops_r2 = -1;
+        {  // both rules without the Euclidean pruning (linear: every size)
+            Options o = on;
+            Stats s12;
+            o.euclid = false;
+            time_full(bm, N, o, &s12, 0);
+            row.ops_r12 = (double)s12.comparisons / (npix * N);
+        }
         if (!big) {  // without rules the scan is quadratic per line
             Options o = on;
             Stats s0, s1, s2;
             o.rule1 = o.rule2 = false;
+            o.euclid = false;
             time_full(bm, N, o, &s0, 0);
             o.rule1 = true;
             time_full(bm, N, o, &s1, 0);
             o.rule1 = false;
             o.rule2 = true;
+            o.euclid = false;
             time_full(bm, N, o, &s2, 0);
             row.ops_none = (double)s0.comparisons / (npix * N);
             row.ops_r1 = (double)s1.comparisons / (npix * N);
@@ -382,8 +391,9 @@ int main(int argc, char **argv)
         fprintf(stderr, "  %s done\n", s.name.c_str());
     }
 
-    printf("%-22s %6s | %9s %9s | %7s %7s %7s | %6s %6s %6s %6s | %7s %6s | %9s %9s | %8s %6s %6s\n", "bitmap", "ones",
-           "N=24 ms", "(1 thr)", "ns/px/s", "(1 thr)", "+FT", "ops", "none", "r1", "r2", "walk", "cand", "unc ms",
+    printf("%-22s %6s | %9s %9s | %7s %7s %7s | %6s %6s %6s %6s %6s | %7s %6s | %9s %9s | %8s %6s %6s\n", "bitmap",
+           "ones", "N=24 ms", "(1 thr)", "ns/px/s", "(1 thr)", "+FT", "ops", "r1+r2", "none", "r1", "r2", "walk", "cand",
+           "unc ms",
            "(1 thr)", "cv ns/px", "ratio", "+FT");
     for (const Row &r0 : rows) {
         char none[16], o1[16], o2[16], cvs[16], ratio[16], ratio_ft[16];
@@ -393,15 +403,17 @@ int main(int argc, char **argv)
         snprintf(cvs, sizeof cvs, r0.cv_ns_1t < 0 ? "n/a" : "%.2f", r0.cv_ns_1t);
         snprintf(ratio, sizeof ratio, r0.cv_ns_1t < 0 ? "n/a" : "%.2f", r0.ns_pix_sector_1t / r0.cv_ns_1t);
         snprintf(ratio_ft, sizeof ratio_ft, r0.cv_ns_1t < 0 ? "n/a" : "%.2f", r0.ns_pix_sector_ft_1t / r0.cv_ns_1t);
-        printf("%-22s %5.1f%% | %9.1f %9.1f | %7.2f %7.2f %7.2f | %6.2f %6s %6s %6s | %7.2f %6.2f | %9.2f %9.2f | %8s %6s %6s\n",
+        printf("%-22s %5.1f%% | %9.1f %9.1f | %7.2f %7.2f %7.2f | %6.2f %6.2f %6s %6s %6s | %7.2f %6.2f | %9.2f %9.2f | %8s "
+               "%6s %6s\n",
                r0.name.c_str(), 100.0 * r0.density, r0.full_ms, r0.full_ms_1t, r0.ns_pix_sector, r0.ns_pix_sector_1t,
-               r0.ns_pix_sector_ft_1t, r0.ops_rules, none, o1, o2, r0.walk_per_pix, r0.cand_per_pix, r0.unc_ms,
+               r0.ns_pix_sector_ft_1t, r0.ops_rules, r0.ops_r12, none, o1, o2, r0.walk_per_pix, r0.cand_per_pix, r0.unc_ms,
                r0.unc_ms_1t, cvs, ratio, ratio_ft);
     }
     printf("\ncolumns: ones = feature density; N=24 ms = all 24 directional DTs, distances only (%d threads, then\n"
            "1 thread); ns/px/s = ns per pixel per sector (distances only; +FT: with the feature transform,\n"
-           "1 thread); ops = candidate comparisons per pixel per sector with both rules, none / r1 / r2 =\n"
-           "without rules / rule 1 only / rule 2 only (native size only: quadratic without rules); walk =\n"
+           "1 thread); ops = candidate comparisons per pixel per sector with both rules and the Euclidean\n"
+           "pruning; r1+r2 = both rules without the pruning; none / r1 / r2 = without rules / rule 1 only /\n"
+           "rule 2 only, no pruning (native size only: quadratic without rules); walk =\n"
            "activation-walk steps, cand = candidates created per pixel per sector; unc ms = unconstrained DT\n"
            "and FT (4 quadrants); cv ns/px = OpenCV distanceTransform(DIST_L2, DIST_MASK_PRECISE) per pixel,\n"
            "1 thread; ratio = ours per sector (1 thread) / OpenCV (1 thread), each the best of rounds that\n"

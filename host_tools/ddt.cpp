@@ -8,6 +8,7 @@
 #include <memory>
 #include <string>
 #include <thread>
+#include <type_traits>
 
 #include "conetrace.h"
 #include "terrain.hpp"  // ct_host::Error
@@ -23,6 +24,7 @@ void Stats::add(const Stats &o)
     never_valid += o.never_valid;
     activated += o.activated;
     dominated += o.dominated;
+    pruned += o.pruned;
     comparisons += o.comparisons;
     walk_steps += o.walk_steps;
 }
@@ -193,7 +195,7 @@ public:
     // later pieces keep the minimum.
     Kernel(const Prepared &bm, const Frame &f, const D &dist, V *dt, Point *ft, const Options &opt, bool first)
         : f_(f), dist_{dist}, dt_(dt), ft_(ft), next_(bm.next(f.dir)), rule1_(opt.rule1), rule2_(opt.rule2),
-          first_(first)
+          euclid_(opt.rule2 && opt.euclid), first_(first)
     {
         const int Hc = f.Hc;
         rows_.resize(Hc);
@@ -249,7 +251,7 @@ private:
     V *dt_;
     Point *ft_;
     const int32_t *next_;
-    const bool rule1_, rule2_, first_;
+    const bool rule1_, rule2_, euclid_, first_;
     std::vector<Row> rows_;
     std::vector<V> lb_;  // lb_[dy] = D(L(dy), dy): no candidate dy rows deeper is nearer (rule 1)
     double tau_ = 0.0;
@@ -303,6 +305,8 @@ private:
         const bool rule1 = rule1_, rule2 = rule2_, first = first_;
         const int64_t c1 = f_.c1, c2 = f_.c2, stepx = f_.stepx, base = f_.base + k * f_.stepx;
         const double tau = tau_;
+        const bool prune = std::is_same<D, EuclideanSq>::value && euclid_;
+        const int64_t xtop = k + rows[Ytop].L, a2 = f_.a2;
         size_t ln = 0, pn = 0;  // used entries of list and pool
         int64_t pmn = 0, psx = 0;  // phimin, psimax of the current row
 
@@ -322,6 +326,29 @@ private:
         auto covers = [&](const Cand &e, const Cand &a) __attribute__((always_inline)) {
             return covers_part(e, a.col, a.key1, a.key2) &&
                    (!kSec || a.skey1 == kNoKey || covers_part(e, a.scol, a.skey1, kNoKey));
+        };
+        // Whether (ca, ra) is no farther than (cb, rb) from every pixel
+        // (x, Y') still to come on the line, Ytop <= Y' <= Y (the squared
+        // distances differ by a function linear in Y', see ddt.hpp).
+        auto le_rest = [&](int64_t Y, int64_t ca, int64_t ra, int64_t cb, int64_t rb) __attribute__((always_inline)) {
+            if (!kSec)
+                return dist_(ca - xtop, ra - Ytop) <= dist_(cb - xtop, rb - Ytop);
+            const int64_t gc = ca - cb, gr = ra - rb;
+            const int64_t sc = c2 * (ca + cb) - 2 * (gc < 0 ? c2 : 0), sr = ra + rb;  // < 2^53
+            const auto at = [&](int64_t y) __attribute__((always_inline)) {
+                return (i128)gc * (sc - 2 * (c2 * k + y * a2)) + (i128)(c2 * gr) * (sr - 2 * y) <= 0;
+            };
+            return at(Y) && at(Ytop);
+        };
+        // The Euclidean pruning (ddt.hpp): entry a is valid at every row
+        // still to come (key1 <= pmn) with q0 as its candidate there (key2 >=
+        // psx), its candidate is no farther than b's at P_Y (da <= db), and
+        // no farther than b's q0 (or primary; b's secondary, in the same row
+        // further right, is farther still) at every pixel still to come.
+        auto beats = [&](int64_t Y, const Cand &a, const Cand &b, V da, V db) __attribute__((always_inline)) {
+            if (!(da <= db) || a.key1 > pmn || (kSec && a.key2 < psx))
+                return false;
+            return le_rest(Y, a.col, a.r, b.col, b.r);
         };
         // The run of entries just below position i that a covers (rule 2):
         // returns where it starts.
@@ -469,8 +496,9 @@ private:
                 }
             } else {
                 const int64_t phiY = w.phi, psiY = w.psi;
+                size_t jb = 0, jdel = ln;  // the best entry; the lowest entry marked for removal
                 for (size_t j = ln; j-- > 0;) {
-                    const Cand &e = list[j];
+                    Cand &e = list[j];
                     const int dy = e.r - Y;
                     if (rule1 && !(lb[dy] < best))
                         break;
@@ -478,15 +506,32 @@ private:
                     // q0 where it is on the valid side of the left boundary,
                     // else the secondary (if any); either valid on the right
                     const bool left = !kSec || e.key2 >= psiY;
-                    if ((left ? e.key1 : e.skey1) <= phiY) {
-                        const int64_t cc = left ? e.col : e.scol;
-                        const V d = dist_(cc - col, dy);
-                        if (d < best) {
-                            best = d;
-                            bc = cc;
-                            br = e.r;
+                    const bool valid = (left ? e.key1 : e.skey1) <= phiY;
+                    if (!valid && !(prune && bc >= 0))
+                        continue;
+                    const int64_t cc = left ? e.col : e.scol;
+                    const V d = dist_(cc - col, dy);
+                    if (valid && d < best) {
+                        if (prune && bc >= 0 && beats(Y, e, list[jb], d, best)) {
+                            list[jb].r = -1;  // the former best: e is nearer for the rest of the line
+                            jdel = std::min(jdel, jb);
+                            count(st.pruned);
                         }
+                        best = d;
+                        bc = cc;
+                        br = e.r;
+                        jb = j;
+                    } else if (prune && bc >= 0 && beats(Y, list[jb], e, best, d)) {
+                        e.r = -1;
+                        jdel = j;
+                        count(st.pruned);
                     }
+                }
+                if (prune && jdel < ln) {
+                    size_t o = jdel;
+                    for (size_t j = jdel; j < ln; ++j)
+                        if (list[j].r >= 0) list[o++] = list[j];
+                    ln = o;
                 }
             }
             if (bc >= 0) {

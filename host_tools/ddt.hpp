@@ -121,6 +121,24 @@
 //   secondary with key2 taken as infinite -- it is used only where q0 falls
 //   out on the left) must be covered so by A's q0, or, where A's q0 may fall
 //   out on the left (key2(A) < min(key2(part), psx)), by A's secondary as well.
+// Euclidean pruning (EuclideanSq only, with rule 2; Options::euclid): rule 2
+//   keeps B while A's column is greater, although for the Euclidean distance
+//   A may stay nearer for the whole rest of the line.  During the scan at
+//   P_Y, with A the best entry so far and B another one met (either order):
+//   B is dropped when A is valid at every row still to come with q0 as its
+//   candidate (key1(A) <= pmn, and key2(A) >= psx if psi varies), A's
+//   candidate is no farther than B's at P_Y, and A's q0 is no farther than
+//   B's q0 (or primary) from every pixel (x, Y') still to come on the line,
+//   Ytop <= Y' <= Y.  B's secondary, used where B's q0 falls out on the left,
+//   lies in the same row further right, so it is farther still.  The squared
+//   distances differ by  gc*(cA + cB - 2x) + gr*(rA + rB - 2Y')  (gc = cA -
+//   cB, gr = rA - rB): linear in Y' when x = k + L(Y') is (integer slope
+//   t2), so the ends Y and Ytop decide; otherwise c2*x lies in [c2*k + Y'*a2,
+//   c2*k + Y'*a2 + c2) and the difference times c2 is bounded above by a
+//   function linear in Y', again checked at both ends (128-bit).  On sparse
+//   cross-sections at 2048^2 it removes half the comparisons (3.2 -> 1.7 per
+//   pixel per sector on p90) and 10-17% of the time; on dense ones it is
+//   neutral.
 // Without the rules (Options::rule1/rule2 = false) every candidate enters the
 // list at once, stays, and the scan visits all of them: still exact, slower.
 //
@@ -139,7 +157,10 @@
 // a proven upper bound).  An entry leaves the list only by rule 2, in favour
 // of one whose candidate is valid at every later pixel where its own is and
 // no farther in |dx| and |dy| there; by induction over removals some list
-// entry's candidate valid at Y is no farther than m_r.  Every valid
+// entry's candidate valid at Y is no farther than m_r (the Euclidean pruning
+// removes B only for an A valid at every later pixel and, at each of them,
+// no farther than B's candidate there; these relations compose, so the
+// induction holds with both removals).  Every valid
 // candidate is a feature in the sector, so the minimum over them is the DT.  Rule 1's scan stop is safe since every valid member at depth dy
 // has dx >= L(dy).  Only comparisons of exact integers (and of one D functor
 // on equal arguments) are involved.
@@ -150,11 +171,12 @@
 // stopping depth -- any D-oblivious exact method must evaluate D on each
 // Pareto-minimal in-sector feature, since any of them can be the unique
 // nearest for some monotone D.  Measured on cross-sections of the real DEM
-// (bench/bench_ddt.cpp, N = 24): 0.9 - 3.8 comparisons, 0.3 - 1.3
-// candidates and 0.25 - 1.8 walk steps per pixel per sector; distances only,
-// one thread: 7 - 15 ns per pixel per sector at 403 x 344 and 11 - 23 ns at
-// 2048^2 (two threads at 2048^2: 7 - 14 ns); OpenCV's exact unconstrained
-// EDT in the same runs: 6.5 - 12.5 ns per pixel.
+// (bench/bench_ddt.cpp, N = 24): 0.5 - 2.0 comparisons (0.9 - 3.8 without
+// the Euclidean pruning), 0.3 - 1.3 candidates and 0.25 - 1.8 walk steps per
+// pixel per sector; distances only, one thread, on the machine of 2026-11-25:
+// 7.7 - 13.5 ns per pixel per sector at 403 x 344 and 11.6 - 20.3 ns at
+// 2048^2 (two threads at 2048^2: 6.3 - 10.6 ns); OpenCV's exact
+// unconstrained EDT in the same runs: 5.8 - 8.7 and 29 - 33 ns per pixel.
 // Unconstrained: the minimum over the four closed quadrants [0,90], [90,180],
 // [180,270], [270,360] degrees (every offset lies in one), same traversal.
 #pragma once
@@ -242,6 +264,7 @@ struct Options {
     int threads = 1;    // lines are independent; 0 = hardware concurrency
     bool rule1 = true;  // propagation rule (see above)
     bool rule2 = true;  // dominance rule
+    bool euclid = true; // the Euclidean pruning (EuclideanSq only; needs rule2)
     bool feature_transform = true;  // false: the DT only, ft left empty
     // Canonical frame per piece: 0 = the measured-fastest choice (above);
     // 1 = never transposed, 2 = always transposed.  Every frame is exact (the
@@ -256,6 +279,7 @@ struct Stats {
     uint64_t never_valid = 0;  // dropped by rule 1 at creation
     uint64_t activated = 0;    // entered the list
     uint64_t dominated = 0;    // removed or refused by rule 2
+    uint64_t pruned = 0;       // removed by the Euclidean pruning
     uint64_t comparisons = 0;  // candidate comparisons: scan visits + rule-2 tests
     uint64_t walk_steps = 0;   // activation-row walk steps
     void add(const Stats &o);

@@ -409,6 +409,102 @@ void test_large_bitmaps(void)
     }
 }
 
+// Clustered, sparse bitmaps with long lines, like the real cross-sections
+// (features in blobs: a sum of random bumps above a level), where the
+// Euclidean pruning removes many entries: squared Euclidean DT and FT for all
+// 24 sectors and random wedges against a brute force that walks rows of
+// features outwards from the pixel (bucketed by row, stopping at dy^2 >=
+// best), with the pruning on and off.  It must fire, and cut comparisons.
+void test_euclidean_pruning(void)
+{
+    ct_rng r;
+    ct_rng_seed(&r, g_seed * 1000003u + 77);
+    const int n = std::max(3, g_cases / 100);
+    Stats on, off;
+    for (int c = 0; c < n; ++c) {
+        Bits m;
+        const int shape = c % 3;  // square, wide, tall: lines long in either frame
+        m.w = shape == 2 ? (int)ct_rng_range(&r, 20, 60) : (int)ct_rng_range(&r, 120, 200);
+        m.h = shape == 1 ? (int)ct_rng_range(&r, 20, 60) : (int)ct_rng_range(&r, 120, 200);
+        const int bumps = (int)ct_rng_range(&r, 5, 40);
+        std::vector<std::array<double, 4>> bp;
+        for (int i = 0; i < bumps; ++i)
+            bp.push_back({ct_rng_unit(&r) * m.w, ct_rng_unit(&r) * m.h, 2.0 + ct_rng_unit(&r) * 20.0,
+                          ct_rng_unit(&r) < 0.2 ? -0.5 : 1.0});
+        std::vector<double> v((size_t)m.w * (size_t)m.h);
+        for (int y = 0; y < m.h; ++y)
+            for (int x = 0; x < m.w; ++x) {
+                double s = 0.0;
+                for (const auto &b : bp) {
+                    const double dx = x - b[0], dy = y - b[1];
+                    s += b[3] * std::exp(-(dx * dx + dy * dy) / (b[2] * b[2]));
+                }
+                v[(size_t)y * (size_t)m.w + (size_t)x] = s + 0.05 * ct_rng_unit(&r);
+            }
+        std::vector<double> sorted = v;
+        std::sort(sorted.begin(), sorted.end());
+        const double density = 0.01 + 0.2 * ct_rng_unit(&r);
+        const double level = sorted[(size_t)((double)(sorted.size() - 1) * (1.0 - density))];
+        m.b.resize(v.size());
+        for (size_t i = 0; i < v.size(); ++i)
+            m.b[i] = v[i] >= level ? 1 : 0;
+        const Prepared bm(m.w, m.h, m.b.data());
+        std::vector<std::vector<int>> rows((size_t)m.h);  // feature columns per row
+        for (int y = 0; y < m.h; ++y)
+            for (int x = 0; x < m.w; ++x)
+                if (m.at(x, y)) rows[(size_t)y].push_back(x);
+        for (int i = 0; i < 26; ++i) {
+            Wedge w;
+            char label[96];
+            if (i < 24) {
+                w = sector_wedge(24, (uint32_t)i);
+                snprintf(label, sizeof label, "clustered %d (%dx%d) N=24 s=%d", c, m.w, m.h, i);
+            } else {
+                w = random_wedge(&r);
+                snprintf(label, sizeof label, "clustered %d (%dx%d) random wedge", c, m.w, m.h);
+            }
+            const XSector in{w, false};
+            Options o = opts_for(&r);
+            std::vector<int64_t> dt, dt0;
+            std::vector<Point> ft, ft0;
+            directional(bm, w, EuclideanSq(), dt, ft, o, &on);
+            o.euclid = false;
+            directional(bm, w, EuclideanSq(), dt0, ft0, o, &off);
+            for (int y = 0; y < m.h; ++y)
+                for (int x = 0; x < m.w; ++x) {
+                    int64_t best = Inf<int64_t>::value;
+                    for (int dy = 0; dy < m.h && (int64_t)dy * dy < best; ++dy)
+                        for (int sgn = -1; sgn <= 1; sgn += 2) {
+                            const int yy = y + sgn * dy;
+                            if ((dy == 0 && sgn > 0) || yy < 0 || yy >= m.h)
+                                continue;
+                            for (int xx : rows[(size_t)yy])
+                                if (in(xx - x, yy - y))
+                                    best = std::min(best, (int64_t)(xx - x) * (xx - x) + (int64_t)dy * dy);
+                        }
+                    const size_t k = (size_t)y * (size_t)m.w + (size_t)x;
+                    if (dt[k] != best || dt0[k] != best)
+                        TEST_FAIL_MSG("%s: pixel (%d,%d): dt %s, without the pruning %s, brute force %s", label, x, y,
+                                      vstr(dt[k]).c_str(), vstr(dt0[k]).c_str(), vstr(best).c_str());
+                    const Point f = ft[k];
+                    const bool ok = best == Inf<int64_t>::value
+                                        ? f.x == -1 && f.y == -1
+                                        : f.x >= 0 && f.y >= 0 && f.x < m.w && f.y < m.h && m.at(f.x, f.y) &&
+                                              in(f.x - x, f.y - y) &&
+                                              (int64_t)(f.x - x) * (f.x - x) + (int64_t)(f.y - y) * (f.y - y) == best;
+                    if (!ok)
+                        TEST_FAIL_MSG("%s: pixel (%d,%d): bad ft (%d,%d)", label, x, y, f.x, f.y);
+                }
+        }
+    }
+    TEST_ASSERT_MSG(on.pruned > 0 && off.pruned == 0, "pruned %llu / %llu", (unsigned long long)on.pruned,
+                    (unsigned long long)off.pruned);
+    TEST_ASSERT_MSG(on.comparisons < off.comparisons, "comparisons %llu with the pruning, %llu without",
+                    (unsigned long long)on.comparisons, (unsigned long long)off.comparisons);
+    printf("  Euclidean pruning: %.2f comparisons per pixel and wedge with it, %.2f without\n",
+           (double)on.comparisons / (double)on.pixels, (double)off.comparisons / (double)off.pixels);
+}
+
 // Without the pruning rules the result must be the same (exact either way).
 void test_rules_off_same_result(void)
 {
@@ -711,6 +807,7 @@ int main(void)
     RUN_TEST(test_random_sector_pairs);
     RUN_TEST(test_unconstrained);
     RUN_TEST(test_large_bitmaps);
+    RUN_TEST(test_euclidean_pruning);
     RUN_TEST(test_rules_off_same_result);
     RUN_TEST(test_distances_only);
     RUN_TEST(test_capped_queries);
