@@ -71,6 +71,39 @@ typedef struct {
     int32_t cx, sy;                       /* ct_dir_of_fraction(k, n)         */
 } ct_vec_dir;
 
+/* One pixel of a camera: unprojection, projection back, and geolocation
+ * with every method (ct_geolocate; outputs zero-initialised before each
+ * call). */
+typedef struct {
+    int64_t u_q16, v_q16;
+    ct_status unp_status;
+    uint32_t unp_iters;
+    int32_t ray_q30[3];                   /* ct_camera_unproject              */
+    ct_status proj_status;                /* ct_camera_project(ray_q30), when
+                                             unp_status == CT_OK              */
+    int64_t pu_q16, pv_q16;
+    ct_geo geo[CT_METHOD_COUNT];
+} ct_vec_pixel;
+
+/* A camera over one of the packages: lens (or unprojection grid), pose,
+ * effects, and its pixels; ct_geolocate_batch over all of them with
+ * batch_method must equal the per-pixel results. */
+typedef struct {
+    const char *name;
+    uint32_t package;                     /* index into ct_vec_set.packages  */
+    ct_lens lens;                         /* used when grid.nu == 0          */
+    ct_unproject_grid grid;               /* nu > 0: ct_camera_init_grid     */
+    ct_status init_status;
+    int64_t r2_max_q32;                   /* the camera's valid field        */
+    int32_t R_q30[9];
+    int64_t e_nm, n_nm, h_nm;
+    ct_status pose_status;
+    ct_effects effects;
+    uint32_t batch_method;
+    const ct_vec_pixel *pixels;
+    uint32_t npixels;
+} ct_vec_camera;
+
 typedef struct {
     const ct_vec_package *packages;
     uint32_t npackages;
@@ -79,6 +112,8 @@ typedef struct {
     const ct_vec_dir *dirs;
     uint32_t ndirs;
     const char *generator;                /* "build_package" or "degenerate"  */
+    const ct_vec_camera *cameras;
+    uint32_t ncameras;
 } ct_vec_set;
 
 extern const ct_vec_set ct_vectors;

@@ -6,7 +6,9 @@
 // N = 24, r = 1), traces a few hundred rays per package with every method
 // on the HOST build of the library (native __int128) and writes everything
 // -- package bytes, rays, prepared rays, every ct_hit field, map-frame
-// conversions, fixed-point results -- as a C99 data file (ct_vectors.h).
+// conversions, fixed-point results, and four cameras over the packages
+// (lenses, an unprojection grid, poses, straight and bent rays: every
+// ct_geolocate output and the batch) -- as a C99 data file (ct_vectors.h).
 // The MCU program re-computes all of it with the Cortex-M build and requires
 // bit-identical results.
 //
@@ -529,6 +531,14 @@ std::string ray_init(const ct_ray &r)
            i64(r.dz) + "}";
 }
 
+std::string hit_init(const ct_hit &h)
+{
+    return "{.x_q16 = " + i64(h.x_q16) + ", .y_q16 = " + i64(h.y_q16) + ", .z_q16 = " + i64(h.z_q16) +
+           ", .e_nm = " + i64(h.e_nm) + ", .n_nm = " + i64(h.n_nm) + ", .h_nm = " + i64(h.h_nm) +
+           ",\n     .t_q26 = " + i64(h.t_q26) + ", .cell_x = " + i32(h.cell_x) + ", .cell_y = " + i32(h.cell_y) +
+           ", .steps = " + u32(h.steps) + ", .iters = " + u32(h.iters) + "}";
+}
+
 void emit_case(FILE *f, const ct_vec_case &c)
 {
     const ct_prepared &p = c.prep;
@@ -541,15 +551,7 @@ void emit_case(FILE *f, const ct_vec_case &c)
                  i64(p.tend_n).c_str(), i64(p.tend_d).c_str(), i32(p.start).c_str());
     std::fprintf(f, "   .status = {%s, %s, %s, %s},\n   .hit = {\n", i32(c.status[0]).c_str(), i32(c.status[1]).c_str(),
                  i32(c.status[2]).c_str(), i32(c.status[3]).c_str());
-    for (int m = 0; m < CT_METHOD_COUNT; ++m) {
-        const ct_hit &h = c.hit[m];
-        std::fprintf(f,
-                     "    {.x_q16 = %s, .y_q16 = %s, .z_q16 = %s, .e_nm = %s, .n_nm = %s, .h_nm = %s,\n"
-                     "     .t_q26 = %s, .cell_x = %s, .cell_y = %s, .steps = %s, .iters = %s},\n",
-                     i64(h.x_q16).c_str(), i64(h.y_q16).c_str(), i64(h.z_q16).c_str(), i64(h.e_nm).c_str(),
-                     i64(h.n_nm).c_str(), i64(h.h_nm).c_str(), i64(h.t_q26).c_str(), i32(h.cell_x).c_str(),
-                     i32(h.cell_y).c_str(), u32(h.steps).c_str(), u32(h.iters).c_str());
-    }
+    for (int m = 0; m < CT_METHOD_COUNT; ++m) std::fprintf(f, "    %s,\n", hit_init(c.hit[m]).c_str());
     std::fprintf(f, "  }},\n");
 }
 
@@ -561,6 +563,247 @@ void emit_point(FILE *f, const ct_vec_point &q)
                  i64(q.n).c_str(), i64(q.h).c_str(), i32(q.m2g_status).c_str(), i64(q.x2).c_str(), i64(q.y2).c_str(),
                  i64(q.z2).c_str(), i32(q.surf_status).c_str(), i64(q.surf_z).c_str(), i64(q.de).c_str(),
                  i64(q.dn).c_str(), i64(q.dh).c_str(), i32(q.rfm_status).c_str(), ray_init(q.rfm).c_str());
+}
+
+// ------------------------------------------------------------------ cameras
+struct Cam {
+    std::string name;
+    uint32_t package = 0;
+    ct_lens lens{};
+    std::vector<int32_t> grid_rays;  // nodes of a grid camera
+    ct_unproject_grid grid{};
+    ct_status init_status = CT_ERR_ARG;
+    int64_t r2_max_q32 = 0;
+    int32_t R[9] = {0};
+    int64_t e_nm = 0, n_nm = 0, h_nm = 0;
+    ct_status pose_status = CT_ERR_ARG;
+    ct_effects effects{};
+    uint32_t batch_method = 0;
+    std::vector<ct_vec_pixel> px;
+};
+
+ct_lens make_lens(uint32_t model, double f, double cx, double cy, std::vector<double> dist)
+{
+    ct_lens L;
+    std::memset(&L, 0, sizeof L);
+    L.model = model;
+    L.width = 640;
+    L.height = 480;
+    L.fx_q32 = (int64_t)std::llround(f * 4294967296.0);
+    L.fy_q32 = (int64_t)std::llround(f * 1.002 * 4294967296.0);
+    L.cx_q32 = (int64_t)std::llround(cx * 4294967296.0);
+    L.cy_q32 = (int64_t)std::llround(cy * 4294967296.0);
+    for (size_t i = 0; i < dist.size() && i < 8; ++i) L.dist_q48[i] = (int64_t)std::llround(dist[i] * 281474976710656.0);
+    return L;
+}
+
+// R_map_cam for a camera looking towards azimuth az (deg from north,
+// clockwise) pitched down by pitch (deg): columns right, down, forward.
+void look(double az_deg, double pitch_deg, int32_t R[9])
+{
+    const double a = az_deg * 3.14159265358979323846 / 180, p = pitch_deg * 3.14159265358979323846 / 180;
+    const double f[3] = {std::sin(a) * std::cos(p), std::cos(a) * std::cos(p), -std::sin(p)};
+    const double r[3] = {std::cos(a), -std::sin(a), 0.0};
+    const double d[3] = {f[1] * r[2] - f[2] * r[1], f[2] * r[0] - f[0] * r[2], f[0] * r[1] - f[1] * r[0]};
+    for (int i = 0; i < 3; ++i) {
+        R[i * 3 + 0] = (int32_t)std::lround(r[i] * 1073741824.0);
+        R[i * 3 + 1] = (int32_t)std::lround(d[i] * 1073741824.0);
+        R[i * 3 + 2] = (int32_t)std::lround(f[i] * 1073741824.0);
+    }
+}
+
+bool same_geo(const ct_geo &a, const ct_geo &b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+// Unprojection, projection back and geolocation (every method, and the
+// batch) of a camera's pixels on the host.
+void run_camera(Rng &g, Cam &c, const ct_package &pkg)
+{
+    ct_camera cam;
+    std::memset(&cam, 0, sizeof cam);
+    c.init_status = c.grid.nu ? ct_camera_init_grid(&cam, &c.grid) : ct_camera_init(&cam, &c.lens);
+    c.r2_max_q32 = cam.r2_max_q32;
+    ct_pose pose;
+    std::memset(&pose, 0, sizeof pose);
+    c.pose_status = ct_pose_init(&pose, c.R, c.e_nm, c.n_nm, c.h_nm);
+    if (c.init_status != CT_OK || c.pose_status != CT_OK) die("camera " + c.name + ": init failed on the host");
+    const int64_t U = INT64_C(1) << 16;
+    const int64_t fixed_px[][2] = {{0, 0}, {639 * U, 0}, {0, 479 * U}, {639 * U, 479 * U}, {319 * U + U / 2, 239 * U + U / 2},
+                                   {-3000 * U, 240 * U}, {320 * U, 9000 * U}, {(INT64_C(1) << 20) * U + 1, 0}};
+    for (int k = 0; k < 40; ++k) {
+        ct_vec_pixel q;
+        std::memset(&q, 0, sizeof q);
+        if (k < 8) {
+            q.u_q16 = fixed_px[k][0];
+            q.v_q16 = fixed_px[k][1];
+        } else {
+            q.u_q16 = g.range(-20 * U, 660 * U);
+            q.v_q16 = g.range(-20 * U, 500 * U);
+        }
+        q.unp_status = ct_camera_unproject(&cam, q.u_q16, q.v_q16, q.ray_q30, &q.unp_iters);
+        if (q.unp_status == CT_OK) q.proj_status = ct_camera_project(&cam, q.ray_q30, &q.pu_q16, &q.pv_q16);
+        for (int m = 0; m < CT_METHOD_COUNT; ++m)
+            ct_geolocate(&pkg, &cam, &pose, (ct_method)m, &c.effects, q.u_q16, q.v_q16, &q.geo[m]);
+        c.px.push_back(q);
+    }
+    std::vector<int64_t> uv;
+    for (const ct_vec_pixel &q : c.px) {
+        uv.push_back(q.u_q16);
+        uv.push_back(q.v_q16);
+    }
+    std::vector<ct_geo> out(c.px.size());
+    std::memset(out.data(), 0, out.size() * sizeof(ct_geo));
+    if (ct_geolocate_batch(&pkg, &cam, &pose, (ct_method)c.batch_method, &c.effects, uv.data(), c.px.size(),
+                           out.data(), out.size()) != CT_OK)
+        die("camera " + c.name + ": batch failed on the host");
+    int hits = 0, miss = 0, errors = 0;
+    for (size_t k = 0; k < c.px.size(); ++k) {
+        if (!same_geo(out[k], c.px[k].geo[c.batch_method])) die("camera " + c.name + ": batch != single on the host");
+        const ct_status st = c.px[k].geo[0].status;
+        hits += st == CT_HIT || st == CT_HIT_VOID;
+        miss += st == CT_MISS;
+        errors += st < 0;
+    }
+    std::fprintf(stderr, "gen_vectors: camera %s: %zu pixels: %d hit, %d miss, %d errors\n", c.name.c_str(),
+                 c.px.size(), hits, miss, errors);
+}
+
+std::vector<Cam> make_cameras(Rng &g, const std::vector<const ct_package *> &pk)
+{
+    std::vector<Cam> cams(4);
+    const double E0 = ORIGIN_E_M, N0 = ORIGIN_N_M;
+    {  // distorted lens looking north over the tile, curvature + refraction
+        Cam &c = cams[0];
+        c.name = "opencv8_oblique_bent";
+        c.package = 1;
+        c.lens = make_lens(CT_LENS_OPENCV8, 900, 319.5, 239.5,
+                           {-0.28, 0.09, 0.0007, -0.0004, -0.01, 0.02, 0.003, 0.001});
+        look(0, 40, c.R);
+        c.e_nm = nm(E0 + 480);
+        c.n_nm = nm(N0 - 1500);
+        c.h_nm = nm(900);
+        c.effects.flags = CT_EFFECT_ALL;
+        c.effects.refraction_k_q16 = CT_REFRACTION_K_STD_Q16;
+        c.batch_method = CT_METHOD_DIRECTIONAL;
+    }
+    {  // pinhole, nearly nadir, straight rays
+        Cam &c = cams[1];
+        c.name = "pinhole_nadir";
+        c.package = 0;
+        c.lens = make_lens(CT_LENS_PINHOLE, 1500, 320, 240, {});
+        look(30, 89, c.R);
+        c.e_nm = nm(E0 + 480);
+        c.n_nm = nm(N0 - 420);
+        c.h_nm = nm(2000);
+        c.batch_method = CT_METHOD_CONE;
+    }
+    {  // grazing from the west on a small planet: strongly bent polylines
+        Cam &c = cams[2];
+        c.name = "opencv4_grazing_small_earth";
+        c.package = 0;
+        c.lens = make_lens(CT_LENS_OPENCV4, 900, 330, 250, {-0.1, 0.01, 0.0001, 0.0001});
+        look(90, 20, c.R);
+        c.e_nm = nm(E0 - 100);
+        c.n_nm = nm(N0 - 400);
+        c.h_nm = nm(600);
+        c.effects.flags = CT_EFFECT_CURVATURE | CT_EFFECT_REFRACTION;
+        c.effects.refraction_k_q16 = 8520;
+        c.effects.earth_radius_nm = INT64_C(1) << 44;
+        c.effects.chord_nm = INT64_C(1) << 20;
+        c.batch_method = CT_METHOD_DIRECTIONAL;
+    }
+    {  // unprojection grid baked from the first lens, curvature only
+        Cam &c = cams[3];
+        c.name = "grid_from_opencv8";
+        c.package = 1;
+        ct_camera src;
+        std::memset(&src, 0, sizeof src);
+        if (ct_camera_init(&src, &cams[0].lens) != CT_OK) die("grid source lens");
+        const uint32_t nu = 13, nv = 10;
+        const int64_t step = 64, u0 = -64, v0 = -64;
+        for (uint32_t j = 0; j < nv; ++j)
+            for (uint32_t i = 0; i < nu; ++i) {
+                int32_t ray[3] = {0, 0, 0};
+                uint32_t it = 0;
+                if (ct_camera_unproject(&src, (u0 + (int64_t)i * step) << 16, (v0 + (int64_t)j * step) << 16, ray, &it) !=
+                    CT_OK)
+                    ray[0] = ray[1] = ray[2] = 0;
+                c.grid_rays.insert(c.grid_rays.end(), ray, ray + 3);
+            }
+        c.grid.nu = nu;
+        c.grid.nv = nv;
+        c.grid.u0_q16 = u0 << 16;
+        c.grid.v0_q16 = v0 << 16;
+        c.grid.step_q16 = step << 16;
+        c.grid.rays_q30 = c.grid_rays.data();
+        c.grid.rays_len = c.grid_rays.size();
+        look(20, 40, c.R);
+        c.e_nm = nm(E0 + 300);
+        c.n_nm = nm(N0 - 1300);
+        c.h_nm = nm(800);
+        c.effects.flags = CT_EFFECT_CURVATURE;
+        c.batch_method = CT_METHOD_HIERARCHICAL;
+    }
+    for (Cam &c : cams) run_camera(g, c, *pk[c.package]);
+    return cams;
+}
+
+std::string geo_init(const ct_geo &o)
+{
+    return "{.status = " + i32(o.status) + ", .unproject_iters = " + u32(o.unproject_iters) + ", .ray_cam_q30 = {" +
+           i32(o.ray_cam_q30[0]) + ", " + i32(o.ray_cam_q30[1]) + ", " + i32(o.ray_cam_q30[2]) + "},\n      .dir_map_q39 = {" +
+           i64(o.dir_map_q39[0]) + ", " + i64(o.dir_map_q39[1]) + ", " + i64(o.dir_map_q39[2]) + "},\n      .hit = " +
+           hit_init(o.hit) + "}";
+}
+
+void emit_cameras(FILE *f, const std::vector<Cam> &cams)
+{
+    for (size_t k = 0; k < cams.size(); ++k) {
+        const Cam &c = cams[k];
+        if (!c.grid_rays.empty()) {
+            std::fprintf(f, "static const int32_t cam%zu_grid[%zu] = {", k, c.grid_rays.size());
+            for (size_t i = 0; i < c.grid_rays.size(); ++i)
+                std::fprintf(f, "%s%s,", (i % 6) ? " " : "\n  ", i32(c.grid_rays[i]).c_str());
+            std::fprintf(f, "\n};\n\n");
+        }
+        std::fprintf(f, "static const ct_vec_pixel cam%zu_pixels[%zu] = {\n", k, c.px.size());
+        for (const ct_vec_pixel &q : c.px) {
+            std::fprintf(f, "  {%s, %s, %s, %s, {%s, %s, %s}, %s, %s, %s,\n   {", i64(q.u_q16).c_str(), i64(q.v_q16).c_str(),
+                         i32(q.unp_status).c_str(), u32(q.unp_iters).c_str(), i32(q.ray_q30[0]).c_str(),
+                         i32(q.ray_q30[1]).c_str(), i32(q.ray_q30[2]).c_str(), i32(q.proj_status).c_str(),
+                         i64(q.pu_q16).c_str(), i64(q.pv_q16).c_str());
+            for (int m = 0; m < CT_METHOD_COUNT; ++m) std::fprintf(f, "%s%s", m ? ",\n    " : "", geo_init(q.geo[m]).c_str());
+            std::fprintf(f, "}},\n");
+        }
+        std::fprintf(f, "};\n\n");
+    }
+    std::fprintf(f, "static const ct_vec_camera cameras[%zu] = {\n", cams.size());
+    for (size_t k = 0; k < cams.size(); ++k) {
+        const Cam &c = cams[k];
+        const ct_lens &L = c.lens;
+        std::fprintf(f, "  {.name = \"%s\", .package = %uu,\n   .lens = {.model = %uu, .width = %uu, .height = %uu, ",
+                     c.name.c_str(), c.package, L.model, L.width, L.height);
+        std::fprintf(f, ".fx_q32 = %s, .fy_q32 = %s, .cx_q32 = %s, .cy_q32 = %s,\n            .dist_q48 = {",
+                     i64(L.fx_q32).c_str(), i64(L.fy_q32).c_str(), i64(L.cx_q32).c_str(), i64(L.cy_q32).c_str());
+        for (int i = 0; i < 8; ++i) std::fprintf(f, "%s%s", i ? ", " : "", i64(L.dist_q48[i]).c_str());
+        std::fprintf(f, "}},\n");
+        if (!c.grid_rays.empty())
+            std::fprintf(f,
+                         "   .grid = {.nu = %uu, .nv = %uu, .u0_q16 = %s, .v0_q16 = %s, .step_q16 = %s, .rays_q30 = "
+                         "cam%zu_grid, .rays_len = %zuu},\n",
+                         c.grid.nu, c.grid.nv, i64(c.grid.u0_q16).c_str(), i64(c.grid.v0_q16).c_str(),
+                         i64(c.grid.step_q16).c_str(), k, c.grid_rays.size());
+        std::fprintf(f, "   .init_status = %s, .r2_max_q32 = %s,\n   .R_q30 = {", i32(c.init_status).c_str(),
+                     i64(c.r2_max_q32).c_str());
+        for (int i = 0; i < 9; ++i) std::fprintf(f, "%s%s", i ? ", " : "", i32(c.R[i]).c_str());
+        std::fprintf(f, "},\n   .e_nm = %s, .n_nm = %s, .h_nm = %s, .pose_status = %s,\n", i64(c.e_nm).c_str(),
+                     i64(c.n_nm).c_str(), i64(c.h_nm).c_str(), i32(c.pose_status).c_str());
+        std::fprintf(f, "   .effects = {.flags = %uu, .refraction_k_q16 = %s, .earth_radius_nm = %s, .chord_nm = %s},\n",
+                     c.effects.flags, i32(c.effects.refraction_k_q16).c_str(), i64(c.effects.earth_radius_nm).c_str(),
+                     i64(c.effects.chord_nm).c_str());
+        std::fprintf(f, "   .batch_method = %uu, .pixels = cam%zu_pixels, .npixels = %zuu},\n", c.batch_method, k,
+                     c.px.size());
+    }
+    std::fprintf(f, "};\n\n");
 }
 
 }  // namespace
@@ -694,6 +937,11 @@ int main(int argc, char **argv)
         }
     }
 
+    std::vector<const ct_package *> pk;
+    for (const Pkg &P : pkgs) pk.push_back(&P.p);
+    Rng gc(20251125u);
+    const std::vector<Cam> cams = make_cameras(gc, pk);
+
     FILE *f = std::fopen(argv[1], "w");
     if (!f) die(std::string("cannot write ") + argv[1]);
     std::fprintf(f, "/* Generated by tests/mcu/gen_vectors.cpp -- do not edit. */\n#include \"ct_vectors.h\"\n\n");
@@ -740,8 +988,11 @@ int main(int argc, char **argv)
         std::fprintf(f, "%s{%uu, %uu, %s, %s},", (i % 3) ? " " : "\n  ", dirs[i].k, dirs[i].n, i32(dirs[i].cx).c_str(),
                      i32(dirs[i].sy).c_str());
     }
-    std::fprintf(f, "\n};\n\nconst ct_vec_set ct_vectors = {packages, %zuu, fixed, %zuu, dirs, %zuu, \"%s\"};\n",
-                 pkgs.size(), fx.size(), dirs.size(), generator.c_str());
+    std::fprintf(f, "\n};\n\n");
+    emit_cameras(f, cams);
+    std::fprintf(f,
+                 "const ct_vec_set ct_vectors = {packages, %zuu, fixed, %zuu, dirs, %zuu, \"%s\", cameras, %zuu};\n",
+                 pkgs.size(), fx.size(), dirs.size(), generator.c_str(), cams.size());
     if (std::fclose(f) != 0) die("write error");
     return 0;
 }

@@ -4,8 +4,10 @@
  * Re-computes every host-generated vector (ct_vectors.h) with the library
  * build linked into this image: package open/verify and derived tables,
  * CRC-32, ray preparation, all four tracing methods through ct_trace and
- * ct_trace_prepared, map-frame conversions, surface heights and the
- * fixed-point core.  Every field must be bit-identical.  Prints a summary
+ * ct_trace_prepared, map-frame conversions, surface heights, the
+ * fixed-point core, and cameras: lens and grid set-up, unprojection,
+ * projection, ct_geolocate with every method (straight and bent rays) and
+ * ct_geolocate_batch.  Every field must be bit-identical.  Prints a summary
  * and stops with pass/fail through the platform layer (semihosting on
  * qemu).  C99, freestanding, no stdio, no float.
  */
@@ -163,9 +165,10 @@ static void eq_prep(const ct_prepared *w, const ct_prepared *g)
 
 /* ---- stack measurement ---------------------------------------------------- */
 
-enum { ST_OPEN, ST_PREPARE, ST_TRACE, ST_TRACE_PREP, ST_COUNT };
-static const char *const st_names[ST_COUNT] = {"ct_package_open", "ct_ray_prepare", "ct_trace",
-                                               "ct_trace_prepared"};
+enum { ST_OPEN, ST_PREPARE, ST_TRACE, ST_TRACE_PREP, ST_UNPROJECT, ST_PROJECT, ST_GEOLOCATE, ST_BATCH, ST_COUNT };
+static const char *const st_names[ST_COUNT] = {"ct_package_open",     "ct_ray_prepare",    "ct_trace",
+                                               "ct_trace_prepared",   "ct_camera_unproject", "ct_camera_project",
+                                               "ct_geolocate",        "ct_geolocate_batch"};
 static unsigned st_max[ST_COUNT];
 
 static void st_note(int k)
@@ -332,6 +335,109 @@ static void check_package(const ct_vec_package *vp, uint32_t *traces, uint32_t *
     }
 }
 
+static void eq_geo(const ct_geo *w, const ct_geo *g)
+{
+    uint32_t i;
+    eq_i64("geo.status", w->status, g->status);
+    eq_u64("geo.unproject_iters", w->unproject_iters, g->unproject_iters);
+    for (i = 0u; i < 3u; ++i) {
+        eq_i64("geo.ray_cam_q30", w->ray_cam_q30[i], g->ray_cam_q30[i]);
+        eq_i64("geo.dir_map_q39", w->dir_map_q39[i], g->dir_map_q39[i]);
+    }
+    eq_hit(&w->hit, &g->hit);
+}
+
+#define CAM_MAX_PIXELS 64u
+static ct_package g_cpkg;
+static ct_camera g_cam;
+static ct_pose g_pose;
+static int64_t g_uv[2u * CAM_MAX_PIXELS];
+static ct_geo g_batch[CAM_MAX_PIXELS];
+
+/* Cameras: lens (or grid) and pose set-up, unprojection, projection back,
+ * geolocation with every method and the batch, each bit-identical to the
+ * host's.  Returns the number of geolocations that matched in full. */
+static uint32_t check_camera(const ct_vec_set *vs, const ct_vec_camera *vc, uint32_t *total)
+{
+    ct_status st;
+    uint32_t k, m, ok = 0u, before;
+    g_where = vc->name;
+    g_idx = 0u;
+    g_method = 0u;
+    *total += vc->npixels * (uint32_t)CT_METHOD_COUNT;
+    if (vc->package >= vs->npackages || vc->npixels > CAM_MAX_PIXELS) {
+        eq_i64("camera vector shape", 0, 1);
+        return 0u;
+    }
+    st = ct_package_open(&g_cpkg, vs->packages[vc->package].bytes, vs->packages[vc->package].size);
+    eq_i64("camera package open", CT_OK, st);
+    if (st != CT_OK) {
+        return 0u;
+    }
+    zero_bytes(&g_cam, sizeof g_cam);
+    st = vc->grid.nu > 0u ? ct_camera_init_grid(&g_cam, &vc->grid) : ct_camera_init(&g_cam, &vc->lens);
+    eq_i64("camera init", vc->init_status, st);
+    eq_i64("r2_max_q32", vc->r2_max_q32, g_cam.r2_max_q32);
+    zero_bytes(&g_pose, sizeof g_pose);
+    eq_i64("pose init", vc->pose_status, ct_pose_init(&g_pose, vc->R_q30, vc->e_nm, vc->n_nm, vc->h_nm));
+    if (vc->init_status != CT_OK || vc->pose_status != CT_OK) {
+        return 0u;
+    }
+    for (k = 0u; k < vc->npixels; ++k) {
+        const ct_vec_pixel *q = &vc->pixels[k];
+        int32_t ray[3] = {0, 0, 0};
+        uint32_t iters = 0u;
+        g_idx = k;
+        g_method = 0u;
+        ct_plat_stack_paint();
+        st = ct_camera_unproject(&g_cam, q->u_q16, q->v_q16, ray, &iters);
+        st_note(ST_UNPROJECT);
+        eq_i64("unproject status", q->unp_status, st);
+        if (q->unp_status == CT_OK) {
+            int64_t u = 0, v = 0;
+            eq_u64("unproject iters", q->unp_iters, iters);
+            eq_i64("ray x", q->ray_q30[0], ray[0]);
+            eq_i64("ray y", q->ray_q30[1], ray[1]);
+            eq_i64("ray z", q->ray_q30[2], ray[2]);
+            ct_plat_stack_paint();
+            st = ct_camera_project(&g_cam, q->ray_q30, &u, &v);
+            st_note(ST_PROJECT);
+            eq_i64("project status", q->proj_status, st);
+            eq_i64("project u", q->pu_q16, u);
+            eq_i64("project v", q->pv_q16, v);
+        }
+        for (m = 0u; m < (uint32_t)CT_METHOD_COUNT; ++m) {
+            ct_geo o;
+            g_method = m;
+            before = g_fail;
+            zero_bytes(&o, sizeof o);
+            ct_plat_stack_paint();
+            st = ct_geolocate(&g_cpkg, &g_cam, &g_pose, (ct_method)m, &vc->effects, q->u_q16, q->v_q16, &o);
+            st_note(ST_GEOLOCATE);
+            eq_i64("geolocate status", q->geo[m].status, st);
+            eq_geo(&q->geo[m], &o);
+            if (g_fail == before) {
+                ok++;
+            }
+        }
+        g_uv[2u * k] = q->u_q16;
+        g_uv[2u * k + 1u] = q->v_q16;
+    }
+    /* the batch: the same pixels, bit-identical to the single calls */
+    g_method = vc->batch_method;
+    zero_bytes(g_batch, sizeof g_batch);
+    ct_plat_stack_paint();
+    st = ct_geolocate_batch(&g_cpkg, &g_cam, &g_pose, (ct_method)vc->batch_method, &vc->effects, g_uv, vc->npixels,
+                            g_batch, CAM_MAX_PIXELS);
+    st_note(ST_BATCH);
+    eq_i64("batch status", CT_OK, st);
+    for (k = 0u; k < vc->npixels && vc->batch_method < (uint32_t)CT_METHOD_COUNT; ++k) {
+        g_idx = k;
+        eq_geo(&vc->pixels[k].geo[vc->batch_method], &g_batch[k]);
+    }
+    return ok;
+}
+
 static void check_fixed(const ct_vec_set *vs)
 {
     uint32_t k;
@@ -411,6 +517,25 @@ int main(void)
         put_str(" mismatching fields");
         flush_line();
     }
+    for (p = 0u; p < vs->ncameras; ++p) {
+        const ct_vec_camera *vc = &vs->cameras[p];
+        uint32_t n = 0u, before = g_fail;
+        const uint32_t ok = check_camera(vs, vc, &n);
+        total += n;
+        traces += ok;
+        put_str("  camera ");
+        put_str(vc->name);
+        put_str(": ");
+        put_u64(vc->npixels);
+        put_str(" pixels x 4 methods: ");
+        put_u64(ok);
+        put_str("/");
+        put_u64(n);
+        put_str(" geolocations identical (batch checked too), ");
+        put_u64(g_fail - before);
+        put_str(" mismatching fields");
+        flush_line();
+    }
 #ifdef CT_MCU_TARGET
     for (p = 0u; p < (uint32_t)ST_COUNT; ++p) {
         put_str("  measured stack ");
@@ -444,7 +569,7 @@ int main(void)
     put_u64(traces);
     put_str("/");
     put_u64(total);
-    put_str(" traces bit-identical, ");
+    put_str(" traces and geolocations bit-identical, ");
     put_u64(g_checks);
     put_str(" values checked, ");
     put_u64(g_fail);
