@@ -365,7 +365,8 @@ static uint32_t check_camera(const ct_vec_set *vs, const ct_vec_camera *vc, uint
     g_idx = 0u;
     g_method = 0u;
     *total += vc->npixels * (uint32_t)CT_METHOD_COUNT;
-    if (vc->package >= vs->npackages || vc->npixels > CAM_MAX_PIXELS) {
+    if (vc->package >= vs->npackages || vc->npixels > CAM_MAX_PIXELS ||
+        vc->batch_method >= (uint32_t)CT_METHOD_COUNT) {
         eq_i64("camera vector shape", 0, 1);
         return 0u;
     }
@@ -431,7 +432,7 @@ static uint32_t check_camera(const ct_vec_set *vs, const ct_vec_camera *vc, uint
                             g_batch, CAM_MAX_PIXELS);
     st_note(ST_BATCH);
     eq_i64("batch status", CT_OK, st);
-    for (k = 0u; k < vc->npixels && vc->batch_method < (uint32_t)CT_METHOD_COUNT; ++k) {
+    for (k = 0u; k < vc->npixels; ++k) {
         g_idx = k;
         eq_geo(&vc->pixels[k].geo[vc->batch_method], &g_batch[k]);
     }
