@@ -143,6 +143,10 @@ double run_embree(const EmbreeTerrain &e, const std::vector<ct_ray> &rays, long 
 
 int g_slices = 0, g_window = 12;  // --slices K, --window R (slice builder)
 bool g_only_slices = false;
+std::string g_family;      // --family NAME: only this ray family
+int g_method = -1;         // --method M (0..3): only this method
+double g_loop_s = 0;       // --loop S: repeat the timed loop for S seconds (for perf)
+std::vector<int> g_reduces; // --r R (repeatable): only these reductions
 
 void bench_dem(const char *title, const ct_host::Terrain &t, int n, const std::vector<int> &reduces,
                const std::vector<ct_host::PptBuilder> &builders)
@@ -156,6 +160,7 @@ void bench_dem(const char *title, const ct_host::Terrain &t, int n, const std::v
 #endif
     for (ct_host::PptBuilder builder : builders)
     for (int r : reduces) {
+        if (!g_reduces.empty() && std::find(g_reduces.begin(), g_reduces.end(), r) == g_reduces.end()) continue;
         ct_host::BuildOptions o;
         o.sectors = 24;
         o.reduce = r;
@@ -177,7 +182,22 @@ void bench_dem(const char *title, const ct_host::Terrain &t, int n, const std::v
         std::printf("%-11s %6s | %-13s %9s %7s %9s %9s %9s\n", "family", "rays", "method", "steps", "median", "ns/ray",
                     "x fewer", "x faster");
         for (const auto &f : fams) {
-            if (f.rays.empty()) continue;
+            if (f.rays.empty() || (!g_family.empty() && f.name != g_family)) continue;
+            if (g_method >= 0) {
+                std::vector<ct_hit> hv;
+                Result one = run(p, f.rays, (ct_method)g_method, &hv);
+                auto t0 = clk::now();
+                ct_hit h;
+                uint64_t sink = 0;
+                while (std::chrono::duration<double>(clk::now() - t0).count() < g_loop_s)
+                    for (const ct_ray &ray : f.rays) {
+                        ct_trace(&p, &ray, (ct_method)g_method, &h);
+                        sink += (uint64_t)h.x_q16;
+                    }
+                std::printf("%-11s %6zu | method %d %9.1f %7.0f %9.0f%s\n", f.name.c_str(), f.rays.size(), g_method,
+                            one.mean_steps, one.median_steps, one.ns, sink == 42 ? " " : "");
+                continue;
+            }
             Result base;
             std::vector<ct_hit> hs[4];
             Result res[4];
@@ -220,6 +240,14 @@ int main(int argc, char **argv)
             g_window = std::atoi(argv[++k]);
         } else if (!std::strcmp(argv[k], "--only-slices")) {
             g_only_slices = true;
+        } else if (!std::strcmp(argv[k], "--family") && k + 1 < argc) {
+            g_family = argv[++k];
+        } else if (!std::strcmp(argv[k], "--method") && k + 1 < argc) {
+            g_method = std::atoi(argv[++k]);
+        } else if (!std::strcmp(argv[k], "--loop") && k + 1 < argc) {
+            g_loop_s = std::atof(argv[++k]);
+        } else if (!std::strcmp(argv[k], "--r") && k + 1 < argc) {
+            g_reduces.push_back(std::atoi(argv[++k]));
         } else if (!std::strcmp(argv[k], "--no-2048")) {
             big = false;
         } else if (!std::strcmp(argv[k], "--brute-2048")) {

@@ -108,6 +108,21 @@ static void test_isqrt(void)
                         "isqrt64(%llu) = %llu", (unsigned long long)hard[k], (unsigned long long)r);
     }
     ct_rng_seed(&rng, ct_test_seed() + 1);
+    /* 64-bit, every bit length, with perfect squares and their neighbours
+     * (the table-started Newton iteration must land exactly on each) */
+    for (k = 0; k < 300000; ++k) {
+        unsigned bits = (unsigned)ct_rng_range(&rng, 1, 64);
+        uint64_t n = bits == 64 ? ct_rng_u64(&rng) : ct_rng_u64(&rng) & (((uint64_t)1 << bits) - 1u);
+        uint64_t r;
+        if (k % 3 == 0) {
+            uint64_t s = n >> (bits / 2u);
+            s &= 0xffffffffu;
+            n = s * s + (uint64_t)(int64_t)ct_rng_range(&rng, -1, 1);
+        }
+        r = ct_isqrt64(n);
+        TEST_ASSERT_MSG((unsigned __int128)r * r <= n && (unsigned __int128)(r + 1) * (r + 1) > n,
+                        "isqrt64(%llu) = %llu", (unsigned long long)n, (unsigned long long)r);
+    }
     for (k = 0; k < 100000; ++k) {
         /* 128-bit: n < 2^126, including perfect squares and their neighbours */
         unsigned bits = (unsigned)ct_rng_range(&rng, 1, 125);

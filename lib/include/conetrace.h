@@ -170,6 +170,9 @@ typedef struct {
     uint32_t width, height; /* posts                                          */
     uint32_t cells_x, cells_y;   /* fine cells = posts - 1                     */
     uint32_t reduce, sectors;    /* r, N                                       */
+    uint32_t reserved0;
+    uint64_t reduce_mul;         /* ceil(2^32 / r): i / r = (i * it) >> 32 for
+                                    i < 2^16 (error i * (1/r)' < 2^-16 < 1/r) */
     uint32_t coarse_x, coarse_y; /* ceil(cells / r)                            */
     uint32_t levels;             /* stored mipmap levels (1..L)                */
     uint32_t planes;             /* angle planes (N or N + 1)                  */

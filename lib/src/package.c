@@ -362,6 +362,8 @@ ct_status ct_package_open(ct_package *pkg, const uint8_t *b, size_t len)
     pkg->cells_x = w - 1u;
     pkg->cells_y = h - 1u;
     pkg->reduce = r;
+    pkg->reserved0 = 0u;
+    pkg->reduce_mul = (((uint64_t)1 << 32) + r - 1u) / r;
     pkg->sectors = n;
     pkg->coarse_x = (pkg->cells_x + r - 1u) / r;
     pkg->coarse_y = (pkg->cells_y + r - 1u) / r;

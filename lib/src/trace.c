@@ -598,6 +598,15 @@ static ct_status walk_hierarchical(const ctx *c, ct_hit *h)
     return CT_ERR_INTERNAL;
 }
 
+/* Coarse cell index of fine cell (i, j): i / r by the multiplier (exact for
+ * i < 2^16, see ct_package.reduce_mul). */
+static size_t coarse_index(const ct_package *p, int32_t i, int32_t j)
+{
+    uint32_t ci = (uint32_t)(((uint64_t)(uint32_t)i * p->reduce_mul) >> 32);
+    uint32_t cj = (uint32_t)(((uint64_t)(uint32_t)j * p->reduce_mul) >> 32);
+    return (size_t)cj * p->coarse_x + ci;
+}
+
 static ct_status walk_cones(const ctx *c, uint32_t plane, ct_hit *h)
 {
     const ct_package *p = c->p;
@@ -612,17 +621,14 @@ static ct_status walk_cones(const ctx *c, uint32_t plane, ct_hit *h)
     locate(c, t, &i, &j);
     /* bound: each iteration leaves at least one fine cell */
     for (it = 0u; it < bound; ++it) {
-        uint32_t ci, cj, code;
+        uint32_t code;
         size_t k;
         if (!inside(c, i, j)) {
             h->iters = it;
             return CT_MISS;
         }
-        cell_exit(c, i, j, &e);
         h->steps++;
-        ci = (uint32_t)i / p->reduce;
-        cj = (uint32_t)j / p->reduce;
-        k = (size_t)cj * p->coarse_x + ci;
+        k = coarse_index(p, i, j);
         code = ang[k];
         if (p->cot_ok[code]) {
             int64_t a16 = (int64_t)ct_ld16(p->apex + 2u * k) * ONE16;
@@ -635,8 +641,8 @@ static ct_status walk_cones(const ctx *c, uint32_t plane, ct_hit *h)
             if (num > 0) {
                 int64_t cot = p->cot_q16[code];
                 int64_t len = cot >= 0 ? r->len_hi : r->len_lo;
-                /* len <= 2^26.5, |cot| <= 2^35: < 2^61.5 */
-                int64_t den = ct_ceil_div(len * cot, ONE16) - (int64_t)r->dz;
+                /* len <= 2^26.5, |cot| <= 2^35: < 2^61.5; ceil by 2^16 */
+                int64_t den = -floor_shr(-(len * cot), 16u) - (int64_t)r->dz;
                 int64_t dt, tn;
                 if (den <= 0) {
                     /* the ray never leaves the empty region: no hit ahead */
@@ -647,25 +653,34 @@ static ct_status walk_cones(const ctx *c, uint32_t plane, ct_hit *h)
                 if (dt > (INT64_C(1) << 35)) {
                     dt = INT64_C(1) << 35;
                 }
-                /* T + dt - 1 < 2^26 times the exact exit of the cone */
+                /* T + dt - 1 < 2^26 times the exact exit of the cone, so the
+                 * ray on [t, tn] lies in the empty region.  The jump is taken
+                 * when it leaves the fine cell (the point at tn lies in
+                 * another cell, or on the exit face, which belongs to the
+                 * next cell); otherwise the exact cell step below. */
                 tn = T + dt - 1;
-                /* tn < 2^36: tn * d < 2^62 */
-                if (tn * e.t.d > e.t.n * T_ONE) {
+                if (tn > T) {
                     rt tj;
+                    int32_t ni, nj;
                     tj.n = tn;
                     tj.d = T_ONE;
-                    if (!rt_lt(tj, c->tend)) {
-                        h->iters = it + 1u;
-                        return CT_MISS;
+                    locate(c, tj, &ni, &nj);
+                    if (ni != i || nj != j) {
+                        if (!rt_lt(tj, c->tend)) {
+                            h->iters = it + 1u;
+                            return CT_MISS;
+                        }
+                        t = tj;
+                        i = ni;
+                        j = nj;
+                        tin_ok = 0;
+                        continue;
                     }
-                    t = tj;
-                    locate(c, t, &i, &j);
-                    tin_ok = 0;
-                    continue;
                 }
             }
         }
         /* exact cell step */
+        cell_exit(c, i, j, &e);
         if (!tin_ok) {
             tin = cell_entry(c, i, j);
         }
