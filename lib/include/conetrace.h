@@ -334,7 +334,13 @@ typedef struct {
     int32_t coeff_q16; /* c in Q16, |c| <= 4 * 2^16; 0 = straight ray       */
     int64_t radius_nm; /* R in nm, [2^40, 2^54] (1.1 km .. 18,000 km)        */
     int64_t chord_nm;  /* largest polyline deviation, [2^10, 2^50] nm       */
+    uint32_t flags;    /* 0, or CT_BEND_NO_CULL                              */
 } ct_bend;
+
+/* The walk skips runs of segments that the max-mipmap shows to be above all
+ * terrain under them (bend.c, "culling"); that changes no result, only the
+ * time.  CT_BEND_NO_CULL traces every segment (for tests that check it).   */
+#define CT_BEND_NO_CULL 1u
 
 #define CT_BEND_MAX_SEGMENTS 65536u
 /* Worst-case iterations of a bent trace: every segment's walk leaves a new

@@ -25,9 +25,14 @@
 #define ONE16 INT64_C(65536)
 #define RHO_MAX_NM (INT64_C(1) << 52)
 #define DIR_MAX (INT64_C(1) << 30)
+/* Largest run of segments culled at once: 2^10 (e.g. 245 km of 240 m
+ * segments); the cull's box then reaches the mipmap's top levels. */
+#define CT_BEND_MAX_RUN_LOG2 10
 
 typedef struct {
     int64_t x, y, z;
+    int64_t line, drop; /* z = line + drop (unless saturated): the straight
+                           ray's height and the bend's, Q16 */
 } v3;
 
 typedef struct {
@@ -48,15 +53,31 @@ static int64_t round_div128(ct_i128 a, int64_t b)
     return ct_i128_floor_div_sat(twice, 2 * b);
 }
 
+/* round(s * u / L) for s >= 0, |u| <= 2^30, 1 <= L < 2^31: in 64 bits when
+ * s < 2^31 (|s u| < 2^61, so 2 s u + L fits), else through 128 bits.  Both
+ * give floor((2 s u + L) / 2L), the same value. */
+static int64_t scale_round(int64_t s, int64_t u, int64_t L)
+{
+    if (s < (INT64_C(1) << 31)) {
+        return ct_floor_div(2 * s * u + L, 2 * L);
+    }
+    return round_div128(ct_i128_mul(s, u), L);
+}
+
 /* The vertex at range s (Q16 cells, s >= 0).  Returns CT_ERR_RANGE when
  * the range exceeds RHO_MAX_NM. */
 static ct_status vertex(const bent *b, int64_t s, v3 *v)
 {
-    ct_i128 rho2;
+    ct_i128 rho2, sp;
     int64_t rho, drop;
-    /* rho = s * posting / 2^16: s < 2^63, posting < 2^62 -> 128-bit */
-    rho = ct_i128_floor_div_sat(ct_i128_mul(s, b->posting), ONE16);
-    if (rho >= RHO_MAX_NM) {
+    /* rho = floor(s * posting / 2^16): s < 2^63, posting < 2^62, both >= 0:
+     * the unsigned 128-bit product shifted right by 16 */
+    sp = ct_umul64((uint64_t)s, (uint64_t)b->posting);
+    if ((sp.hi >> 16) != 0u) {
+        return CT_ERR_RANGE;
+    }
+    rho = (int64_t)((sp.hi << 48) | (sp.lo >> 16));
+    if (rho >= RHO_MAX_NM || rho < 0) {
         return CT_ERR_RANGE;
     }
     /* c * rho^2: |c| <= 2^18, rho^2 < 2^104 -> < 2^122 */
@@ -70,9 +91,11 @@ static ct_status vertex(const bent *b, int64_t s, v3 *v)
     }
     /* s * U / L: |s| < 2^63, |U| <= 2^30: 128-bit; quotients < 2^63 / 1 are
      * saturated at 2^62 (far outside the box: the segment clip rejects) */
-    v->x = b->ox + round_div128(ct_i128_mul(s, b->ux), b->L);
-    v->y = b->oy + round_div128(ct_i128_mul(s, b->uy), b->L);
-    v->z = b->oz + round_div128(ct_i128_mul(s, b->uz), b->L);
+    v->x = b->ox + scale_round(s, b->ux, b->L);
+    v->y = b->oy + scale_round(s, b->uy, b->L);
+    v->z = b->oz + scale_round(s, b->uz, b->L);
+    v->line = v->z;
+    v->drop = drop;
     /* keep z within +-2^62 */
     if (drop > 0 && v->z > (INT64_C(1) << 62) - drop) {
         v->z = INT64_C(1) << 62;
@@ -82,6 +105,86 @@ static ct_status vertex(const bent *b, int64_t s, v3 *v)
         v->z += drop;
     }
     return CT_OK;
+}
+
+/* Max-mipmap value of block (bi, bj) at level l >= 1 (the hierarchical
+ * walk's array). */
+static int64_t mip_max(const ct_package *p, uint32_t l, int64_t bi, int64_t bj)
+{
+    return (int64_t)ct_ld16(p->mip[l] + 2u * ((size_t)bj * p->mip_w[l] + (size_t)bi));
+}
+
+/* Culling.  1 when nothing at or below zmin (Q16) stands under the
+ * horizontal box [x0, x1] x [y0, y1] (Q16): zmin is above the max-mipmap's
+ * maximum over the fine cells the box touches.  *over_tile says whether the
+ * box meets the tile at all.  At most four mipmap reads: the level is the
+ * first whose blocks are at least as wide as the box (the box top hmax when
+ * none is). */
+static int box_above_terrain(const ct_package *p, int64_t x0, int64_t x1, int64_t y0, int64_t y1, int64_t zmin,
+                             int *over_tile)
+{
+    int64_t i0, i1, j0, j1, top, bi, bj;
+    uint32_t l = 1u;
+    *over_tile = !(x1 < 0 || y1 < 0 || x0 > (int64_t)p->cells_x * ONE16 || y0 > (int64_t)p->cells_y * ONE16);
+    if (!*over_tile) {
+        return 1;
+    }
+    /* cells touched, clamped to the tile (x0 < 0 -> cell 0) */
+    i0 = ct_min64(ct_max64(x0, 0) >> 16, (int64_t)p->cells_x - 1);
+    j0 = ct_min64(ct_max64(y0, 0) >> 16, (int64_t)p->cells_y - 1);
+    i1 = ct_min64(x1 >> 16, (int64_t)p->cells_x - 1);
+    j1 = ct_min64(y1 >> 16, (int64_t)p->cells_y - 1);
+    /* bound: CT_MAX_LEVELS levels */
+    while (l < p->levels && (((i1 >> l) - (i0 >> l)) > 1 || ((j1 >> l) - (j0 >> l)) > 1)) {
+        l++;
+    }
+    if (p->levels == 0u || ((i1 >> l) - (i0 >> l)) > 1 || ((j1 >> l) - (j0 >> l)) > 1) {
+        top = p->hmax;
+    } else {
+        top = 0;
+        /* bound: at most 2 x 2 blocks */
+        for (bj = j0 >> l; bj <= (j1 >> l); ++bj) {
+            for (bi = i0 >> l; bi <= (i1 >> l); ++bi) {
+                top = ct_max64(top, mip_max(p, l, bi, bj));
+            }
+        }
+    }
+    return zmin > top * ONE16;
+}
+
+/* Culling a run of polyline segments from vertex a to vertex b (one segment
+ * or 2^q consecutive ones).  Their vertices lie between a and b
+ * horizontally (monotone along the ray), and every point of the polyline
+ * over the run is at least
+ *     min(line_a, line_b) + min(drop_a, drop_b) - chord - 2
+ * (the straight part is linear, the bend's drop monotone in range for
+ * either sign of c, the chords within `chord` of the curve, vertices
+ * rounded by < 2 units); for a single segment (run = 0) the chord itself is
+ * used: min(z_a, z_b).  The slack, 2 + max|b - a| / 2^24 Q16 units, also
+ * covers each prepared segment's own rounding (entry 1/2 unit, direction
+ * 2^-25 of the distance), so no ray the walk would trace over the run can
+ * meet the surface when this returns 1: skipping the run changes no
+ * result. */
+static int run_above_terrain(const ct_package *p, const v3 *a, const v3 *b, int run, int64_t chord_q16,
+                             int *over_tile)
+{
+    int64_t dx = b->x - a->x, dy = b->y - a->y;
+    int64_t m = ct_max64(ct_abs64(dx), ct_max64(ct_abs64(dy), ct_abs64(b->z - a->z)));
+    int64_t slack = 2 + (m >> 24);
+    int64_t zlo = run ? ct_min64(a->line, b->line) + ct_min64(a->drop, b->drop) - chord_q16 - 2
+                      : ct_min64(a->z, b->z);
+    return box_above_terrain(p, ct_min64(a->x, b->x) - slack, ct_max64(a->x, b->x) + slack,
+                             ct_min64(a->y, b->y) - slack, ct_max64(a->y, b->y) + slack, zlo - slack, over_tile);
+}
+
+/* Both ends of the run inside the tile's closed box (so the polyline over
+ * it is too: straight horizontally; vertically ct_ray_prepare_segment clips
+ * any part above the top and starts at or above the surface). */
+static int run_inside(const ct_package *p, const v3 *a, const v3 *b, int64_t ztop)
+{
+    int64_t wq = (int64_t)p->cells_x * ONE16, hq = (int64_t)p->cells_y * ONE16;
+    return a->x >= 0 && a->y >= 0 && b->x >= 0 && b->y >= 0 && a->x <= wq && b->x <= wq && a->y <= hq &&
+           b->y <= hq && a->z <= ztop && b->z <= ztop;
 }
 
 /* Range interval [s0, s1] (Q16 cells) where the horizontal path is inside
@@ -142,7 +245,7 @@ ct_status ct_bend_segment(const ct_package *p, const ct_bend *bd, int64_t *delta
 {
     if (bd->coeff_q16 < -(4 * 65536) || bd->coeff_q16 > 4 * 65536 || bd->radius_nm < (INT64_C(1) << 40) ||
         bd->radius_nm > (INT64_C(1) << 54) || bd->chord_nm < (INT64_C(1) << 10) ||
-        bd->chord_nm > (INT64_C(1) << 50)) {
+        bd->chord_nm > (INT64_C(1) << 50) || (bd->flags & ~CT_BEND_NO_CULL) != 0u) {
         return CT_ERR_ARG;
     }
     *delta = 0;
@@ -167,7 +270,9 @@ ct_status ct_trace_bent(const ct_package *p, const ct_ray *ray, const ct_bend *b
                         ct_hit *h)
 {
     bent b;
-    int64_t s0, s1, delta, k0, k1, k;
+    int64_t s0, s1, delta, k0, k1, k, chord_q16;
+    int64_t ztop;
+    int q;
     int entered = 0;
     uint32_t steps = 0u, iters = 0u;
     v3 va, vb;
@@ -236,20 +341,61 @@ ct_status ct_trace_bent(const ct_package *p, const ct_ray *ray, const ct_bend *b
     if (st != CT_OK) {
         return st;
     }
-    /* bound: k1 - k0 <= CT_BEND_MAX_SEGMENTS segments */
-    for (k = k0; k < k1; ++k) {
+    ztop = ((int64_t)p->hmax + 1) * ONE16;
+    /* the chord tolerance in Q16 height units, rounded up (run culling) */
+    chord_q16 = ct_i128_floor_div_sat(ct_i128_shl(ct_i128_from64(bd->chord_nm), 16), p->height_scale_nm) + 1;
+    /* Runs of 2^q segments are culled at once where the polyline is high
+     * above the terrain (q grows by one after each success, shrinks by one
+     * after each failure, as the hierarchical walk's level); q = 0 is one
+     * segment, culled or traced.  bound: every iteration advances k or
+     * lowers q, and q rises only with an advance, so at most
+     * 2 (k1 - k0) + CT_BEND_MAX_RUN_LOG2 + 1 iterations. */
+    q = 0;
+    for (k = k0; k < k1;) { /* bound: see above */
         ct_ray seg;
         ct_prepared pr;
         ct_hit sh;
-        int64_t ztop = ((int64_t)p->hmax + 1) * ONE16;
-        st = vertex(&b, (k + 1) * delta, &vb);
+        int over = 0, run = 0;
+        int64_t kn = k + ((int64_t)1 << q);
+        if (q > 0 && kn > k1) {
+            q--;
+            continue;
+        }
+        st = vertex(&b, kn * delta, &vb);
         if (st != CT_OK) {
             return st;
         }
-        /* convex and rising above the box: it never comes back */
-        if (b.coeff > 0 && va.z > ztop && vb.z >= va.z) {
+        run = q > 0;
+        /* one convex segment above the box and rising: the polyline never
+         * comes back (not for a run: a convex curve may dip between) */
+        if (!run && b.coeff > 0 && va.z > ztop && vb.z >= va.z) {
             break;
         }
+        if ((bd->flags & CT_BEND_NO_CULL) == 0u && run_above_terrain(p, &va, &vb, run, chord_q16, &over)) {
+            int inside = run_inside(p, &va, &vb, ztop);
+            /* skipped when ct_ray_prepare_segment's answer for each segment
+             * is known without it: off the tile or above the box (CT_MISS),
+             * or inside the box above the surface (CT_OK: entered) */
+            if (!over || (run ? ct_min64(va.line, vb.line) + ct_min64(va.drop, vb.drop) - chord_q16 - 2
+                              : ct_min64(va.z, vb.z)) > ztop || inside) {
+                if (inside) {
+                    entered = 1;
+                }
+                steps++;
+                iters++;
+                va = vb;
+                k = kn;
+                if (q < CT_BEND_MAX_RUN_LOG2) {
+                    q++;
+                }
+                continue;
+            }
+        }
+        if (run) {
+            q--;
+            continue;
+        }
+        /* one segment, traced exactly */
         seg.x_q16 = va.x;
         seg.y_q16 = va.y;
         seg.z_q16 = va.z;
@@ -257,6 +403,7 @@ ct_status ct_trace_bent(const ct_package *p, const ct_ray *ray, const ct_bend *b
         seg.dy = vb.y - va.y;
         seg.dz = vb.z - va.z;
         va = vb;
+        k = kn;
         if (ct_abs64(seg.x_q16) > CT_MAX_ORIGIN_Q16 || ct_abs64(seg.y_q16) > CT_MAX_ORIGIN_Q16 ||
             ct_abs64(seg.z_q16) > CT_MAX_ORIGIN_Q16) {
             /* a vertex beyond the library's origin range: only possible
@@ -287,7 +434,7 @@ ct_status ct_trace_bent(const ct_package *p, const ct_ray *ray, const ct_bend *b
             pr.start = CT_HIT;
         }
         entered = 1;
-        st = ct_trace_prepared(p, &pr, m, &sh);
+        st = ct_trace_prepared_own(p, &pr, m, &sh);
         if (st < 0) {
             return st;
         }

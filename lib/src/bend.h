@@ -15,6 +15,10 @@ extern "C" {
  * CT_OK, or CT_ERR_ARG for a parameter out of range or Delta < 1/64 cell. */
 ct_status ct_bend_segment(const ct_package *pkg, const ct_bend *bd, int64_t *delta_q16);
 
+/* ct_trace_prepared for a ray this library prepared itself (skips the
+ * re-validation of the caller-visible struct). */
+ct_status ct_trace_prepared_own(const ct_package *pkg, const ct_prepared *ray, ct_method method, ct_hit *hit);
+
 #ifdef __cplusplus
 }
 #endif

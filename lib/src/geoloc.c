@@ -39,6 +39,7 @@ static ct_status effects_to_bend(const ct_package *p, const ct_effects *fx, ct_b
     int64_t delta;
     int32_t c = 0;
     bd->coeff_q16 = 0;
+    bd->flags = 0u;
     bd->radius_nm = CT_EARTH_RADIUS_NM;
     bd->chord_nm = CT_EFFECTS_CHORD_NM;
     if (fx == NULL) {

@@ -24,6 +24,7 @@
  * reported hit position is rounded: the root is computed to 2^-32 of the
  * cell and the position reported at t_q26 = floor(t * 2^26).
  */
+#include "bend.h"
 #include "conetrace.h"
 #include "fixed.h"
 
@@ -833,9 +834,30 @@ static ct_status prepare_impl(const ct_package *p, const ct_ray *ray, int seg, c
     tin.n = ct_i128_from64(0);
     tin.d = 1;
     tout = tin;
+    /* A segment that starts and ends inside the box (the bent walk's usual
+     * case) needs no clipping: tin = 0, and every box exit is at t >= 1.
+     * |O| <= 2^46, |U| <= 2^62: O + U fits in int64. */
+    if (seg) {
+        int in = 1;
+        for (k = 0; k < 3; ++k) { /* bound: 3 axes */
+            int64_t e = O[k] + U[k];
+            if ((k < 2 && (O[k] < lo[k] || e < lo[k])) || O[k] > hi[k] || e > hi[k]) {
+                in = 0;
+            }
+        }
+        if (in) {
+            has_out = 1;
+            tout.n = ct_i128_from64(1);
+            k = 3; /* skip the clip below */
+        } else {
+            k = 0;
+        }
+    } else {
+        k = 0;
+    }
     /* Clip the caller's ray (unnormalised direction, exact 128-bit
      * rationals) to the box.  bound: 3 axes */
-    for (k = 0; k < 3; ++k) {
+    for (; k < 3; ++k) {
         bigrt a, b;
         int floorless = (k == 2);
         if (U[k] == 0) {
@@ -1073,7 +1095,7 @@ static ct_status check_prepared(const ct_package *p, const ct_prepared *r)
     return CT_OK;
 }
 
-ct_status ct_trace_prepared(const ct_package *p, const ct_prepared *r, ct_method m, ct_hit *h)
+static ct_status trace_impl(const ct_package *p, const ct_prepared *r, ct_method m, int checked, ct_hit *h)
 {
     ctx c;
     ct_status st;
@@ -1093,7 +1115,9 @@ ct_status ct_trace_prepared(const ct_package *p, const ct_prepared *r, ct_method
     if (r->start == CT_MISS || r->start == CT_BELOW) {
         return r->start;
     }
-    st = check_prepared(p, r);
+    /* a ray prepared by this library needs no re-check (ct_trace, the bent
+     * walk); one handed in by a caller does */
+    st = checked ? CT_OK : check_prepared(p, r);
     if (st != CT_OK) {
         return st;
     }
@@ -1167,7 +1191,17 @@ ct_status ct_trace(const ct_package *p, const ct_ray *ray, ct_method m, ct_hit *
     if (st < 0) {
         return st;
     }
-    return ct_trace_prepared(p, &r, m, h);
+    return trace_impl(p, &r, m, 1, h);
+}
+
+ct_status ct_trace_prepared(const ct_package *p, const ct_prepared *r, ct_method m, ct_hit *h)
+{
+    return trace_impl(p, r, m, 0, h);
+}
+
+ct_status ct_trace_prepared_own(const ct_package *p, const ct_prepared *r, ct_method m, ct_hit *h)
+{
+    return trace_impl(p, r, m, 1, h);
 }
 
 /* ------------------------------------------------------------------------ */
