@@ -42,11 +42,11 @@ namespace {
                  "                       [--builder slices|brute] [--window R] [--levels H1,H2,...]\n"
                  "                       [--emit-c NAME]\n"
                  "       conetrace info PKG\n"
-                 "       conetrace trace PKG --rays rays.csv [--method M] -o hits.csv\n"
+                 "       conetrace trace PKG --rays rays.csv [--method M] [--threads T] -o hits.csv\n"
                  "       conetrace demo DEM\n"
                  "       conetrace geoloc PKG --camera C.cameramodel --pixels px.csv [--method M]\n"
                  "                        [--effects curvature,refraction] [--refraction-k K]\n"
-                 "                        [--earth-radius M] [--grid-step PX] -o g.csv\n"
+                 "                        [--earth-radius M] [--grid-step PX] [--threads T] -o g.csv\n"
                  "       conetrace render DEM_or_PKG --what bitmap|dt|ddt|angles|apex -o OUT.png\n"
                  "                       [--slice H | --level k --slices K] [--reduce r] [--sectors N]\n"
                  "                       [--sector LIST] [--range LO,HI] [--hillshade] [--zoom Z]\n"
@@ -240,36 +240,45 @@ int cmd_info(int argc, char **argv)
 
 int cmd_trace(int argc, char **argv)
 {
-    Args a = parse(argc, argv, 2, {"--rays", "--method", "-o"});
+    Args a = parse(argc, argv, 2, {"--rays", "--method", "--threads", "-o"});
     if (a.pos.size() != 1) usage("trace needs exactly one package file");
     if (!a.opt.count("--rays")) usage("trace needs --rays rays.csv");
     if (!a.opt.count("-o")) usage("trace needs -o hits.csv");
     ct_method m = parse_method(a.opt.count("--method") ? a.opt["--method"] : "directional");
+    const int threads = a.opt.count("--threads") ? threads_option(a.opt["--threads"], "trace") : 0;
     std::vector<uint8_t> bytes = read_file(a.pos[0]);
     ct_package p;
     ct_status st = ct_package_open(&p, bytes.data(), bytes.size());
     if (st != CT_OK) throw Error(a.pos[0] + ": not a valid package (" + status_name(st) + ")");
     std::vector<MapRay> rays = read_rays_csv(a.opt["--rays"]);
+    // rows formatted by the threads into their slots, written in input order
+    std::vector<std::string> rows(rays.size());
+    parallel_chunks(rays.size(), threads, 1024, [&](size_t b, size_t e) {
+        char line[256];
+        for (size_t k = b; k < e; ++k) {
+            const MapRay &r = rays[k];
+            ct_ray gr;
+            ct_hit h;
+            ct_status s = map_ray_to_grid(p, r, &gr);
+            if (s == CT_OK) s = ct_trace(&p, &gr, m, &h);
+            if (s == CT_HIT || s == CT_HIT_VOID) {
+                double e_m = h.e_nm * 1e-9, n_m = h.n_nm * 1e-9, hh = h.h_nm * 1e-9;
+                double d2 = r.de * r.de + r.dn * r.dn + r.dh * r.dh;
+                double t = ((e_m - r.e) * r.de + (n_m - r.n) * r.dn + (hh - r.h) * r.dh) / d2;
+                std::snprintf(line, sizeof line, "%s,%.6f,%.6f,%.6f,%.9g,%u\n", status_name(s).c_str(), e_m, n_m, hh, t,
+                              h.steps);
+            } else if (s >= 0) {
+                std::snprintf(line, sizeof line, "%s,nan,nan,nan,nan,%u\n", status_name(s).c_str(),
+                              s == CT_MISS || s == CT_BELOW ? h.steps : 0u);
+            } else {
+                std::snprintf(line, sizeof line, "%s,nan,nan,nan,nan,0\n", status_name(s).c_str());
+            }
+            rows[k] = line;
+        }
+    });
     std::ostringstream out;
     out << "status,E,N,h,t,steps\n";
-    char line[256];
-    for (const MapRay &r : rays) {
-        ct_ray gr;
-        ct_hit h;
-        ct_status s = map_ray_to_grid(p, r, &gr);
-        if (s == CT_OK) s = ct_trace(&p, &gr, m, &h);
-        if (s == CT_HIT || s == CT_HIT_VOID) {
-            double e = h.e_nm * 1e-9, n = h.n_nm * 1e-9, hh = h.h_nm * 1e-9;
-            double d2 = r.de * r.de + r.dn * r.dn + r.dh * r.dh;
-            double t = ((e - r.e) * r.de + (n - r.n) * r.dn + (hh - r.h) * r.dh) / d2;
-            std::snprintf(line, sizeof line, "%s,%.6f,%.6f,%.6f,%.9g,%u\n", status_name(s).c_str(), e, n, hh, t, h.steps);
-        } else if (s >= 0) {
-            std::snprintf(line, sizeof line, "%s,nan,nan,nan,nan,%u\n", status_name(s).c_str(), s == CT_MISS || s == CT_BELOW ? h.steps : 0u);
-        } else {
-            std::snprintf(line, sizeof line, "%s,nan,nan,nan,nan,0\n", status_name(s).c_str());
-        }
-        out << line;
-    }
+    for (const std::string &row : rows) out << row;
     std::string txt = out.str();
     write_file_atomic(a.opt["-o"], std::vector<uint8_t>(txt.begin(), txt.end()));
     return 0;

@@ -2,7 +2,7 @@
 //
 //   conetrace geoloc PKG --camera C.cameramodel --pixels px.csv [--method M]
 //                        [--effects LIST] [--refraction-k K] [--earth-radius M]
-//                        [--grid-step PX] -o g.csv
+//                        [--grid-step PX] [--threads T] -o g.csv
 //
 // C.cameramodel: an mrcal camera model (read by libmrcal's C reader); its
 //   extrinsics are rt_cam_ref with the package's map frame (metres) as the
@@ -21,6 +21,9 @@
 //   horizontal range rho, c = [curvature] - k [refraction].
 //   --refraction-k K (default 0.13, in [-2, 2]; needs refraction) and
 //   --earth-radius M (metres, default 6371000; needs an effect).
+// --threads T: threads (default 0: all cores); each runs ct_geolocate_batch
+//   on chunks of pixels, the rows stay in input order and are the same for
+//   any T.
 // The work is the flight library's: ct_camera_init, ct_pose_init,
 // ct_geolocate_batch.  Errors print one line and exit non-zero; the output
 // is written atomically (never a partial file).
@@ -44,7 +47,7 @@ int cmd_geoloc(int argc, char **argv)
     std::vector<std::string> pos;
     std::map<std::string, std::string> opt;
     const char *valued[] = {"--camera", "--pixels",       "--method",       "--effects",
-                            "--grid-step", "--refraction-k", "--earth-radius", "-o"};
+                            "--grid-step", "--refraction-k", "--earth-radius", "--threads", "-o"};
     for (int k = 2; k < argc; ++k) {
         std::string s = argv[k];
         if (s.size() > 1 && s[0] == '-') {
@@ -110,6 +113,8 @@ int cmd_geoloc(int argc, char **argv)
             throw Error("--grid-step needs a number of pixels in [1, 4096], got '" + g + "'");
     }
 
+    const int threads = opt.count("--threads") ? threads_option(opt["--threads"], "geoloc") : 0;
+
     std::vector<uint8_t> bytes = read_file(pos[0]);
     ct_package p;
     ct_status st = ct_package_open(&p, bytes.data(), bytes.size());
@@ -125,7 +130,13 @@ int cmd_geoloc(int argc, char **argv)
         if (!in_range[k]) uv[2 * k] = uv[2 * k + 1] = 0;
     }
     std::vector<ct_geo> g(px.size());
-    st = ct_geolocate_batch(&p, &cam.cam, &cam.pose, m, &fx, uv.data(), px.size(), g.data(), g.size());
+    // the set-up's status (the same for every chunk; an empty input still
+    // checks the camera and the effects)
+    st = ct_geolocate_batch(&p, &cam.cam, &cam.pose, m, &fx, uv.data(), 0, g.data(), 0);
+    if (st == CT_OK)
+        parallel_chunks(px.size(), threads, 1024, [&](size_t b, size_t e) {
+            (void)ct_geolocate_batch(&p, &cam.cam, &cam.pose, m, &fx, uv.data() + 2 * b, e - b, g.data() + b, e - b);
+        });
     if (st == CT_ERR_EFFECTS)
         throw Error("--effects: the effect parameters are out of range for this package (" + status_name(st) + ")");
     if (st != CT_OK) throw Error(cpath + ": cannot geolocate from this camera (" + status_name(st) + ")");

@@ -6,7 +6,9 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <atomic>
 #include <sstream>
+#include <thread>
 
 #include <unistd.h>
 
@@ -185,6 +187,35 @@ void Progress::update(size_t done, size_t total)
 void Progress::finish()
 {
     if (shown_ && isatty(2)) std::fprintf(stderr, "\n");
+}
+
+}  // namespace ct_host
+
+namespace ct_host {
+
+void parallel_chunks(size_t n, int threads, size_t chunk, const std::function<void(size_t, size_t)> &work)
+{
+    if (chunk == 0) chunk = 1;
+    size_t chunks = (n + chunk - 1) / chunk;
+    size_t t = threads > 0 ? (size_t)threads : std::max(1u, std::thread::hardware_concurrency());
+    t = std::min(t, std::max<size_t>(chunks, 1));
+    std::atomic<size_t> next{0};
+    auto run = [&]() {
+        for (size_t c; (c = next.fetch_add(1)) < chunks;) work(c * chunk, std::min(n, (c + 1) * chunk));
+    };
+    std::vector<std::thread> pool;
+    for (size_t k = 1; k < t; ++k) pool.emplace_back(run);
+    run();
+    for (auto &th : pool) th.join();
+}
+
+int threads_option(const std::string &text, const std::string &cmd)
+{
+    char *end = nullptr;
+    long v = std::strtol(text.c_str(), &end, 10);
+    if (text.empty() || !end || *end || v < 0 || v > 256)
+        throw Error(cmd + ": --threads needs a number of threads in [0, 256] (0 = all cores), got '" + text + "'");
+    return (int)v;
 }
 
 }  // namespace ct_host

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cstdint>
 #include <cstdio>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -44,6 +45,14 @@ double proc_status_kib(const char *key);
 void reset_peak_rss();
 
 std::string status_name(ct_status s);
+
+// Run work(begin, end) over [0, n) in chunks of `chunk` items on `threads`
+// threads (0: all cores; never more threads than chunks), each chunk once;
+// the calling thread takes part.  Outputs indexed by item keep input order.
+void parallel_chunks(size_t n, int threads, size_t chunk, const std::function<void(size_t, size_t)> &work);
+
+// --threads T: a number of threads in [0, 256] (0 = all cores).
+int threads_option(const std::string &text, const std::string &cmd);
 
 // A ray in the map frame (metres): origin (e, n, h), direction (de, dn, dh).
 struct MapRay {

@@ -511,6 +511,15 @@ static void test_trace_methods(void)
         jobs.push_back(Job{d, args});
     }
     jobs.push_back(Job{d, {"trace", pkg, "--rays", "rays_rev.csv", "-o", "hits_rev.csv"}});
+    // --threads: the rays 60 times over (several 1,024-ray chunks), on one
+    // and on three threads
+    {
+        std::vector<TRay> many;
+        for (int k = 0; k < 60; ++k) many.insert(many.end(), rays.begin(), rays.end());
+        write_rays(d + "/rays_many.csv", many, false);
+    }
+    jobs.push_back(Job{d, {"trace", pkg, "--rays", "rays_many.csv", "-o", "hits_t1.csv", "--threads", "1"}});
+    jobs.push_back(Job{d, {"trace", pkg, "--rays", "rays_many.csv", "-o", "hits_t3.csv", "--threads", "3"}});
     std::vector<Run> runs = run_all(jobs);
 
     std::vector<std::vector<Row>> all;
@@ -552,7 +561,17 @@ static void test_trace_methods(void)
     TEST_ASSERT_MSG(rr.code == 0, "trace with reordered columns exited %d: %s", rr.code, rr.err.c_str());
     std::string rev = slurp(d + "/hits_rev.csv");
     TEST_ASSERT_MSG(rev == texts[4], "reordered columns give different hits:\n%s\nvs\n%s", rev.c_str(), texts[4].c_str());
-    std::set<std::string> files = listing(d), want = {"rays.csv", "rays_rev.csv", "hits_rev.csv"};
+    // --threads 1 and 3: the same file, and the one-ray-set output 60 times
+    {
+        TEST_ASSERT_MSG(runs[6].code == 0 && runs[7].code == 0, "trace --threads exited %d / %d: %s%s", runs[6].code,
+                        runs[7].code, runs[6].err.c_str(), runs[7].err.c_str());
+        std::string t1 = slurp(d + "/hits_t1.csv"), t3 = slurp(d + "/hits_t3.csv");
+        TEST_ASSERT_MSG(t1 == t3, "trace --threads 3 differs from --threads 1");
+        std::string body = texts[4].substr(texts[4].find('\n') + 1), want_many = texts[4].substr(0, texts[4].find('\n') + 1);
+        for (int k = 0; k < 60; ++k) want_many += body;
+        TEST_ASSERT_MSG(t1 == want_many, "trace --threads: rows not the single run's, in input order");
+    }
+    std::set<std::string> files = listing(d), want = {"rays.csv", "rays_rev.csv", "hits_rev.csv", "rays_many.csv"};
     for (const Job &j : jobs) want.insert(j.args[5]);
     TEST_ASSERT_MSG(files == want, "trace left {%s}", join(files).c_str());
 }
@@ -714,6 +733,10 @@ static void test_bad_inputs(void)
          good + "195600,4068000,15x0,0,0,-1\n"},
         // usage errors
         {"method", {"trace", pkg, "--rays", "rays.csv", "--method", "bogus", "-o", "hits.csv"}, "", "bogus", true, good},
+        {"threads", {"trace", pkg, "--rays", "rays.csv", "--threads", "x", "-o", "hits.csv"}, "", "--threads", false,
+         good},
+        {"threads257", {"trace", pkg, "--rays", "rays.csv", "--threads", "257", "-o", "hits.csv"}, "", "--threads",
+         false, good},
         {"option", {"build", fix, "-o", "X.ctp", "--frobnicate", "1"}, "", "--frobnicate", true, ""},
         {"sectors0", {"build", fix, "-o", "X.ctp", "--sectors", "0"}, "", "--sectors", true, ""},
         {"sectors65", {"build", fix, "-o", "X.ctp", "--sectors", "65"}, "", "--sectors", true, ""},

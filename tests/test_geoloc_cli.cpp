@@ -237,6 +237,64 @@ void test_geoloc_end_to_end()
     fs::remove(g_dir + "/px2.csv");
 }
 
+// --threads: 5,000 pixels (five chunks) give the same file, byte for byte,
+// on 1, 2 and 3 threads and by default, in input order; spot rows are the
+// library's ct_geolocate.
+void test_geoloc_threads()
+{
+    Setup *s = setup();
+    TEST_ASSERT(s != nullptr);
+    std::string px = "u,v\n";
+    ct_rng rng;
+    ct_rng_seed(&rng, 77);
+    std::vector<std::pair<double, double>> uv;
+    for (int k = 0; k < 5000; ++k) {
+        double u = -100 + 2200 * ct_rng_unit(&rng), v = -100 + 1700 * ct_rng_unit(&rng);
+        uv.push_back({u, v});
+        char line[64];
+        std::snprintf(line, sizeof line, "%.17g,%.17g\n", u, v);
+        px += line;
+    }
+    spit(g_dir + "/pxt.csv", px);
+    std::string first;
+    for (const char *t : {"1", "2", "3", ""}) {
+        std::vector<std::string> args = {"geoloc", "t.ctp", "--camera", "cam.cameramodel", "--pixels", "pxt.csv",
+                                         "--effects", "curvature,refraction", "-o", "gt.csv"};
+        if (*t) {
+            args.push_back("--threads");
+            args.push_back(t);
+        }
+        Run r = run(args);
+        TEST_ASSERT_MSG(r.code == 0, "--threads %s: exit %d: %s", t, r.code, r.err.c_str());
+        std::string got = slurp(g_dir + "/gt.csv");
+        if (first.empty()) first = got;
+        TEST_ASSERT_MSG(got == first, "--threads %s: output differs from one thread", t);
+    }
+    std::vector<std::string> rows = lines_of(first);
+    TEST_ASSERT_EQUAL_INT(5001, rows.size());
+    ct_host::CameraModel cm = ct_host::read_cameramodel(g_dir + "/cam.cameramodel");
+    ct_host::LibCamera lc = ct_host::lib_camera(cm, "cam");
+    ct_effects fx = {CT_EFFECT_CURVATURE | CT_EFFECT_REFRACTION, CT_REFRACTION_K_STD_Q16, 0, 0};
+    int hits = 0;
+    for (size_t k = 0; k < uv.size(); k += 97) {
+        std::vector<std::string> f = split(rows[k + 1]);
+        int64_t uq, vq;
+        TEST_ASSERT(ct_host::pixel_to_q16(uv[k].first, uv[k].second, &uq, &vq));
+        ct_geo g;
+        ct_status want = ct_geolocate(&s->p, &lc.cam, &lc.pose, CT_METHOD_DIRECTIONAL, &fx, uq, vq, &g);
+        TEST_ASSERT_MSG(f[2] == ct_host::status_name(want), "row %zu: %s vs %s", k + 1, f[2].c_str(),
+                        ct_host::status_name(want).c_str());
+        if (want == CT_HIT) {
+            ++hits;
+            TEST_ASSERT(f[3] == ct_host::nm_to_decimal(g.hit.e_nm) && f[4] == ct_host::nm_to_decimal(g.hit.n_nm) &&
+                        f[5] == ct_host::nm_to_decimal(g.hit.h_nm));
+        }
+    }
+    TEST_ASSERT_MSG(hits > 20, "only %d hits", hits);
+    fs::remove(g_dir + "/gt.csv");
+    fs::remove(g_dir + "/pxt.csv");
+}
+
 // --effects curvature,refraction with --refraction-k and --earth-radius:
 // the rows are the library's ct_geolocate with the same ct_effects, bit for
 // bit, and (with an exaggerated 30 km earth) differ from the straight rays.
@@ -422,6 +480,11 @@ void test_geoloc_bad_inputs()
         {{"geoloc", "t.ctp", "--camera", "cam.cameramodel", "--pixels", "px.csv", "--grid-step", "0.5", "-o",
           "out.csv"},
          "--grid-step"},
+        {{"geoloc", "t.ctp", "--camera", "cam.cameramodel", "--pixels", "px.csv", "--threads", "-1", "-o", "out.csv"},
+         "--threads"},
+        {{"geoloc", "t.ctp", "--camera", "cam.cameramodel", "--pixels", "px.csv", "--threads", "two", "-o",
+          "out.csv"},
+         "--threads"},
     };
     // pixels 'bad.ctp' swap: the package is the second argument
     cases[7].args = {"geoloc", "bad.ctp", "--camera", "cam.cameramodel", "--pixels", "px.csv", "-o", "out.csv"};
@@ -460,6 +523,7 @@ int main()
     g_dir = std::string(tmpl) + "/work";
     RUN_TEST(test_geoloc_end_to_end);
     RUN_TEST(test_geoloc_effects);
+    RUN_TEST(test_geoloc_threads);
     RUN_TEST(test_geoloc_splined_grid);
     RUN_TEST(test_geoloc_bad_inputs);
     int rc = TEST_END();

@@ -134,6 +134,33 @@ uint64_t ct_i128_isqrt(ct_i128 n)
         }
         x = (ct_isqrt64(top) + 1u) << s;
     }
+    /* One Newton step from x0 lands within a few units of the root: x0 is
+     * within 2^s of it (relative 2^-29), so the step's error is at most
+     * 2^2s / 2^(30+s) = 2^(s-30) <= 8 (s <= 33), plus 2 for the floors and
+     * the +1.  The result is then fixed by exact squares (128-bit products:
+     * y < 2^63).  bound: 16 + 16 fix-ups; if they do not suffice (they
+     * always do by the argument above), the Newton loop below finishes. */
+    if (n.hi < x) {
+        uint64_t y = (x >> 1) + (udiv128(n.hi, n.lo, x, &rem) >> 1) + 1u;
+        int ok = 0;
+        for (k = 0; k < 16; ++k) {
+            ct_i128 sq = ct_umul64(y, y);
+            if (ct_i128_cmp(sq, n) <= 0) {
+                ok = 1;
+                break;
+            }
+            y--;
+        }
+        if (ok) {
+            for (k = 0; k < 16; ++k) {
+                ct_i128 sq = ct_umul64(y + 1u, y + 1u);
+                if (ct_i128_cmp(sq, n) > 0) {
+                    return y;
+                }
+                y++;
+            }
+        }
+    }
     for (k = 0; k < 70; ++k) {
         uint64_t y;
         if (n.hi >= x) {

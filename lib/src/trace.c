@@ -352,7 +352,7 @@ static int interior_hit(const ctx *c, const quad *Q, rt tin, rt tout)
 static int64_t root_t_q26(const ctx *c, const quad *Q, rt tin, rt tout)
 {
     ct_i128 D = disc(Q);
-    int64_t sd, w, lo, hi, pn, pd;
+    int64_t sd, w, pn, pd;
     ct_i128 num;
     (void)c;
     if (ct_i128_sign(D) < 0) {
@@ -373,23 +373,31 @@ static int64_t root_t_q26(const ctx *c, const quad *Q, rt tin, rt tout)
     } else {
         w = 0; /* f not decreasing: cannot happen for a decided hit */
     }
-    /* clamp to the segment: lo = ceil(w(tin) 2^60), hi = floor(w(tout) 2^60);
-     * |pn| < 2^61: pn 2^60 < 2^121 */
+    /* clamp to the segment: w >= lo = ceil(w(tin) 2^60) and w <= hi =
+     * floor(w(tout) 2^60), w(t) = pn / pd.  For an integer w, w < lo iff
+     * w pd < pn 2^60 and w > hi iff w pd > pn 2^60, so the quotients are
+     * formed only when a clamp applies.  |pn| < 2^61: pn 2^60 < 2^121;
+     * |w| <= 2^62, pd <= 2^42: w pd < 2^104. */
     p_at(c, Q, tin, &pn, &pd);
-    lo = -ct_i128_floor_div_sat(ct_i128_neg(ct_i128_shl(ct_i128_from64(pn), W_BITS)), pd);
+    num = ct_i128_shl(ct_i128_from64(pn), W_BITS);
+    if (ct_i128_cmp(ct_i128_mul(w, pd), num) < 0) {
+        w = -ct_i128_floor_div_sat(ct_i128_neg(num), pd);
+    }
     p_at(c, Q, tout, &pn, &pd);
-    hi = ct_i128_floor_div_sat(ct_i128_shl(ct_i128_from64(pn), W_BITS), pd);
-    if (w < lo) {
-        w = lo;
+    num = ct_i128_shl(ct_i128_from64(pn), W_BITS);
+    if (ct_i128_cmp(ct_i128_mul(w, pd), num) > 0) {
+        w = ct_i128_floor_div_sat(num, pd);
     }
-    if (w > hi) {
-        w = hi;
-    }
-    /* d*t = dps + w*2^16, so t_q26 = floor((dps 2^60 + w 2^16) / (d 2^34));
-     * |dps| 2^60 < 2^91, w 2^16 < 2^77, d 2^34 <= 2^60. */
-    num = ct_i128_add(ct_i128_shl(ct_i128_from64(Q->dps), W_BITS), ct_i128_shl(ct_i128_from64(w), 16));
+    /* d*t = dps + w*2^16, so t_q26 = floor((dps 2^60 + w 2^16) / (d 2^34))
+     * = floor((dps 2^44 + w) / (d 2^18)).  In 64 bits: dps 2^26 = q1 d + r1
+     * (0 <= r1 < d), so t_q26 = q1 + floor((r1 2^18 + w) / (d 2^18)).
+     * |dps| < 2^31: dps 2^26 < 2^57; r1 2^18 < 2^44 and |w| <= 2^62: the
+     * sum < 2^63; d 2^18 <= 2^44. */
     {
-        int64_t t = ct_i128_floor_div_sat(num, Q->d << (W_BITS - CT_T_FRAC_BITS));
+        int64_t q1 = ct_floor_div(Q->dps * T_ONE, Q->d);
+        int64_t r1 = Q->dps * T_ONE - q1 * Q->d;
+        int64_t t = q1 + ct_floor_div(r1 * (INT64_C(1) << (W_BITS - 16u - CT_T_FRAC_BITS)) + w,
+                                      Q->d << (W_BITS - 16u - CT_T_FRAC_BITS));
         return t < 0 ? 0 : t;
     }
 }
