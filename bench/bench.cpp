@@ -5,7 +5,9 @@
 // Everything is measured in one run; nothing here is a pass/fail test.
 //
 // Options: --quick (fewer rays, no 2048 DEM), --rays N (per family),
-//          --no-2048.
+//          --no-2048; for profiling: --family NAME, --method 0..3, --r R,
+//          --loop S (repeat the timed loop S seconds), --azimuth DEG (all
+//          rays in one direction: one sector plane, mostly in cache).
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -32,6 +34,8 @@ struct FamilyRays {
     std::vector<ct_ray> rays;
 };
 
+double g_azimuth = -1;  // --azimuth DEG: every ray (nearly) in this direction, one sector's plane
+
 double elev_deg_rand(ct_rng *r, double lo, double hi) { return lo + (hi - lo) * ct_rng_unit(r); }
 
 // Ray families in the paper's spirit, in the metric frame of the terrain.
@@ -52,6 +56,7 @@ std::vector<FamilyRays> make_families(const ct_host::Terrain &t, const ct_packag
     };
     for (int k = 0; k < n; ++k) {
         double x = ct_rng_unit(&r) * cw, y = ct_rng_unit(&r) * ch, az = ct_rng_unit(&r) * 2 * M_PI;
+        if (g_azimuth >= 0) az = g_azimuth * M_PI / 180 + 1e-3 * ct_rng_unit(&r);
         fam[0].rays.push_back(start_above(x, y, -90 + elev_deg_rand(&r, 0, 0.0), az));
         fam[1].rays.push_back(start_above(x, y, -30, az));
         fam[2].rays.push_back(start_above(x, y, -3, az));
@@ -68,6 +73,7 @@ std::vector<FamilyRays> make_families(const ct_host::Terrain &t, const ct_packag
     while ((int)fam[4].rays.size() < n && tries < 400 * n) {
         ++tries;
         double x = ct_rng_unit(&r) * cw, y = ct_rng_unit(&r) * ch, az = ct_rng_unit(&r) * 2 * M_PI;
+        if (g_azimuth >= 0) az = g_azimuth * M_PI / 180 + 1e-3 * ct_rng_unit(&r);
         double d[3];
         dem_cases::metric_dir(t, az, 0, d);
         d[2] = 0;
@@ -240,6 +246,8 @@ int main(int argc, char **argv)
             g_window = std::atoi(argv[++k]);
         } else if (!std::strcmp(argv[k], "--only-slices")) {
             g_only_slices = true;
+        } else if (!std::strcmp(argv[k], "--azimuth") && k + 1 < argc) {
+            g_azimuth = std::atof(argv[++k]);
         } else if (!std::strcmp(argv[k], "--family") && k + 1 < argc) {
             g_family = argv[++k];
         } else if (!std::strcmp(argv[k], "--method") && k + 1 < argc) {
