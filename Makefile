@@ -23,6 +23,7 @@ bench: all
 	$(BUILD)/bench/ct_bench_geoloc
 	$(BUILD)/bench/ct_bench_build
 	$(BUILD)/bench/ct_bench_ddt
+	scripts/bench_m4.sh $(BUILD)
 
 cross: deps
 	scripts/cross.sh $(BUILD)/cross
