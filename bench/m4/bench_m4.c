@@ -99,7 +99,7 @@ int main(void)
     put(".");
     put_u(((ipt_q16 & 0xFFFFu) * 100u) >> 16, 0u);
     flush();
-    put("family        rays | method         steps  instructions/ray");
+    put("family        rays | method         steps  instructions/ray (directional: of which ct_ray_prepare)");
     flush();
     /* bound: families x methods x rays (baked arrays) */
     for (f = 0u; f < m4_family_count; ++f) {
@@ -155,6 +155,28 @@ int main(void)
             put(".");
             put_u(b > a ? (steps * 10u / (b - a)) % 10u : 0u, 0u);
             put_u(b > a ? ((ticks * ipt_q16) >> 16) / (b - a) : 0u, 18u);
+            if (m == 3u) {
+                /* of which the preparation (ct_ray_prepare alone) */
+                uint64_t pt = 0u;
+                for (k = a; k < b; ++k) {
+                    ct_ray r;
+                    ct_prepared pr;
+                    uint32_t dt;
+                    r.x_q16 = m4_rays[k].ray[0];
+                    r.y_q16 = m4_rays[k].ray[1];
+                    r.z_q16 = m4_rays[k].ray[2];
+                    r.dx = m4_rays[k].ray[3];
+                    r.dy = m4_rays[k].ray[4];
+                    r.dz = m4_rays[k].ray[5];
+                    t0 = SYST_CVR;
+                    (void)ct_ray_prepare(&p, &r, &pr);
+                    dt = ticks_since(t0);
+                    pt += dt > empty ? dt - empty : 0u;
+                }
+                put("  (prepare ");
+                put_u(b > a ? ((pt * ipt_q16) >> 16) / (b - a) : 0u, 0u);
+                put(")");
+            }
             flush();
         }
     }

@@ -4,7 +4,32 @@
  */
 #include "fixed.h"
 
-/* Unsigned (hi:lo) / d with hi < d; returns the quotient, *rem the rest. */
+#ifndef CT_NATIVE_INT128
+/* Number of leading zero bits of v (64 for 0), by halving: no loop. */
+static unsigned nlz64(uint64_t v)
+{
+    unsigned n = 0u;
+    if (v == 0u) {
+        return 64u;
+    }
+    if ((v >> 32) == 0u) { n += 32u; v <<= 32; }
+    if ((v >> 48) == 0u) { n += 16u; v <<= 16; }
+    if ((v >> 56) == 0u) { n += 8u; v <<= 8; }
+    if ((v >> 60) == 0u) { n += 4u; v <<= 4; }
+    if ((v >> 62) == 0u) { n += 2u; v <<= 2; }
+    if ((v >> 63) == 0u) { n += 1u; }
+    return n;
+}
+#endif
+
+/* Unsigned (hi:lo) / d with hi < d; returns the quotient, *rem the rest.
+ * Portable: long division in base 2^32 (Knuth's algorithm D, as in Hacker's
+ * Delight's divlu): d normalised so its top bit is set, then two quotient
+ * digits, each estimated from the top digits (a 64-by-32-bit division) and
+ * corrected at most twice (Knuth's theorem B).  The 64-bit intermediates
+ * fit: un32 < vn (from hi < d), so q1 <= 2^32 and q1 vn0 < 2^64; un21 and
+ * the remainder are < vn.  (The former version took one quotient bit per
+ * round, 64 rounds: ~8x the instructions on Cortex-M.) */
 static uint64_t udiv128(uint64_t hi, uint64_t lo, uint64_t d, uint64_t *rem)
 {
 #ifdef CT_NATIVE_INT128
@@ -12,19 +37,40 @@ static uint64_t udiv128(uint64_t hi, uint64_t lo, uint64_t d, uint64_t *rem)
     *rem = (uint64_t)(n % d);
     return (uint64_t)(n / d);
 #else
-    uint64_t q = 0u, r = hi;
-    int i;
-    /* bound: 64 iterations, one quotient bit each */
-    for (i = 63; i >= 0; --i) {
-        uint64_t carry = r >> 63;
-        r = (r << 1) | ((lo >> (unsigned)i) & 1u);
-        if (carry != 0u || r >= d) {
-            r -= d;
-            q |= (uint64_t)1 << (unsigned)i;
+    const uint64_t b = (uint64_t)1 << 32;
+    const uint64_t m32 = 0xFFFFFFFFu;
+    unsigned s = nlz64(d), k;
+    uint64_t vn = d << s, vn1 = vn >> 32, vn0 = vn & m32;
+    uint64_t un32 = s == 0u ? hi : (hi << s) | (lo >> (64u - s));
+    uint64_t un10 = lo << s, un1 = un10 >> 32, un0 = un10 & m32;
+    uint64_t q1, q0, rhat, un21;
+    q1 = un32 / vn1;
+    rhat = un32 - q1 * vn1;
+    for (k = 0u; k < 2u; ++k) { /* bound: at most two corrections */
+        if (q1 >= b || q1 * vn0 > ((rhat << 32) | un1)) {
+            q1--;
+            rhat += vn1;
+            if (rhat < b) {
+                continue;
+            }
         }
+        break;
     }
-    *rem = r;
-    return q;
+    un21 = (un32 << 32) + un1 - q1 * vn; /* mod 2^64; the value is < vn */
+    q0 = un21 / vn1;
+    rhat = un21 - q0 * vn1;
+    for (k = 0u; k < 2u; ++k) { /* bound: at most two corrections */
+        if (q0 >= b || q0 * vn0 > ((rhat << 32) | un0)) {
+            q0--;
+            rhat += vn1;
+            if (rhat < b) {
+                continue;
+            }
+        }
+        break;
+    }
+    *rem = ((un21 << 32) + un0 - q0 * vn) >> s;
+    return (q1 << 32) | q0;
 #endif
 }
 
