@@ -812,7 +812,8 @@ static ct_status prepare_impl(const ct_package *p, const ct_ray *ray, int seg, c
     int32_t D[3];
     int64_t O[3], U[3], lo[3], hi[3];
     bigrt tin, tout;
-    int k, has_out = 0;
+    int k, has_out = 0, kin = -1;
+    int64_t kin_at = 0; /* the entry face's coordinate on axis kin */
     CT_ASSERT(p != NULL && ray != NULL && out != NULL);
     if (p == NULL || ray == NULL || out == NULL) {
         return CT_ERR_ARG;
@@ -882,6 +883,8 @@ static ct_status prepare_impl(const ct_package *p, const ct_ray *ray, int seg, c
             b.n = ct_i128_from64(hi[k] - O[k]);
             if (!floorless && bigrt_lt(&tin, &a)) {
                 tin = a;
+                kin = k;
+                kin_at = lo[k];
             }
             if (!has_out || bigrt_lt(&b, &tout)) {
                 tout = b;
@@ -892,6 +895,8 @@ static ct_status prepare_impl(const ct_package *p, const ct_ray *ray, int seg, c
             b.n = ct_i128_from64(O[k] - lo[k]);
             if (bigrt_lt(&tin, &a)) {
                 tin = a;
+                kin = k;
+                kin_at = hi[k];
             }
             if (!floorless && (!has_out || bigrt_lt(&b, &tout))) {
                 tout = b;
@@ -926,7 +931,9 @@ static ct_status prepare_impl(const ct_package *p, const ct_ray *ray, int seg, c
         }
         /* the entry point, rounded to Q16 and kept in the box */
         for (k = 0; k < 3; ++k) {
-            O[k] = round_axis(O[k], U[k], &tin);
+            /* on the entry face's axis the point is the face itself, exactly
+             * (o + (bound - o)/U U): no division */
+            O[k] = k == kin ? kin_at : round_axis(O[k], U[k], &tin);
         }
         for (k = 0; k < 3; ++k) {
             if (O[k] > hi[k]) {
