@@ -165,16 +165,39 @@ static int box_above_terrain(const ct_package *p, int64_t x0, int64_t x1, int64_
  * 2^-25 of the distance), so no ray the walk would trace over the run can
  * meet the surface when this returns 1: skipping the run changes no
  * result. */
+static uint64_t absdiff64(int64_t a, int64_t b)
+{
+    return a > b ? (uint64_t)a - (uint64_t)b : (uint64_t)b - (uint64_t)a;
+}
+
+/* A lower bound of the polyline over the run (Q16), kept within +-2^61:
+ * |line| <= 2^62 + 2^46 and |drop| <= 2^62 (vertex's saturations), so each
+ * is clamped to +-2^60 first (only ever lowering a bound that high, far
+ * above any tile) and the sum and the chord's 2^60 at most stay in range. */
+static int64_t run_floor(const v3 *a, const v3 *b, int run, int64_t chord_q16)
+{
+    const int64_t lim = INT64_C(1) << 60;
+    if (run) {
+        int64_t l = ct_min64(ct_max64(ct_min64(a->line, b->line), -lim), lim);
+        int64_t d = ct_min64(ct_max64(ct_min64(a->drop, b->drop), -lim), lim);
+        return l + d - ct_min64(chord_q16, lim) - 2;
+    }
+    return ct_min64(a->z, b->z);
+}
+
 static int run_above_terrain(const ct_package *p, const v3 *a, const v3 *b, int run, int64_t chord_q16,
                              int *over_tile)
 {
-    int64_t dx = b->x - a->x, dy = b->y - a->y;
-    int64_t m = ct_max64(ct_abs64(dx), ct_max64(ct_abs64(dy), ct_abs64(b->z - a->z)));
-    int64_t slack = 2 + (m >> 24);
-    int64_t zlo = run ? ct_min64(a->line, b->line) + ct_min64(a->drop, b->drop) - chord_q16 - 2
-                      : ct_min64(a->z, b->z);
+    /* |b - a| as unsigned differences (vertices lie within +-(2^62 + 2^46),
+     * so a difference may not fit an int64); the slack <= 2 + 2^40 */
+    uint64_t m = absdiff64(a->x, b->x);
+    int64_t slack;
+    m = absdiff64(a->y, b->y) > m ? absdiff64(a->y, b->y) : m;
+    m = absdiff64(a->z, b->z) > m ? absdiff64(a->z, b->z) : m;
+    slack = 2 + (int64_t)(m >> 24);
     return box_above_terrain(p, ct_min64(a->x, b->x) - slack, ct_max64(a->x, b->x) + slack,
-                             ct_min64(a->y, b->y) - slack, ct_max64(a->y, b->y) + slack, zlo - slack, over_tile);
+                             ct_min64(a->y, b->y) - slack, ct_max64(a->y, b->y) + slack,
+                             run_floor(a, b, run, chord_q16) - slack, over_tile);
 }
 
 /* Both ends of the run inside the tile's closed box (so the polyline over
@@ -376,8 +399,7 @@ ct_status ct_trace_bent(const ct_package *p, const ct_ray *ray, const ct_bend *b
             /* skipped when ct_ray_prepare_segment's answer for each segment
              * is known without it: off the tile or above the box (CT_MISS),
              * or inside the box above the surface (CT_OK: entered) */
-            if (!over || (run ? ct_min64(va.line, vb.line) + ct_min64(va.drop, vb.drop) - chord_q16 - 2
-                              : ct_min64(va.z, vb.z)) > ztop || inside) {
+            if (!over || run_floor(&va, &vb, run, chord_q16) > ztop || inside) {
                 if (inside) {
                     entered = 1;
                 }
