@@ -97,6 +97,38 @@ static void test_i128_random(void)
     }
 }
 
+/* ct_bitlen64 against counting bits one at a time: every power of two and
+ * its neighbours, and random values of every length. */
+static unsigned bitlen_ref(uint64_t v)
+{
+    unsigned n = 0u;
+    while (v != 0u) {
+        v >>= 1;
+        n++;
+    }
+    return n;
+}
+
+static void test_bitlen(void)
+{
+    ct_rng r;
+    unsigned k;
+    long i;
+    TEST_ASSERT_EQUAL_INT(0, (int)ct_bitlen64(0u));
+    for (k = 0u; k < 64u; ++k) {
+        uint64_t p = (uint64_t)1 << k;
+        TEST_ASSERT_EQUAL_INT((int)bitlen_ref(p), (int)ct_bitlen64(p));
+        TEST_ASSERT_EQUAL_INT((int)bitlen_ref(p - 1u), (int)ct_bitlen64(p - 1u));
+        TEST_ASSERT_EQUAL_INT((int)bitlen_ref(p + 1u), (int)ct_bitlen64(p + 1u));
+    }
+    TEST_ASSERT_EQUAL_INT(64, (int)ct_bitlen64(~(uint64_t)0));
+    ct_rng_seed(&r, ct_test_seed() + 41u);
+    for (i = 0; i < 100000; ++i) {
+        uint64_t v = ct_rng_u64(&r) >> ct_rng_range(&r, 0, 63);
+        TEST_ASSERT_EQUAL_INT((int)bitlen_ref(v), (int)ct_bitlen64(v));
+    }
+}
+
 static void test_isqrt(void)
 {
     const uint64_t hard[] = {0, 1, 2, 3, 4, 15, 16, 17, 0xffffffffull, 0x100000000ull, 0xfffffffe00000001ull,
@@ -267,6 +299,7 @@ int main(void)
     TEST_BEGIN("test_fixed");
     RUN_TEST(test_i128_hard_values);
     RUN_TEST(test_i128_random);
+    RUN_TEST(test_bitlen);
     RUN_TEST(test_isqrt);
     RUN_TEST(test_cot_table);
     RUN_TEST(test_sector_boundaries);

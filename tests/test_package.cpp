@@ -245,6 +245,31 @@ void test_prepared_ray_tampering()
     bad = pr;
     bad.tend_d = 0;
     TEST_ASSERT_EQUAL_INT(CT_ERR_RAY, ct_trace_prepared(&p, &bad, CT_METHOD_HIERARCHICAL, &h));
+    bad = pr;
+    bad.zshift = CT_ZSHIFT_MAX + 1;
+    TEST_ASSERT_EQUAL_INT(CT_ERR_RAY, ct_trace_prepared(&p, &bad, CT_METHOD_DIRECTIONAL, &h));
+    bad = pr;
+    bad.zshift = -1;
+    TEST_ASSERT_EQUAL_INT(CT_ERR_RAY, ct_trace_prepared(&p, &bad, CT_METHOD_INCREMENTAL, &h));
+    bad = pr;
+    bad.dx = bad.dy = 0;
+    bad.dz = -(1 << 26);
+    bad.sector = -1;
+    bad.len_lo = bad.len_hi = 0;
+    bad.zshift = 1;  // a vertical ray is traced in Q16 only
+    TEST_ASSERT_EQUAL_INT(CT_ERR_RAY, ct_trace_prepared(&p, &bad, CT_METHOD_INCREMENTAL, &h));
+    bad.zshift = 0;
+    bad.oz = pr.oz * ((int64_t)1 << pr.zshift);
+    TEST_ASSERT(ct_trace_prepared(&p, &bad, CT_METHOD_INCREMENTAL, &h) >= 0);  // the same ray, well formed
+    bad = pr;
+    bad.tend_n = pr.tend_n + pr.tend_d;  // one unit of t past where the ray leaves the box
+    TEST_ASSERT_EQUAL_INT(CT_ERR_RAY, ct_trace_prepared(&p, &bad, CT_METHOD_DIRECTIONAL, &h));
+    bad = pr;
+    bad.oz = ((int64_t)p.hmin - 1) * (65536 >> pr.zshift);  // a traceable ray must start above the box's floor
+    TEST_ASSERT_EQUAL_INT(CT_ERR_RAY, ct_trace_prepared(&p, &bad, CT_METHOD_CONE, &h));
+    bad = pr;
+    bad.oz = ((int64_t)p.hmax + 1) * (65536 >> pr.zshift) + 1;  // above the box in the ray's z units
+    TEST_ASSERT_EQUAL_INT(CT_ERR_RAY, ct_trace_prepared(&p, &bad, CT_METHOD_INCREMENTAL, &h));
     TEST_ASSERT_EQUAL_INT(CT_ERR_METHOD, ct_trace_prepared(&p, &pr, (ct_method)7, &h));
     ct_ray zero = {0, 0, 0, 0, 0, 0};
     TEST_ASSERT_EQUAL_INT(CT_ERR_RAY, ct_trace(&p, &zero, CT_METHOD_INCREMENTAL, &h));

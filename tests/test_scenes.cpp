@@ -224,9 +224,11 @@ void test_scene_accuracy()
         TEST_ASSERT_MSG(a.fail == 0, "%s: %ld points beyond the bound", name, a.fail);
         TEST_ASSERT(accepted(a, posting));
         // tighter than the bound: the error across the surface
-        // (error x sin(incidence)) is the library's own: the 1 mm polyline
-        // chord plus the 2^-25 direction quantisation (measured <= 1.7 mm)
-        TEST_ASSERT_MSG(a.max_perp <= 0.01, "%s: error across the surface %.4f m", name, a.max_perp);
+        // (error x sin(incidence)) is the library's own: the polyline's 1 mm
+        // chord (bent scenes), the prepared ray's <= 1 mm from the caller's
+        // ray and the reported point's rounding (<= 1 Q16 unit per axis,
+        // 0.46 mm at 30 m): 2.5 mm (measured <= 1.4 mm)
+        TEST_ASSERT_MSG(a.max_perp <= 0.0025, "%s: error across the surface %.4f m", name, a.max_perp);
         total_wrong += a.wrong_surface;
         if (std::string(name) == "grazing3") TEST_ASSERT_MSG(a.occ * 4 >= a.n, "%s: only %ld occluded", name, a.occ);
         // all methods, and the batch form, give the same hits with effects

@@ -39,10 +39,10 @@ ref::Ray to_ref(const ct_prepared &p)
     ref::Ray r;
     r.ox = (ref::ld)p.ox / 65536;
     r.oy = (ref::ld)p.oy / 65536;
-    r.oz = (ref::ld)p.oz / 65536;
+    r.oz = std::ldexp((ref::ld)p.oz, p.zshift) / 65536;  // z in units of 2^zshift Q16
     r.dx = (ref::ld)p.dx / 65536;
     r.dy = (ref::ld)p.dy / 65536;
-    r.dz = (ref::ld)p.dz / 65536;
+    r.dz = std::ldexp((ref::ld)p.dz, p.zshift) / 65536;
     r.tend = (ref::ld)p.tend_n / (ref::ld)p.tend_d;
     return r;
 }

@@ -86,6 +86,7 @@ enum {
 #define CT_MAX_LEVELS 16          /* mipmap levels 1..15 stored               */
 #define CT_MAX_ORIGIN_Q16 ((int64_t)1 << 46) /* |origin| in q16, 2^30 cells   */
 #define CT_DIR_BITS 26            /* prepared direction: max |d| in [2^25, 2^26] */
+#define CT_ZSHIFT_MAX 16          /* prepared z unit: at most 2^16 Q16 units  */
 #define CT_T_FRAC_BITS 26         /* t_q26                                    */
 
 /* Worst-case loop iterations, published per method (DESIGN.md): every
@@ -170,7 +171,10 @@ typedef struct {
     uint32_t width, height; /* posts                                          */
     uint32_t cells_x, cells_y;   /* fine cells = posts - 1                     */
     uint32_t reduce, sectors;    /* r, N                                       */
-    uint32_t reserved0;
+    uint32_t zshift_max;         /* largest k <= 16 with 2^k * height_scale <=
+                                    min |posting|: the coarsest z unit
+                                    (2^k Q16 LSB) a prepared ray may use,
+                                    still no coarser than a Q16 cell unit  */
     uint64_t reduce_mul;         /* ceil(2^32 / r): i / r = (i * it) >> 32 for
                                     i < 2^16 (error i * (1/r)' < 2^-16 < 1/r) */
     uint32_t coarse_x, coarse_y; /* ceil(cells / r)                            */
@@ -204,11 +208,22 @@ typedef struct {
 
 /* A ray clipped to the tile and quantised: the object the tracer is exact
  * for.  Transparent so tests can trace the same ray independently.
- * Position(t) = o + t * d, t >= 0; o lies in the tile's box.               */
+ * Position(t) = o + t * d, t >= 0; o lies in the tile's box.
+ * Per-axis scaling: x and y are Q16 cells, but z is counted in units of
+ * 2^zshift Q16 LSB (z_q16 = oz * 2^zshift + t * dz * 2^zshift).  The grid
+ * frame is anisotropic (a 30 m cell is 480 LSB of 1/16 m), so a steep ray
+ * scaled as one vector would keep only ~16 bits in dx and dy; with z in
+ * coarser units (never coarser than a Q16 cell unit in metres, see
+ * ct_package.zshift_max) every component keeps ~26 bits and the prepared
+ * ray stays within 1 mm of the caller's (README, "Exactness").             */
 typedef struct {
-    int64_t ox, oy, oz;    /* Q16 origin (the entry point, rounded to Q16)    */
-    int32_t dx, dy, dz;    /* Q16 units per unit t; max |.| in [2^25, 2^26]   */
+    int64_t ox, oy, oz;    /* origin (the entry point): x, y Q16; z in units
+                              of 2^zshift Q16                                 */
+    int32_t dx, dy, dz;    /* the same units per unit t; max |.| in
+                              [2^25, 2^26] (preparation makes it 2^26 - 1
+                              or 2^26)                                        */
     int32_t sector;        /* sector of (dx, dy); -1 for vertical rays        */
+    int32_t zshift;        /* 0..CT_ZSHIFT_MAX; 0 for vertical rays           */
     int64_t len_lo, len_hi;/* floor/ceil of sqrt(dx^2 + dy^2)                 */
     int64_t tend_n, tend_d;/* t where the ray leaves the tile's box (> 0 den) */
     ct_status start;       /* CT_OK, or CT_MISS/CT_BELOW/CT_HIT decided at prep */
@@ -282,7 +297,10 @@ ct_status ct_ray_prepare(const ct_package *pkg, const ct_ray *ray,
                          ct_prepared *out);
 
 /* Trace a prepared ray.  Returns CT_HIT, CT_HIT_VOID, CT_MISS, CT_BELOW or an
- * error; *hit is filled for every non-error result (steps, iters).         */
+ * error; *hit is filled for every non-error result (steps, iters).  A ray
+ * that ct_ray_prepare could not have made is CT_ERR_RAY: direction scale,
+ * zshift, sector, length, an origin outside the box (or, for start CT_OK,
+ * at or below its floor hmin - 1), a tend beyond where it leaves the box.  */
 ct_status ct_trace_prepared(const ct_package *pkg, const ct_prepared *ray,
                             ct_method method, ct_hit *hit);
 

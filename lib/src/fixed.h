@@ -46,6 +46,20 @@ static inline int64_t ct_abs64(int64_t a) { return a < 0 ? -a : a; }
 static inline int64_t ct_max64(int64_t a, int64_t b) { return a > b ? a : b; }
 static inline int64_t ct_min64(int64_t a, int64_t b) { return a < b ? a : b; }
 
+/* Number of significant bits of v (0 for 0), by halving: six tests, no
+ * loop (compilers turn them into conditional moves).                       */
+static inline unsigned ct_bitlen64(uint64_t v)
+{
+    unsigned n = 0u;
+    if ((v >> 32) != 0u) { n += 32u; v >>= 32; }
+    if ((v >> 16) != 0u) { n += 16u; v >>= 16; }
+    if ((v >> 8) != 0u) { n += 8u; v >>= 8; }
+    if ((v >> 4) != 0u) { n += 4u; v >>= 4; }
+    if ((v >> 2) != 0u) { n += 2u; v >>= 2; }
+    if ((v >> 1) != 0u) { n += 1u; v >>= 1; }
+    return n + (unsigned)v;
+}
+
 /* Little-endian loads from byte buffers: portable, alignment- and
  * aliasing-safe; compilers merge them into one load where allowed.         */
 static inline uint32_t ct_ld16(const uint8_t *p)

@@ -362,7 +362,16 @@ ct_status ct_package_open(ct_package *pkg, const uint8_t *b, size_t len)
     pkg->cells_x = w - 1u;
     pkg->cells_y = h - 1u;
     pkg->reduce = r;
-    pkg->reserved0 = 0u;
+    {
+        /* the coarsest prepared z unit, 2^k Q16 LSB, that is still no larger
+         * in nm than a Q16 cell unit: 2^k * scale <= |posting|, i.e.
+         * scale <= floor(|posting| / 2^k).  bound: 16 doublings */
+        uint32_t zk = 0u;
+        while (zk < (uint32_t)CT_ZSHIFT_MAX && pkg->height_scale_nm <= (ct_abs64(pe) >> (zk + 1u))) {
+            zk++;
+        }
+        pkg->zshift_max = zk;
+    }
     pkg->reduce_mul = (((uint64_t)1 << 32) + r - 1u) / r;
     pkg->sectors = n;
     pkg->coarse_x = (pkg->cells_x + r - 1u) / r;

@@ -8,8 +8,11 @@
  *   DIRECTIONAL   one cone per sector per coarse cell (Paglieroni 1997)
  *
  * Number formats (see conetrace.h):
- *   positions  Q16 in int64; inside the tile box x, y < 2^31, z in
- *              [(hmin-1)*2^16, (hmax+1)*2^16] so |z| < 2^33.
+ *   positions  x, y Q16 in int64; z in units of 2^k Q16 LSB (k = the
+ *              prepared ray's zshift, 0..16; a height h is h * zone,
+ *              zone = 2^(16-k)).  Inside the tile box x, y < 2^31, z in
+ *              [(hmin-1)*zone, (hmax+1)*zone] so |z| < 2^33 (and
+ *              |z * 2^k| < 2^33 too: bounds written for z hold for both).
  *   direction  int32, max component in [2^25, 2^26].
  *   t          rational n/d, d in {1, |dx|, |dy|, |dz|, 2^26} <= 2^26;
  *              the ray is inside the box for t <= tend < 2^8 (the dominant
@@ -17,6 +20,12 @@
  *              0 <= n < 2^34.
  * Every product below is annotated with its bound; all stay < 2^62 in
  * int64 except the few marked "128-bit".
+ * Where z meets a horizontal quantity (the cell's exit sign, the quadratic)
+ * it is scaled back to Q16 by zmul = 2^k.  Such a product is d * z_q16 at a
+ * point of the cell being tested, physically bounded: the ray is in the box
+ * at the cell's entry tin (< tend), |z_q16| < 2^33 there, and within one
+ * cell it moves at most 2^16 |dz| / max(|dx|, |dy|) prepared z units, so
+ * d * |z_q16 - z_q16(tin)| <= 2^16 |dz| 2^k <= 2^58 for d <= max(|dx|,|dy|).
  *
  * Exactness: whether the ray meets the surface in a cell is decided with
  * exact integer arithmetic (the sign of f = z_ray - S at cell faces in
@@ -50,7 +59,17 @@ typedef struct {
     int64_t adx, ady; /* |dx|, |dy| */
     int32_t cx, cy;   /* fine cells */
     rt tend;
+    unsigned zs;      /* the ray's zshift k */
+    uint32_t zone;    /* one height LSB in prepared z units: 2^(16-k) */
+    uint32_t zmul;    /* 2^k: prepared z units to Q16 */
+    int64_t dzf;      /* dz * 2^k: the z direction in Q16 units (<= 2^42) */
 } ctx;
+
+/* Height code h >= 0 (< 2^17) in the ray's z units: one 32x32 product. */
+static int64_t zh(const ctx *c, uint32_t h)
+{
+    return (int64_t)((uint64_t)h * c->zone);
+}
 
 static int sgn64(int64_t v) { return (v > 0) - (v < 0); }
 
@@ -199,8 +218,10 @@ static void load_posts(const ct_package *p, int32_t i, int32_t j, posts4 *q)
 }
 
 /* Sign of f = z_ray - S at the exit point, exact.  With d = e->t.d and
- * n = e->t.n:  d*Z = oz*d + n*dz (< 2^58 + 2^60); h*2^16*d < 2^58;
- * d*2^16*v in [0, 2^42] times |dh| < 2^16: < 2^58.  Sum < 2^62.        */
+ * n = e->t.n:  d*Z = oz*d + n*dz (< 2^58 + 2^60) in prepared z units; at a
+ * face, d*Z*2^k = d*z_q16 < 2^59 (the header's argument: d*|z_q16(tin)|
+ * < 2^59... 2^26 * 2^33, plus <= 2^58 within the cell); h*2^16*d < 2^58;
+ * d*2^16*v in [0, 2^42] times |dh| < 2^16: < 2^58.  Sum < 2^61.        */
 static int exit_sign(const ctx *c, int32_t i, int32_t j, const cexit *e, const posts4 *q)
 {
     int64_t d = e->t.d, n = e->t.n;
@@ -208,8 +229,9 @@ static int exit_sign(const ctx *c, int32_t i, int32_t j, const cexit *e, const p
     int64_t ha, hb, dw, val;
     if (e->face == FACE_XY) {
         int32_t h = (e->xf == i) ? (e->yf == j ? q->h00 : q->h01) : (e->yf == j ? q->h10 : q->h11);
-        return sgn64(dz - (int64_t)h * ONE16 * d);
+        return sgn64(dz - zh(c, (uint32_t)h) * d);
     }
+    dz *= (int64_t)c->zmul;
     if (e->face == FACE_X) {
         ha = (e->xf == i) ? q->h00 : q->h10;
         hb = (e->xf == i) ? q->h01 : q->h11;
@@ -235,9 +257,11 @@ static int exit_sign(const ctx *c, int32_t i, int32_t j, const cexit *e, const p
  *     Z0 = d*2^16 * (z(L) - g00) = d*(o_z - g00*2^16) + s*(L-o_p)*D_z
  *     d*2^16 * f(w) = A w^2 + B w + C,
  *     C = Z0 - b*V0,  B = 2^16*(D_z - a*d - b*D_q) - c*V0,  A = -c*2^16*D_q
- * Bounds (|D_q| <= |D_p| so v(L) in [-1, 2]; |a|,|b| < 2^16, |c| < 2^17):
- * |V0| <= 2^43, |Z0| < 2^59.5, |C| < 2^60, |B| < 2^61, |A| < 2^59;
- * B^2 - 4AC < 2^123 (128-bit).                                           */
+ * In the ray's prepared z units D_z is 2^k times smaller and z values are
+ * 2^k times coarser; the formulas use D_z * 2^k and z * 2^k (Q16).
+ * Bounds (|D_q| <= |D_p| so v(L) in [-1, 2]; |a|,|b| < 2^16, |c| < 2^17;
+ * |D_z| 2^k <= 2^42): |V0| <= 2^43, |Z0| < 2^59.6, |C| < 2^60.6,
+ * |B| < 2^61, |A| < 2^59; B^2 - 4AC < 2^123 (128-bit).                    */
 typedef struct {
     int64_t A, B, C;
     int p;       /* 0: x-major, 1: y-major */
@@ -292,10 +316,14 @@ static void make_quad(const ctx *c, int32_t i, int32_t j, const posts4 *q, quad 
     Q->dps = s * (L - op); /* |L - o_p| < 2^31 */
     /* d*(o_q - k_q 2^16): 2^26 * 2^31; s*(L - o_p)*D_q: 2^31 * 2^26 */
     V0 = Q->d * (oq - kq * ONE16) + Q->dps * Dq;
-    /* d*(o_z - g00 2^16): 2^26 * 2^33; s*(L - o_p)*D_z: 2^31 * 2^26 */
-    Z0 = Q->d * (c->r->oz - g00 * ONE16) + Q->dps * (int64_t)c->r->dz;
+    /* Z0 = d * 2^16 * (z(L) - g00) with z(L) in LSB: the bracket is d times
+     * z(L) - g00 in prepared z units (d*(o_z - g00*zone): 2^26 * 2^33;
+     * s*(L - o_p)*D_z: 2^31 * 2^26), times 2^k it is d * (z_q16(L) -
+     * g00 2^16) < 2^59 + 2^58 (the header's argument: L is the cell's
+     * entry line, within one cell of tin). */
+    Z0 = (int64_t)c->zmul * (Q->d * (c->r->oz - zh(c, (uint32_t)g00)) + Q->dps * (int64_t)c->r->dz);
     Q->C = Z0 - b * V0;
-    Q->B = ONE16 * ((int64_t)c->r->dz - a * Q->d - b * Dq) - cc * V0;
+    Q->B = ONE16 * (c->dzf - a * Q->d - b * Dq) - cc * V0;
     Q->A = -cc * ONE16 * Dq;
 }
 
@@ -407,11 +435,11 @@ static int64_t root_t_q26(const ctx *c, const quad *Q, rt tin, rt tout)
 static void fill_hit(const ctx *c, int64_t tq, int32_t i, int32_t j, ct_hit *h)
 {
     const ct_prepared *r = c->r;
-    /* tq < 2^35, |d| <= 2^26: < 2^61 */
+    /* tq < 2^35, |d| <= 2^26: < 2^61; z in Q16: oz 2^k + tq dz 2^k / 2^26 */
     h->t_q26 = tq;
     h->x_q16 = r->ox + ct_floor_div(tq * (int64_t)r->dx, T_ONE);
     h->y_q16 = r->oy + ct_floor_div(tq * (int64_t)r->dy, T_ONE);
-    h->z_q16 = r->oz + ct_floor_div(tq * (int64_t)r->dz, T_ONE);
+    h->z_q16 = r->oz * (int64_t)c->zmul + floor_shr(tq * (int64_t)r->dz, CT_T_FRAC_BITS - c->zs);
     h->cell_x = i;
     h->cell_y = j;
     (void)ct_grid_to_map(c->p, h->x_q16, h->y_q16, h->z_q16, &h->e_nm, &h->n_nm, &h->h_nm);
@@ -439,7 +467,7 @@ static int cell_test(const ctx *c, int32_t i, int32_t j, rt tin, const cexit *e,
     /* cheap reject: lowest ray point above the tallest corner.
      * d*Z < 2^60 (see exit_sign), hmax*2^16*d < 2^58. */
     tlo = c->r->dz <= 0 ? e->t : tin;
-    zlim = (int64_t)q.hmax * ONE16 * tlo.d;
+    zlim = zh(c, (uint32_t)q.hmax) * tlo.d;
     if (c->r->oz * tlo.d + tlo.n * (int64_t)c->r->dz > zlim) {
         return 0;
     }
@@ -577,7 +605,7 @@ static ct_status walk_hierarchical(const ctx *c, ct_hit *h)
             }
             {
                 rt tl = c->r->dz <= 0 ? tx : t;
-                if (c->r->oz * tl.d + tl.n * (int64_t)c->r->dz > bmax * ONE16 * tl.d) {
+                if (c->r->oz * tl.d + tl.n * (int64_t)c->r->dz > zh(c, (uint32_t)bmax) * tl.d) {
                     /* skip the block: the ray is above its max all along */
                     h->steps++;
                     if (!rt_lt(tx, c->tend)) {
@@ -640,7 +668,7 @@ static ct_status walk_cones(const ctx *c, uint32_t plane, ct_hit *h)
         k = coarse_index(p, i, j);
         code = ang[k];
         if (p->cot_ok[code]) {
-            int64_t a16 = (int64_t)ct_ld16(p->apex + 2u * k) * ONE16;
+            int64_t a16 = zh(c, ct_ld16(p->apex + 2u * k));
             /* T = floor(t 2^26), and a lower bound of z(t) from a Q26 point
              * (z at T for a rising ray, at T + 1 for a descending one unless
              * t is exactly T / 2^26): t.n 2^26 < 2^60. */
@@ -650,14 +678,19 @@ static ct_status walk_cones(const ctx *c, uint32_t plane, ct_hit *h)
             if (num > 0) {
                 int64_t cot = p->cot_q16[code];
                 int64_t len = cot >= 0 ? r->len_hi : r->len_lo;
-                /* len <= 2^26.5, |cot| <= 2^35: < 2^61.5; ceil by 2^16 */
-                int64_t den = -floor_shr(-(len * cot), 16u) - (int64_t)r->dz;
+                /* in Q16 z units: num 2^k < 2^34 (a lower bound of the
+                 * height above the apex); len <= 2^26.5, |cot| <= 2^35:
+                 * < 2^61.5, ceil by 2^16 (cot is Q16 LSB per cell), minus
+                 * dz 2^k (<= 2^42).  den <= 0 iff the ray's rise per unit t
+                 * reaches the cone's, as in prepared z units. */
+                int64_t den = -floor_shr(-(len * cot), 16u) - c->dzf;
                 int64_t dt, tn;
                 if (den <= 0) {
                     /* the ray never leaves the empty region: no hit ahead */
                     h->iters = it + 1u;
                     return CT_MISS;
                 }
+                num = (int64_t)((uint64_t)num * c->zmul);
                 dt = (num * T_ONE) / den; /* num*2^26 < 2^60 */
                 if (dt > (INT64_C(1) << 35)) {
                     dt = INT64_C(1) << 35;
@@ -770,39 +803,100 @@ static int64_t round_axis(int64_t o, int64_t D, const bigrt *t)
     return q;
 }
 
-/* Direction scaled so that max |component| is in [2^25, 2^26] (rounded to
- * nearest; relative error of each component <= 2^-26 of the maximum).    */
-static void normalize_dir(const int64_t v0[3], int32_t out[3])
+/* a * 2^e for a <= 2^62 and a result known to be <= 2^32, rounded to
+ * nearest (halves away from zero) when e < 0. */
+static uint64_t scale_pow2(uint64_t a, int e)
 {
-    int64_t v[3], m = 0;
-    int k, shift = 0;
+    if (e >= 0) {
+        return a << (unsigned)e;
+    }
+    if (e <= -64) {
+        return 0u;
+    }
+    /* a + 2^(-e-1) <= 2^62 + 2^62: fits uint64 */
+    return (a + ((uint64_t)1 << (unsigned)(-e - 1))) >> (unsigned)(-e);
+}
+
+/* z shift of a direction: the smallest k <= kmax with |Uz| / 2^k <= the
+ * larger horizontal component h (so that z, in units of 2^k Q16, no longer
+ * dominates a steep ray); 0 for a vertical ray.  With k0 = bitlen(|Uz|) -
+ * bitlen(h), |Uz| >> k0 < 2^bitlen(h) <= 2h, so k is k0 or k0 + 1. */
+static unsigned dir_zshift(const int64_t U[3], uint32_t kmax)
+{
+    uint64_t h = (uint64_t)ct_max64(ct_abs64(U[0]), ct_abs64(U[1])), az = (uint64_t)ct_abs64(U[2]);
+    unsigned bh = ct_bitlen64(h), bz = ct_bitlen64(az), k;
+    if (h == 0u || bz < bh) {
+        return 0u;
+    }
+    k = bz - bh;
+    k += (az >> k) > h ? 1u : 0u;
+    return k < kmax ? k : kmax;
+}
+
+/* The direction (Ux, Uy, Uz / 2^zs) scaled so that its largest component is
+ * 2^26 - 1 or 2^26.  |U| <= 2^62.  V = (Ux 2^zs, Uy 2^zs, Uz) is first
+ * brought by a common power of two to a largest component m' in
+ * [2^31, 2^32] (rounding error <= 1/2 in 2^31: relative 2^-32), then
+ * multiplied by f / 2^32 with f = floor(2^58 / m') in [2^26, 2^27] and
+ * rounded: each component is within 1/2 + 2^-5 of the exact (common)
+ * scaling, whose largest component is in (2^26 - 1, 2^26].  Products
+ * V' f <= 2^32 2^27 = 2^59.                                               */
+static void normalize_dir(const int64_t U[3], unsigned zs, int32_t out[3])
+{
+    uint64_t a[3], v[3], m = 0u, f;
+    int e[3], top, k;
     /* bound: 3 components */
     for (k = 0; k < 3; ++k) {
-        v[k] = v0[k];
-        m = ct_max64(m, ct_abs64(v[k]));
+        a[k] = (uint64_t)ct_abs64(U[k]);
     }
-    /* bound: at most 37 halvings or 25 doublings */
-    while ((m >> shift) > (INT64_C(1) << CT_DIR_BITS)) {
-        shift++;
+    top = (int)ct_bitlen64(a[0] > a[1] ? a[0] : a[1]) + (int)zs;
+    k = (int)ct_bitlen64(a[2]);
+    top = k > top ? k : top;
+    for (k = 0; k < 3; ++k) { /* bound: 3 components */
+        /* V_k / 2^(top - 32), V_k = a_k 2^(zs for x, y) */
+        e[k] = (k < 2 ? (int)zs : 0) - (top - 32);
+        v[k] = scale_pow2(a[k], e[k]);
+        m = v[k] > m ? v[k] : m;
     }
-    if (shift > 0) {
-        int64_t half = INT64_C(1) << (shift - 1);
-        for (k = 0; k < 3; ++k) {
-            int64_t a = ct_abs64(v[k]);
-            int64_t q = (a + half) >> shift; /* round half away from zero */
-            v[k] = v[k] < 0 ? -q : q;
-        }
-    } else {
-        while (m < (INT64_C(1) << (CT_DIR_BITS - 1))) {
-            m <<= 1;
-            for (k = 0; k < 3; ++k) {
-                v[k] *= 2;
-            }
-        }
+    f = ((uint64_t)1 << 58) / m; /* m >= 2^31 */
+    for (k = 0; k < 3; ++k) { /* bound: 3 components */
+        int64_t q = (int64_t)((v[k] * f + ((uint64_t)1 << 31)) >> 32);
+        out[k] = (int32_t)(U[k] < 0 ? -q : q);
     }
+}
+
+/* Where the ray o + t D (o in the box: x, y Q16, z in units of 2^16/zone
+ * Q16) leaves the tile's box: horizontally, through the top (rising) or
+ * below hmin - 1 (descending; never reached without a hit).  Candidates
+ * have n < 2^34 and d <= 2^26, so rt_lt cannot overflow; with no candidate
+ * (cannot happen: some axis moves) te stays 2^34. */
+static rt box_exit(const ct_package *p, const int64_t O[3], const int32_t D[3], int64_t zone)
+{
+    rt te = {INT64_C(1) << 34, 1}, c;
+    int64_t ztop = ((int64_t)p->hmax + 1) * zone, zbot = ((int64_t)p->hmin - 1) * zone;
+    int have = 0, k;
+    /* bound: 3 axes */
     for (k = 0; k < 3; ++k) {
-        out[k] = (int32_t)v[k];
+        if (D[k] == 0) {
+            continue;
+        }
+        c.d = ct_abs64(D[k]);
+        if (k < 2) {
+            c.n = D[k] > 0 ? (int64_t)(k == 0 ? p->cells_x : p->cells_y) * ONE16 - O[k] : O[k];
+        } else if (D[k] > 0) {
+            c.n = ct_max64(ztop - O[2], 0);
+        } else {
+            if (O[2] <= zbot) {
+                continue;
+            }
+            c.n = O[2] - zbot;
+        }
+        if (!have || rt_lt(c, te)) {
+            te = c;
+            have = 1;
+        }
     }
+    return te;
 }
 
 /* seg != 0: the ray ends at origin + direction (t <= 1 in the caller's
@@ -813,6 +907,8 @@ static ct_status prepare_impl(const ct_package *p, const ct_ray *ray, int seg, c
     int64_t O[3], U[3], lo[3], hi[3];
     bigrt tin, tout;
     int k, has_out = 0, kin = -1;
+    unsigned zs;
+    int64_t zone;
     int64_t kin_at = 0; /* the entry face's coordinate on axis kin */
     CT_ASSERT(p != NULL && ray != NULL && out != NULL);
     if (p == NULL || ray == NULL || out == NULL) {
@@ -944,13 +1040,28 @@ static ct_status prepare_impl(const ct_package *p, const ct_ray *ray, int seg, c
             }
         }
     }
-    normalize_dir(U, D);
+    /* per-axis scaling: z in units of 2^zs Q16 (see ct_prepared); the
+     * origin's z rounded to them (O[2] <= hi[2], a multiple of 2^16, stays
+     * in the box; |O[2]| <= 2^46 here) */
+    zs = dir_zshift(U, p->zshift_max);
+    normalize_dir(U, zs, D);
+    if (zs > 0u && D[0] == 0 && D[1] == 0) {
+        /* horizontal components too small to survive: a vertical ray,
+         * which the tracer handles in Q16 */
+        zs = 0u;
+        normalize_dir(U, zs, D);
+    }
+    zone = ONE16 >> zs;
+    if (zs > 0u) {
+        O[2] = floor_shr(O[2] + (INT64_C(1) << (zs - 1u)), zs);
+    }
     out->ox = O[0];
     out->oy = O[1];
     out->oz = O[2];
     out->dx = D[0];
     out->dy = D[1];
     out->dz = D[2];
+    out->zshift = (int32_t)zs;
     {
         /* dx^2 + dy^2 <= 2^53 */
         uint64_t l2 = (uint64_t)((int64_t)D[0] * D[0] + (int64_t)D[1] * D[1]);
@@ -971,32 +1082,7 @@ static ct_status prepare_impl(const ct_package *p, const ct_ray *ray, int seg, c
     /* tend: leaving the box horizontally, through the top (rising) or
      * below hmin - 1 (descending; never reached without a hit).          */
     {
-        /* candidates have n < 2^34 and d <= 2^26, so rt_lt cannot overflow;
-         * with no candidate (cannot happen: some axis moves) te stays 2^34 */
-        rt te = {INT64_C(1) << 34, 1}, c;
-        int64_t ztop = ((int64_t)p->hmax + 1) * ONE16, zbot = ((int64_t)p->hmin - 1) * ONE16;
-        int have = 0;
-        /* bound: 3 axes */
-        for (k = 0; k < 3; ++k) {
-            if (D[k] == 0) {
-                continue;
-            }
-            c.d = ct_abs64(D[k]);
-            if (k < 2) {
-                c.n = D[k] > 0 ? hi[k] - O[k] : O[k];
-            } else if (D[k] > 0) {
-                c.n = ct_max64(ztop - O[2], 0);
-            } else {
-                if (O[2] <= zbot) {
-                    continue;
-                }
-                c.n = O[2] - zbot;
-            }
-            if (!have || rt_lt(c, te)) {
-                te = c;
-                have = 1;
-            }
-        }
+        rt te = box_exit(p, O, D, zone), c;
         if (seg) {
             /* the segment's end: where the prepared ray reaches the end
              * point's coordinate on its dominant axis m.  The end is
@@ -1011,9 +1097,13 @@ static ct_status prepare_impl(const ct_package *p, const ct_ray *ray, int seg, c
                 }
             }
             e = (m == 0 ? ray->x_q16 : (m == 1 ? ray->y_q16 : ray->z_q16)) + U[m];
-            num = (e - O[m]) * (D[m] > 0 ? 1 : -1);
+            num = (e - (m == 2 ? O[2] * (INT64_C(1) << zs) : O[m])) * (D[m] > 0 ? 1 : -1);
             if (num < 0) {
                 num = 0;
+            }
+            if (m == 2) {
+                /* in prepared z units, rounded up */
+                num = (num >> zs) + ((num & ((INT64_C(1) << zs) - 1)) != 0 ? 1 : 0);
             }
             if (num < (INT64_C(1) << 34)) {
                 c.n = num;
@@ -1045,11 +1135,11 @@ static ct_status prepare_impl(const ct_package *p, const ct_ray *ray, int seg, c
             j = (int32_t)p->cells_y - 1;
         }
         s = surface_q32(p, i, j, O[0], O[1]);
-        if (O[2] < -(INT64_C(1) << 46)) {
+        if (O[2] < -(INT64_C(1) << (46u - zs))) {
             out->start = CT_BELOW;
             return CT_BELOW;
         }
-        f = O[2] * ONE16 - s; /* |oz| <= 2^46: < 2^62 */
+        f = O[2] * (INT64_C(1) << zs) * ONE16 - s; /* |oz 2^zs| <= 2^46: < 2^62 */
         if (f < 0) {
             out->start = CT_BELOW;
             return CT_BELOW;
@@ -1082,9 +1172,12 @@ static ct_status check_prepared(const ct_package *p, const ct_prepared *r)
     if (m > (INT64_C(1) << CT_DIR_BITS) || m < (INT64_C(1) << (CT_DIR_BITS - 1))) {
         return CT_ERR_RAY;
     }
+    if (r->zshift < 0 || r->zshift > CT_ZSHIFT_MAX || (r->zshift != 0 && r->dx == 0 && r->dy == 0)) {
+        return CT_ERR_RAY;
+    }
     if (r->ox < 0 || r->oy < 0 || r->ox > (int64_t)p->cells_x * ONE16 ||
-        r->oy > (int64_t)p->cells_y * ONE16 || r->oz > ((int64_t)p->hmax + 1) * ONE16 ||
-        r->oz < -(INT64_C(1) << 46)) {
+        r->oy > (int64_t)p->cells_y * ONE16 || r->oz > ((int64_t)p->hmax + 1) * (ONE16 >> r->zshift) ||
+        r->oz < -(INT64_C(1) << (46 - r->zshift))) {
         return CT_ERR_RAY;
     }
     if (r->len_lo < 0 || r->len_hi - r->len_lo < 0 || r->len_hi - r->len_lo > 1 ||
@@ -1094,6 +1187,19 @@ static ct_status check_prepared(const ct_package *p, const ct_prepared *r)
     if (r->tend_d <= 0 || r->tend_d > (INT64_C(1) << CT_DIR_BITS) || r->tend_n < 0 ||
         r->tend_n > (INT64_C(1) << 34)) {
         return CT_ERR_RAY;
+    }
+    {
+        /* the walk's bounds assume the ray is in the box up to tend, and a
+         * traceable ray (start CT_OK) starts above the terrain's floor */
+        const int64_t O[3] = {r->ox, r->oy, r->oz};
+        const int32_t D[3] = {r->dx, r->dy, r->dz};
+        int64_t zone = ONE16 >> r->zshift;
+        rt te = box_exit(p, O, D, zone), tr;
+        tr.n = r->tend_n;
+        tr.d = r->tend_d;
+        if (rt_lt(te, tr) || (r->start == CT_OK && r->oz <= ((int64_t)p->hmin - 1) * zone)) {
+            return CT_ERR_RAY;
+        }
     }
     if (r->dx == 0 && r->dy == 0) {
         if (r->sector != -1) {
@@ -1144,6 +1250,10 @@ static ct_status trace_impl(const ct_package *p, const ct_prepared *r, ct_method
     c.ady = ct_abs64(r->dy);
     c.cx = (int32_t)p->cells_x;
     c.cy = (int32_t)p->cells_y;
+    c.zs = (unsigned)r->zshift;
+    c.zone = (uint32_t)1 << (16u - c.zs);
+    c.zmul = (uint32_t)1 << c.zs;
+    c.dzf = (int64_t)r->dz * (int64_t)c.zmul;
     c.tend.n = r->tend_n;
     c.tend.d = r->tend_d;
     if (r->start == CT_HIT) {

@@ -545,10 +545,10 @@ void emit_case(FILE *f, const ct_vec_case &c)
     const ct_prepared &p = c.prep;
     std::fprintf(f, "  {.ray = %s,\n   .prep_status = %s,\n", ray_init(c.ray).c_str(), i32(c.prep_status).c_str());
     std::fprintf(f,
-                 "   .prep = {.ox = %s, .oy = %s, .oz = %s, .dx = %s, .dy = %s, .dz = %s, .sector = %s,\n"
+                 "   .prep = {.ox = %s, .oy = %s, .oz = %s, .dx = %s, .dy = %s, .dz = %s, .sector = %s, .zshift = %s,\n"
                  "            .len_lo = %s, .len_hi = %s, .tend_n = %s, .tend_d = %s, .start = %s},\n",
                  i64(p.ox).c_str(), i64(p.oy).c_str(), i64(p.oz).c_str(), i32(p.dx).c_str(), i32(p.dy).c_str(),
-                 i32(p.dz).c_str(), i32(p.sector).c_str(), i64(p.len_lo).c_str(), i64(p.len_hi).c_str(),
+                 i32(p.dz).c_str(), i32(p.sector).c_str(), i32(p.zshift).c_str(), i64(p.len_lo).c_str(), i64(p.len_hi).c_str(),
                  i64(p.tend_n).c_str(), i64(p.tend_d).c_str(), i32(p.start).c_str());
     std::fprintf(f, "   .status = {%s, %s, %s, %s},\n   .hit = {\n", i32(c.status[0]).c_str(), i32(c.status[1]).c_str(),
                  i32(c.status[2]).c_str(), i32(c.status[3]).c_str());

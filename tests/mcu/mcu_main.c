@@ -156,6 +156,7 @@ static void eq_prep(const ct_prepared *w, const ct_prepared *g)
     eq_i64("prep.dy", w->dy, g->dy);
     eq_i64("prep.dz", w->dz, g->dz);
     eq_i64("prep.sector", w->sector, g->sector);
+    eq_i64("prep.zshift", w->zshift, g->zshift);
     eq_i64("prep.len_lo", w->len_lo, g->len_lo);
     eq_i64("prep.len_hi", w->len_hi, g->len_hi);
     eq_i64("prep.tend_n", w->tend_n, g->tend_n);
