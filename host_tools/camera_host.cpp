@@ -311,13 +311,27 @@ bool pixel_to_q16(double u, double v, int64_t *uq, int64_t *vq)
     return true;
 }
 
+void append_nm_decimal(std::string &out, int64_t nm)
+{
+    // metres with nine decimals, exact: the digits of |nm| with a point
+    // before the last nine (no printf: this runs once per output value)
+    uint64_t a = nm < 0 ? (uint64_t)0 - (uint64_t)nm : (uint64_t)nm;
+    char buf[32];
+    int n = 0;
+    while (n < 10 || a != 0) {  // at least "0.000000000"
+        if (n == 9) buf[n++] = '.';
+        buf[n++] = (char)('0' + (int)(a % 10u));
+        a /= 10u;
+    }
+    if (nm < 0) out.push_back('-');
+    while (n > 0) out.push_back(buf[--n]);
+}
+
 std::string nm_to_decimal(int64_t nm)
 {
-    uint64_t a = nm < 0 ? (uint64_t)0 - (uint64_t)nm : (uint64_t)nm;
-    char buf[48];
-    std::snprintf(buf, sizeof buf, "%s%llu.%09llu", nm < 0 ? "-" : "", (unsigned long long)(a / 1000000000u),
-                  (unsigned long long)(a % 1000000000u));
-    return buf;
+    std::string s;
+    append_nm_decimal(s, nm);
+    return s;
 }
 
 }  // namespace ct_host

@@ -97,5 +97,6 @@ bool pixel_to_q16(double u, double v, int64_t *u_q16, int64_t *v_q16);
 
 // Integer nanometres as exact decimal metres ("-123.000000456").
 std::string nm_to_decimal(int64_t nm);
+void append_nm_decimal(std::string &out, int64_t nm);  // the same, appended
 
 }  // namespace ct_host

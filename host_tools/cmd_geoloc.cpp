@@ -141,18 +141,37 @@ int cmd_geoloc(int argc, char **argv)
         throw Error("--effects: the effect parameters are out of range for this package (" + status_name(st) + ")");
     if (st != CT_OK) throw Error(cpath + ": cannot geolocate from this camera (" + status_name(st) + ")");
 
-    std::ostringstream out;
-    out << "u,v,status,E,N,h,steps\n";
-    for (size_t k = 0; k < px.size(); ++k) {
-        ct_status s = in_range[k] ? g[k].status : CT_ERR_UNPROJECT;
-        out << px[k].u_text << ',' << px[k].v_text << ',' << status_name(s) << ',';
-        if (s == CT_HIT || s == CT_HIT_VOID)
-            out << nm_to_decimal(g[k].hit.e_nm) << ',' << nm_to_decimal(g[k].hit.n_nm) << ','
-                << nm_to_decimal(g[k].hit.h_nm) << ',' << g[k].hit.steps << '\n';
-        else
-            out << "nan,nan,nan," << (s >= 0 ? g[k].hit.steps : 0u) << '\n';
-    }
-    std::string txt = out.str();
+    // rows formatted in chunks on the same threads, joined in input order
+    const size_t CH = 1024;
+    std::vector<std::string> parts((px.size() + CH - 1) / CH);
+    parallel_chunks(px.size(), threads, CH, [&](size_t b, size_t e) {
+        std::string &o = parts[b / CH];
+        o.reserve((e - b) * 64);
+        for (size_t k = b; k < e; ++k) {
+            ct_status s = in_range[k] ? g[k].status : CT_ERR_UNPROJECT;
+            o += px[k].u_text;
+            o += ',';
+            o += px[k].v_text;
+            o += ',';
+            o += status_name(s);
+            o += ',';
+            if (s == CT_HIT || s == CT_HIT_VOID) {
+                append_nm_decimal(o, g[k].hit.e_nm);
+                o += ',';
+                append_nm_decimal(o, g[k].hit.n_nm);
+                o += ',';
+                append_nm_decimal(o, g[k].hit.h_nm);
+                o += ',';
+                o += std::to_string(g[k].hit.steps);
+            } else {
+                o += "nan,nan,nan,";
+                o += std::to_string(s >= 0 ? g[k].hit.steps : 0u);
+            }
+            o += '\n';
+        }
+    });
+    std::string txt = "u,v,status,E,N,h,steps\n";
+    for (const std::string &part : parts) txt += part;
     write_file_atomic(opt["-o"], std::vector<uint8_t>(txt.begin(), txt.end()));
     return 0;
 }

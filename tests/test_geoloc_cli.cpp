@@ -168,6 +168,28 @@ const char *kPixels =
     "\n"
     "1800.5,200.5\n";
 
+// The output's metres: ct_host::nm_to_decimal against printf's digits, at
+// the edges (0, +-1 nm, +-1 m, the int64 limits) and at random values.
+void test_nm_decimal()
+{
+    auto ref = [](int64_t nm) {
+        uint64_t a = nm < 0 ? (uint64_t)0 - (uint64_t)nm : (uint64_t)nm;
+        char b[48];
+        std::snprintf(b, sizeof b, "%s%llu.%09llu", nm < 0 ? "-" : "", (unsigned long long)(a / 1000000000u),
+                      (unsigned long long)(a % 1000000000u));
+        return std::string(b);
+    };
+    const int64_t edge[] = {0, 1, -1, 999999999, -999999999, 1000000000, -1000000000, 1000000001,
+                            INT64_MAX, INT64_MIN, INT64_MIN + 1};
+    for (int64_t v : edge) TEST_ASSERT_MSG(ct_host::nm_to_decimal(v) == ref(v), "%lld", (long long)v);
+    ct_rng r;
+    ct_rng_seed(&r, ct_test_seed() + 5);
+    for (int k = 0; k < 100000; ++k) {
+        int64_t v = (int64_t)(ct_rng_u64(&r) >> ct_rng_range(&r, 0, 63)) * (ct_rng_range(&r, 0, 1) ? 1 : -1);
+        TEST_ASSERT_MSG(ct_host::nm_to_decimal(v) == ref(v), "%lld", (long long)v);
+    }
+}
+
 void test_geoloc_end_to_end()
 {
     Setup *s = setup();
@@ -521,6 +543,7 @@ int main()
     }
     fs::create_directory(std::string(tmpl) + "/work");
     g_dir = std::string(tmpl) + "/work";
+    RUN_TEST(test_nm_decimal);
     RUN_TEST(test_geoloc_end_to_end);
     RUN_TEST(test_geoloc_effects);
     RUN_TEST(test_geoloc_threads);
