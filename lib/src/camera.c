@@ -92,6 +92,16 @@ static int radial(const ct_lens *l, int64_t r2, int64_t *R, int64_t *Rp)
     }
     N = poly(k[0], k[1], k[4], r2);
     Np = dpoly(k[0], k[1], k[4], r2);
+    if (k[5] == 0 && k[6] == 0 && k[7] == 0) {
+        /* no denominator: D = 2^32 and D' = 0 exactly, so the quotients
+         * below are N and N' themselves (the same bits, no division) */
+        if (ct_abs64(N) > R_MAX || N < R_MIN || ct_abs64(Np) > RP_MAX) {
+            return 0;
+        }
+        *R = N;
+        *Rp = Np;
+        return 1;
+    }
     D = poly(k[5], k[6], k[7], r2);
     Dp = dpoly(k[5], k[6], k[7], r2);
     if (D < D_MIN) {

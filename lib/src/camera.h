@@ -34,14 +34,7 @@ static inline ct_i128 ct_i128_abs(ct_i128 a) { return ct_i128_sign(a) < 0 ? ct_i
 /* Number of significant bits of a non-negative 128-bit value (0 for 0).    */
 static inline unsigned ct_i128_bits(ct_i128 a)
 {
-    unsigned n = 0u;
-    uint64_t w = a.hi != 0u ? a.hi : a.lo;
-    /* bound: 64 bits */
-    while (w != 0u && n < 64u) {
-        w >>= 1;
-        n++;
-    }
-    return a.hi != 0u ? n + 64u : n;
+    return a.hi != 0u ? ct_bitlen64(a.hi) + 64u : ct_bitlen64(a.lo);
 }
 
 /* round(num / d) for d in (0, 2^61]: returns 0 (and leaves *q alone) when
