@@ -162,9 +162,10 @@ static int box_above_terrain(const ct_package *p, int64_t x0, int64_t x1, int64_
  * rounded by < 2 units); for a single segment (run = 0) the chord itself is
  * used: min(z_a, z_b).  The slack, 2 + max|b - a| / 2^24 Q16 units, also
  * covers each prepared segment's own rounding (entry 1/2 unit, direction
- * 2^-25 of the distance), so no ray the walk would trace over the run can
- * meet the surface when this returns 1: skipping the run changes no
- * result. */
+ * ~2^-26 of the distance, see ct_prepared), and vertically 2^zshift_max
+ * more for the entry's z rounded to the segment's z unit (2^k Q16, k <=
+ * zshift_max), so no ray the walk would trace over the run can meet the
+ * surface when this returns 1: skipping the run changes no result. */
 static uint64_t absdiff64(int64_t a, int64_t b)
 {
     return a > b ? (uint64_t)a - (uint64_t)b : (uint64_t)b - (uint64_t)a;
@@ -197,7 +198,7 @@ static int run_above_terrain(const ct_package *p, const v3 *a, const v3 *b, int 
     slack = 2 + (int64_t)(m >> 24);
     return box_above_terrain(p, ct_min64(a->x, b->x) - slack, ct_max64(a->x, b->x) + slack,
                              ct_min64(a->y, b->y) - slack, ct_max64(a->y, b->y) + slack,
-                             run_floor(a, b, run, chord_q16) - slack, over_tile);
+                             run_floor(a, b, run, chord_q16) - slack - ((int64_t)1 << p->zshift_max), over_tile);
 }
 
 /* Both ends of the run inside the tile's closed box (so the polyline over
