@@ -33,10 +33,9 @@ using namespace ct_host;
 
 namespace {
 
-[[noreturn]] void usage(const std::string &msg)
+void print_usage(std::FILE *f)
 {
-    std::fprintf(stderr, "conetrace: %s\n", msg.c_str());
-    std::fprintf(stderr,
+    std::fprintf(f,
                  "usage: conetrace build DEM -o OUT.ctp [--sectors N] [--reduce r] [--slices K]\n"
                  "                       [--height-scale M] [--posting M] [--threads T]\n"
                  "                       [--builder slices|brute] [--window R] [--levels H1,H2,...]\n"
@@ -52,8 +51,16 @@ namespace {
                  "                       [--sector LIST] [--range LO,HI] [--hillshade] [--zoom Z]\n"
                  "                       [--columns C] [--no-legend] [--threads T]\n"
                  "methods: incremental, hierarchical, cone, directional (default)\n");
+}
+
+[[noreturn]] void usage(const std::string &msg)
+{
+    std::fprintf(stderr, "conetrace: %s\n", msg.c_str());
+    print_usage(stderr);
     std::exit(2);
 }
+
+bool is_help(const std::string &s) { return s == "-h" || s == "--help" || s == "help"; }
 
 struct Args {
     std::vector<std::string> pos;
@@ -366,6 +373,11 @@ int main(int argc, char **argv)
 {
     if (argc < 2) usage("missing command");
     std::string cmd = argv[1];
+    // `conetrace --help` and `conetrace CMD --help`: the usage on stdout, exit 0
+    if (is_help(cmd) || (argc >= 3 && is_help(argv[2]) && std::string(argv[2]) != "help")) {
+        print_usage(stdout);
+        return 0;
+    }
     try {
         if (cmd == "build") return cmd_build(argc, argv);
         if (cmd == "info") return cmd_info(argc, argv);
@@ -373,7 +385,6 @@ int main(int argc, char **argv)
         if (cmd == "demo") return cmd_demo(argc, argv);
         if (cmd == "geoloc") return cmd_geoloc(argc, argv);
         if (cmd == "render") return cmd_render(argc, argv);
-        if (cmd == "-h" || cmd == "--help" || cmd == "help") usage("help");
         usage("unknown command '" + cmd + "'");
     } catch (const std::exception &e) {
         std::fprintf(stderr, "conetrace: %s\n", e.what());

@@ -273,6 +273,28 @@ static std::string fixture_package()
 // ---------------------------------------------------------------------------
 // 1. build + info on the real DEM
 
+// --help: the usage on stdout and exit 0 (for the program and for each
+// command); a missing or unknown command: the usage on stderr and exit 2.
+static void test_help(void)
+{
+    std::string d = new_dir("help");
+    std::vector<Job> jobs;
+    for (const char *c : {"build", "info", "trace", "demo", "geoloc", "render"}) jobs.push_back(Job{d, {c, "--help"}});
+    jobs.push_back(Job{d, {"--help"}});
+    jobs.push_back(Job{d, {"-h"}});
+    jobs.push_back(Job{d, {"help"}});
+    std::vector<Run> runs = run_all(jobs);
+    for (const Run &r : runs) {
+        TEST_ASSERT_MSG(r.code == 0, "%s exited %d", r.cmd.c_str(), r.code);
+        TEST_ASSERT_MSG(starts_with(r.out, "usage: conetrace build") && contains(r.out, "conetrace geoloc PKG"),
+                        "%s: no usage on stdout", r.cmd.c_str());
+        TEST_ASSERT_MSG(r.err.empty(), "%s wrote to stderr: %s", r.cmd.c_str(), r.err.c_str());
+    }
+    Run bad = run_cli(d, {"frobnicate"});
+    TEST_ASSERT(bad.code == 2 && bad.out.empty() && contains(bad.err, "unknown command 'frobnicate'") &&
+                contains(bad.err, "usage: conetrace build"));
+}
+
 static void test_build_info_fixture(void)
 {
     std::string d = new_dir("build");
@@ -839,6 +861,7 @@ int main(void)
         return 1;
     }
     load_fixture();
+    RUN_TEST(test_help);
     RUN_TEST(test_build_info_fixture);
     RUN_TEST(test_trace_methods);
     RUN_TEST(test_nodata_policy);
