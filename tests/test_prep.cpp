@@ -8,7 +8,7 @@
 //     | (u_x (1/2 + c t), u_y (1/2 + c t), u_z ((2^k + 1)/2 + 2^k c t)) |
 // metres of the caller's line (u: metres per Q16 unit, k = zshift,
 // c = 1/2 + 2^-6: each direction component's rounding), which keeps it within
-// 1 mm anywhere in a tile up to ~100 km across; and a returned hit is within
+// 1 mm anywhere in a tile up to 2,048 cells (61 km at 30 m); and a hit is within
 // 2 Q16 units (2 z units) of the prepared ray's exact first hit.  This test
 // checks both against an independent clip (128-bit rationals written
 // separately from lib/) and long double geometry, plus the grid <-> map
