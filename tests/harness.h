@@ -69,7 +69,10 @@ CT_HARNESS_INLINE double ct_rng_unit(ct_rng *r) { return (double)(ct_rng_u64(r) 
 /* uniform integer in [lo, hi] */
 CT_HARNESS_INLINE int64_t ct_rng_range(ct_rng *r, int64_t lo, int64_t hi)
 {
-    return lo + (int64_t)(ct_rng_u64(r) % (uint64_t)(hi - lo + 1));
+    /* in unsigned arithmetic (hi - lo may not fit an int64); the same values
+     * as lo + u % (hi - lo + 1) wherever that fits */
+    uint64_t span = (uint64_t)hi - (uint64_t)lo + 1u, u = ct_rng_u64(r);
+    return (int64_t)((uint64_t)lo + (span == 0u ? u : u % span));
 }
 
 #define TEST_BEGIN(name)                                  \

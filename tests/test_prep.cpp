@@ -15,6 +15,7 @@
 // conversions.
 #include <cmath>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "conetrace.h"
@@ -38,12 +39,12 @@ struct Fixture {
 
 Fixture *make_fixture(int w, int h, uint64_t seed, double lo = 200, double hi = 3000, double scale = 0.25)
 {
-    static std::vector<Fixture *> keep;
-    Fixture *f = new Fixture;
+    static std::vector<std::unique_ptr<Fixture>> keep;  // alive until exit, then freed
+    keep.push_back(std::make_unique<Fixture>());
+    Fixture *f = keep.back().get();
     f->c = dem_cases::make_case("smooth", dem_cases::make_terrain(w, h, dem_cases::smooth(w, h, seed, lo, hi), scale),
                                 8, 2);
     if (ct_package_open(&f->p, f->c.pkg.data(), f->c.pkg.size()) != CT_OK) return nullptr;
-    keep.push_back(f);
     return f;
 }
 
@@ -316,6 +317,51 @@ void test_within_1mm_on_a_long_tile()
     TEST_ASSERT_MSG(worst_b <= 1e-3L, "the stated bound reaches %.3Lf mm on this tile", worst_b * 1000);
 }
 
+// Regressions from issue 19's first fuzzing run (run under ASan + UBSan as
+// test_prep_san): an origin inside the tile horizontally but far below it
+// (within the documented 2^46) made the box exit's rationals overflow before
+// the ray was found to start below the surface; a direction component of
+// INT64_MIN (outside the documented 2^62) overflowed |.| and was traced.
+void test_fuzz_regressions()
+{
+    Fixture *f = make_fixture(9, 7, 13);
+    TEST_ASSERT(f != nullptr);
+    const ct_package &p = f->p;
+    ct_prepared pr;
+    ct_hit h;
+    ct_ray deep = {5 * 65536, 4 * 65536, -INT64_C(1098567909376), INT64_C(107784773119), 1048576, 2146435072};
+    TEST_ASSERT_EQUAL_INT(CT_BELOW, ct_ray_prepare(&p, &deep, &pr));
+    TEST_ASSERT_EQUAL_INT(CT_BELOW, ct_trace(&p, &deep, CT_METHOD_DIRECTIONAL, &h));
+    for (int k = 0; k < 3; ++k) {  // the lowest documented origin, in every direction
+        ct_ray r = {3 * 65536, 2 * 65536, -CT_MAX_ORIGIN_Q16, 0, 0, 0};
+        int64_t *d = k == 0 ? &r.dx : k == 1 ? &r.dy : &r.dz;
+        for (int64_t mag : {INT64_C(1), INT64_C(1) << 31, INT64_C(1) << 62}) {
+            *d = mag;
+            r.dz = k == 2 ? mag : 1;
+            TEST_ASSERT_EQUAL_INT(CT_BELOW, ct_ray_prepare(&p, &r, &pr));
+        }
+    }
+    const int64_t bad[][6] = {
+        {0, 0, 0, INT64_C(1369094286723776512), INT64_MIN, -2097152},
+        {0, 0, 0, INT64_MIN, 1, 1},
+        {0, 0, 0, 1, 1, INT64_MIN},
+        {INT64_MIN, 0, 0, 1, 1, 1},
+        {0, 0, INT64_MIN, 1, 1, -1},
+    };
+    ct_bend bd = {65536, INT64_C(6371000000000000), INT64_C(1000000), 0};
+    for (const auto &b : bad) {
+        ct_ray r = {b[0], b[1], b[2], b[3], b[4], b[5]};
+        TEST_ASSERT_EQUAL_INT(CT_ERR_RAY, ct_ray_prepare(&p, &r, &pr));
+        TEST_ASSERT_EQUAL_INT(CT_ERR_RAY, ct_trace(&p, &r, CT_METHOD_DIRECTIONAL, &h));
+        TEST_ASSERT_EQUAL_INT(CT_ERR_RAY, ct_trace_bent(&p, &r, &bd, CT_METHOD_HIERARCHICAL, &h));
+    }
+    ct_ray out;
+    TEST_ASSERT_EQUAL_INT(CT_ERR_RAY, ct_ray_from_map(&p, p.origin_e_nm, p.origin_n_nm, 0, INT64_MIN, 1, 1, &out));
+    int64_t e, n, z;
+    TEST_ASSERT_EQUAL_INT(CT_ERR_RANGE, ct_map_to_grid(&p, INT64_MIN, 0, 0, &e, &n, &z));
+    TEST_ASSERT_EQUAL_INT(CT_ERR_RANGE, ct_grid_to_map(&p, 0, INT64_MIN, 0, &e, &n, &z));
+}
+
 void test_grid_map_round_trip()
 {
     Fixture *f = make_fixture(19, 23, 3);
@@ -387,6 +433,7 @@ int main()
     RUN_TEST(test_clip_entry_and_direction);
     RUN_TEST(test_hit_is_near_callers_ray);
     RUN_TEST(test_within_1mm_on_a_long_tile);
+    RUN_TEST(test_fuzz_regressions);
     RUN_TEST(test_grid_map_round_trip);
     RUN_TEST(test_ray_from_map);
     return TEST_END();

@@ -422,20 +422,24 @@ ct_status ct_trace_bent(const ct_package *p, const ct_ray *ray, const ct_bend *b
         seg.x_q16 = va.x;
         seg.y_q16 = va.y;
         seg.z_q16 = va.z;
-        seg.dx = vb.x - va.x;
-        seg.dy = vb.y - va.y;
-        seg.dz = vb.z - va.z;
-        va = vb;
-        k = kn;
         if (ct_abs64(seg.x_q16) > CT_MAX_ORIGIN_Q16 || ct_abs64(seg.y_q16) > CT_MAX_ORIGIN_Q16 ||
             ct_abs64(seg.z_q16) > CT_MAX_ORIGIN_Q16) {
             /* a vertex beyond the library's origin range: only possible
              * far above or below the tile */
+            va = vb;
+            k = kn;
             if (seg.z_q16 < 0 && entered == 0) {
                 return CT_BELOW;
             }
             continue;
         }
+        /* |va| <= 2^46 (just checked) and |vb| <= 2^62 + 2^46 (vertex's
+         * saturation): the differences fit in int64 */
+        seg.dx = vb.x - va.x;
+        seg.dy = vb.y - va.y;
+        seg.dz = vb.z - va.z;
+        va = vb;
+        k = kn;
         if (seg.dx == 0 && seg.dy == 0 && seg.dz == 0) {
             continue;
         }

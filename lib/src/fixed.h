@@ -42,7 +42,9 @@ static inline int64_t ct_ceil_div(int64_t a, int64_t b)
     return -ct_floor_div(-a, b);
 }
 
-static inline int64_t ct_abs64(int64_t a) { return a < 0 ? -a : a; }
+/* |a|, saturated: INT64_MIN (whose negation overflows) gives INT64_MAX, so
+ * a range check |a| <= limit written with it refuses INT64_MIN.            */
+static inline int64_t ct_abs64(int64_t a) { return a < 0 ? (a == INT64_MIN ? INT64_MAX : -a) : a; }
 static inline int64_t ct_max64(int64_t a, int64_t b) { return a > b ? a : b; }
 static inline int64_t ct_min64(int64_t a, int64_t b) { return a < b ? a : b; }
 

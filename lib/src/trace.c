@@ -909,6 +909,7 @@ static ct_status prepare_impl(const ct_package *p, const ct_ray *ray, int seg, c
     int k, has_out = 0, kin = -1;
     unsigned zs;
     int64_t zone;
+    ct_status start;
     int64_t kin_at = 0; /* the entry face's coordinate on axis kin */
     CT_ASSERT(p != NULL && ray != NULL && out != NULL);
     if (p == NULL || ray == NULL || out == NULL) {
@@ -1079,6 +1080,42 @@ static ct_status prepare_impl(const ct_package *p, const ct_ray *ray, int seg, c
     } else {
         out->sector = -1;
     }
+    /* the first point: below, on, or above the surface (exact); decided
+     * first, so that tend below is formed only for a point at or above the
+     * surface (z >= 0: every candidate < 2^34) */
+    {
+        int32_t i = axis_cell(O[0], ONE16, D[0] > 0 ? 1 : (D[0] < 0 ? -1 : 0), (int32_t)p->cells_x);
+        int32_t j = axis_cell(O[1], ONE16, D[1] > 0 ? 1 : (D[1] < 0 ? -1 : 0), (int32_t)p->cells_y);
+        int64_t s, f;
+        /* the first point is on the tile; use the cell it is in, clamped */
+        if (i < 0) {
+            i = 0;
+        }
+        if (j < 0) {
+            j = 0;
+        }
+        if (i >= (int32_t)p->cells_x) {
+            i = (int32_t)p->cells_x - 1;
+        }
+        if (j >= (int32_t)p->cells_y) {
+            j = (int32_t)p->cells_y - 1;
+        }
+        s = surface_q32(p, i, j, O[0], O[1]);
+        if (O[2] < -(INT64_C(1) << (46u - zs))) {
+            start = CT_BELOW;
+        } else {
+            f = O[2] * (INT64_C(1) << zs) * ONE16 - s; /* |oz 2^zs| <= 2^46: < 2^62 */
+            start = f < 0 ? CT_BELOW : (f == 0 ? CT_HIT : CT_OK);
+        }
+    }
+    if (start == CT_BELOW) {
+        /* decided before tend: below the surface, z may be far under the
+         * box, where tend's rationals would not fit */
+        out->tend_n = 0;
+        out->tend_d = 1;
+        out->start = CT_BELOW;
+        return CT_BELOW;
+    }
     /* tend: leaving the box horizontally, through the top (rising) or
      * below hmin - 1 (descending; never reached without a hit).          */
     {
@@ -1116,41 +1153,8 @@ static ct_status prepare_impl(const ct_package *p, const ct_ray *ray, int seg, c
         out->tend_n = te.n;
         out->tend_d = te.d;
     }
-    /* the first point: below, on, or above the surface (exact) */
-    {
-        int32_t i = axis_cell(O[0], ONE16, D[0] > 0 ? 1 : (D[0] < 0 ? -1 : 0), (int32_t)p->cells_x);
-        int32_t j = axis_cell(O[1], ONE16, D[1] > 0 ? 1 : (D[1] < 0 ? -1 : 0), (int32_t)p->cells_y);
-        int64_t s, f;
-        /* the first point is on the tile; use the cell it is in, clamped */
-        if (i < 0) {
-            i = 0;
-        }
-        if (j < 0) {
-            j = 0;
-        }
-        if (i >= (int32_t)p->cells_x) {
-            i = (int32_t)p->cells_x - 1;
-        }
-        if (j >= (int32_t)p->cells_y) {
-            j = (int32_t)p->cells_y - 1;
-        }
-        s = surface_q32(p, i, j, O[0], O[1]);
-        if (O[2] < -(INT64_C(1) << (46u - zs))) {
-            out->start = CT_BELOW;
-            return CT_BELOW;
-        }
-        f = O[2] * (INT64_C(1) << zs) * ONE16 - s; /* |oz 2^zs| <= 2^46: < 2^62 */
-        if (f < 0) {
-            out->start = CT_BELOW;
-            return CT_BELOW;
-        }
-        if (f == 0) {
-            out->start = CT_HIT;
-            return CT_HIT;
-        }
-    }
-    out->start = CT_OK;
-    return CT_OK;
+    out->start = start;
+    return start;
 }
 
 ct_status ct_ray_prepare(const ct_package *p, const ct_ray *ray, ct_prepared *out)
