@@ -3,7 +3,8 @@
 BUILD ?= build
 JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 
-.PHONY: all test demo bench cross clean deps
+.PHONY: all test demo bench cross fuzz clean deps
+FUZZ_SECONDS ?= 1800
 
 all: deps
 	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release
@@ -27,6 +28,11 @@ bench: all
 
 cross: deps
 	scripts/cross.sh $(BUILD)/cross
+
+# long fuzzing of lib/ (10^7 inputs or FUZZ_SECONDS, whichever comes first);
+# the corpus is kept in $(BUILD)/fuzz_corpus between runs
+fuzz: all
+	sh tests/fuzz/fuzz.sh $(BUILD) 10000000 $(FUZZ_SECONDS) $(BUILD)/fuzz_corpus
 
 clean:
 	rm -rf $(BUILD)

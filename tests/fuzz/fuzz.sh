@@ -1,0 +1,48 @@
+#!/bin/sh
+# fuzz.sh -- build tests/fuzz/fuzz_lib.c with clang's libFuzzer, ASan and
+# UBSan over the flight library and run it.
+#   tests/fuzz/fuzz.sh <build-dir> <runs> [max-seconds] [corpus-dir]
+# The packages come from the MCU vectors the host build generates
+# (<build-dir>/tests/mcu/ct_vectors.c).  `make test` runs 100,000 inputs from
+# an empty corpus with a fixed seed (reproducible); `make fuzz` runs long
+# (FUZZ_SECONDS, default 1800) and keeps its corpus in <build-dir>/fuzz_corpus.
+# Exit 0: no finding; 1: a finding (the crashing input is saved in
+# <build-dir>/fuzz/ and printed); 77: clang's libFuzzer is not available.
+set -u
+ROOT=$(cd "$(dirname "$0")/../.." && pwd)
+BUILD=$(cd "$1" && pwd)
+RUNS=${2:-100000}
+SECS=${3:-0}
+CORPUS=${4:-}
+CC=${CT_FUZZ_CC:-clang}
+OUT="$BUILD/fuzz"
+VEC="$BUILD/tests/mcu/ct_vectors.c"
+[ -f "$VEC" ] || { echo "fuzz: $VEC missing (build the project first)"; exit 1; }
+command -v "$CC" >/dev/null 2>&1 || { echo "fuzz: $CC not found (scripts/deps.sh installs clang)"; exit 77; }
+mkdir -p "$OUT"
+if [ -z "$CORPUS" ]; then
+    CORPUS=$(mktemp -d /tmp/ct_fuzz_XXXXXX)
+    trap 'rm -rf "$CORPUS"' EXIT
+fi
+mkdir -p "$CORPUS"
+FLAGS="-g -O1 -std=c99 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all"
+if ! "$CC" $FLAGS -I"$ROOT/lib/include" -I"$ROOT/lib/src" -I"$ROOT/tests/mcu" \
+        "$ROOT/tests/fuzz/fuzz_lib.c" "$VEC" "$ROOT"/lib/src/*.c -o "$OUT/fuzz_lib" 2>"$OUT/build.log"; then
+    if grep -q "fuzzer" "$OUT/build.log" && ! grep -q "error:" "$OUT/build.log"; then
+        echo "fuzz: libFuzzer not available"; exit 77
+    fi
+    cat "$OUT/build.log"; echo "fuzz: build failed"; exit 1
+fi
+cd "$OUT" || exit 1
+LIMIT=""
+[ "$SECS" -gt 0 ] && LIMIT="-max_total_time=$SECS"
+./fuzz_lib -runs="$RUNS" $LIMIT -seed=1 -max_len=512 -len_control=0 -print_final_stats=1 "$CORPUS" >"$OUT/run.log" 2>&1
+rc=$?
+grep -E "^(stat::number_of_executed_units|stat::new_units_added)|^#[0-9]+.*DONE|Done [0-9]+ runs" "$OUT/run.log"
+if [ $rc -ne 0 ]; then
+    tail -40 "$OUT/run.log"
+    echo "fuzz: FINDING (input saved in $OUT, see run.log)"
+    exit 1
+fi
+echo "fuzz: ok"
+exit 0

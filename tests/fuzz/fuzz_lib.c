@@ -1,0 +1,206 @@
+/*
+ * fuzz_lib.c -- libFuzzer harness for the flight library (ASan + UBSan):
+ * packages and rays the fuzzer makes up, checked against the library's own
+ * contracts, not only for crashes.
+ *
+ * Input: byte 0 selects the mode and byte 1 the base package (the two
+ * packages of the MCU vectors, built by the project's builder: N = 8, r = 2
+ * and N = 24, r = 1, with real cones).
+ *   mode 0 (ray):     six int64 (x, y, z, dx, dy, dz), then a bend (c Q16,
+ *                     R and chord exponents) -- traced straight and bent
+ *                     with all four methods on the intact package;
+ *   mode 1 (package): edits (u16 offset, u8 value) applied to a copy of the
+ *                     package, its CRC re-stamped (unless bit 7 of byte 1
+ *                     is set), then ct_package_open / ct_package_verify and
+ *                     a few rays from the bytes that follow the edits.
+ * Contracts asserted (abort on violation):
+ *   - every status is one the API documents for the call;
+ *   - on a package that opens and verifies, the four methods return the same
+ *     status and the same hit, bit for bit, straight and bent;
+ *   - a hit lies in the tile (its cell, and x, y within the tile's box);
+ *   - iters never exceed the published bound (CT_WCET_*).
+ */
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "conetrace.h"
+#include "ct_vectors.h"
+
+#define CHECK(c)       \
+    do {               \
+        if (!(c)) {    \
+            abort();   \
+        }              \
+    } while (0)
+
+static uint8_t g_buf[65536] __attribute__((aligned(8)));
+
+static int64_t rd64(const uint8_t *d, size_t n, size_t *pos)
+{
+    uint64_t v = 0u;
+    unsigned k;
+    for (k = 0u; k < 8u; ++k) {
+        uint64_t b = *pos < n ? d[*pos] : 0u;
+        v |= b << (8u * k);
+        (*pos)++;
+    }
+    return (int64_t)v;
+}
+
+static int trace_status_ok(ct_status s)
+{
+    return s == CT_HIT || s == CT_HIT_VOID || s == CT_MISS || s == CT_BELOW || s == CT_ERR_RAY ||
+           s == CT_ERR_RANGE || s == CT_ERR_ARG;
+}
+
+static void check_hit(const ct_package *p, ct_status s, const ct_hit *h, uint32_t bound)
+{
+    CHECK(trace_status_ok(s));
+    if (s >= 0) {
+        CHECK(h->iters <= bound);
+    }
+    if (s == CT_HIT || s == CT_HIT_VOID) {
+        CHECK(h->cell_x >= 0 && h->cell_y >= 0 && (uint32_t)h->cell_x < p->cells_x &&
+              (uint32_t)h->cell_y < p->cells_y);
+        CHECK(h->x_q16 >= -2 && h->y_q16 >= -2 && h->x_q16 <= (int64_t)p->cells_x * 65536 + 2 &&
+              h->y_q16 <= (int64_t)p->cells_y * 65536 + 2);
+    }
+}
+
+static int same_hit(ct_status a, const ct_hit *ha, ct_status b, const ct_hit *hb)
+{
+    if (a != b) {
+        return 0;
+    }
+    if (a != CT_HIT && a != CT_HIT_VOID) {
+        return 1;
+    }
+    return ha->x_q16 == hb->x_q16 && ha->y_q16 == hb->y_q16 && ha->z_q16 == hb->z_q16 &&
+           ha->t_q26 == hb->t_q26 && ha->cell_x == hb->cell_x && ha->cell_y == hb->cell_y &&
+           ha->e_nm == hb->e_nm && ha->n_nm == hb->n_nm && ha->h_nm == hb->h_nm;
+}
+
+/* All methods, straight and (if bd) bent; identical results when `same`. */
+static void trace_all(const ct_package *p, const ct_ray *r, const ct_bend *bd, int same)
+{
+    ct_hit h0, h;
+    ct_status s0, s;
+    int m;
+    uint32_t segs = CT_BEND_MAX_SEGMENTS;
+    s0 = ct_trace(p, r, CT_METHOD_INCREMENTAL, &h0);
+    check_hit(p, s0, &h0, CT_WCET_CELL_ITERS(p->cells_x, p->cells_y));
+    for (m = 1; m < CT_METHOD_COUNT; ++m) {
+        s = ct_trace(p, r, (ct_method)m, &h);
+        check_hit(p, s, &h,
+                  m == CT_METHOD_HIERARCHICAL ? CT_WCET_HIER_ITERS(p->cells_x, p->cells_y, p->levels)
+                                              : CT_WCET_CELL_ITERS(p->cells_x, p->cells_y));
+        if (same) {
+            CHECK(same_hit(s0, &h0, s, &h));
+        }
+    }
+    if (bd == NULL) {
+        return;
+    }
+    s0 = ct_trace_bent(p, r, bd, CT_METHOD_INCREMENTAL, &h0);
+    CHECK(trace_status_ok(s0));
+    if (s0 == CT_HIT || s0 == CT_HIT_VOID) {
+        check_hit(p, s0, &h0, CT_WCET_BENT_ITERS(p->cells_x, p->cells_y, segs));
+    }
+    for (m = 1; m < CT_METHOD_COUNT; ++m) {
+        s = ct_trace_bent(p, r, bd, (ct_method)m, &h);
+        CHECK(trace_status_ok(s));
+        if (same) {
+            CHECK(same_hit(s0, &h0, s, &h));
+        }
+    }
+}
+
+static void ray_mode(const ct_vec_package *vp, const uint8_t *d, size_t n)
+{
+    static ct_package pkg;
+    size_t pos = 0u;
+    ct_ray r;
+    ct_bend bd;
+    CHECK(ct_package_open(&pkg, vp->bytes, vp->size) == CT_OK);
+    r.x_q16 = rd64(d, n, &pos);
+    r.y_q16 = rd64(d, n, &pos);
+    r.z_q16 = rd64(d, n, &pos);
+    r.dx = rd64(d, n, &pos);
+    r.dy = rd64(d, n, &pos);
+    r.dz = rd64(d, n, &pos);
+    {
+        /* a bend: c in [-4, 4] (Q16), R = 2^(40..54) nm, chord 2^(10..50) nm */
+        int64_t e = rd64(d, n, &pos);
+        bd.coeff_q16 = (int32_t)((e & 0x7ffff) - 0x40000);
+        bd.radius_nm = INT64_C(1) << (40 + ((e >> 20) & 0xf) % 15);
+        bd.chord_nm = INT64_C(1) << (10 + ((e >> 24) & 0x3f) % 41);
+        bd.flags = (uint32_t)((e >> 30) & 1);
+    }
+    trace_all(&pkg, &r, &bd, 1);
+}
+
+static void package_mode(const ct_vec_package *vp, int stamp_crc, const uint8_t *d, size_t n)
+{
+    static ct_package pkg;
+    size_t pos = 0u, k;
+    size_t edits = n > 0u ? d[0] : 0u;
+    ct_status st;
+    uint32_t crc;
+    int verified;
+    memcpy(g_buf, vp->bytes, vp->size);
+    pos = 1u;
+    for (k = 0u; k < edits && pos + 3u <= n; ++k, pos += 3u) {
+        size_t off = ((size_t)d[pos] | ((size_t)d[pos + 1u] << 8)) % vp->size;
+        g_buf[off] = d[pos + 2u];
+    }
+    if (stamp_crc) {
+        memset(g_buf + 12, 0, 4);
+        CHECK(ct_crc32(0u, g_buf, vp->size, &crc) == CT_OK);
+        g_buf[12] = (uint8_t)crc;
+        g_buf[13] = (uint8_t)(crc >> 8);
+        g_buf[14] = (uint8_t)(crc >> 16);
+        g_buf[15] = (uint8_t)(crc >> 24);
+    }
+    st = ct_package_open(&pkg, g_buf, vp->size);
+    CHECK(st == CT_OK || (st <= CT_ERR_ARG && st >= CT_ERR_FLAGS));
+    if (st != CT_OK) {
+        return;
+    }
+    st = ct_package_verify(&pkg);
+    CHECK(st == CT_OK || st == CT_ERR_VERIFY);
+    verified = st == CT_OK;
+    /* rays from the remaining bytes: a start over the tile and a direction */
+    for (k = 0u; k < 4u && pos < n; ++k) {
+        ct_ray r;
+        int64_t a = rd64(d, n, &pos), b = rd64(d, n, &pos);
+        r.x_q16 = (int64_t)((uint64_t)a % ((uint64_t)pkg.cells_x * 65536u + 1u));
+        r.y_q16 = (int64_t)((uint64_t)(a >> 32) % ((uint64_t)pkg.cells_y * 65536u + 1u));
+        r.z_q16 = ((int64_t)pkg.hmax + 1 + (int64_t)(b & 0x3ff)) * 65536;
+        r.dx = (int16_t)(b >> 16);
+        r.dy = (int16_t)(b >> 32);
+        r.dz = -(int64_t)(1 + ((uint64_t)b >> 48));
+        /* on unverified content the methods may disagree (their
+         * acceleration data is not what the builder wrote), never crash */
+        trace_all(&pkg, &r, NULL, verified);
+    }
+}
+
+int LLVMFuzzerTestOneInput(const uint8_t *d, size_t n);
+int LLVMFuzzerTestOneInput(const uint8_t *d, size_t n)
+{
+    const ct_vec_package *vp;
+    if (n < 2u || ct_vectors.npackages == 0u) {
+        return 0;
+    }
+    vp = &ct_vectors.packages[(d[1] & 0x7fu) % ct_vectors.npackages];
+    if (vp->size > sizeof g_buf) {
+        return 0;
+    }
+    if ((d[0] & 1u) == 0u) {
+        ray_mode(vp, d + 2, n - 2u);
+    } else {
+        package_mode(vp, (d[1] & 0x80u) == 0u, d + 2, n - 2u);
+    }
+    return 0;
+}
