@@ -3,7 +3,7 @@
 BUILD ?= build
 JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 
-.PHONY: all test demo bench cross fuzz clean deps
+.PHONY: all test demo bench cross fuzz coverage clean deps
 FUZZ_SECONDS ?= 1800
 
 all: deps
@@ -33,6 +33,11 @@ cross: deps
 # the corpus is kept in $(BUILD)/fuzz_corpus between runs
 fuzz: all
 	sh tests/fuzz/fuzz.sh $(BUILD) 10000000 $(FUZZ_SECONDS) $(BUILD)/fuzz_corpus
+
+# line and branch coverage of lib/ by the test suite (gcov, gcovr), in a
+# separate build directory
+coverage: deps
+	scripts/coverage.sh $(BUILD)-coverage
 
 clean:
 	rm -rf $(BUILD)

@@ -116,13 +116,18 @@ static void trace_all(const ct_package *p, const ct_ray *r, const ct_bend *bd, i
     }
 }
 
-static void ray_mode(const ct_vec_package *vp, const uint8_t *d, size_t n)
+static void ray_mode(const ct_vec_package *vp, uint32_t idx, const uint8_t *d, size_t n)
 {
-    static ct_package pkg;
+    static ct_package pkgs[8]; /* opened once each */
+    static int opened[8];
+    ct_package *pkg = &pkgs[idx % 8u];
     size_t pos = 0u;
     ct_ray r;
     ct_bend bd;
-    CHECK(ct_package_open(&pkg, vp->bytes, vp->size) == CT_OK);
+    if (!opened[idx % 8u]) {
+        CHECK(ct_package_open(pkg, vp->bytes, vp->size) == CT_OK);
+        opened[idx % 8u] = 1;
+    }
     r.x_q16 = rd64(d, n, &pos);
     r.y_q16 = rd64(d, n, &pos);
     r.z_q16 = rd64(d, n, &pos);
@@ -137,7 +142,7 @@ static void ray_mode(const ct_vec_package *vp, const uint8_t *d, size_t n)
         bd.chord_nm = INT64_C(1) << (10 + ((e >> 24) & 0x3f) % 41);
         bd.flags = (uint32_t)((e >> 30) & 1);
     }
-    trace_all(&pkg, &r, &bd, 1);
+    trace_all(pkg, &r, &bd, 1);
 }
 
 static void package_mode(const ct_vec_package *vp, int stamp_crc, const uint8_t *d, size_t n)
@@ -190,15 +195,17 @@ int LLVMFuzzerTestOneInput(const uint8_t *d, size_t n);
 int LLVMFuzzerTestOneInput(const uint8_t *d, size_t n)
 {
     const ct_vec_package *vp;
+    uint32_t idx;
     if (n < 2u || ct_vectors.npackages == 0u) {
         return 0;
     }
-    vp = &ct_vectors.packages[(d[1] & 0x7fu) % ct_vectors.npackages];
+    idx = (d[1] & 0x7fu) % ct_vectors.npackages;
+    vp = &ct_vectors.packages[idx];
     if (vp->size > sizeof g_buf) {
         return 0;
     }
     if ((d[0] & 1u) == 0u) {
-        ray_mode(vp, d + 2, n - 2u);
+        ray_mode(vp, idx, d + 2, n - 2u);
     } else {
         package_mode(vp, (d[1] & 0x80u) == 0u, d + 2, n - 2u);
     }
