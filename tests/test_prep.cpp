@@ -362,6 +362,29 @@ void test_fuzz_regressions()
     TEST_ASSERT_EQUAL_INT(CT_ERR_RANGE, ct_grid_to_map(&p, 0, INT64_MIN, 0, &e, &n, &z));
 }
 
+// ct_surface_height: the bilinear surface at a Q16 point, rounded up,
+// against long double; outside the tile CT_ERR_RANGE, NULL CT_ERR_ARG.
+void test_surface_height()
+{
+    Fixture *f = make_fixture(23, 17, 8);
+    TEST_ASSERT(f != nullptr);
+    const ct_package &p = f->p;
+    ct_rng r;
+    ct_rng_seed(&r, ct_test_seed() * 23 + 9);
+    for (int k = 0; k < 100000; ++k) {
+        int64_t x = ct_rng_range(&r, 0, (int64_t)p.cells_x << 16), y = ct_rng_range(&r, 0, (int64_t)p.cells_y << 16), z;
+        if (k < 4) x = k & 1 ? (int64_t)p.cells_x << 16 : 0, y = k & 2 ? (int64_t)p.cells_y << 16 : 0;  // corners
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_surface_height(&p, x, y, &z));
+        ld ref = (ld)dem_cases::surf(f->c.t, (double)x / 65536, (double)y / 65536) * 65536;
+        if (!((ld)z >= ref - 1e-6L && (ld)z < ref + 1 + 1e-6L))
+            TEST_FAIL_MSG("surface at (%lld, %lld): %lld, long double %.4Lf", (long long)x, (long long)y, (long long)z, ref);
+    }
+    int64_t z;
+    TEST_ASSERT_EQUAL_INT(CT_ERR_RANGE, ct_surface_height(&p, -1, 0, &z));
+    TEST_ASSERT_EQUAL_INT(CT_ERR_RANGE, ct_surface_height(&p, 0, ((int64_t)p.cells_y << 16) + 1, &z));
+    TEST_ASSERT_EQUAL_INT(CT_ERR_ARG, ct_surface_height(&p, 0, 0, nullptr));
+}
+
 void test_grid_map_round_trip()
 {
     Fixture *f = make_fixture(19, 23, 3);
@@ -434,6 +457,7 @@ int main()
     RUN_TEST(test_hit_is_near_callers_ray);
     RUN_TEST(test_within_1mm_on_a_long_tile);
     RUN_TEST(test_fuzz_regressions);
+    RUN_TEST(test_surface_height);
     RUN_TEST(test_grid_map_round_trip);
     RUN_TEST(test_ray_from_map);
     return TEST_END();
