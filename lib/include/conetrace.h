@@ -251,7 +251,11 @@ ct_status ct_package_open(ct_package *pkg, const uint8_t *bytes, size_t len);
 
 /* Deep content check, O(cells): mipmap levels are the max of their children,
  * every apex is at least its coarse cell's tallest corner, hmin/hmax match
- * the samples.  Returns CT_OK or CT_ERR_VERIFY.                             */
+ * the samples.  Returns CT_OK or CT_ERR_VERIFY.  The cones' opening angles
+ * are not checked (only the builder's whole computation could confirm them):
+ * the CRC guards them, and a package whose angle codes were altered with the
+ * CRC re-stamped may make the cone methods pass terrain (never read out of
+ * bounds).                                                                 */
 ct_status ct_package_verify(const ct_package *pkg);
 
 /* Size in bytes of a package with these parameters (0 if out of limits).    */

@@ -25,6 +25,8 @@ if [ -z "$CORPUS" ]; then
     trap 'rm -rf "$CORPUS"' EXIT
 fi
 mkdir -p "$CORPUS"
+# the seed corpus: inputs worth keeping (earlier findings among them)
+cp "$ROOT"/tests/fuzz/corpus/* "$CORPUS"/ 2>/dev/null || true
 FLAGS="-g -O1 -std=c99 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all"
 if ! "$CC" $FLAGS -I"$ROOT/lib/include" -I"$ROOT/lib/src" -I"$ROOT/tests/mcu" \
         "$ROOT/tests/fuzz/fuzz_lib.c" "$VEC" "$ROOT"/lib/src/*.c -o "$OUT/fuzz_lib" 2>"$OUT/build.log"; then
