@@ -79,6 +79,21 @@ std::vector<std::string> split(const std::string &s)
     return v;
 }
 
+// A geoloc row (fields f, row number `row`) against the library's answer for
+// its pixel: the status, and for a hit E, N, h to the nanometre (counted in
+// *hits).  `what` prefixes the messages.
+void check_row(const std::vector<std::string> &f, const std::string &what, size_t row, ct_status want,
+               const ct_geo &g, int *hits)
+{
+    TEST_ASSERT_MSG(f[2] == ct_host::status_name(want), "%srow %zu: status %s, library %s", what.c_str(), row,
+                    f[2].c_str(), ct_host::status_name(want).c_str());
+    if (want == CT_HIT) {
+        ++*hits;
+        TEST_ASSERT(f[3] == ct_host::nm_to_decimal(g.hit.e_nm) && f[4] == ct_host::nm_to_decimal(g.hit.n_nm) &&
+                    f[5] == ct_host::nm_to_decimal(g.hit.h_nm));
+    }
+}
+
 std::string quote(const std::string &s)
 {
     std::string r = "'";
@@ -304,13 +319,7 @@ void test_geoloc_threads()
         TEST_ASSERT(ct_host::pixel_to_q16(uv[k].first, uv[k].second, &uq, &vq));
         ct_geo g;
         ct_status want = ct_geolocate(&s->p, &lc.cam, &lc.pose, CT_METHOD_DIRECTIONAL, &fx, uq, vq, &g);
-        TEST_ASSERT_MSG(f[2] == ct_host::status_name(want), "row %zu: %s vs %s", k + 1, f[2].c_str(),
-                        ct_host::status_name(want).c_str());
-        if (want == CT_HIT) {
-            ++hits;
-            TEST_ASSERT(f[3] == ct_host::nm_to_decimal(g.hit.e_nm) && f[4] == ct_host::nm_to_decimal(g.hit.n_nm) &&
-                        f[5] == ct_host::nm_to_decimal(g.hit.h_nm));
-        }
+        check_row(f, "", k + 1, want, g, &hits);
     }
     TEST_ASSERT_MSG(hits > 20, "only %d hits", hits);
     fs::remove(g_dir + "/gt.csv");
@@ -358,12 +367,9 @@ void test_geoloc_effects()
             ct_geo g;
             if (ct_host::pixel_to_q16(px[k].u, px[k].v, &uq, &vq))
                 want = ct_geolocate(&s->p, &lc.cam, &lc.pose, CT_METHOD_DIRECTIONAL, &o.fx, uq, vq, &g);
-            TEST_ASSERT_MSG(f[2] == ct_host::status_name(want), "%s row %zu: status %s, library %s",
-                            o.extra[1].c_str(), k + 1, f[2].c_str(), ct_host::status_name(want).c_str());
+            check_row(f, o.extra[1] + " ", k + 1, want, g, &hits);
             if (want == CT_HIT) {
-                ++hits;
-                TEST_ASSERT(f[3] == ct_host::nm_to_decimal(g.hit.e_nm) && f[4] == ct_host::nm_to_decimal(g.hit.n_nm) &&
-                            f[5] == ct_host::nm_to_decimal(g.hit.h_nm) && f[6] == std::to_string(g.hit.steps));
+                TEST_ASSERT(f[6] == std::to_string(g.hit.steps));
                 differ += rows[k + 1] != rows0[k + 1];
             }
         }
@@ -424,13 +430,7 @@ void test_geoloc_splined_grid()
             ct_geo g;
             if (ct_host::pixel_to_q16(px[k].u, px[k].v, &uq, &vq))
                 want = ct_geolocate(&s->p, &lc.cam, &lc.pose, CT_METHOD_DIRECTIONAL, nullptr, uq, vq, &g);
-            TEST_ASSERT_MSG(f[2] == ct_host::status_name(want), "row %zu: %s vs %s", k + 1, f[2].c_str(),
-                            ct_host::status_name(want).c_str());
-            if (want == CT_HIT) {
-                ++hits;
-                TEST_ASSERT(f[3] == ct_host::nm_to_decimal(g.hit.e_nm) && f[4] == ct_host::nm_to_decimal(g.hit.n_nm) &&
-                            f[5] == ct_host::nm_to_decimal(g.hit.h_nm));
-            }
+            check_row(f, "", k + 1, want, g, &hits);
         }
         // pixels of the image hit; the two beyond it are outside the grid
         TEST_ASSERT_MSG(hits == 7, "%d hits", hits);

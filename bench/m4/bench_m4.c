@@ -60,6 +60,33 @@ static void flush(void)
     g_buf[0] = '\0';
 }
 
+/* s, then spaces up to width characters. */
+static void put_pad(const char *s, uint32_t width)
+{
+    uint32_t n = 0u;
+    put(s);
+    while (s[n] != '\0' && n < width) { /* bound: width */
+        n++;
+    }
+    while (n < width) { /* bound: width */
+        put(" ");
+        n++;
+    }
+}
+
+/* Baked ray k as a ct_ray. */
+static ct_ray ray_at(uint32_t k)
+{
+    ct_ray r;
+    r.x_q16 = m4_rays[k].ray[0];
+    r.y_q16 = m4_rays[k].ray[1];
+    r.z_q16 = m4_rays[k].ray[2];
+    r.dx = m4_rays[k].ray[3];
+    r.dy = m4_rays[k].ray[4];
+    r.dz = m4_rays[k].ray[5];
+    return r;
+}
+
 static uint32_t ticks_since(uint32_t start) { return (start - SYST_CVR) & 0xFFFFFFu; }
 
 /* 2 n + 1 instructions (subs; bne per round, the last bne not taken) */
@@ -107,16 +134,10 @@ int main(void)
         for (m = 0u; m < 4u; ++m) {
             uint64_t ticks = 0u, steps = 0u;
             for (k = a; k < b; ++k) {
-                ct_ray r;
+                ct_ray r = ray_at(k);
                 ct_hit h;
                 ct_status st;
                 uint32_t dt;
-                r.x_q16 = m4_rays[k].ray[0];
-                r.y_q16 = m4_rays[k].ray[1];
-                r.z_q16 = m4_rays[k].ray[2];
-                r.dx = m4_rays[k].ray[3];
-                r.dy = m4_rays[k].ray[4];
-                r.dz = m4_rays[k].ray[5];
                 t0 = SYST_CVR;
                 st = ct_trace(&p, &r, (ct_method)m, &h);
                 dt = ticks_since(t0);
@@ -126,31 +147,10 @@ int main(void)
                     ok = 0;
                 }
             }
-            put(m == 0u ? m4_family_name[f] : "");
-            {
-                uint32_t pad = 0u;
-                const char *s = m == 0u ? m4_family_name[f] : "";
-                while (s[pad] != '\0' && pad < 12u) { /* bound: 12 */
-                    pad++;
-                }
-                while (pad < 12u) { /* bound: 12 */
-                    put(" ");
-                    pad++;
-                }
-            }
+            put_pad(m == 0u ? m4_family_name[f] : "", 12u);
             put_u(b - a, 6u);
             put(" | ");
-            put(mname[m]);
-            {
-                uint32_t pad = 0u;
-                while (mname[m][pad] != '\0') { /* bound: name */
-                    pad++;
-                }
-                while (pad < 13u) { /* bound: 13 */
-                    put(" ");
-                    pad++;
-                }
-            }
+            put_pad(mname[m], 13u);
             put_u(b > a ? (steps * 10u / (b - a)) / 10u : 0u, 6u);
             put(".");
             put_u(b > a ? (steps * 10u / (b - a)) % 10u : 0u, 0u);
@@ -159,15 +159,9 @@ int main(void)
                 /* of which the preparation (ct_ray_prepare alone) */
                 uint64_t pt = 0u;
                 for (k = a; k < b; ++k) {
-                    ct_ray r;
+                    ct_ray r = ray_at(k);
                     ct_prepared pr;
                     uint32_t dt;
-                    r.x_q16 = m4_rays[k].ray[0];
-                    r.y_q16 = m4_rays[k].ray[1];
-                    r.z_q16 = m4_rays[k].ray[2];
-                    r.dx = m4_rays[k].ray[3];
-                    r.dy = m4_rays[k].ray[4];
-                    r.dz = m4_rays[k].ray[5];
                     t0 = SYST_CVR;
                     (void)ct_ray_prepare(&p, &r, &pr);
                     dt = ticks_since(t0);

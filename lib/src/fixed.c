@@ -20,6 +20,27 @@ static unsigned nlz64(uint64_t v)
     if ((v >> 63) == 0u) { n += 1u; }
     return n;
 }
+
+/* One quotient digit of Knuth's algorithm D in base 2^32: the estimate
+ * un / vn1, corrected at most twice (Knuth's theorem B) against the next
+ * dividend digit un_next and the divisor's second digit vn0. */
+static uint64_t knuth_digit(uint64_t un, uint64_t un_next, uint64_t vn1, uint64_t vn0)
+{
+    const uint64_t b = (uint64_t)1 << 32;
+    uint64_t q = un / vn1, rhat = un - q * vn1;
+    unsigned k;
+    for (k = 0u; k < 2u; ++k) { /* bound: at most two corrections */
+        if (q >= b || q * vn0 > ((rhat << 32) | un_next)) {
+            q--;
+            rhat += vn1;
+            if (rhat < b) {
+                continue;
+            }
+        }
+        break;
+    }
+    return q;
+}
 #endif
 
 /* Unsigned (hi:lo) / d with hi < d; returns the quotient, *rem the rest.
@@ -37,38 +58,15 @@ static uint64_t udiv128(uint64_t hi, uint64_t lo, uint64_t d, uint64_t *rem)
     *rem = (uint64_t)(n % d);
     return (uint64_t)(n / d);
 #else
-    const uint64_t b = (uint64_t)1 << 32;
     const uint64_t m32 = 0xFFFFFFFFu;
-    unsigned s = nlz64(d), k;
+    unsigned s = nlz64(d);
     uint64_t vn = d << s, vn1 = vn >> 32, vn0 = vn & m32;
     uint64_t un32 = s == 0u ? hi : (hi << s) | (lo >> (64u - s));
     uint64_t un10 = lo << s, un1 = un10 >> 32, un0 = un10 & m32;
-    uint64_t q1, q0, rhat, un21;
-    q1 = un32 / vn1;
-    rhat = un32 - q1 * vn1;
-    for (k = 0u; k < 2u; ++k) { /* bound: at most two corrections */
-        if (q1 >= b || q1 * vn0 > ((rhat << 32) | un1)) {
-            q1--;
-            rhat += vn1;
-            if (rhat < b) {
-                continue;
-            }
-        }
-        break;
-    }
+    uint64_t q1, q0, un21;
+    q1 = knuth_digit(un32, un1, vn1, vn0);
     un21 = (un32 << 32) + un1 - q1 * vn; /* mod 2^64; the value is < vn */
-    q0 = un21 / vn1;
-    rhat = un21 - q0 * vn1;
-    for (k = 0u; k < 2u; ++k) { /* bound: at most two corrections */
-        if (q0 >= b || q0 * vn0 > ((rhat << 32) | un0)) {
-            q0--;
-            rhat += vn1;
-            if (rhat < b) {
-                continue;
-            }
-        }
-        break;
-    }
+    q0 = knuth_digit(un21, un0, vn1, vn0);
     *rem = ((un21 << 32) + un0 - q0 * vn) >> s;
     return (q1 << 32) | q0;
 #endif
