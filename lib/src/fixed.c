@@ -5,22 +5,6 @@
 #include "fixed.h"
 
 #ifndef CT_NATIVE_INT128
-/* Number of leading zero bits of v (64 for 0), by halving: no loop. */
-static unsigned nlz64(uint64_t v)
-{
-    unsigned n = 0u;
-    if (v == 0u) {
-        return 64u;
-    }
-    if ((v >> 32) == 0u) { n += 32u; v <<= 32; }
-    if ((v >> 48) == 0u) { n += 16u; v <<= 16; }
-    if ((v >> 56) == 0u) { n += 8u; v <<= 8; }
-    if ((v >> 60) == 0u) { n += 4u; v <<= 4; }
-    if ((v >> 62) == 0u) { n += 2u; v <<= 2; }
-    if ((v >> 63) == 0u) { n += 1u; }
-    return n;
-}
-
 /* One quotient digit of Knuth's algorithm D in base 2^32: the estimate
  * un / vn1, corrected at most twice (Knuth's theorem B) against the next
  * dividend digit un_next and the divisor's second digit vn0. */
@@ -49,8 +33,7 @@ static uint64_t knuth_digit(uint64_t un, uint64_t un_next, uint64_t vn1, uint64_
  * digits, each estimated from the top digits (a 64-by-32-bit division) and
  * corrected at most twice (Knuth's theorem B).  The 64-bit intermediates
  * fit: un32 < vn (from hi < d), so q1 <= 2^32 and q1 vn0 < 2^64; un21 and
- * the remainder are < vn.  (The former version took one quotient bit per
- * round, 64 rounds: ~8x the instructions on Cortex-M.) */
+ * the remainder are < vn. */
 static uint64_t udiv128(uint64_t hi, uint64_t lo, uint64_t d, uint64_t *rem)
 {
 #ifdef CT_NATIVE_INT128
@@ -59,7 +42,7 @@ static uint64_t udiv128(uint64_t hi, uint64_t lo, uint64_t d, uint64_t *rem)
     return (uint64_t)(n / d);
 #else
     const uint64_t m32 = 0xFFFFFFFFu;
-    unsigned s = nlz64(d);
+    unsigned s = 64u - ct_bitlen64(d); /* leading zeros; d > 0 */
     uint64_t vn = d << s, vn1 = vn >> 32, vn0 = vn & m32;
     uint64_t un32 = s == 0u ? hi : (hi << s) | (lo >> (64u - s));
     uint64_t un10 = lo << s, un1 = un10 >> 32, un0 = un10 & m32;
@@ -105,19 +88,6 @@ int64_t ct_i128_floor_div_sat(ct_i128 n, int64_t d)
     return ct_i128_floor_div(n, d);
 }
 
-/* Bit length of a nonzero v (1..64), by halving: 6 steps, no loop.      */
-static unsigned bitlen64(uint64_t v)
-{
-    unsigned b = 1u;
-    if (v >> 32) { v >>= 32; b += 32u; }
-    if (v >> 16) { v >>= 16; b += 16u; }
-    if (v >> 8) { v >>= 8; b += 8u; }
-    if (v >> 4) { v >>= 4; b += 4u; }
-    if (v >> 2) { v >>= 2; b += 2u; }
-    if (v >> 1) { b += 1u; }
-    return b;
-}
-
 /* ceil(sqrt((i + 1) * 2^59)) for i = 8..31: an upper bound of sqrt(m) for
  * m in [i * 2^59, (i + 1) * 2^59), i.e. for the top five bits of m.       */
 static const uint32_t isqrt_top5[24] = {
@@ -140,7 +110,7 @@ uint64_t ct_isqrt64(uint64_t n)
     if (n < 2u) {
         return n;
     }
-    e = (64u - bitlen64(n)) / 2u; /* m = n << 2e in [2^62, 2^64) */
+    e = (64u - ct_bitlen64(n)) / 2u; /* m = n << 2e in [2^62, 2^64) */
     x = (uint64_t)isqrt_top5[((n << (2u * e)) >> 59) - 8u];
     x = (x + (((uint64_t)1 << e) - 1u)) >> e;
     for (k = 0u; k < 8u; ++k) {
@@ -168,7 +138,7 @@ uint64_t ct_i128_isqrt(ct_i128 n)
      * x <- (x + n/x)/2 decreases monotonically to floor(sqrt(n)) (two or
      * three steps from this start).  bound: 70 iterations.               */
     {
-        unsigned bits = 64u + bitlen64(n.hi), s;
+        unsigned bits = 64u + ct_bitlen64(n.hi), s;
         uint64_t top;
         s = (bits - 61u) / 2u + 1u; /* 2s >= bits - 62, 2s < 64 + ... */
         if (2u * s >= 64u) {
