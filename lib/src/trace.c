@@ -817,14 +817,31 @@ static uint64_t scale_pow2(uint64_t a, int e)
     return (a + ((uint64_t)1 << (unsigned)(-e - 1))) >> (unsigned)(-e);
 }
 
-/* z shift of a direction: the smallest k <= kmax with |Uz| / 2^k <= the
- * larger horizontal component h (so that z, in units of 2^k Q16, no longer
- * dominates a steep ray); 0 for a vertical ray.  With k0 = bitlen(|Uz|) -
- * bitlen(h), |Uz| >> k0 < 2^bitlen(h) <= 2h, so k is k0 or k0 + 1. */
-static unsigned dir_zshift(const int64_t U[3], uint32_t kmax)
+/* A direction's magnitudes: the larger horizontal component h = max(|Ux|,
+ * |Uy|), az = |Uz|, and their bit lengths. */
+typedef struct {
+    uint64_t h, az;
+    unsigned bh, bz;
+} dir_mag;
+
+static dir_mag dir_magnitudes(const int64_t U[3])
 {
-    uint64_t h = (uint64_t)ct_max64(ct_abs64(U[0]), ct_abs64(U[1])), az = (uint64_t)ct_abs64(U[2]);
-    unsigned bh = ct_bitlen64(h), bz = ct_bitlen64(az), k;
+    dir_mag g;
+    g.h = (uint64_t)ct_max64(ct_abs64(U[0]), ct_abs64(U[1]));
+    g.az = (uint64_t)ct_abs64(U[2]);
+    g.bh = ct_bitlen64(g.h);
+    g.bz = ct_bitlen64(g.az);
+    return g;
+}
+
+/* z shift of a direction: the smallest k <= kmax with |Uz| / 2^k <= h (so
+ * that z, in units of 2^k Q16, no longer dominates a steep ray); 0 for a
+ * vertical ray.  With k0 = bitlen(|Uz|) - bitlen(h), |Uz| >> k0 <
+ * 2^bitlen(h) <= 2h, so k is k0 or k0 + 1. */
+static unsigned dir_zshift(const dir_mag *g, uint32_t kmax)
+{
+    uint64_t h = g->h, az = g->az;
+    unsigned bh = g->bh, bz = g->bz, k;
     if (h == 0u || bz < bh) {
         return 0u;
     }
@@ -841,7 +858,7 @@ static unsigned dir_zshift(const int64_t U[3], uint32_t kmax)
  * rounded: each component is within 1/2 + 2^-5 of the exact (common)
  * scaling, whose largest component is in (2^26 - 1, 2^26].  Products
  * V' f <= 2^32 2^27 = 2^59.                                               */
-static void normalize_dir(const int64_t U[3], unsigned zs, int32_t out[3])
+static void normalize_dir(const int64_t U[3], const dir_mag *g, unsigned zs, int32_t out[3])
 {
     uint64_t a[3], v[3], m = 0u, f;
     int e[3], top, k;
@@ -849,9 +866,7 @@ static void normalize_dir(const int64_t U[3], unsigned zs, int32_t out[3])
     for (k = 0; k < 3; ++k) {
         a[k] = (uint64_t)ct_abs64(U[k]);
     }
-    top = (int)ct_bitlen64(a[0] > a[1] ? a[0] : a[1]) + (int)zs;
-    k = (int)ct_bitlen64(a[2]);
-    top = k > top ? k : top;
+    top = (int)(g->bh + zs) > (int)g->bz ? (int)(g->bh + zs) : (int)g->bz;
     for (k = 0; k < 3; ++k) { /* bound: 3 components */
         /* V_k / 2^(top - 32), V_k = a_k 2^(zs for x, y) */
         e[k] = (k < 2 ? (int)zs : 0) - (top - 32);
@@ -910,6 +925,7 @@ static ct_status prepare_impl(const ct_package *p, const ct_ray *ray, int seg, c
     unsigned zs;
     int64_t zone;
     ct_status start;
+    dir_mag mag;
     int64_t kin_at = 0; /* the entry face's coordinate on axis kin */
     CT_ASSERT(p != NULL && ray != NULL && out != NULL);
     if (p == NULL || ray == NULL || out == NULL) {
@@ -1044,13 +1060,14 @@ static ct_status prepare_impl(const ct_package *p, const ct_ray *ray, int seg, c
     /* per-axis scaling: z in units of 2^zs Q16 (see ct_prepared); the
      * origin's z rounded to them (O[2] <= hi[2], a multiple of 2^16, stays
      * in the box; |O[2]| <= 2^46 here) */
-    zs = dir_zshift(U, p->zshift_max);
-    normalize_dir(U, zs, D);
+    mag = dir_magnitudes(U);
+    zs = dir_zshift(&mag, p->zshift_max);
+    normalize_dir(U, &mag, zs, D);
     if (zs > 0u && D[0] == 0 && D[1] == 0) {
         /* horizontal components too small to survive: a vertical ray,
          * which the tracer handles in Q16 */
         zs = 0u;
-        normalize_dir(U, zs, D);
+        normalize_dir(U, &mag, zs, D);
     }
     zone = ONE16 >> zs;
     if (zs > 0u) {
