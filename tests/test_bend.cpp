@@ -30,6 +30,8 @@ struct Scene {
 
 struct Counts {
     long rays = 0, hits = 0, miss = 0, below = 0, differ_from_straight = 0, bad = 0, fewer_steps_culled = 0;
+    long lowered = 0, polyline = 0;  // rays traced by each model
+    bool rise_matters = false;       // the largest rise is 1/10 of the relief or more
     ld worst_lead = 0;
 };
 
@@ -74,15 +76,25 @@ void run_scene(const dem_cases::Case &cs, const Scene &sc, long nrays, Counts *c
     bd.radius_nm = (int64_t)std::llround(sc.radius_m * 1e9);
     bd.chord_nm = (int64_t)std::llround(sc.chord_m * 1e9);
     const ld c = (ld)bd.coeff_q16 / 65536, R = (ld)bd.radius_nm * 1e-9L;
+    const double cw = cs.t.width - 1, ch = cs.t.height - 1;
+    const ld cw_ = cw, ch_ = ch;
     // largest slope (LSB per cell) for the horizontal part of the delta
     ld slope = 0;
     for (int j = 0; j + 1 < d.h; ++j)
         for (int i = 0; i + 1 < d.w; ++i)
             slope = std::max(slope, (ld)std::abs(d.at(i + 1, j) - d.at(i, j)) + std::abs(d.at(i, j + 1) - d.at(i, j)));
-    const ld delta = sc.chord_m / scale * 1.001L + (3 + 3 * slope) / 65536.0L + 1e-6L;
+    // the polyline's tolerance: its chord plus the vertices' and the prepared
+    // segments' rounding; the lowered model's (c > 0, ct_lower): the rise's
+    // bilinear interpolation between posts, c posting^2 / (4R), plus the
+    // prepared ray's rounding
+    const ld rounding = (3 + 3 * slope) / 65536.0L + 1e-6L;
+    const ld delta_poly = sc.chord_m / scale * 1.001L + rounding;
+    const ld delta_low = c * posting * posting / (4 * R) / scale * 1.001L + rounding;
+    // the largest rise over the scene's lines of sight (2.5 tile widths), in LSB
+    const ld rise = std::fabs(c) * std::pow(2.5L * std::max(cw_, ch_) * posting, 2) / (2 * R) / scale;
+    cnt->rise_matters = rise > 0.1L * (hi - lo);
     ct_rng rng;
     ct_rng_seed(&rng, ct_test_seed() * 31 + (uint64_t)(sc.radius_m / 1000) + (uint64_t)cs.t.width);
-    const double cw = cs.t.width - 1, ch = cs.t.height - 1;
     for (long n = 0; n < nrays; ++n) {
         // a target near the terrain, an observer up to 1.5 tile widths back
         // along a line of sight at elevation angle el; a few rising rays
@@ -102,6 +114,10 @@ void run_scene(const dem_cases::Case &cs, const Scene &sc, long nrays, Counts *c
         double dv[3];
         dem_cases::metric_dir(cs.t, az, -el, dv);
         ct_ray ray = dem_cases::to_ray(x, y, zm, dv);
+        ct_lower lw;
+        const bool lowered = ct_lower_setup(&p, &ray, &bd, &lw) == CT_OK;
+        const ld delta = lowered ? delta_low : delta_poly;
+        (lowered ? cnt->lowered : cnt->polyline)++;
         ct_hit h[4];
         ct_status st[4];
         for (int m = 0; m < 4; ++m) st[m] = ct_trace_bent(&p, &ray, &bd, (ct_method)m, &h[m]);
@@ -188,11 +204,17 @@ void test_bent_vs_reference()
         for (const Scene &sc : kScenes) {
             Counts cnt;
             run_scene(cs, sc, per, &cnt);
-            printf("  %-13s %-28s %ld rays: %ld hit, %ld miss, %ld below; %ld differ from the straight ray; "
-                   "worst |z - curve| %.4Lf LSB; bad %ld; culling saved steps on %ld\n",
-                   cs.name.c_str(), sc.name, cnt.rays, cnt.hits, cnt.miss, cnt.below, cnt.differ_from_straight,
-                   cnt.worst_lead, cnt.bad, cnt.fewer_steps_culled);
-            TEST_ASSERT(cnt.fewer_steps_culled > cnt.rays / 20);  // culling happens (measured 8-66 % of rays)
+            printf("  %-13s %-28s %ld rays (%ld lowered, %ld polyline): %ld hit, %ld miss, %ld below; %ld differ "
+                   "from the straight ray; worst |z - curve| %.4Lf LSB; bad %ld; culling saved steps on %ld\n",
+                   cs.name.c_str(), sc.name, cnt.rays, cnt.lowered, cnt.polyline, cnt.hits, cnt.miss, cnt.below,
+                   cnt.differ_from_straight, cnt.worst_lead, cnt.bad, cnt.fewer_steps_culled);
+            // culling happens where the rise is large against the relief
+            // (lowered: bounds of the lowering ahead; polyline: runs of
+            // segments above the mipmap)
+            if (cnt.rise_matters || cnt.polyline > 0) TEST_ASSERT(cnt.fewer_steps_culled > cnt.rays / 20);
+            // both models are exercised where they apply
+            if (sc.coeff > 0) TEST_ASSERT(cnt.lowered > cnt.rays / 2);
+            if (sc.coeff < 0) TEST_ASSERT(cnt.polyline == cnt.rays);
             TEST_ASSERT(cnt.bad == 0);
             TEST_ASSERT(cnt.hits > cnt.rays / (sc.radius_m < 1e6 ? 10 : 3));  // strong bending lifts many over the tile
             if (sc.radius_m < 1e6) TEST_ASSERT(cnt.differ_from_straight > cnt.hits / 4);  // the effect is real

@@ -290,9 +290,85 @@ ct_status ct_bend_segment(const ct_package *p, const ct_bend *bd, int64_t *delta
     return CT_OK;
 }
 
+/* Bits of a non-negative 128-bit value. */
+static unsigned bitlen128(ct_i128 v)
+{
+    return v.hi != 0u ? 64u + ct_bitlen64(v.hi) : ct_bitlen64(v.lo);
+}
+
+/* q = floor(n 2^s / d) with s chosen so that q is in [2^61, 2^63): n > 0
+ * (< 2^126), 0 < d < 2^63.  Returns q; *s may be negative (n shifted right
+ * first, floored).  n 2^s < 2^(62 + bitlen(d)) <= 2^125. */
+static uint64_t norm_div(ct_i128 n, int64_t d, int *s)
+{
+    int e = 62 - ((int)bitlen128(n) - (int)ct_bitlen64((uint64_t)d));
+    if (e >= 0) {
+        /* e <= 62 + 63 - 1: in two shifts of < 64 */
+        n = ct_i128_shl(n, (unsigned)(e > 63 ? 63 : e));
+        if (e > 63) {
+            n = ct_i128_shl(n, (unsigned)(e - 63));
+        }
+    } else {
+        unsigned r = (unsigned)(-e);
+        n.lo = r >= 64u ? n.hi >> (r - 64u) : (n.lo >> r) | (r == 0u ? 0u : n.hi << (64u - r));
+        n.hi = r >= 64u ? 0u : n.hi >> r;
+    }
+    *s = e;
+    return (uint64_t)ct_i128_floor_div(n, d);
+}
+
+/* The lowered model's constants (ct_lower, bend.h) for an observer at the
+ * ray's origin; CT_ERR_RANGE when it does not apply (c <= 0, the observer
+ * too far from the tile, the rise over the tile beyond 2^16 LSB), and the
+ * polyline is traced instead.
+ *   D = c Q posting^2 / (2^33 R scale)  (Q16 LSB per squared Q16 cell):
+ * rho_nm^2 = Q posting^2 / 2^32, rise = c rho^2 / (2R) nm, / scale * 2^16.
+ * kf = floor(K 2^kshift) in [2^30, 2^32): K's relative error < 2^-29.    */
+ct_status ct_lower_setup(const ct_package *p, const ct_ray *ray, const ct_bend *bd, ct_lower *lw)
+{
+    int64_t post = ct_abs64(p->posting_e_nm), W = (int64_t)p->cells_x * ONE16, H = (int64_t)p->cells_y * ONE16;
+    int s1, s2, e, k;
+    uint64_t q1, q2;
+    if (bd->coeff_q16 <= 0 || post >= (INT64_C(1) << 40) || p->height_scale_nm <= 0) {
+        return CT_ERR_RANGE;
+    }
+    lw->obx = ray->x_q16;
+    lw->oby = ray->y_q16;
+    /* every corner within 2^31 on each axis: |o| <= 2^46, so no overflow */
+    if (lw->obx <= W - (INT64_C(1) << 31) || lw->obx >= (INT64_C(1) << 31) ||
+        lw->oby <= H - (INT64_C(1) << 31) || lw->oby >= (INT64_C(1) << 31)) {
+        return CT_ERR_RANGE;
+    }
+    /* c posting^2 < 2^18 2^80; / R (< 2^55); / scale (< 2^63) */
+    q1 = norm_div(ct_i128_mul128_64(ct_umul64((uint64_t)post, (uint64_t)post), bd->coeff_q16), bd->radius_nm, &s1);
+    q2 = norm_div(ct_i128_from64((int64_t)(q1 >> 1)), p->height_scale_nm, &s2);
+    /* K = q1 2^-s1 / (2^33 scale) = (q1/2) 2^(1-s1) / 2^33 / scale
+     *   = q2 2^-(s1 + s2 + 32); kf = q2 / 2^31 */
+    e = s1 + s2 + 32 - 31;
+    if (e < 0 || e > 127) {
+        return CT_ERR_RANGE;
+    }
+    lw->kf = q2 >> 31;
+    lw->kshift = (uint32_t)e;
+    lw->dmax = 0;
+    /* the largest rise is at a corner: bound 4 corners */
+    for (k = 0; k < 4; ++k) {
+        uint64_t ex = (uint64_t)ct_abs64(((k & 1) ? W : 0) - lw->obx);
+        uint64_t ey = (uint64_t)ct_abs64(((k & 2) ? H : 0) - lw->oby);
+        ct_i128 d = ct_umul64(ex * ex + ey * ey, lw->kf); /* < 2^63 * 2^32 */
+        if (bitlen128(d) > 32u + lw->kshift) {
+            return CT_ERR_RANGE; /* D >= 2^32 */
+        }
+        lw->dmax = ct_max64(lw->dmax, ct_lower_at(lw, (k & 1) ? W : 0, (k & 2) ? H : 0));
+    }
+    lw->cull = (bd->flags & CT_BEND_NO_CULL) == 0u;
+    return CT_OK;
+}
+
 ct_status ct_trace_bent(const ct_package *p, const ct_ray *ray, const ct_bend *bd, ct_method m,
                         ct_hit *h)
 {
+    ct_lower lw;
     bent b;
     int64_t s0, s1, delta, k0, k1, k, chord_q16;
     int64_t ztop;
@@ -319,6 +395,10 @@ ct_status ct_trace_bent(const ct_package *p, const ct_ray *ray, const ct_bend *b
         ct_abs64(ray->z_q16) > CT_MAX_ORIGIN_Q16 || ct_abs64(ray->dx) > (INT64_C(1) << 62) ||
         ct_abs64(ray->dy) > (INT64_C(1) << 62) || ct_abs64(ray->dz) > (INT64_C(1) << 62)) {
         return CT_ERR_RAY;
+    }
+    if (ct_lower_setup(p, ray, bd, &lw) == CT_OK) {
+        /* one straight walk against the lowered terrain */
+        return ct_trace_lowered(p, ray, &lw, m, h);
     }
     b.p = p;
     b.ox = ray->x_q16;

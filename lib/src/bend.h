@@ -15,6 +15,40 @@ extern "C" {
  * CT_OK, or CT_ERR_ARG for a parameter out of range or Delta < 1/64 cell. */
 ct_status ct_bend_segment(const ct_package *pkg, const ct_bend *bd, int64_t *delta_q16);
 
+/* Lowered terrain (trace.c): a bent ray with c > 0 is traced as its straight
+ * tangent at the observer against the terrain lowered, post by post, by the
+ * bend's rise at that post's horizontal range from the observer:
+ *     D(post) = floor(Q * kf / 2^kshift)  Q16 height LSB,
+ *     Q = (x_post - obx)^2 + (y_post - oby)^2  (Q16 cells, squared),
+ * so z_tangent(t) <= S - D  <=>  z_tangent + rise <= S  at every post.  In a
+ * cell the surface is the bilinear patch of the lowered posts; the rise is
+ * a quadratic in (x, y) whose bilinear interpolation exceeds it by at most
+ * c posting^2 / (4 R) (0.035 mm for 30 m cells), the model's only error
+ * besides kf's rounding (relative < 2^-29).  Bounds set up by bend.c: every
+ * tile corner within 2^31 Q16 of the observer on each axis (Q < 2^63),
+ * kf < 2^32 (Q kf < 2^95), dmax = D at the farthest corner < 2^32.        */
+typedef struct {
+    int64_t obx, oby;  /* observer, Q16 cells                               */
+    uint64_t kf;       /* rise per squared Q16 cell, times 2^kshift          */
+    uint32_t kshift;   /* < 128                                             */
+    int64_t dmax;      /* largest D over the tile, Q16 LSB, < 2^32           */
+    int32_t cull;      /* 1: the walks use lower bounds of D ahead (culling) */
+} ct_lower;
+
+/* The lowered model's constants for an observer at ray's origin (bend.c):
+ * CT_OK, or CT_ERR_RANGE where it does not apply (c <= 0, the observer
+ * 2^31 Q16 or more from a tile corner on an axis, a rise of 2^16 LSB or
+ * more over the tile); ct_trace_bent then traces the polyline.  *bd's
+ * ranges are checked by the caller (ct_bend_segment).                      */
+ct_status ct_lower_setup(const ct_package *pkg, const ct_ray *ray, const ct_bend *bd, ct_lower *lw);
+
+/* D at a Q16 point (x, y) of the tile (exact, the formula above). */
+int64_t ct_lower_at(const ct_lower *lw, int64_t x, int64_t y);
+
+/* ct_trace for the lowered model (ray's origin = the observer). */
+ct_status ct_trace_lowered(const ct_package *pkg, const ct_ray *ray, const ct_lower *lw, ct_method method,
+                           ct_hit *hit);
+
 /* ct_trace_prepared for a ray this library prepared itself (skips the
  * re-validation of the caller-visible struct). */
 ct_status ct_trace_prepared_own(const ct_package *pkg, const ct_prepared *ray, ct_method method, ct_hit *hit);

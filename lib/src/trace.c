@@ -63,6 +63,9 @@ typedef struct {
     uint32_t zone;    /* one height LSB in prepared z units: 2^(16-k) */
     uint32_t zmul;    /* 2^k: prepared z units to Q16 */
     int64_t dzf;      /* dz * 2^k: the z direction in Q16 units (<= 2^42) */
+    const ct_lower *lw; /* bent ray: the lowered terrain (NULL: straight)  */
+    int64_t ratio_q30;  /* lowered culling: floor(2^30 len_lo / |D_p|), in
+                           [2^30, 2^30.5]; 0 when culling is off            */
 } ctx;
 
 /* Height code h >= 0 (< 2^17) in the ray's z units: one 32x32 product. */
@@ -72,6 +75,67 @@ static int64_t zh(const ctx *c, uint32_t h)
 }
 
 static int sgn64(int64_t v) { return (v > 0) - (v < 0); }
+
+/* ------------------------------------------------------------------------ */
+/* Lowered terrain (bent rays, see ct_lower in bend.h).                      */
+
+/* floor(v / 2^n) of a non-negative 128-bit v, n < 128. */
+static uint64_t ushr128(ct_i128 v, uint32_t n)
+{
+    if (n >= 64u) {
+        return v.hi >> (n - 64u);
+    }
+    if (n == 0u) {
+        return v.lo;
+    }
+    return (v.hi << (64u - n)) | (v.lo >> n);
+}
+
+/* D for a squared Q16 distance q < 2^63: q kf < 2^95, result < 2^33 for
+ * any point of the tile (<= dmax < 2^32 by set-up) */
+static int64_t lower_of(const ct_lower *lw, uint64_t q)
+{
+    return (int64_t)ushr128(ct_umul64(q, lw->kf), lw->kshift);
+}
+
+int64_t ct_lower_at(const ct_lower *lw, int64_t x, int64_t y)
+{
+    /* |x - obx|, |y - oby| < 2^31 inside the tile (set-up): squares < 2^62 */
+    int64_t ex = x - lw->obx, ey = y - lw->oby;
+    return lower_of(lw, (uint64_t)(ex * ex) + (uint64_t)(ey * ey));
+}
+
+/* A lower bound of D over every post of every cell the ray visits from
+ * fine cell (i, j) on, in the ray's z units (0 for a straight ray or with
+ * culling off).  The ray's horizontal path runs away from the observer, so
+ * a visited point q has range rho(q) >= rho at the current cell's back face
+ * along the primary axis p, = dp len / |D_p| for points on the ray (dp =
+ * that face's distance from the observer along p; the prepared ray passes
+ * within 1 mm of the observer's line, far inside the slack); a post of a
+ * visited cell is within sqrt(2) cells of such a point: 2 cells of slack.
+ * dp < 2^31 + 2^31, ratio < 2^30.5: the product < 2^62; the bound is
+ * clamped to 2^31 (its square < 2^62) and to dmax. */
+static int64_t lower_ahead(const ctx *c, int32_t i, int32_t j)
+{
+    int64_t dp, rho;
+    if (c->ratio_q30 == 0) {
+        return 0;
+    }
+    if (c->adx >= c->ady) {
+        dp = c->sx > 0 ? (int64_t)i * ONE16 - c->lw->obx : c->lw->obx - ((int64_t)i + 1) * ONE16;
+    } else {
+        dp = c->sy > 0 ? (int64_t)j * ONE16 - c->lw->oby : c->lw->oby - ((int64_t)j + 1) * ONE16;
+    }
+    if (dp <= 0) {
+        return 0;
+    }
+    rho = (int64_t)(((uint64_t)dp * (uint64_t)c->ratio_q30) >> 30) - 2 * ONE16;
+    if (rho <= 0) {
+        return 0;
+    }
+    rho = ct_min64(rho, (INT64_C(1) << 31) - 1);
+    return ct_min64(lower_of(c->lw, (uint64_t)(rho * rho)), c->lw->dmax) >> c->zs;
+}
 
 /* floor(a / 2^n) without relying on the implementation-defined right shift
  * of negative values. */
@@ -440,6 +504,10 @@ static void fill_hit(const ctx *c, int64_t tq, int32_t i, int32_t j, ct_hit *h)
     h->x_q16 = r->ox + ct_floor_div(tq * (int64_t)r->dx, T_ONE);
     h->y_q16 = r->oy + ct_floor_div(tq * (int64_t)r->dy, T_ONE);
     h->z_q16 = r->oz * (int64_t)c->zmul + floor_shr(tq * (int64_t)r->dz, CT_T_FRAC_BITS - c->zs);
+    if (c->lw != NULL) {
+        /* a bent ray: the curve is the tangent plus the rise at the hit */
+        h->z_q16 += ct_lower_at(c->lw, h->x_q16, h->y_q16);
+    }
     h->cell_x = i;
     h->cell_y = j;
     (void)ct_grid_to_map(c->p, h->x_q16, h->y_q16, h->z_q16, &h->e_nm, &h->n_nm, &h->h_nm);
@@ -456,6 +524,240 @@ static ct_status hit_status(const ct_package *p, int32_t i, int32_t j)
     return CT_HIT;
 }
 
+/* ------------------------------------------------------------------------ */
+/* The cell test on the lowered terrain (bent rays).  Posts G = h 2^16 - D
+ * in Q16 LSB, |G| < 2^33 (D <= dmax < 2^32).  Everything is as for the
+ * straight test with heights 2^16 finer, so the products grow by 16 bits:
+ * 128-bit where marked, and the interior minimum's discriminant compared
+ * in 256 bits.                                                             */
+
+typedef struct {
+    int64_t g00, g10, g01, g11;
+} lposts;
+
+static void lower_posts(const ctx *c, int32_t i, int32_t j, const posts4 *q, lposts *L)
+{
+    int64_t x0 = (int64_t)i * ONE16, y0 = (int64_t)j * ONE16;
+    L->g00 = (int64_t)q->h00 * ONE16 - ct_lower_at(c->lw, x0, y0);
+    L->g10 = (int64_t)q->h10 * ONE16 - ct_lower_at(c->lw, x0 + ONE16, y0);
+    L->g01 = (int64_t)q->h01 * ONE16 - ct_lower_at(c->lw, x0, y0 + ONE16);
+    L->g11 = (int64_t)q->h11 * ONE16 - ct_lower_at(c->lw, x0 + ONE16, y0 + ONE16);
+}
+
+/* Sign of f at the exit point.  dq = d * z_q16 (< 2^61, the header's
+ * argument); G d < 2^59.  At a face: 2^16 (dq - Ga d) < 2^78 and
+ * (Gb - Ga) dw < 2^34 * 2^42 (128-bit). */
+static int exit_sign_low(const ctx *c, int32_t i, int32_t j, const cexit *e, const lposts *L)
+{
+    int64_t d = e->t.d, n = e->t.n;
+    int64_t dq = (c->r->oz * d + n * (int64_t)c->r->dz) * (int64_t)c->zmul;
+    int64_t ga, gb, dw;
+    if (e->face == FACE_XY) {
+        int64_t g = (e->xf == i) ? (e->yf == j ? L->g00 : L->g01) : (e->yf == j ? L->g10 : L->g11);
+        return sgn64(dq - g * d);
+    }
+    if (e->face == FACE_X) {
+        ga = (e->xf == i) ? L->g00 : L->g10;
+        gb = (e->xf == i) ? L->g01 : L->g11;
+        dw = c->r->oy * d + n * (int64_t)c->r->dy - (int64_t)j * ONE16 * d;
+    } else {
+        ga = (e->yf == j) ? L->g00 : L->g01;
+        gb = (e->yf == j) ? L->g10 : L->g11;
+        dw = c->r->ox * d + n * (int64_t)c->r->dx - (int64_t)i * ONE16 * d;
+    }
+    return ct_i128_sign(ct_i128_sub(ct_i128_shl(ct_i128_from64(dq - ga * d), 16), ct_i128_mul(gb - ga, dw)));
+}
+
+/* d 2^16 f_q16(w) = A w^2 + B w + C (make_quad's derivation with posts in
+ * Q16): C = 2^16 Z0 - b V0, B = 2^32 D_z 2^k - 2^16 (a d + b D_q) - c V0,
+ * A = -c 2^16 D_q.  |a|, |b| < 2^34, |c| < 2^35, |V0| <= 2^43, |Z0| <
+ * 2^60.6: |C| < 2^78, |B| < 2^80, |A| < 2^77 (128-bit). */
+typedef struct {
+    ct_i128 A, B, C;
+    quad q; /* p, d, dps as make_quad; its A, B, C: the above scaled down */
+} wquad;
+
+static void make_quad_low(const ctx *c, int32_t i, int32_t j, const lposts *L, wquad *W)
+{
+    int64_t op, oq, Dp, Dq, kq, Lp, g00, g10, g01, g11, a, b, cc, V0, Z0, s;
+    int32_t kp;
+    quad *Q = &W->q;
+    Q->p = (c->adx >= c->ady) ? 0 : 1;
+    if (Q->p == 0) {
+        op = c->r->ox;
+        oq = c->r->oy;
+        Dp = c->r->dx;
+        Dq = c->r->dy;
+        kp = i;
+        kq = j;
+        g00 = L->g00;
+        g10 = L->g10;
+        g01 = L->g01;
+        g11 = L->g11;
+    } else {
+        op = c->r->oy;
+        oq = c->r->ox;
+        Dp = c->r->dy;
+        Dq = c->r->dx;
+        kp = j;
+        kq = i;
+        g00 = L->g00;
+        g10 = L->g01;
+        g01 = L->g10;
+        g11 = L->g11;
+    }
+    s = Dp > 0 ? 1 : -1;
+    if (s < 0) {
+        int64_t t0 = g00, t1 = g01;
+        g00 = g10;
+        g01 = g11;
+        g10 = t0;
+        g11 = t1;
+        Lp = ((int64_t)kp + 1) * ONE16;
+    } else {
+        Lp = (int64_t)kp * ONE16;
+    }
+    a = g10 - g00;
+    b = g01 - g00;
+    cc = g11 - g10 - g01 + g00;
+    Q->d = ct_abs64(Dp);
+    Q->dps = s * (Lp - op);
+    V0 = Q->d * (oq - kq * ONE16) + Q->dps * Dq;
+    /* d z_q16(L) (< 2^59 + 2^58, the header's argument) - d g00 (< 2^59) */
+    Z0 = (int64_t)c->zmul * (Q->d * c->r->oz + Q->dps * (int64_t)c->r->dz) - Q->d * g00;
+    W->C = ct_i128_sub(ct_i128_shl(ct_i128_from64(Z0), 16), ct_i128_mul(b, V0));
+    /* a d, b D_q < 2^60 each */
+    W->B = ct_i128_sub(ct_i128_sub(ct_i128_shl(ct_i128_from64(c->dzf), 32),
+                                   ct_i128_shl(ct_i128_from64(a * Q->d + b * Dq), 16)),
+                       ct_i128_mul(cc, V0));
+    W->A = ct_i128_neg(ct_i128_shl(ct_i128_mul(cc, Dq), 16)); /* cc D_q < 2^61 */
+}
+
+/* |a| for a 128-bit a > -2^127. */
+static ct_i128 abs128(ct_i128 a) { return ct_i128_sign(a) < 0 ? ct_i128_neg(a) : a; }
+
+/* Unsigned 128 x 128 -> 256-bit product (a, b < 2^127), limbs low first. */
+static void umul128x128(ct_i128 a, ct_i128 b, uint64_t r[4])
+{
+    ct_i128 p00 = ct_umul64(a.lo, b.lo), p01 = ct_umul64(a.lo, b.hi);
+    ct_i128 p10 = ct_umul64(a.hi, b.lo), p11 = ct_umul64(a.hi, b.hi);
+    uint64_t c1, c2, t;
+    r[0] = p00.lo;
+    t = p00.hi + p01.lo;
+    c1 = t < p00.hi ? 1u : 0u;
+    r[1] = t + p10.lo;
+    c1 += r[1] < t ? 1u : 0u;
+    t = p11.lo + p01.hi;
+    c2 = t < p11.lo ? 1u : 0u;
+    t += p10.hi;
+    c2 += t < p10.hi ? 1u : 0u;
+    r[2] = t + c1;
+    c2 += r[2] < t ? 1u : 0u;
+    r[3] = p11.hi + c2;
+}
+
+/* B^2 >= 4AC for A > 0 (exact; 4|A| < 2^79, |B|, |C| < 2^80). */
+static int disc_nonneg_low(const wquad *W)
+{
+    uint64_t l[4], r[4];
+    int k;
+    if (ct_i128_sign(W->C) <= 0) {
+        return 1;
+    }
+    umul128x128(abs128(W->B), abs128(W->B), l);
+    umul128x128(ct_i128_shl(W->A, 2), W->C, r);
+    for (k = 3; k >= 0; --k) { /* bound: 4 limbs */
+        if (l[k] != r[k]) {
+            return l[k] > r[k];
+        }
+    }
+    return 1;
+}
+
+/* sign of dQ/dw at w = pn/pd: B pd + 2A pn.  pd <= 2^42 and, for t in the
+ * cell, |pn| <= pd (w in [0, 1]): < 2^122 + 2^120 (128-bit). */
+static int dq_sign_low(const wquad *W, int64_t pn, int64_t pd)
+{
+    return ct_i128_sign(ct_i128_add(ct_i128_mul128_64(W->B, pd), ct_i128_mul128_64(ct_i128_shl(W->A, 1), pn)));
+}
+
+static int interior_hit_low(const ctx *c, const wquad *W, rt tin, rt tout)
+{
+    int64_t pn, pd;
+    if (ct_i128_sign(W->A) <= 0) {
+        return 0;
+    }
+    p_at(c, &W->q, tin, &pn, &pd);
+    if (dq_sign_low(W, pn, pd) >= 0) {
+        return 0;
+    }
+    p_at(c, &W->q, tout, &pn, &pd);
+    if (dq_sign_low(W, pn, pd) <= 0) {
+        return 0;
+    }
+    return disc_nonneg_low(W);
+}
+
+/* floor(a / 2^n) of a signed 128-bit a, 0 < n < 64 */
+static ct_i128 sar128(ct_i128 a, unsigned n)
+{
+    ct_i128 r;
+    r.lo = (a.lo >> n) | (a.hi << (64u - n));
+    r.hi = (uint64_t)(((a.hi >> 63) != 0u) ? ~(~a.hi >> n) : (a.hi >> n));
+    return r;
+}
+
+/* The hit's position only (the decision above is exact): the coefficients
+ * scaled by one power of two into make_quad's ranges (|A|, |B|, |C| <
+ * 2^59), which moves the root by far less than its 2^-32 cell resolution
+ * except where the ray is tangent to the surface; root_t_q26 clamps it to
+ * [tin, tout] exactly either way. */
+static int64_t root_low(const ctx *c, wquad *W, rt tin, rt tout)
+{
+    ct_i128 m = abs128(W->A);
+    uint64_t top;
+    unsigned n;
+    if (ct_i128_cmp(abs128(W->B), m) > 0) {
+        m = abs128(W->B);
+    }
+    if (ct_i128_cmp(abs128(W->C), m) > 0) {
+        m = abs128(W->C);
+    }
+    top = m.hi != 0u ? m.hi : 0u;
+    n = top != 0u ? 64u + ct_bitlen64(top) : ct_bitlen64(m.lo);
+    n = n > 59u ? n - 59u : 0u;
+    if (n > 0u) {
+        W->A = sar128(W->A, n);
+        W->B = sar128(W->B, n);
+        W->C = sar128(W->C, n);
+    }
+    W->q.A = ct_i128_to64(W->A);
+    W->q.B = ct_i128_to64(W->B);
+    W->q.C = ct_i128_to64(W->C);
+    return root_t_q26(c, &W->q, tin, tout);
+}
+
+static int cell_test_low(const ctx *c, int32_t i, int32_t j, rt tin, const cexit *e, const posts4 *q, ct_hit *h)
+{
+    lposts L;
+    wquad W;
+    lower_posts(c, i, j, q, &L);
+    if (exit_sign_low(c, i, j, e, &L) > 0) {
+        int64_t cc = L.g11 - L.g10 - L.g01 + L.g00;
+        if (cc == 0 || (cc > 0) == ((c->sx * c->sy) > 0) || c->sx == 0 || c->sy == 0) {
+            return 0;
+        }
+        make_quad_low(c, i, j, &L, &W);
+        if (!interior_hit_low(c, &W, tin, e->t)) {
+            return 0;
+        }
+    } else {
+        make_quad_low(c, i, j, &L, &W);
+    }
+    fill_hit(c, root_low(c, &W, tin, e->t), i, j, h);
+    return 1;
+}
+
 /* The exact cell test on [tin, exit]; f(tin) > 0 is known by the caller.
  * Returns 1 and fills *h on a hit. */
 static int cell_test(const ctx *c, int32_t i, int32_t j, rt tin, const cexit *e, ct_hit *h)
@@ -464,12 +766,16 @@ static int cell_test(const ctx *c, int32_t i, int32_t j, rt tin, const cexit *e,
     int64_t zlim;
     rt tlo;
     load_posts(c->p, i, j, &q);
-    /* cheap reject: lowest ray point above the tallest corner.
+    /* cheap reject: lowest ray point above the tallest corner (for a bent
+     * ray, less the lowering's bound ahead, < 2^33 >> k).
      * d*Z < 2^60 (see exit_sign), hmax*2^16*d < 2^58. */
     tlo = c->r->dz <= 0 ? e->t : tin;
-    zlim = zh(c, (uint32_t)q.hmax) * tlo.d;
+    zlim = (zh(c, (uint32_t)q.hmax) - (c->lw != NULL ? lower_ahead(c, i, j) : 0)) * tlo.d;
     if (c->r->oz * tlo.d + tlo.n * (int64_t)c->r->dz > zlim) {
         return 0;
+    }
+    if (c->lw != NULL) {
+        return cell_test_low(c, i, j, tin, e, &q, h);
     }
     if (exit_sign(c, i, j, e, &q) > 0) {
         int64_t cc = (int64_t)q.h11 - q.h10 - q.h01 + q.h00;
@@ -605,7 +911,10 @@ static ct_status walk_hierarchical(const ctx *c, ct_hit *h)
             }
             {
                 rt tl = c->r->dz <= 0 ? tx : t;
-                if (c->r->oz * tl.d + tl.n * (int64_t)c->r->dz > zh(c, (uint32_t)bmax) * tl.d) {
+                /* a bent ray: the block's max less the lowering's bound
+                 * ahead (the same range as zh, see cell_test) */
+                int64_t zb = zh(c, (uint32_t)bmax) - (c->lw != NULL ? lower_ahead(c, i, j) : 0);
+                if (c->r->oz * tl.d + tl.n * (int64_t)c->r->dz > zb * tl.d) {
                     /* skip the block: the ray is above its max all along */
                     h->steps++;
                     if (!rt_lt(tx, c->tend)) {
@@ -668,7 +977,9 @@ static ct_status walk_cones(const ctx *c, uint32_t plane, ct_hit *h)
         k = coarse_index(p, i, j);
         code = ang[k];
         if (p->cot_ok[code]) {
-            int64_t a16 = zh(c, ct_ld16(p->apex + 2u * k));
+            /* a bent ray: the apex less the lowering's bound ahead (the
+             * cone of the lowered terrain; |a16| < 2^33) */
+            int64_t a16 = zh(c, ct_ld16(p->apex + 2u * k)) - (c->lw != NULL ? lower_ahead(c, i, j) : 0);
             /* T = floor(t 2^26), and a lower bound of z(t) from a Q26 point
              * (z at T for a rising ray, at T + 1 for a descending one unless
              * t is exactly T / 2^26): t.n 2^26 < 2^60. */
@@ -756,6 +1067,25 @@ static int64_t surface_q32(const ct_package *p, int32_t i, int32_t j, int64_t x,
     b = (int64_t)q.h01 - q.h00;
     cc = (int64_t)q.h11 - q.h10 - q.h01 + q.h00;
     return (int64_t)q.h00 * (ONE16 * ONE16) + a * U * ONE16 + b * V * ONE16 + cc * U * V;
+}
+
+/* The lowered surface (bent rays) at a Q16 point of cell (i, j), in Q16
+ * LSB times 2^32, exact: posts G < 2^33 in Q16 LSB, a, b < 2^34, c < 2^35,
+ * U, V in [0, 2^16]: G00 2^32 + (a U + b V) 2^16 + c U V < 2^68 (128-bit). */
+static ct_i128 surface_low_q48(const ct_package *p, const ct_lower *lw, int32_t i, int32_t j, int64_t x, int64_t y)
+{
+    posts4 q;
+    int64_t U = x - (int64_t)i * ONE16, V = y - (int64_t)j * ONE16, x0 = (int64_t)i * ONE16,
+            y0 = (int64_t)j * ONE16;
+    int64_t g00, g10, g01, g11;
+    load_posts(p, i, j, &q);
+    g00 = (int64_t)q.h00 * ONE16 - ct_lower_at(lw, x0, y0);
+    g10 = (int64_t)q.h10 * ONE16 - ct_lower_at(lw, x0 + ONE16, y0);
+    g01 = (int64_t)q.h01 * ONE16 - ct_lower_at(lw, x0, y0 + ONE16);
+    g11 = (int64_t)q.h11 * ONE16 - ct_lower_at(lw, x0 + ONE16, y0 + ONE16);
+    return ct_i128_add(ct_i128_add(ct_i128_shl(ct_i128_from64(g00), 32),
+                                   ct_i128_shl(ct_i128_add(ct_i128_mul(g10 - g00, U), ct_i128_mul(g01 - g00, V)), 16)),
+                       ct_i128_mul((g11 - g10 - g01 + g00) * U, V));
 }
 
 ct_status ct_surface_height(const ct_package *p, int64_t x, int64_t y, int64_t *z)
@@ -882,13 +1212,15 @@ static void normalize_dir(const int64_t U[3], const dir_mag *g, unsigned zs, int
 
 /* Where the ray o + t D (o in the box: x, y Q16, z in units of 2^16/zone
  * Q16) leaves the tile's box: horizontally, through the top (rising) or
- * below hmin - 1 (descending; never reached without a hit).  Candidates
+ * below hmin - 1 (descending; never reached without a hit), the floor
+ * lowered by zlow (a bent ray's largest lowering in its z units, < 2^32;
+ * 0 for a straight ray): |zbot| < 2^33.  Candidates
  * have n < 2^34 and d <= 2^26, so rt_lt cannot overflow; with no candidate
  * (cannot happen: some axis moves) te stays 2^34. */
-static rt box_exit(const ct_package *p, const int64_t O[3], const int32_t D[3], int64_t zone)
+static rt box_exit(const ct_package *p, const int64_t O[3], const int32_t D[3], int64_t zone, int64_t zlow)
 {
     rt te = {INT64_C(1) << 34, 1}, c;
-    int64_t ztop = ((int64_t)p->hmax + 1) * zone, zbot = ((int64_t)p->hmin - 1) * zone;
+    int64_t ztop = ((int64_t)p->hmax + 1) * zone, zbot = ((int64_t)p->hmin - 1) * zone - zlow;
     int have = 0, k;
     /* bound: 3 axes */
     for (k = 0; k < 3; ++k) {
@@ -916,7 +1248,7 @@ static rt box_exit(const ct_package *p, const int64_t O[3], const int32_t D[3], 
 
 /* seg != 0: the ray ends at origin + direction (t <= 1 in the caller's
  * parameter) as well as at the box. */
-static ct_status prepare_impl(const ct_package *p, const ct_ray *ray, int seg, ct_prepared *out)
+static ct_status prepare_impl(const ct_package *p, const ct_ray *ray, int seg, const ct_lower *lw, ct_prepared *out)
 {
     int32_t D[3];
     int64_t O[3], U[3], lo[3], hi[3];
@@ -1117,10 +1449,15 @@ static ct_status prepare_impl(const ct_package *p, const ct_ray *ray, int seg, c
         if (j >= (int32_t)p->cells_y) {
             j = (int32_t)p->cells_y - 1;
         }
-        s = surface_q32(p, i, j, O[0], O[1]);
         if (O[2] < -(INT64_C(1) << (46u - zs))) {
             start = CT_BELOW;
+        } else if (lw != NULL) {
+            /* the lowered surface, Q16 2^32: z_q16 2^32 < 2^78 */
+            int sg = ct_i128_cmp(ct_i128_shl(ct_i128_from64(O[2] * (INT64_C(1) << zs)), 32),
+                                 surface_low_q48(p, lw, i, j, O[0], O[1]));
+            start = sg < 0 ? CT_BELOW : (sg == 0 ? CT_HIT : CT_OK);
         } else {
+            s = surface_q32(p, i, j, O[0], O[1]);
             f = O[2] * (INT64_C(1) << zs) * ONE16 - s; /* |oz 2^zs| <= 2^46: < 2^62 */
             start = f < 0 ? CT_BELOW : (f == 0 ? CT_HIT : CT_OK);
         }
@@ -1136,7 +1473,7 @@ static ct_status prepare_impl(const ct_package *p, const ct_ray *ray, int seg, c
     /* tend: leaving the box horizontally, through the top (rising) or
      * below hmin - 1 (descending; never reached without a hit).          */
     {
-        rt te = box_exit(p, O, D, zone), c;
+        rt te = box_exit(p, O, D, zone, lw != NULL ? lw->dmax >> zs : 0), c;
         if (seg) {
             /* the segment's end: where the prepared ray reaches the end
              * point's coordinate on its dominant axis m.  The end is
@@ -1176,12 +1513,12 @@ static ct_status prepare_impl(const ct_package *p, const ct_ray *ray, int seg, c
 
 ct_status ct_ray_prepare(const ct_package *p, const ct_ray *ray, ct_prepared *out)
 {
-    return prepare_impl(p, ray, 0, out);
+    return prepare_impl(p, ray, 0, NULL, out);
 }
 
 ct_status ct_ray_prepare_segment(const ct_package *p, const ct_ray *ray, ct_prepared *out)
 {
-    return prepare_impl(p, ray, 1, out);
+    return prepare_impl(p, ray, 1, NULL, out);
 }
 
 /* ------------------------------------------------------------------------ */
@@ -1215,7 +1552,7 @@ static ct_status check_prepared(const ct_package *p, const ct_prepared *r)
         const int64_t O[3] = {r->ox, r->oy, r->oz};
         const int32_t D[3] = {r->dx, r->dy, r->dz};
         int64_t zone = ONE16 >> r->zshift;
-        rt te = box_exit(p, O, D, zone), tr;
+        rt te = box_exit(p, O, D, zone, 0), tr;
         tr.n = r->tend_n;
         tr.d = r->tend_d;
         if (rt_lt(te, tr) || (r->start == CT_OK && r->oz <= ((int64_t)p->hmin - 1) * zone)) {
@@ -1237,7 +1574,8 @@ static ct_status check_prepared(const ct_package *p, const ct_prepared *r)
     return CT_OK;
 }
 
-static ct_status trace_impl(const ct_package *p, const ct_prepared *r, ct_method m, int checked, ct_hit *h)
+static ct_status trace_impl(const ct_package *p, const ct_prepared *r, ct_method m, int checked,
+                            const ct_lower *lw, ct_hit *h)
 {
     ctx c;
     ct_status st;
@@ -1277,6 +1615,12 @@ static ct_status trace_impl(const ct_package *p, const ct_prepared *r, ct_method
     c.dzf = (int64_t)r->dz * (int64_t)c.zmul;
     c.tend.n = r->tend_n;
     c.tend.d = r->tend_d;
+    c.lw = lw;
+    c.ratio_q30 = 0;
+    if (lw != NULL && lw->cull && (r->dx != 0 || r->dy != 0)) {
+        /* len_lo 2^30 < 2^56.5; the quotient in [2^30, 2^30.5] */
+        c.ratio_q30 = (r->len_lo << 30) / (c.adx >= c.ady ? c.adx : c.ady);
+    }
     if (r->start == CT_HIT) {
         int32_t i, j;
         rt t0 = {0, 1};
@@ -1302,13 +1646,21 @@ static ct_status trace_impl(const ct_package *p, const ct_prepared *r, ct_method
             return CT_MISS;
         }
         locate(&c, t0, &i, &j);
-        s = surface_q32(p, i, j, r->ox, r->oy);
+        if (lw != NULL) {
+            /* the lowered surface rounded up to Q16 2^16 (a hit at or
+             * above it); |s| < 2^50 as below */
+            ct_i128 sl = surface_low_q48(p, lw, i, j, r->ox, r->oy);
+            s = -ct_i128_floor_div(ct_i128_neg(sl), ONE16);
+        } else {
+            s = surface_q32(p, i, j, r->ox, r->oy);
+        }
         /* t = (oz*2^16 - s) / (2^16 * |dz|) ; in Q26, floored:
          * (oz*2^16 - s) < 2^50, * 2^26 / 2^16 = * 2^10: < 2^60 */
         tq = ct_floor_div((r->oz * ONE16 - s) * 1024, -(int64_t)r->dz);
         fill_hit(&c, tq, i, j, h);
-        /* report the exact surface height at a vertical hit */
-        h->z_q16 = -ct_floor_div(-s, ONE16);
+        /* report the exact surface height at a vertical hit (for a bent
+         * ray: the lowered surface's, plus the rise there) */
+        h->z_q16 = -ct_floor_div(-s, ONE16) + (lw != NULL ? ct_lower_at(lw, h->x_q16, h->y_q16) : 0);
         (void)ct_grid_to_map(p, h->x_q16, h->y_q16, h->z_q16, &h->e_nm, &h->n_nm, &h->h_nm);
         return hit_status(p, i, j);
     }
@@ -1337,17 +1689,27 @@ ct_status ct_trace(const ct_package *p, const ct_ray *ray, ct_method m, ct_hit *
     if (st < 0) {
         return st;
     }
-    return trace_impl(p, &r, m, 1, h);
+    return trace_impl(p, &r, m, 1, NULL, h);
 }
 
 ct_status ct_trace_prepared(const ct_package *p, const ct_prepared *r, ct_method m, ct_hit *h)
 {
-    return trace_impl(p, r, m, 0, h);
+    return trace_impl(p, r, m, 0, NULL, h);
 }
 
 ct_status ct_trace_prepared_own(const ct_package *p, const ct_prepared *r, ct_method m, ct_hit *h)
 {
-    return trace_impl(p, r, m, 1, h);
+    return trace_impl(p, r, m, 1, NULL, h);
+}
+
+ct_status ct_trace_lowered(const ct_package *p, const ct_ray *ray, const ct_lower *lw, ct_method m, ct_hit *h)
+{
+    ct_prepared r;
+    ct_status st = prepare_impl(p, ray, 0, lw, &r);
+    if (st < 0) {
+        return st;
+    }
+    return trace_impl(p, &r, m, 1, lw, h);
 }
 
 /* ------------------------------------------------------------------------ */
