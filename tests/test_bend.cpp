@@ -115,7 +115,7 @@ void run_scene(const dem_cases::Case &cs, const Scene &sc, long nrays, Counts *c
         dem_cases::metric_dir(cs.t, az, -el, dv);
         ct_ray ray = dem_cases::to_ray(x, y, zm, dv);
         ct_lower lw;
-        const bool lowered = ct_lower_setup(&p, &ray, &bd, &lw) == CT_OK;
+        const bool lowered = ct_lower_setup(&p, ray.x_q16, ray.y_q16, &bd, &lw) == CT_OK;
         const ld delta = lowered ? delta_low : delta_poly;
         (lowered ? cnt->lowered : cnt->polyline)++;
         ct_hit h[4];

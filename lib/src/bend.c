@@ -324,7 +324,7 @@ static uint64_t norm_div(ct_i128 n, int64_t d, int *s)
  *   D = c Q posting^2 / (2^33 R scale)  (Q16 LSB per squared Q16 cell):
  * rho_nm^2 = Q posting^2 / 2^32, rise = c rho^2 / (2R) nm, / scale * 2^16.
  * kf = floor(K 2^kshift) in [2^30, 2^32): K's relative error < 2^-29.    */
-ct_status ct_lower_setup(const ct_package *p, const ct_ray *ray, const ct_bend *bd, ct_lower *lw)
+ct_status ct_lower_setup(const ct_package *p, int64_t ox, int64_t oy, const ct_bend *bd, ct_lower *lw)
 {
     int64_t post = ct_abs64(p->posting_e_nm), W = (int64_t)p->cells_x * ONE16, H = (int64_t)p->cells_y * ONE16;
     int s1, s2, e, k;
@@ -332,8 +332,8 @@ ct_status ct_lower_setup(const ct_package *p, const ct_ray *ray, const ct_bend *
     if (bd->coeff_q16 <= 0 || post >= (INT64_C(1) << 40) || p->height_scale_nm <= 0) {
         return CT_ERR_RANGE;
     }
-    lw->obx = ray->x_q16;
-    lw->oby = ray->y_q16;
+    lw->obx = ox;
+    lw->oby = oy;
     /* every corner within 2^31 on each axis: |o| <= 2^46, so no overflow */
     if (lw->obx <= W - (INT64_C(1) << 31) || lw->obx >= (INT64_C(1) << 31) ||
         lw->oby <= H - (INT64_C(1) << 31) || lw->oby >= (INT64_C(1) << 31)) {
@@ -350,6 +350,13 @@ ct_status ct_lower_setup(const ct_package *p, const ct_ray *ray, const ct_bend *
     }
     lw->kf = q2 >> 31;
     lw->kshift = (uint32_t)e;
+    /* kc = floor(kf 2^48 / 2^e), at most 2^33 (a smaller kc only weakens
+     * the walks' lower bounds) */
+    lw->kc = e >= 48 ? (int64_t)(lw->kf >> (e - 48)) : INT64_C(1) << 33;
+    if (e < 48 && e >= 15 && (lw->kf >> (e - 15)) == 0u) {
+        lw->kc = (int64_t)(lw->kf << (48 - e)); /* kf 2^(48-e) < 2^33 */
+    }
+    lw->kc = ct_min64(lw->kc, INT64_C(1) << 33);
     lw->dmax = 0;
     /* the largest rise is at a corner: bound 4 corners */
     for (k = 0; k < 4; ++k) {
@@ -365,25 +372,53 @@ ct_status ct_lower_setup(const ct_package *p, const ct_ray *ray, const ct_bend *
     return CT_OK;
 }
 
+ct_status ct_bent_prepare(const ct_package *p, const ct_bend *bd, int64_t ox, int64_t oy, ct_bent_setup *bs)
+{
+    ct_status st;
+    CT_ASSERT(p != NULL && bd != NULL && bs != NULL);
+    if (p == NULL || bd == NULL || bs == NULL) {
+        return CT_ERR_ARG;
+    }
+    st = ct_bend_segment(p, bd, &bs->delta);
+    if (st != CT_OK) {
+        return st;
+    }
+    bs->bend = *bd;
+    bs->lowered = bd->coeff_q16 != 0 && ct_lower_setup(p, ox, oy, bd, &bs->lw) == CT_OK;
+    return CT_OK;
+}
+
 ct_status ct_trace_bent(const ct_package *p, const ct_ray *ray, const ct_bend *bd, ct_method m,
                         ct_hit *h)
 {
-    ct_lower lw;
+    ct_bent_setup bs;
+    ct_status st;
+    CT_ASSERT(p != NULL && ray != NULL && bd != NULL && h != NULL);
+    if (p == NULL || ray == NULL || bd == NULL || h == NULL) {
+        return CT_ERR_ARG;
+    }
+    st = ct_bent_prepare(p, bd, ray->x_q16, ray->y_q16, &bs);
+    if (st != CT_OK) {
+        return st;
+    }
+    return ct_trace_bent_set(p, ray, &bs, m, h);
+}
+
+ct_status ct_trace_bent_set(const ct_package *p, const ct_ray *ray, const ct_bent_setup *bs, ct_method m,
+                            ct_hit *h)
+{
+    const ct_bend *bd = &bs->bend;
     bent b;
-    int64_t s0, s1, delta, k0, k1, k, chord_q16;
+    int64_t s0, s1, delta = bs->delta, k0, k1, k, chord_q16;
     int64_t ztop;
     int q;
     int entered = 0;
     uint32_t steps = 0u, iters = 0u;
     v3 va, vb;
     ct_status st;
-    CT_ASSERT(p != NULL && ray != NULL && bd != NULL && h != NULL);
-    if (p == NULL || ray == NULL || bd == NULL || h == NULL) {
+    CT_ASSERT(p != NULL && ray != NULL && h != NULL);
+    if (p == NULL || ray == NULL || h == NULL) {
         return CT_ERR_ARG;
-    }
-    st = ct_bend_segment(p, bd, &delta);
-    if (st != CT_OK) {
-        return st;
     }
     if (bd->coeff_q16 == 0 || (ray->dx == 0 && ray->dy == 0)) {
         return ct_trace(p, ray, m, h);
@@ -396,9 +431,12 @@ ct_status ct_trace_bent(const ct_package *p, const ct_ray *ray, const ct_bend *b
         ct_abs64(ray->dy) > (INT64_C(1) << 62) || ct_abs64(ray->dz) > (INT64_C(1) << 62)) {
         return CT_ERR_RAY;
     }
-    if (ct_lower_setup(p, ray, bd, &lw) == CT_OK) {
+    if (bs->lowered) {
+        if (ray->x_q16 != bs->lw.obx || ray->y_q16 != bs->lw.oby) {
+            return CT_ERR_ARG; /* set up for another observer */
+        }
         /* one straight walk against the lowered terrain */
-        return ct_trace_lowered(p, ray, &lw, m, h);
+        return ct_trace_lowered(p, ray, &bs->lw, m, h);
     }
     b.p = p;
     b.ox = ray->x_q16;

@@ -32,6 +32,8 @@ typedef struct {
     uint64_t kf;       /* rise per squared Q16 cell, times 2^kshift          */
     uint32_t kshift;   /* < 128                                             */
     int64_t dmax;      /* largest D over the tile, Q16 LSB, < 2^32           */
+    int64_t kc;        /* the walks' lower bounds: D per squared whole cell,
+                          Q16 (floor(kf 2^48 / 2^kshift), at most 2^33)   */
     int32_t cull;      /* 1: the walks use lower bounds of D ahead (culling) */
 } ct_lower;
 
@@ -40,7 +42,26 @@ typedef struct {
  * 2^31 Q16 or more from a tile corner on an axis, a rise of 2^16 LSB or
  * more over the tile); ct_trace_bent then traces the polyline.  *bd's
  * ranges are checked by the caller (ct_bend_segment).                      */
-ct_status ct_lower_setup(const ct_package *pkg, const ct_ray *ray, const ct_bend *bd, ct_lower *lw);
+ct_status ct_lower_setup(const ct_package *pkg, int64_t ox_q16, int64_t oy_q16, const ct_bend *bd, ct_lower *lw);
+
+/* Everything ct_trace_bent derives from the package, the bend and the
+ * observer's horizontal position, formed once for many rays from one
+ * observer (geoloc.c: every pixel of a camera).                            */
+typedef struct {
+    ct_bend bend;
+    int64_t delta;   /* the polyline's segment length (ct_bend_segment)   */
+    int32_t lowered; /* 1: lw applies (c > 0, ct_lower_setup succeeded)   */
+    ct_lower lw;
+} ct_bent_setup;
+
+/* ct_bend_segment's checks, then the set-up for an observer at (ox, oy). */
+ct_status ct_bent_prepare(const ct_package *pkg, const ct_bend *bd, int64_t ox_q16, int64_t oy_q16,
+                          ct_bent_setup *bs);
+
+/* ct_trace_bent with a set-up from ct_bent_prepare; the ray's origin must
+ * be the observer it was made for (CT_ERR_ARG otherwise, when lowered).    */
+ct_status ct_trace_bent_set(const ct_package *pkg, const ct_ray *ray, const ct_bent_setup *bs, ct_method method,
+                            ct_hit *hit);
 
 /* D at a Q16 point (x, y) of the tile (exact, the formula above). */
 int64_t ct_lower_at(const ct_lower *lw, int64_t x, int64_t y);

@@ -29,6 +29,7 @@ typedef struct {
     int64_t sx, sy, sz;   /* direction scale factors        */
     unsigned shift;       /* common right shift (0..63)     */
     ct_bend bend;         /* coeff_q16 == 0: straight rays  */
+    ct_bent_setup bent;   /* the bend for this observer     */
 } geo_setup;
 
 #define K_MAX_Q16 (2 * 65536)
@@ -106,6 +107,9 @@ static ct_status setup(const ct_package *p, const ct_camera *cam, const ct_pose 
         b++;
     }
     s->shift = b + 40u > 62u ? b + 40u - 62u : 0u;
+    if (s->bend.coeff_q16 != 0 && ct_bent_prepare(p, &s->bend, s->ox, s->oy, &s->bent) != CT_OK) {
+        return CT_ERR_EFFECTS; /* checked by effects_to_bend already */
+    }
     return CT_OK;
 }
 
@@ -143,7 +147,7 @@ static ct_status one_pixel(const ct_package *p, const ct_camera *cam, const ct_p
         ray.dy = scale_dir(out->dir_map_q39[1], s->sy, s->shift);
         ray.dz = scale_dir(out->dir_map_q39[2], s->sz, s->shift);
         st = s->bend.coeff_q16 == 0 ? ct_trace(p, &ray, m, &out->hit)
-                                    : ct_trace_bent(p, &ray, &s->bend, m, &out->hit);
+                                    : ct_trace_bent_set(p, &ray, &s->bent, m, &out->hit);
     }
     out->status = st;
     return st;

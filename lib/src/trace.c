@@ -113,11 +113,12 @@ int64_t ct_lower_at(const ct_lower *lw, int64_t x, int64_t y)
  * that face's distance from the observer along p; the prepared ray passes
  * within 1 mm of the observer's line, far inside the slack); a post of a
  * visited cell is within sqrt(2) cells of such a point: 2 cells of slack.
- * dp < 2^31 + 2^31, ratio < 2^30.5: the product < 2^62; the bound is
- * clamped to 2^31 (its square < 2^62) and to dmax. */
+ * In whole cells, floored: r = floor(dp ratio / 2^46) - 2 (dp < 2^32,
+ * ratio < 2^30.5: < 2^62.5), clamped to 2^15 (r^2 <= 2^30), and D >=
+ * r^2 kc / 2^16 (kc <= 2^33, ct_lower: < 2^63), clamped to dmax. */
 static int64_t lower_ahead(const ctx *c, int32_t i, int32_t j)
 {
-    int64_t dp, rho;
+    int64_t dp, r;
     if (c->ratio_q30 == 0) {
         return 0;
     }
@@ -129,12 +130,12 @@ static int64_t lower_ahead(const ctx *c, int32_t i, int32_t j)
     if (dp <= 0) {
         return 0;
     }
-    rho = (int64_t)(((uint64_t)dp * (uint64_t)c->ratio_q30) >> 30) - 2 * ONE16;
-    if (rho <= 0) {
+    r = (int64_t)(((uint64_t)dp * (uint64_t)c->ratio_q30) >> 46) - 2;
+    if (r <= 0) {
         return 0;
     }
-    rho = ct_min64(rho, (INT64_C(1) << 31) - 1);
-    return ct_min64(lower_of(c->lw, (uint64_t)(rho * rho)), c->lw->dmax) >> c->zs;
+    r = ct_min64(r, INT64_C(1) << 15);
+    return ct_min64((r * r * c->lw->kc) >> 16, c->lw->dmax) >> c->zs;
 }
 
 /* floor(a / 2^n) without relying on the implementation-defined right shift
@@ -759,22 +760,30 @@ static int cell_test_low(const ctx *c, int32_t i, int32_t j, rt tin, const cexit
 }
 
 /* The exact cell test on [tin, exit]; f(tin) > 0 is known by the caller.
+ * lb: for a bent ray, lower_ahead(c, i, j) if the caller has it, else -1.
  * Returns 1 and fills *h on a hit. */
-static int cell_test(const ctx *c, int32_t i, int32_t j, rt tin, const cexit *e, ct_hit *h)
+static int cell_test(const ctx *c, int32_t i, int32_t j, rt tin, const cexit *e, int64_t lb, ct_hit *h)
 {
     posts4 q;
-    int64_t zlim;
+    int64_t zlo, zmax;
     rt tlo;
     load_posts(c->p, i, j, &q);
     /* cheap reject: lowest ray point above the tallest corner (for a bent
-     * ray, less the lowering's bound ahead, < 2^33 >> k).
+     * ray, less the lowering's bound ahead, < 2^32 >> k, when needed).
      * d*Z < 2^60 (see exit_sign), hmax*2^16*d < 2^58. */
     tlo = c->r->dz <= 0 ? e->t : tin;
-    zlim = (zh(c, (uint32_t)q.hmax) - (c->lw != NULL ? lower_ahead(c, i, j) : 0)) * tlo.d;
-    if (c->r->oz * tlo.d + tlo.n * (int64_t)c->r->dz > zlim) {
+    zlo = c->r->oz * tlo.d + tlo.n * (int64_t)c->r->dz;
+    zmax = zh(c, (uint32_t)q.hmax);
+    if (zlo > zmax * tlo.d) {
         return 0;
     }
     if (c->lw != NULL) {
+        if (lb < 0) {
+            lb = lower_ahead(c, i, j);
+        }
+        if (zlo > (zmax - lb) * tlo.d) {
+            return 0;
+        }
         return cell_test_low(c, i, j, tin, e, &q, h);
     }
     if (exit_sign(c, i, j, e, &q) > 0) {
@@ -827,7 +836,7 @@ static ct_status walk_incremental(const ctx *c, ct_hit *h)
         }
         cell_exit(c, i, j, &e);
         h->steps++;
-        if (cell_test(c, i, j, tin, &e, h)) {
+        if (cell_test(c, i, j, tin, &e, -1, h)) {
             h->iters = it + 1u;
             return hit_status(c->p, i, j);
         }
@@ -851,6 +860,8 @@ static ct_status walk_hierarchical(const ctx *c, ct_hit *h)
     const ct_package *p = c->p;
     int32_t i, j;
     uint32_t lvl = p->levels, it, bound = CT_WCET_HIER_ITERS(c->cx, c->cy, p->levels);
+    int32_t lbi = -2, lbj = -2; /* the cell lb was formed for */
+    int64_t lb = 0;
     rt t = {0, 1};
     cexit e;
     locate(c, t, &i, &j);
@@ -863,7 +874,7 @@ static ct_status walk_hierarchical(const ctx *c, ct_hit *h)
         if (lvl == 0u) {
             cell_exit(c, i, j, &e);
             h->steps++;
-            if (cell_test(c, i, j, t, &e, h)) {
+            if (cell_test(c, i, j, t, &e, -1, h)) {
                 h->iters = it + 1u;
                 return hit_status(p, i, j);
             }
@@ -911,10 +922,18 @@ static ct_status walk_hierarchical(const ctx *c, ct_hit *h)
             }
             {
                 rt tl = c->r->dz <= 0 ? tx : t;
-                /* a bent ray: the block's max less the lowering's bound
-                 * ahead (the same range as zh, see cell_test) */
-                int64_t zb = zh(c, (uint32_t)bmax) - (c->lw != NULL ? lower_ahead(c, i, j) : 0);
-                if (c->r->oz * tl.d + tl.n * (int64_t)c->r->dz > zb * tl.d) {
+                int64_t zlo = c->r->oz * tl.d + tl.n * (int64_t)c->r->dz, zb = zh(c, (uint32_t)bmax);
+                if (c->lw != NULL && zlo <= zb * tl.d) {
+                    /* a bent ray: the block's max less the lowering's
+                     * bound ahead (the same range as zh, see cell_test) */
+                    if (lbi != i || lbj != j) {
+                        lb = lower_ahead(c, i, j);
+                        lbi = i;
+                        lbj = j;
+                    }
+                    zb -= lb;
+                }
+                if (zlo > zb * tl.d) {
                     /* skip the block: the ray is above its max all along */
                     h->steps++;
                     if (!rt_lt(tx, c->tend)) {
@@ -963,6 +982,7 @@ static ct_status walk_cones(const ctx *c, uint32_t plane, ct_hit *h)
     rt t = {0, 1};   /* current point */
     rt tin = {0, 1}; /* canonical entry of the current cell */
     int tin_ok = 1;
+    int64_t lb;      /* lower_ahead at (i, j), -1 when not formed */
     cexit e;
     locate(c, t, &i, &j);
     /* bound: each iteration leaves at least one fine cell */
@@ -976,10 +996,15 @@ static ct_status walk_cones(const ctx *c, uint32_t plane, ct_hit *h)
         h->steps++;
         k = coarse_index(p, i, j);
         code = ang[k];
+        lb = -1;
         if (p->cot_ok[code]) {
             /* a bent ray: the apex less the lowering's bound ahead (the
              * cone of the lowered terrain; |a16| < 2^33) */
-            int64_t a16 = zh(c, ct_ld16(p->apex + 2u * k)) - (c->lw != NULL ? lower_ahead(c, i, j) : 0);
+            int64_t a16 = zh(c, ct_ld16(p->apex + 2u * k));
+            if (c->lw != NULL) {
+                lb = lower_ahead(c, i, j);
+                a16 -= lb;
+            }
             /* T = floor(t 2^26), and a lower bound of z(t) from a Q26 point
              * (z at T for a rising ray, at T + 1 for a descending one unless
              * t is exactly T / 2^26): t.n 2^26 < 2^60. */
@@ -1037,7 +1062,7 @@ static ct_status walk_cones(const ctx *c, uint32_t plane, ct_hit *h)
         if (!tin_ok) {
             tin = cell_entry(c, i, j);
         }
-        if (cell_test(c, i, j, tin, &e, h)) {
+        if (cell_test(c, i, j, tin, &e, lb, h)) {
             h->iters = it + 1u;
             return hit_status(p, i, j);
         }
@@ -1057,6 +1082,14 @@ static ct_status walk_cones(const ctx *c, uint32_t plane, ct_hit *h)
 
 /* Surface height at a Q16 point of cell (i, j), times 2^32 (exact):
  * h00*2^32 + a*U*2^16 + b*V*2^16 + c*U*V with U, V in [0, 2^16]: < 2^50. */
+/* The tallest post of cell (i, j). */
+static int32_t cell_hmax(const ct_package *p, int32_t i, int32_t j)
+{
+    posts4 q;
+    load_posts(p, i, j, &q);
+    return q.hmax;
+}
+
 static int64_t surface_q32(const ct_package *p, int32_t i, int32_t j, int64_t x, int64_t y)
 {
     posts4 q;
@@ -1451,6 +1484,8 @@ static ct_status prepare_impl(const ct_package *p, const ct_ray *ray, int seg, c
         }
         if (O[2] < -(INT64_C(1) << (46u - zs))) {
             start = CT_BELOW;
+        } else if (lw != NULL && O[2] * (INT64_C(1) << zs) > (int64_t)cell_hmax(p, i, j) * ONE16) {
+            start = CT_OK; /* above the cell's tallest post (|O[2] 2^zs| <= 2^46) */
         } else if (lw != NULL) {
             /* the lowered surface, Q16 2^32: z_q16 2^32 < 2^78 */
             int sg = ct_i128_cmp(ct_i128_shl(ct_i128_from64(O[2] * (INT64_C(1) << zs)), 32),
