@@ -7,8 +7,11 @@
 // steps per pixel; hits; and the error statistics against the scene's
 // ground truth (tests/scene.hpp: mrcal + the reference tracer, --samples
 // points).  Also the directional trace without effects (straight rays),
-// to show what bending costs.  Nothing here is a pass/fail test; it only
-// reports (and says so) if the two methods ever disagree.
+// to show what bending costs (last column: with effects / straight, the
+// median of per-round ratios; "incr. / dir." likewise).  The sides run in
+// alternating rounds, each the best of 5 after a warm-up.  Nothing here is
+// a pass/fail test; it only reports (and says so) if the two methods ever
+// disagree.
 //
 // Options: --quick (every 4th pixel in each direction, 300 samples),
 //          --samples N, --scene NAME (only that one).
@@ -74,8 +77,9 @@ int main(int argc, char **argv)
     std::printf("geolocation benchmark: every %spixel of each scene's image, one thread; ns per pixel\n",
                 stride == 1 ? "" : "4th (--quick) ");
     std::printf("| scene | effects | pixels hit | unproject ns | directional: trace ns / steps | incremental: trace ns / "
-                "steps | incr. / dir. time | straight dir.: trace ns / steps | error RMS / max (m), N points |\n");
-    std::printf("|---|---|---|---|---|---|---|---|---|\n");
+                "steps | incr. / dir. time | straight dir.: trace ns / steps | error RMS / max (m), N points | with effects / "
+                "straight (dir.) |\n");
+    std::printf("|---|---|---|---|---|---|---|---|---|---|\n");
     for (const char *name : names) {
         if (!only.empty() && only != name) continue;
         scene::World *w;
@@ -92,9 +96,8 @@ int main(int argc, char **argv)
                 uv.push_back((int64_t)v << 16);
             }
         size_t n = uv.size() / 2;
-        // unprojection + rotation alone (best of 3)
-        double un = 1e30;
-        for (int rep = 0; rep < 3; ++rep) {
+        // unprojection + rotation alone
+        auto unproject_ns = [&]() {
             int32_t ray[3];
             int64_t dm[3];
             int64_t sink = 0;
@@ -104,16 +107,38 @@ int main(int argc, char **argv)
                     ct_pose_rotate(&w->cam.pose, ray, dm) == CT_OK)
                     sink += dm[0];
             }
-            un = std::min(un, (now_ns() - t0) / (double)n);
             if (sink == 42) std::printf(" ");
-        }
+            return (now_ns() - t0) / (double)n;
+        };
         ct_effects fx = scene::lib_effects(w->s, w->s.effects);
         std::vector<ct_geo> gd, gi, gs;
-        Run rd = geolocate(*w, uv, CT_METHOD_DIRECTIONAL, &fx, &gd);
-        Run rd2 = geolocate(*w, uv, CT_METHOD_DIRECTIONAL, &fx, &gd);  // warm
-        rd.ns = std::min(rd.ns, rd2.ns);
-        Run ri = geolocate(*w, uv, CT_METHOD_INCREMENTAL, &fx, &gi);
-        Run rs = geolocate(*w, uv, CT_METHOD_DIRECTIONAL, nullptr, &gs);
+        // This machine's speed drifts by tens of percent within seconds: the
+        // unprojection and the three traces in alternating rounds (one
+        // warm-up round first); each trace is its batch less the same
+        // round's unprojection; the table shows each side's best round and
+        // the median over rounds of the per-round ratios.
+        const int rounds = 5;
+        Run rd, ri, rs;
+        double un = 1e30;
+        std::vector<double> r_eff, r_inc;
+        for (int round = 0; round <= rounds; ++round) {
+            double u = unproject_ns();
+            Run a = geolocate(*w, uv, CT_METHOD_DIRECTIONAL, &fx, &gd);
+            Run b = geolocate(*w, uv, CT_METHOD_DIRECTIONAL, nullptr, &gs);
+            Run c = geolocate(*w, uv, CT_METHOD_INCREMENTAL, &fx, &gi);
+            if (round == 0) continue;
+            a.ns -= u;
+            b.ns -= u;
+            c.ns -= u;
+            r_eff.push_back(a.ns / std::max(1.0, b.ns));
+            r_inc.push_back(c.ns / std::max(1.0, a.ns));
+            if (round == 1 || a.ns < rd.ns) rd = a;
+            if (round == 1 || b.ns < rs.ns) rs = b;
+            if (round == 1 || c.ns < ri.ns) ri = c;
+            un = std::min(un, u);
+        }
+        std::sort(r_eff.begin(), r_eff.end());
+        std::sort(r_inc.begin(), r_inc.end());
         long differ = 0;
         for (size_t k = 0; k < n; ++k)
             differ += gd[k].status != gi[k].status || gd[k].hit.e_nm != gi[k].hit.e_nm ||
@@ -139,10 +164,11 @@ int main(int argc, char **argv)
             mx = std::max(mx, e);
             ++cnt;
         }
-        std::printf("| %s | %s | %.1f %% | %.0f | %.0f / %.1f | %.0f / %.1f | %.1fx | %.0f / %.1f | %.4f / %.4f, %ld |\n",
-                    name, scene::fx_names(w->s.effects).c_str(), 100.0 * (double)rd.hits / (double)n, un, rd.ns - un,
-                    rd.steps, ri.ns - un, ri.steps, (ri.ns - un) / std::max(1.0, rd.ns - un), rs.ns - un, rs.steps,
-                    std::sqrt(s2 / std::max(1L, cnt)), mx, cnt);
+        std::printf("| %s | %s | %.1f %% | %.0f | %.0f / %.1f | %.0f / %.1f | %.1fx | %.0f / %.1f | %.4f / %.4f, %ld | "
+                    "%.2fx |\n",
+                    name, scene::fx_names(w->s.effects).c_str(), 100.0 * (double)rd.hits / (double)n, un, rd.ns,
+                    rd.steps, ri.ns, ri.steps, r_inc[r_inc.size() / 2], rs.ns, rs.steps, std::sqrt(s2 / std::max(1L, cnt)),
+                    mx, cnt, r_eff[r_eff.size() / 2]);
         std::fflush(stdout);
         delete w;
     }

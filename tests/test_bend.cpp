@@ -286,6 +286,40 @@ void test_bent_segment_length_regression()
     }
 }
 
+// ct_trace_bent refuses a chord whose polyline segment would be under 1/64
+// cell (CT_ERR_ARG) whichever model then traces the ray; the lowered model's
+// set-up checks it without the segment's square root.  Around the threshold
+// (for R = 2^40 nm, c = 4, 30 m cells: chord ~ 1e5 nm) both must agree.
+void test_bent_chord_check_agrees()
+{
+    auto cs = dem_cases::make_case("flat", dem_cases::make_terrain(9, 9, std::vector<uint16_t>(81, 100)), 4, 1);
+    ct_package p;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_package_open(&p, cs.pkg.data(), cs.pkg.size()));
+    ct_ray ray = {0, 0, 200 << 16, 1 << 20, 1 << 20, -(250 << 16)};
+    long refused = 0, accepted = 0;
+    const int32_t cs_[] = {4 * 65536, 3 * 65536 + 12345, 65536, -65536};
+    for (int32_t c : cs_) {
+        // the threshold chord for this c, then +-3000 nm around it
+        long double post = (long double)std::llabs(p.posting_e_nm);
+        long double t = std::pow(std::ceil(post / 64), 2) * std::fabs((long double)c) / (std::ldexp(1.0L, 40 + 19));
+        for (int64_t chord = (int64_t)t - 3000; chord <= (int64_t)t + 3000; chord += 13) {
+            ct_bend bd = {c, INT64_C(1) << 40, chord, 0u};
+            int64_t delta;
+            ct_hit h;
+            ct_status want = ct_bend_segment(&p, &bd, &delta) == CT_OK ? CT_OK : CT_ERR_ARG;
+            ct_status got = ct_trace_bent(&p, &ray, &bd, CT_METHOD_DIRECTIONAL, &h);
+            if (want == CT_ERR_ARG) {
+                TEST_ASSERT_EQUAL_INT(CT_ERR_ARG, got);
+                refused++;
+            } else {
+                TEST_ASSERT(got >= 0);
+                accepted++;
+            }
+        }
+    }
+    TEST_ASSERT(refused > 100 && accepted > 100);
+}
+
 }  // namespace
 
 int main()
@@ -293,6 +327,7 @@ int main()
     TEST_BEGIN("test_bend");
     RUN_TEST(test_bent_arguments);
     RUN_TEST(test_bent_segment_length_regression);
+    RUN_TEST(test_bent_chord_check_agrees);
     RUN_TEST(test_bent_vs_reference);
     return TEST_END();
 }

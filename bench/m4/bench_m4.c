@@ -14,6 +14,7 @@
 #include <stdint.h>
 
 #include "bench_m4_data.h"
+#include "bend.h"
 #include "conetrace.h"
 #include "mcu_platform.h"
 
@@ -168,6 +169,52 @@ int main(void)
                     pt += dt > empty ? dt - empty : 0u;
                 }
                 put("  (prepare ");
+                put_u(b > a ? ((pt * ipt_q16) >> 16) / (b - a) : 0u, 0u);
+                put(")");
+            }
+            flush();
+        }
+        {
+            /* the same rays bent by curvature and refraction (M4_BEND_*),
+             * directional: the lowered walk for these observers */
+            const ct_bend bd = {M4_BEND_COEFF_Q16, M4_BEND_RADIUS_NM, M4_BEND_CHORD_NM, 0u};
+            uint64_t ticks = 0u, steps = 0u;
+            for (k = a; k < b; ++k) {
+                ct_ray r = ray_at(k);
+                ct_hit h;
+                ct_status st;
+                uint32_t dt;
+                t0 = SYST_CVR;
+                st = ct_trace_bent(&p, &r, &bd, CT_METHOD_DIRECTIONAL, &h);
+                dt = ticks_since(t0);
+                ticks += dt > empty ? dt - empty : 0u;
+                steps += h.steps;
+                if ((int32_t)st != m4_rays[k].bent_status || h.steps != m4_rays[k].bent_steps) {
+                    ok = 0;
+                }
+            }
+            put_pad("", 12u);
+            put_u(b - a, 6u);
+            put(" | ");
+            put_pad("dir., bent", 13u);
+            put_u(b > a ? (steps * 10u / (b - a)) / 10u : 0u, 6u);
+            put(".");
+            put_u(b > a ? (steps * 10u / (b - a)) % 10u : 0u, 0u);
+            put_u(b > a ? ((ticks * ipt_q16) >> 16) / (b - a) : 0u, 18u);
+            {
+                /* of which the bend's set-up for the ray's observer
+                 * (ct_bent_prepare: formed once per call by
+                 * ct_geolocate_batch for all of a camera's pixels) */
+                uint64_t pt = 0u;
+                for (k = a; k < b; ++k) {
+                    ct_bent_setup bs;
+                    uint32_t dt;
+                    t0 = SYST_CVR;
+                    (void)ct_bent_prepare(&p, &bd, m4_rays[k].ray[0], m4_rays[k].ray[1], &bs);
+                    dt = ticks_since(t0);
+                    pt += dt > empty ? dt - empty : 0u;
+                }
+                put("  (set-up ");
                 put_u(b > a ? ((pt * ipt_q16) >> 16) / (b - a) : 0u, 0u);
                 put(")");
             }

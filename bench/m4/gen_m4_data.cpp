@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_m4_data.h"
 #include "conetrace.h"
 #include "families.hpp"
 
@@ -62,10 +63,13 @@ int main(int argc, char **argv)
             ct_hit h[4];
             ct_status st[4];
             for (int m = 0; m < 4; ++m) st[m] = ct_trace(&p, &r, (ct_method)m, &h[m]);
-            std::fprintf(f, "  {{%lld, %lld, %lld, %lld, %lld, %lld}, {%d, %d, %d, %d}, {%u, %u, %u, %u}},\n",
+            const ct_bend bd = {M4_BEND_COEFF_Q16, M4_BEND_RADIUS_NM, M4_BEND_CHORD_NM, 0u};
+            ct_hit hb;
+            ct_status sb = ct_trace_bent(&p, &r, &bd, CT_METHOD_DIRECTIONAL, &hb);
+            std::fprintf(f, "  {{%lld, %lld, %lld, %lld, %lld, %lld}, {%d, %d, %d, %d}, {%u, %u, %u, %u}, %d, %u},\n",
                          (long long)r.x_q16, (long long)r.y_q16, (long long)r.z_q16, (long long)r.dx, (long long)r.dy,
                          (long long)r.dz, (int)st[0], (int)st[1], (int)st[2], (int)st[3], h[0].steps, h[1].steps,
-                         h[2].steps, h[3].steps);
+                         h[2].steps, h[3].steps, (int)sb, hb.steps);
         }
     std::fprintf(f, "};\n");
     if (std::fclose(f) != 0 || std::rename(tmp.c_str(), argv[1]) != 0) {

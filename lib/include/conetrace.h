@@ -345,8 +345,16 @@ ct_status ct_ray_prepare_segment(const ct_package *pkg, const ct_ray *ray,
 /* Model: over a projected-grid DEM, a ray from an observer gains height
  * above the datum of  c * rho^2 / (2 R)  at horizontal range rho from its
  * origin, c = (curvature ? 1 : 0) - (refraction ? k : 0), k the refraction
- * coefficient (~0.13), R the earth radius.  The library traces the polyline
- * with vertices on that curve (rounded to Q16) every Delta of horizontal
+ * coefficient (~0.13), R the earth radius.
+ * c > 0: the caller's (straight) ray is traced once against the terrain
+ * with each post lowered by the rise at its range from the observer
+ * (exact integers; inside a cell the bilinear patch of the lowered posts,
+ * within c posting^2 / (4 R) of the exact rise: 0.035 mm for 30 m cells),
+ * by the method's own walk, bound and exactness; the hit is reported on
+ * the curve.  This needs every tile corner within 2^31 Q16 (2^15 cells) of
+ * the observer on each axis and the rise over the tile below 2^16 LSB.
+ * Otherwise (c < 0, or out of that range) the library traces the polyline
+ * with vertices on the curve (rounded to Q16) every Delta of horizontal
  * range, Delta = sqrt(8 * chord * R / |c|), so the polyline stays within
  * chord_nm (+ 1 Q16 unit of vertex rounding) of the curve; each segment is
  * traced exactly (ct_ray_prepare_segment), so the result is the exact first
@@ -359,21 +367,25 @@ typedef struct {
     uint32_t flags;    /* 0, or CT_BEND_NO_CULL                              */
 } ct_bend;
 
-/* The walk skips runs of segments that the max-mipmap shows to be above all
- * terrain under them (bend.c, "culling"); that changes no result, only the
- * time.  CT_BEND_NO_CULL traces every segment (for tests that check it).   */
+/* The walks lower the mipmap's and cones' bounds by the rise ahead (the
+ * lowered walk), the polyline skips runs of segments that the max-mipmap
+ * shows to be above all terrain under them (bend.c, "culling"); that
+ * changes no result, only the time.  CT_BEND_NO_CULL turns both off (for
+ * tests that check it).                                                    */
 #define CT_BEND_NO_CULL 1u
 
 #define CT_BEND_MAX_SEGMENTS 65536u
-/* Worst-case iterations of a bent trace: every segment's walk leaves a new
+/* Worst-case iterations of a bent trace: the method's straight bound for
+ * the lowered walk; for the polyline, every segment's walk leaves a new
  * fine cell per iteration except at most twice per segment (its first and
  * last cell are shared with its neighbours).                               */
 #define CT_WCET_BENT_ITERS(cx, cy, segments) \
     (CT_WCET_CELL_ITERS(cx, cy) + 2u * (uint32_t)(segments))
 
 /* Trace ray (its origin is the observer) bent by *bend.  Returns as
- * ct_trace; hit->t_q26 is the parameter on the segment holding the hit,
- * hit->steps and hit->iters are summed over segments.                      */
+ * ct_trace; hit->t_q26 is the parameter on the prepared straight ray (the
+ * lowered walk) or on the segment holding the hit (the polyline), whose
+ * steps and iters are summed over segments.                                */
 ct_status ct_trace_bent(const ct_package *pkg, const ct_ray *ray,
                         const ct_bend *bend, ct_method method, ct_hit *hit);
 
@@ -518,10 +530,11 @@ typedef struct {
  * at horizontal range rho from the camera (the earth falls away below the
  * tangent plane by rho^2/2R; refraction bends the ray down along an arc of
  * radius R/k).  Both: (1 - k) rho^2 / 2R.  The ray is traced by
- * ct_trace_bent (a polyline within chord_nm of that parabola, each segment
- * traced exactly), so the tracer's exactness and its step bound
- * (CT_WCET_BENT_ITERS) hold with effects on.  A zero field means the
- * default where one is given.                                              */
+ * ct_trace_bent (for c > 0 one walk against the terrain lowered by the
+ * rise, within c posting^2 / 4R of the parabola; otherwise a polyline
+ * within chord_nm of it), so the tracer's exactness and its step bounds
+ * hold with effects on.  A zero field means the default where one is
+ * given.                                                                   */
 #define CT_EFFECT_CURVATURE 1u   /* earth curvature                          */
 #define CT_EFFECT_REFRACTION 2u  /* atmospheric refraction, coefficient k    */
 #define CT_EFFECT_ALL 3u
@@ -594,8 +607,9 @@ ct_status ct_pose_rotate(const ct_pose *pose, const int32_t ray_cam_q30[3],
  * camera centre is beyond CT_MAX_ORIGIN_Q16 of the tile; CT_ERR_RANGE when
  * a bent ray would need more than CT_BEND_MAX_SEGMENTS segments or the
  * camera is more than 2^52 nm (4500 km) from the tile.  With effects,
- * out->hit.t_q26 is the parameter on the polyline segment holding the hit
- * and steps/iters are summed over segments (ct_trace_bent).                */
+ * out->hit.t_q26 is the parameter on the prepared straight ray (lowered
+ * walk) or on the polyline segment holding the hit, and steps/iters are
+ * summed over segments (ct_trace_bent).                                    */
 ct_status ct_geolocate(const ct_package *pkg, const ct_camera *cam,
                        const ct_pose *pose, ct_method method,
                        const ct_effects *effects, int64_t u_q16,

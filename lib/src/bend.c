@@ -265,6 +265,29 @@ static ct_i128 udiv128_small(ct_i128 n, uint64_t d)
     return q;
 }
 
+/* *bd's ranges, and (c != 0) whether the polyline's segment would be at
+ * least 1024 Q16 units (1/64 cell) -- ct_bend_segment's checks without its
+ * square root: floor(isqrt(q) 2^16 / posting) >= 1024 iff isqrt(q) >=
+ * ceil(posting / 64) iff q >= ceil(posting / 64)^2 (q as in
+ * ct_bend_segment; ceil(posting / 64) < 2^57, its square 128-bit). */
+static ct_status bend_check(const ct_package *p, const ct_bend *bd)
+{
+    if (bd->coeff_q16 < -(4 * 65536) || bd->coeff_q16 > 4 * 65536 || bd->radius_nm < (INT64_C(1) << 40) ||
+        bd->radius_nm > (INT64_C(1) << 54) || bd->chord_nm < (INT64_C(1) << 10) ||
+        bd->chord_nm > (INT64_C(1) << 50) || (bd->flags & ~CT_BEND_NO_CULL) != 0u) {
+        return CT_ERR_ARG;
+    }
+    if (bd->coeff_q16 != 0) {
+        ct_i128 num = ct_i128_shl(ct_umul64((uint64_t)bd->chord_nm, (uint64_t)bd->radius_nm), 19);
+        ct_i128 q = udiv128_small(num, (uint64_t)ct_abs64((int64_t)bd->coeff_q16));
+        uint64_t m = ((uint64_t)ct_abs64(p->posting_e_nm) + 63u) / 64u;
+        if (ct_i128_cmp(q, ct_umul64(m, m)) < 0) {
+            return CT_ERR_ARG;
+        }
+    }
+    return CT_OK;
+}
+
 ct_status ct_bend_segment(const ct_package *p, const ct_bend *bd, int64_t *delta)
 {
     if (bd->coeff_q16 < -(4 * 65536) || bd->coeff_q16 > 4 * 65536 || bd->radius_nm < (INT64_C(1) << 40) ||
@@ -379,13 +402,15 @@ ct_status ct_bent_prepare(const ct_package *p, const ct_bend *bd, int64_t ox, in
     if (p == NULL || bd == NULL || bs == NULL) {
         return CT_ERR_ARG;
     }
-    st = ct_bend_segment(p, bd, &bs->delta);
+    st = bend_check(p, bd);
     if (st != CT_OK) {
         return st;
     }
     bs->bend = *bd;
+    bs->delta = 0;
     bs->lowered = bd->coeff_q16 != 0 && ct_lower_setup(p, ox, oy, bd, &bs->lw) == CT_OK;
-    return CT_OK;
+    /* the polyline's segment length only where the polyline is traced */
+    return bs->lowered ? CT_OK : ct_bend_segment(p, bd, &bs->delta);
 }
 
 ct_status ct_trace_bent(const ct_package *p, const ct_ray *ray, const ct_bend *bd, ct_method m,
