@@ -429,23 +429,17 @@ ct_status ct_trace_bent(const ct_package *p, const ct_ray *ray, const ct_bend *b
     return ct_trace_bent_set(p, ray, &bs, m, h);
 }
 
+static ct_status trace_polyline(const ct_package *p, const ct_ray *ray, const ct_bent_setup *bs, ct_method m,
+                                ct_hit *h);
+
 ct_status ct_trace_bent_set(const ct_package *p, const ct_ray *ray, const ct_bent_setup *bs, ct_method m,
                             ct_hit *h)
 {
-    const ct_bend *bd = &bs->bend;
-    bent b;
-    int64_t s0, s1, delta = bs->delta, k0, k1, k, chord_q16;
-    int64_t ztop;
-    int q;
-    int entered = 0;
-    uint32_t steps = 0u, iters = 0u;
-    v3 va, vb;
-    ct_status st;
-    CT_ASSERT(p != NULL && ray != NULL && h != NULL);
-    if (p == NULL || ray == NULL || h == NULL) {
+    CT_ASSERT(p != NULL && ray != NULL && bs != NULL && h != NULL);
+    if (p == NULL || ray == NULL || bs == NULL || h == NULL) {
         return CT_ERR_ARG;
     }
-    if (bd->coeff_q16 == 0 || (ray->dx == 0 && ray->dy == 0)) {
+    if (bs->bend.coeff_q16 == 0 || (ray->dx == 0 && ray->dy == 0)) {
         return ct_trace(p, ray, m, h);
     }
     if ((uint32_t)m >= (uint32_t)CT_METHOD_COUNT) {
@@ -463,6 +457,24 @@ ct_status ct_trace_bent_set(const ct_package *p, const ct_ray *ray, const ct_ben
         /* one straight walk against the lowered terrain */
         return ct_trace_lowered(p, ray, &bs->lw, m, h);
     }
+    return trace_polyline(p, ray, bs, m, h);
+}
+
+/* The polyline (c < 0, or the lowered model out of range); its own
+ * function, kept out of line, so that its large frame is not on the
+ * lowered walk's stack.  The ray is checked by the caller. */
+CT_NOINLINE static ct_status trace_polyline(const ct_package *p, const ct_ray *ray, const ct_bent_setup *bs,
+                                            ct_method m, ct_hit *h)
+{
+    const ct_bend *bd = &bs->bend;
+    bent b;
+    int64_t s0, s1, delta = bs->delta, k0, k1, k, chord_q16;
+    int64_t ztop;
+    int q;
+    int entered = 0;
+    uint32_t steps = 0u, iters = 0u;
+    v3 va, vb;
+    ct_status st;
     b.p = p;
     b.ox = ray->x_q16;
     b.oy = ray->y_q16;

@@ -18,6 +18,15 @@
 #define CT_ASSERT(cond) ((void)0)
 #endif
 
+/* Keeps a rarely taken path with a large frame (the bent rays' 128-bit cell
+ * test) out of its caller, so the common path's stack stays small; only a
+ * hint, so compilers without it lose nothing but stack.                    */
+#if defined(__GNUC__)
+#define CT_NOINLINE __attribute__((noinline))
+#else
+#define CT_NOINLINE
+#endif
+
 typedef struct {
     uint64_t hi;
     uint64_t lo;

@@ -738,7 +738,8 @@ static int64_t root_low(const ctx *c, wquad *W, rt tin, rt tout)
     return root_t_q26(c, &W->q, tin, tout);
 }
 
-static int cell_test_low(const ctx *c, int32_t i, int32_t j, rt tin, const cexit *e, const posts4 *q, ct_hit *h)
+CT_NOINLINE static int cell_test_low(const ctx *c, int32_t i, int32_t j, rt tin, const cexit *e, const posts4 *q,
+                                     ct_hit *h)
 {
     lposts L;
     wquad W;
@@ -1105,7 +1106,8 @@ static int64_t surface_q32(const ct_package *p, int32_t i, int32_t j, int64_t x,
 /* The lowered surface (bent rays) at a Q16 point of cell (i, j), in Q16
  * LSB times 2^32, exact: posts G < 2^33 in Q16 LSB, a, b < 2^34, c < 2^35,
  * U, V in [0, 2^16]: G00 2^32 + (a U + b V) 2^16 + c U V < 2^68 (128-bit). */
-static ct_i128 surface_low_q48(const ct_package *p, const ct_lower *lw, int32_t i, int32_t j, int64_t x, int64_t y)
+CT_NOINLINE static ct_i128 surface_low_q48(const ct_package *p, const ct_lower *lw, int32_t i, int32_t j, int64_t x,
+                                               int64_t y)
 {
     posts4 q;
     int64_t U = x - (int64_t)i * ONE16, V = y - (int64_t)j * ONE16, x0 = (int64_t)i * ONE16,
