@@ -452,8 +452,11 @@ enum {
                                distortion, or behind the camera           */
     CT_ERR_POSE = -22,      /* rotation not orthonormal with det +1, or the
                                camera centre out of range                 */
-    CT_ERR_EFFECTS = -23    /* unknown scene-effect flags or an effect
+    CT_ERR_EFFECTS = -23,   /* unknown scene-effect flags or an effect
                                parameter out of range (ct_effects)        */
+    CT_ERR_CRS = -24        /* a coordinate reference system the library
+                               does not convert (only UTM north/south on
+                               WGS84, EPSG 326xx / 327xx)                 */
 };
 
 typedef enum {
@@ -627,6 +630,36 @@ ct_status ct_geolocate_batch(const ct_package *pkg, const ct_camera *cam,
                              const int64_t *uv_q16,
                              size_t count, ct_geo *out, size_t out_len);
 /* ======================== end of camera and geolocation ================= */
+
+/* ------------------------------------------------------------------------ */
+/* WGS84 geodetic <-> UTM (lib/src/geodesy.c): transverse Mercator by
+ * Krueger's series to order n^6 (Karney 2011), in integers.  Geodetic
+ * angles are radians in Q61 (int64: value * 2^61; 2^-61 rad is 3 pm on the
+ * ground); map coordinates are nm with UTM's false easting (500 km) and,
+ * south, false northing (10,000 km).  Accuracy (tests/test_geodesy.cpp,
+ * against PROJ): see README "Geodesy".  Domain: |lat| <= 84.5 deg and
+ * |lon - the zone's central meridian| <= CT_UTM_MAX_DLON_DEG; outside,
+ * CT_ERR_RANGE.                                                            */
+typedef struct {
+    int32_t zone;   /* 1..60 */
+    int32_t south;  /* 0: north (EPSG 326zz), 1: south (EPSG 327zz) */
+} ct_utm;
+
+#define CT_PI_Q61 INT64_C(7244019458077122842)       /* pi, Q61 (rounded) */
+#define CT_UTM_MAX_LAT_Q61 INT64_C(3400664690041760445) /* 84.5 deg, Q61 */
+#define CT_UTM_MAX_DLON_DEG 9
+
+/* The UTM zone of an EPSG code (32601..32660, 32701..32760), else
+ * CT_ERR_CRS.                                                              */
+ct_status ct_utm_zone_of_epsg(int32_t epsg, ct_utm *zone);
+
+/* Geodetic (lat, lon: Q61 radians) to UTM (E, N: nm, rounded).            */
+ct_status ct_utm_forward(const ct_utm *zone, int64_t lat_q61, int64_t lon_q61,
+                         int64_t *e_nm, int64_t *n_nm);
+
+/* UTM (nm) to geodetic (Q61 radians).                                      */
+ct_status ct_utm_inverse(const ct_utm *zone, int64_t e_nm, int64_t n_nm,
+                         int64_t *lat_q61, int64_t *lon_q61);
 
 #ifdef __cplusplus
 }

@@ -500,7 +500,9 @@ ct_status ct_status_name(ct_status s, const char **out)
         "err_size", "err_offset", "err_range", "err_georef", "err_flags",
         "err_ray", "err_method", "err_internal", "err_verify",
         /* camera and geolocation */
-        "err_lens", "err_unproject", "err_pose", "err_effects"};
+        "err_lens", "err_unproject", "err_pose", "err_effects",
+        /* geodesy */
+        "err_crs"};
     CT_ASSERT(out != NULL);
     if (out == NULL) {
         return CT_ERR_ARG;
@@ -509,7 +511,7 @@ ct_status ct_status_name(ct_status s, const char **out)
         *out = names[s];
         return CT_OK;
     }
-    if (s < 0 && s >= CT_ERR_EFFECTS) {
+    if (s < 0 && s >= CT_ERR_CRS) {
         *out = errs[-s - 1];
         return CT_OK;
     }

@@ -104,6 +104,16 @@ typedef struct {
     uint32_t npixels;
 } ct_vec_camera;
 
+/* WGS84 <-> UTM (lib/src/geodesy.c): the host's results. */
+typedef struct {
+    ct_utm zone;
+    int64_t lat_q61, lon_q61;
+    ct_status fwd_status;
+    int64_t e_nm, n_nm;                   /* ct_utm_forward                  */
+    ct_status inv_status;
+    int64_t lat2_q61, lon2_q61;           /* ct_utm_inverse(e_nm, n_nm)      */
+} ct_vec_geo;
+
 typedef struct {
     const ct_vec_package *packages;
     uint32_t npackages;
@@ -114,6 +124,8 @@ typedef struct {
     const char *generator;                /* "build_package" or "degenerate"  */
     const ct_vec_camera *cameras;
     uint32_t ncameras;
+    const ct_vec_geo *geo;
+    uint32_t ngeo;
 } ct_vec_set;
 
 extern const ct_vec_set ct_vectors;

@@ -979,9 +979,40 @@ int main(int argc, char **argv)
     }
     std::fprintf(f, "\n};\n\n");
     emit_cameras(f, cams);
+    // geodesy: points across zones and hemispheres, some out of range
+    std::vector<ct_vec_geo> geo;
+    {
+        Rng gg(4326u);
+        for (int k = 0; k < 64; ++k) {
+            ct_vec_geo v{};
+            v.zone.zone = 1 + (int32_t)(gg.u64() % 60u);
+            v.zone.south = (int32_t)(gg.u64() % 2u);
+            long double lat = (v.zone.south ? -81.0L : -1.0L) + (long double)(gg.u64() % 860000u) * 1e-4L;
+            long double dl = ((long double)(gg.u64() % 200001u) - 100000.0L) * 1e-4L;  // +-10 deg
+            long double lon = 6.0L * v.zone.zone - 183 + dl;
+            if (lon > 180) lon -= 360;
+            v.lat_q61 = (int64_t)std::llround(lat * 3.14159265358979323846264338L / 180 * std::ldexp(1.0L, 61));
+            v.lon_q61 = (int64_t)std::llround(lon * 3.14159265358979323846264338L / 180 * std::ldexp(1.0L, 61));
+            v.fwd_status = ct_utm_forward(&v.zone, v.lat_q61, v.lon_q61, &v.e_nm, &v.n_nm);
+            if (v.fwd_status != CT_OK) {
+                // an inverse of a map point off the zone as well
+                v.e_nm = INT64_C(500000000000000) + (int64_t)(gg.u64() % 2000000u) * INT64_C(1000000000);
+                v.n_nm = (int64_t)(gg.u64() % 10000000u) * INT64_C(1000000000);
+            }
+            v.inv_status = ct_utm_inverse(&v.zone, v.e_nm, v.n_nm, &v.lat2_q61, &v.lon2_q61);
+            geo.push_back(v);
+        }
+    }
+    std::fprintf(f, "static const ct_vec_geo geo[%zu] = {\n", geo.size());
+    for (const ct_vec_geo &v : geo)
+        std::fprintf(f, "  {{%d, %d}, %s, %s, %d, %s, %s, %d, %s, %s},\n", (int)v.zone.zone, (int)v.zone.south,
+                     i64(v.lat_q61).c_str(), i64(v.lon_q61).c_str(), (int)v.fwd_status, i64(v.e_nm).c_str(),
+                     i64(v.n_nm).c_str(), (int)v.inv_status, i64(v.lat2_q61).c_str(), i64(v.lon2_q61).c_str());
+    std::fprintf(f, "};\n\n");
     std::fprintf(f,
-                 "const ct_vec_set ct_vectors = {packages, %zuu, fixed, %zuu, dirs, %zuu, \"%s\", cameras, %zuu};\n",
-                 pkgs.size(), fx.size(), dirs.size(), generator.c_str(), cams.size());
+                 "const ct_vec_set ct_vectors = {packages, %zuu, fixed, %zuu, dirs, %zuu, \"%s\", cameras, %zuu, geo, "
+                 "%zuu};\n",
+                 pkgs.size(), fx.size(), dirs.size(), generator.c_str(), cams.size(), geo.size());
     if (std::fclose(f) != 0) die("write error");
     return 0;
 }

@@ -474,11 +474,27 @@ static void check_fixed(const ct_vec_set *vs)
         eq_i64("boundary x", d->cx, cx);
         eq_i64("boundary y", d->sy, sy);
     }
+    g_where = "utm";
+    for (k = 0u; k < vs->ngeo; ++k) {
+        const ct_vec_geo *v = &vs->geo[k];
+        int64_t e = 0, n = 0, la = 0, lo = 0;
+        g_idx = k;
+        eq_i64("utm forward status", v->fwd_status, ct_utm_forward(&v->zone, v->lat_q61, v->lon_q61, &e, &n));
+        if (v->fwd_status == CT_OK) {
+            eq_i64("utm e", v->e_nm, e);
+            eq_i64("utm n", v->n_nm, n);
+        }
+        eq_i64("utm inverse status", v->inv_status, ct_utm_inverse(&v->zone, v->e_nm, v->n_nm, &la, &lo));
+        if (v->inv_status == CT_OK) {
+            eq_i64("utm lat", v->lat2_q61, la);
+            eq_i64("utm lon", v->lon2_q61, lo);
+        }
+    }
     g_where = "status names";
-    for (k = 0u; k < 30u; ++k) {
+    for (k = 0u; k < 31u; ++k) {
         const char *name = NULL;
-        ct_status s = (ct_status)k - 24;
-        ct_status want = (s >= CT_ERR_EFFECTS && s <= CT_HIT_VOID) ? CT_OK : CT_ERR_ARG;
+        ct_status s = (ct_status)k - 25;
+        ct_status want = (s >= CT_ERR_CRS && s <= CT_HIT_VOID) ? CT_OK : CT_ERR_ARG;
         g_idx = k;
         eq_i64("status_name", want, ct_status_name(s, &name));
         eq_i64("status_name set", 1, name != NULL);
@@ -494,7 +510,16 @@ int main(void)
     put_str(vs->generator);
     flush_line();
     check_crc();
-    check_fixed(vs);
+    {
+        uint32_t before = g_fail;
+        check_fixed(vs);
+        put_str("  fixed point, directions, UTM (");
+        put_u64(vs->ngeo);
+        put_str(" points forward and back): ");
+        put_u64(g_fail - before);
+        put_str(" mismatching fields");
+        flush_line();
+    }
     for (p = 0u; p < vs->npackages; ++p) {
         const ct_vec_package *vp = &vs->packages[p];
         uint32_t t = 0u, h = 0u, before = g_fail;

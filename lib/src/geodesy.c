@@ -1,0 +1,385 @@
+/*
+ * geodesy.c -- WGS84 geodetic <-> UTM (transverse Mercator) in integers.
+ *
+ * Krueger's series to order n^6 as in Karney (2011), "Transverse Mercator
+ * with an accuracy of a few nanometers": the conformal latitude from
+ * tau = tan(phi) by tau' = tau sqrt(1 + sigma^2) - sigma sqrt(1 + tau^2),
+ * sigma = sinh(e atanh(e sin(phi))); the spherical transverse Mercator
+ * xi' = atan2(tau', cos(lam)), eta' = asinh(sin(lam) / sqrt(tau'^2 +
+ * cos^2(lam))); then zeta = zeta' + sum alpha_j sin(2 j zeta') (complex,
+ * summed by Clenshaw's recurrence); E = 500 km + k0 A eta, N = FN + k0 A xi.
+ * The inverse reverses each step (the beta series; tau from tau' by
+ * Newton's method).  The series' own error is a few nm within the zone.
+ *
+ * Number format: every internal quantity is Q59 (value * 2^59 in int64,
+ * |value| < 16, resolution 1.7e-18); products and quotients go through
+ * 128 bits and are rounded to nearest.  Angles are radians.  Bounds that
+ * keep values below 16: |lat| <= 84.5 deg (tan < 9.7, 1 / cos < 9.8),
+ * |lon - lon0| <= CT_UTM_MAX_DLON_DEG = 9 deg (sinh(eta') < 0.16), so
+ * every series below converges geometrically with ratio <= 0.04 (term
+ * counts chosen for < 2^-60).  Public angles are Q61 radians (|.| <= pi <
+ * 2^1.7), map coordinates integer nm.
+ */
+#include "conetrace.h"
+#include "fixed.h"
+#include "geodesy_tables.h"
+
+#define QB 59u
+#define ONE (INT64_C(1) << QB)
+#define HALF_NM_Q8 INT64_C(128)
+
+/* round(v / 2^n), n in 1..126, for a 128-bit v whose result fits int64:
+ * floor((v + 2^(n-1)) / 2^n) by an arithmetic shift of the two words */
+static int64_t round_shr128(ct_i128 v, unsigned n)
+{
+    ct_i128 h = ct_i128_from64(1);
+    ct_i128 r;
+    uint64_t neg;
+    h = n - 1u >= 64u ? ct_i128_shl(ct_i128_shl(h, 63u), n - 64u) : ct_i128_shl(h, n - 1u);
+    r = ct_i128_add(v, h);
+    neg = (r.hi >> 63) != 0u ? ~(uint64_t)0 : 0u;
+    if (n >= 64u) {
+        /* (hi >> (n - 64)) with the sign's bits shifted in */
+        return (int64_t)(((r.hi ^ neg) >> (n - 64u)) ^ neg);
+    }
+    return (int64_t)((r.lo >> n) | (r.hi << (64u - n)));
+}
+
+/* a * b in Q59, rounded: |a b| < 2^63 * 2^59 */
+static int64_t qmul(int64_t a, int64_t b)
+{
+    return round_shr128(ct_i128_mul(a, b), QB);
+}
+
+/* a / b in Q59 (b != 0, |a / b| < 16), floored: a 2^59 < 2^126 */
+static int64_t qdiv(int64_t a, int64_t b)
+{
+    ct_i128 n = ct_i128_shl(ct_i128_from64(a), QB);
+    if (b < 0) {
+        n = ct_i128_neg(n);
+        b = -b;
+    }
+    return ct_i128_floor_div(n, b);
+}
+
+/* sqrt(a^2 + b^2) in Q59 for |a|, |b| < 16 (the sum of squares < 2^127 is
+ * formed in 128 bits; ct_i128_isqrt needs < 2^126: |a|, |b| < 11.3, which
+ * the callers' bounds give) */
+static int64_t qhypot(int64_t a, int64_t b)
+{
+    return (int64_t)ct_i128_isqrt(ct_i128_add(ct_i128_mul(a, a), ct_i128_mul(b, b)));
+}
+
+/* x * (c[0] + x^2 (c[1] + x^2 (...))), Horner in x^2, n terms */
+static int64_t odd_series(int64_t x, const int64_t *c, int n)
+{
+    int64_t x2 = qmul(x, x), s = c[n - 1];
+    int k;
+    for (k = n - 2; k >= 0; --k) { /* bound: n */
+        s = c[k] + qmul(x2, s);
+    }
+    return qmul(x, s);
+}
+
+/* c[0] + x^2 (c[1] + ...), n terms */
+static int64_t even_series(int64_t x, const int64_t *c, int n)
+{
+    int64_t x2 = qmul(x, x), s = c[n - 1];
+    int k;
+    for (k = n - 2; k >= 0; --k) { /* bound: n */
+        s = c[k] + qmul(x2, s);
+    }
+    return s;
+}
+
+/* Series coefficients (Q59, rounded): 1/(2k+1)! with alternating sign
+ * (sin), 1/(2k)! (cos), the same without signs (sinh, cosh), 1/(2k+1)
+ * (atanh; alternating: atan), asinh's (-1)^k (2k)! / (4^k k!^2 (2k+1)). */
+#define NS 12
+static const int64_t c_sin[NS] = {
+    INT64_C(576460752303423488), -INT64_C(96076792050570581), INT64_C(4803839602528529),
+    -INT64_C(114377133393536),   INT64_C(1588571297132),      -INT64_C(14441557247),
+    INT64_C(92574085),           -INT64_C(440829),            INT64_C(1621),
+    -INT64_C(5),                 INT64_C(0),                  INT64_C(0)};
+static const int64_t c_cos[NS] = {
+    INT64_C(576460752303423488), -INT64_C(288230376151711744), INT64_C(24019198012642645),
+    -INT64_C(800639933754755),   INT64_C(14297141674192),      -INT64_C(158857129713),
+    INT64_C(1203463104),         -INT64_C(6612437),            INT64_C(27552),
+    -INT64_C(90),                INT64_C(0),                   INT64_C(0)};
+
+/* sin and cos of |r| <= pi/4 (Q59): Taylor to r^21 / r^20, error < 2^-60 */
+static void sincos_small(int64_t r, int64_t *s, int64_t *c)
+{
+    *s = odd_series(r, c_sin, 10);
+    *c = even_series(r, c_cos, 10);
+}
+
+/* sin, cos of |x| <= pi (Q59): quadrant reduction by pi/2 */
+static void qsincos(int64_t x, int64_t *s, int64_t *c)
+{
+    int64_t k = (x >= 0 ? x + TM_PI_2 / 2 : x - TM_PI_2 / 2) / TM_PI_2; /* nearest, |k| <= 2 */
+    int64_t r = x - k * TM_PI_2, sr, cr;
+    sincos_small(r, &sr, &cr);
+    switch ((int)(k & 3)) {
+    case 0:
+        *s = sr;
+        *c = cr;
+        break;
+    case 1:
+        *s = cr;
+        *c = -sr;
+        break;
+    case 2:
+        *s = -sr;
+        *c = -cr;
+        break;
+    default:
+        *s = -cr;
+        *c = sr;
+        break;
+    }
+}
+
+/* atan(x) for |x| <= 1 (Q59): two halvings x / (1 + sqrt(1 + x^2)) bring
+ * it to <= tan(pi/16) < 0.2, then 14 terms of the series (0.04^14 <
+ * 2^-64), times 4. */
+static int64_t atan_unit(int64_t x)
+{
+    int64_t c[14], s;
+    int k;
+    /* bound: 2 halvings */
+    for (k = 0; k < 2; ++k) {
+        x = qdiv(x, ONE + qhypot(ONE, x));
+    }
+    /* bound: 14 coefficients */
+    for (k = 0; k < 14; ++k) {
+        int64_t v = ONE / (2 * k + 1);
+        c[k] = (k & 1) ? -v : v;
+    }
+    s = odd_series(x, c, 14);
+    return 4 * s;
+}
+
+/* atan2(y, x) in (-pi, pi], |x|, |y| < 16, not both 0 */
+static int64_t qatan2(int64_t y, int64_t x)
+{
+    int64_t ay = ct_abs64(y), ax = ct_abs64(x), a;
+    if (ay <= ax) {
+        a = atan_unit(qdiv(ay, ax));
+    } else {
+        a = TM_PI_2 - atan_unit(qdiv(ax, ay));
+    }
+    if (x < 0) {
+        a = TM_PI - a;
+    }
+    return y < 0 ? -a : a;
+}
+
+/* atanh(x) for |x| <= 0.1: 12 terms of x + x^3/3 + ... (0.01^12) */
+static int64_t atanh_small(int64_t x)
+{
+    int64_t c[12];
+    int k;
+    for (k = 0; k < 12; ++k) { /* bound: 12 */
+        c[k] = ONE / (2 * k + 1);
+    }
+    return odd_series(x, c, 12);
+}
+
+/* asinh(x) for |x| <= 0.17: 14 terms (0.029^14 < 2^-70) */
+static int64_t asinh_small(int64_t x)
+{
+    int64_t c[14], t = ONE; /* t = (2k)! / (4^k k!^2) */
+    int k;
+    for (k = 0; k < 14; ++k) { /* bound: 14 */
+        int64_t v = t / (2 * k + 1);
+        c[k] = (k & 1) ? -v : v;
+        t = t / (2 * k + 2) * (2 * k + 1); /* t_{k+1} = t_k (2k+1) / (2k+2) */
+    }
+    return odd_series(x, c, 14);
+}
+
+/* sinh and cosh of |x| <= 0.2: 12 terms each */
+static void sinhcosh_small(int64_t x, int64_t *sh, int64_t *ch)
+{
+    int64_t cs[NS], cc[NS];
+    int k;
+    for (k = 0; k < NS; ++k) { /* bound: NS */
+        cs[k] = ct_abs64(c_sin[k]);
+        cc[k] = ct_abs64(c_cos[k]);
+    }
+    *sh = odd_series(x, cs, 10);
+    *ch = even_series(x, cc, 10);
+}
+
+/* tau' from tau = sin / cos of the latitude (Karney's taupf):
+ * sigma = sinh(e atanh(e sin)), tau' = tau sqrt(1 + sigma^2) - sigma / cos. */
+static int64_t taup(int64_t sphi, int64_t cphi, int64_t tau)
+{
+    int64_t sig, ch;
+    sinhcosh_small(qmul(TM_E, atanh_small(qmul(TM_E, sphi))), &sig, &ch);
+    /* ch = sqrt(1 + sigma^2) */
+    return qmul(tau, ch) - qdiv(sig, cphi);
+}
+
+/* Complex Clenshaw: zeta + sum_j a_j sin(2 j zeta), zeta = xi + i eta,
+ * from sin/cos of 2 xi and sinh/cosh of 2 eta; sign -1 for the inverse. */
+static void clenshaw(const int64_t *a, int sign, int64_t xi, int64_t eta, int64_t s2, int64_t c2, int64_t sh2,
+                     int64_t ch2, int64_t *oxi, int64_t *oeta)
+{
+    /* ar + i ai = 2 cos(2 zeta) = 2 (c2 ch2 - i s2 sh2) */
+    int64_t ar = 2 * qmul(c2, ch2), ai = -2 * qmul(s2, sh2);
+    int64_t yr0 = 0, yi0 = 0, yr1 = 0, yi1 = 0;
+    int j;
+    /* bound: 6 terms; y_j = a_j + (ar + i ai) y_{j+1} - y_{j+2} */
+    for (j = 5; j >= 0; --j) {
+        int64_t yr = a[j] + qmul(ar, yr0) - qmul(ai, yi0) - yr1;
+        int64_t yi = qmul(ar, yi0) + qmul(ai, yr0) - yi1;
+        yr1 = yr0;
+        yi1 = yi0;
+        yr0 = yr;
+        yi0 = yi;
+    }
+    {
+        /* sin(2 zeta) = s2 ch2 + i c2 sh2; the sum = sin(2 zeta) y_1 */
+        int64_t sr = qmul(s2, ch2), si = qmul(c2, sh2);
+        int64_t tr = qmul(sr, yr0) - qmul(si, yi0), ti = qmul(sr, yi0) + qmul(si, yr0);
+        *oxi = xi + sign * tr;
+        *oeta = eta + sign * ti;
+    }
+}
+
+static int64_t lon0_q59(int32_t zone) { return (int64_t)(6 * zone - 183) * TM_DEG_Q59; }
+
+/* Q61 -> Q59, rounded */
+static int64_t q61_to_59(int64_t v) { return v >= 0 ? (v + 2) >> 2 : -((-v + 2) >> 2); }
+
+ct_status ct_utm_zone_of_epsg(int32_t epsg, ct_utm *z)
+{
+    CT_ASSERT(z != NULL);
+    if (z == NULL) {
+        return CT_ERR_ARG;
+    }
+    if (epsg >= 32601 && epsg <= 32660) {
+        z->zone = epsg - 32600;
+        z->south = 0;
+        return CT_OK;
+    }
+    if (epsg >= 32701 && epsg <= 32760) {
+        z->zone = epsg - 32700;
+        z->south = 1;
+        return CT_OK;
+    }
+    return CT_ERR_CRS;
+}
+
+ct_status ct_utm_forward(const ct_utm *z, int64_t lat_q61, int64_t lon_q61, int64_t *e_nm, int64_t *n_nm)
+{
+    int64_t phi, lam, sphi, cphi, slam, clam, tau, tp, r, sxi, cxi, sheta, cheta, xi, eta, s2, c2, sh2, ch2;
+    CT_ASSERT(z != NULL && e_nm != NULL && n_nm != NULL);
+    if (z == NULL || e_nm == NULL || n_nm == NULL || z->zone < 1 || z->zone > 60) {
+        return CT_ERR_ARG;
+    }
+    if (ct_abs64(lat_q61) > CT_UTM_MAX_LAT_Q61 || ct_abs64(lon_q61) > CT_PI_Q61) {
+        return CT_ERR_RANGE;
+    }
+    phi = q61_to_59(lat_q61);
+    lam = q61_to_59(lon_q61) - lon0_q59(z->zone);
+    /* wrap into (-pi, pi] */
+    if (lam > TM_PI) {
+        lam -= 2 * TM_PI;
+    } else if (lam <= -TM_PI) {
+        lam += 2 * TM_PI;
+    }
+    if (ct_abs64(lam) > CT_UTM_MAX_DLON_DEG * TM_DEG_Q59) {
+        return CT_ERR_RANGE;
+    }
+    qsincos(phi, &sphi, &cphi);
+    qsincos(lam, &slam, &clam);
+    tau = qdiv(sphi, cphi);
+    tp = taup(sphi, cphi, tau);
+    /* xi' = atan2(tau', cos lam), and its sine and cosine; sinh eta' =
+     * sin lam / r, cosh eta' = sqrt(1 + tau'^2) / r, r = hypot(tau', cos lam) */
+    r = qhypot(tp, clam);
+    xi = qatan2(tp, clam);
+    sxi = qdiv(tp, r);
+    cxi = qdiv(clam, r);
+    sheta = qdiv(slam, r);
+    cheta = qdiv(qhypot(ONE, tp), r);
+    eta = asinh_small(sheta);
+    s2 = 2 * qmul(sxi, cxi);
+    c2 = qmul(cxi, cxi) - qmul(sxi, sxi);
+    sh2 = 2 * qmul(sheta, cheta);
+    ch2 = qmul(cheta, cheta) + qmul(sheta, sheta);
+    clenshaw(tm_alpha, 1, xi, eta, s2, c2, sh2, ch2, &xi, &eta);
+    /* k0 A (nm, Q8, < 2^61) times xi, eta (Q59, |.| < 2): Q67 -> nm */
+    *e_nm = INT64_C(500000000000000) + round_shr128(ct_i128_mul(TM_K0A_NM_Q8, eta), QB + 8u);
+    *n_nm = (z->south ? INT64_C(10000000000000000) : 0) + round_shr128(ct_i128_mul(TM_K0A_NM_Q8, xi), QB + 8u);
+    return CT_OK;
+}
+
+/* tau from tau' by Newton's method (Karney's tauf): d tau' / d tau =
+ * (1 - e^2) sqrt(1 + tau'^2) sqrt(1 + tau^2) / (1 + (1 - e^2) tau^2), so
+ * the step is (tau'(tau) - target) w / ((1 - e^2) sqrt(1 + tau'^2)), w =
+ * (1 + (1 - e^2) tau^2) / sqrt(1 + tau^2) (<= sqrt(1 + tau^2) < 10; its
+ * numerator formed in Q118, < 2^126).  Start tau' / (1 - e^2); the error
+ * squares each step: 5 steps reach the Q59 resolution. */
+static int64_t tau_of_taup(int64_t target)
+{
+    int64_t tau = qdiv(target, TM_1ME2);
+    int k;
+    for (k = 0; k < 5; ++k) { /* bound: 5 Newton steps */
+        int64_t sec = qhypot(ONE, tau); /* sqrt(1 + tau^2) = 1 / cos(phi) */
+        int64_t cphi = qdiv(ONE, sec), sphi = qdiv(tau, sec);
+        int64_t tp = taup(sphi, cphi, tau);
+        ct_i128 w2 = ct_i128_add(ct_i128_shl(ct_i128_from64(ONE), QB), ct_i128_mul(qmul(TM_1ME2, tau), tau));
+        int64_t w = ct_i128_floor_div(w2, sec);
+        int64_t d = qmul(TM_1ME2, qhypot(ONE, tp));
+        tau -= qdiv(qmul(tp - target, w), d);
+    }
+    return tau;
+}
+
+ct_status ct_utm_inverse(const ct_utm *z, int64_t e_nm, int64_t n_nm, int64_t *lat_q61, int64_t *lon_q61)
+{
+    int64_t xi, eta, sh, ch, s2, c2, sh2, ch2, sxi, cxi, sheta, cheta, r, tp, lam, phi, de, dn;
+    CT_ASSERT(z != NULL && lat_q61 != NULL && lon_q61 != NULL);
+    if (z == NULL || lat_q61 == NULL || lon_q61 == NULL || z->zone < 1 || z->zone > 60) {
+        return CT_ERR_ARG;
+    }
+    de = e_nm - INT64_C(500000000000000);
+    dn = n_nm - (z->south ? INT64_C(10000000000000000) : 0);
+    /* |de| <= 1100 km (eta <= 0.173), |dn| <= 9,400 km (lat <= 84.5 deg):
+     * d 2^67 < 2^120, quotients < 2^62 */
+    if (ct_abs64(de) > INT64_C(1100000000000000) || ct_abs64(dn) > INT64_C(9400000000000000)) {
+        return CT_ERR_RANGE;
+    }
+    xi = ct_i128_floor_div(ct_i128_shl(ct_i128_shl(ct_i128_from64(dn), QB), 8u), TM_K0A_NM_Q8);
+    eta = ct_i128_floor_div(ct_i128_shl(ct_i128_shl(ct_i128_from64(de), QB), 8u), TM_K0A_NM_Q8);
+    qsincos(2 * xi, &s2, &c2);
+    sinhcosh_small(eta, &sh, &ch);
+    sh2 = 2 * qmul(sh, ch);
+    ch2 = qmul(ch, ch) + qmul(sh, sh);
+    clenshaw(tm_beta, -1, xi, eta, s2, c2, sh2, ch2, &xi, &eta);
+    qsincos(xi, &sxi, &cxi);
+    sinhcosh_small(eta, &sheta, &cheta);
+    r = qhypot(sheta, cxi);
+    if (r == 0) {
+        return CT_ERR_RANGE; /* a pole */
+    }
+    tp = qdiv(sxi, r);
+    lam = qatan2(sheta, cxi);
+    if (ct_abs64(lam) > CT_UTM_MAX_DLON_DEG * TM_DEG_Q59 || ct_abs64(tp) > 10 * ONE) {
+        return CT_ERR_RANGE;
+    }
+    phi = qatan2(tau_of_taup(tp), ONE);
+    *lat_q61 = phi * 4;
+    lam += lon0_q59(z->zone);
+    if (lam > TM_PI) {
+        lam -= 2 * TM_PI;
+    } else if (lam <= -TM_PI) {
+        lam += 2 * TM_PI;
+    }
+    *lon_q61 = lam * 4;
+    return CT_OK;
+}
