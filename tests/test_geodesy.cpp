@@ -174,6 +174,51 @@ void test_utm_bad_input()
     TEST_ASSERT(std::string(name) == "err_crs");
 }
 
+// The meridian convergence and the point scale against PROJ's
+// proj_factors (numerical derivatives of its projection, ~1e-10 deg and
+// ~1e-10 relative: the tolerance is set by them, not by the library).
+void test_utm_factors_vs_proj()
+{
+    ct_rng rng;
+    ct_rng_seed(&rng, ct_test_seed() * 31337);
+    double worst_g = 0, worst_k = 0;
+    long n = 0;
+    const int zones[] = {5, 17, 33};
+    for (int zone : zones)
+        for (int south = 0; south < 2; ++south) {
+            char def[64];
+            std::snprintf(def, sizeof def, "+proj=utm +zone=%d %s+ellps=WGS84", zone, south ? "+south " : "");
+            PJ_CONTEXT *ctx = proj_context_create();
+            PJ *pj = proj_create(ctx, def);
+            TEST_ASSERT(pj != nullptr);
+            ct_utm z = {zone, south};
+            for (int k = 0; k < (int)(200 * ct_test_scale()); ++k) {
+                double lat = south ? -80 * ct_rng_unit(&rng) : 84 * ct_rng_unit(&rng);
+                double lon = 6.0 * zone - 183 + 4 * (2 * ct_rng_unit(&rng) - 1);
+                int64_t g, kk;
+                TEST_ASSERT_EQUAL_INT(CT_OK, ct_utm_factors(&z, q61(lat), q61(lon), &g, &kk));
+                PJ_FACTORS f = proj_factors(pj, proj_coord(proj_torad(deg_of(q61(lon))), proj_torad(deg_of(q61(lat))), 0, 0));
+                worst_g = std::max(worst_g, std::fabs((double)deg_of(g) - proj_todeg(f.meridian_convergence)));
+                worst_k = std::max(worst_k, std::fabs((double)((ld)kk / std::ldexp(1.0L, 61)) - f.parallel_scale));
+                n++;
+            }
+            proj_destroy(pj);
+            proj_context_destroy(ctx);
+        }
+    std::printf("  %ld points: convergence within %.2g deg, point scale within %.2g of PROJ's proj_factors\n", n,
+                worst_g, worst_k);
+    TEST_ASSERT(worst_g < 1e-8 && worst_k < 1e-9);
+    int64_t g, kk;
+    ct_utm z = {17, 0};
+    TEST_ASSERT_EQUAL_INT(CT_ERR_RANGE, ct_utm_factors(&z, q61(45), q61(-60), &g, &kk));
+    TEST_ASSERT_EQUAL_INT(CT_ERR_ARG, ct_utm_factors(&z, q61(45), q61(-81), nullptr, &kk));
+    // on the central meridian: no convergence, scale k0 = 0.9996 exactly
+    // up to the series' rounding
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_utm_factors(&z, q61(45), q61(-81), &g, &kk));
+    TEST_ASSERT(std::llabs(g) < 64);
+    TEST_ASSERT(std::fabs((double)((ld)kk / std::ldexp(1.0L, 61) - 0.9996L)) < 1e-15);
+}
+
 }  // namespace
 
 int main()
@@ -182,5 +227,6 @@ int main()
     RUN_TEST(test_utm_fixed_points);
     RUN_TEST(test_utm_bad_input);
     RUN_TEST(test_utm_vs_proj);
+    RUN_TEST(test_utm_factors_vs_proj);
     return TEST_END();
 }

@@ -657,6 +657,13 @@ ct_status ct_utm_zone_of_epsg(int32_t epsg, ct_utm *zone);
 ct_status ct_utm_forward(const ct_utm *zone, int64_t lat_q61, int64_t lon_q61,
                          int64_t *e_nm, int64_t *n_nm);
 
+/* The meridian convergence gamma (Q61 radians: the angle from true north
+ * to grid north, clockwise positive as in PROJ) and the point scale k (Q61)
+ * at a geodetic point: what turns a north-east-down attitude into the map
+ * frame, and ground distances into map distances.                         */
+ct_status ct_utm_factors(const ct_utm *zone, int64_t lat_q61, int64_t lon_q61,
+                         int64_t *gamma_q61, int64_t *k_q61);
+
 /* UTM (nm) to geodetic (Q61 radians).                                      */
 ct_status ct_utm_inverse(const ct_utm *zone, int64_t e_nm, int64_t n_nm,
                          int64_t *lat_q61, int64_t *lon_q61);

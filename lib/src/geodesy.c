@@ -62,6 +62,12 @@ static int64_t qdiv(int64_t a, int64_t b)
     return ct_i128_floor_div(n, b);
 }
 
+/* sqrt(1 - a) in Q59 for 0 <= a <= 1 */
+static int64_t qsqrt_one_minus(int64_t a)
+{
+    return (int64_t)ct_i128_isqrt(ct_i128_shl(ct_i128_from64(ONE - a), QB));
+}
+
 /* sqrt(a^2 + b^2) in Q59 for |a|, |b| < 16 (the sum of squares < 2^127 is
  * formed in 128 bits; ct_i128_isqrt needs < 2^126: |a|, |b| < 11.3, which
  * the callers' bounds give) */
@@ -222,6 +228,31 @@ static int64_t taup(int64_t sphi, int64_t cphi, int64_t tau)
     return qmul(tau, ch) - qdiv(sig, cphi);
 }
 
+/* 1 + sum_j 2 j a_j cos(2 j zeta) = p - i q (the derivative of the series
+ * below), by the same recurrence on the coefficients 2 j a_j: the cosine
+ * sum is cos(2 zeta) y_1 - y_2. */
+static void clenshaw_deriv(const int64_t *a, int64_t s2, int64_t c2, int64_t sh2, int64_t ch2, int64_t *p,
+                           int64_t *q)
+{
+    int64_t ar = 2 * qmul(c2, ch2), ai = -2 * qmul(s2, sh2);
+    int64_t yr0 = 0, yi0 = 0, yr1 = 0, yi1 = 0;
+    int j;
+    for (j = 5; j >= 0; --j) { /* bound: 6 terms */
+        int64_t yr = 2 * (j + 1) * a[j] + qmul(ar, yr0) - qmul(ai, yi0) - yr1;
+        int64_t yi = qmul(ar, yi0) + qmul(ai, yr0) - yi1;
+        yr1 = yr0;
+        yi1 = yi0;
+        yr0 = yr;
+        yi0 = yi;
+    }
+    {
+        /* cos(2 zeta) = c2 ch2 - i s2 sh2 */
+        int64_t cr = qmul(c2, ch2), ci = -qmul(s2, sh2);
+        *p = ONE + qmul(cr, yr0) - qmul(ci, yi0) - yr1;
+        *q = -(qmul(cr, yi0) + qmul(ci, yr0) - yi1);
+    }
+}
+
 /* Complex Clenshaw: zeta + sum_j a_j sin(2 j zeta), zeta = xi + i eta,
  * from sin/cos of 2 xi and sinh/cosh of 2 eta; sign -1 for the inverse. */
 static void clenshaw(const int64_t *a, int sign, int64_t xi, int64_t eta, int64_t s2, int64_t c2, int64_t sh2,
@@ -273,7 +304,31 @@ ct_status ct_utm_zone_of_epsg(int32_t epsg, ct_utm *z)
     return CT_ERR_CRS;
 }
 
+static ct_status forward(const ct_utm *z, int64_t lat_q61, int64_t lon_q61, int64_t *e_nm, int64_t *n_nm,
+                         int64_t *gamma_q61, int64_t *k_q61);
+
 ct_status ct_utm_forward(const ct_utm *z, int64_t lat_q61, int64_t lon_q61, int64_t *e_nm, int64_t *n_nm)
+{
+    return forward(z, lat_q61, lon_q61, e_nm, n_nm, NULL, NULL);
+}
+
+ct_status ct_utm_factors(const ct_utm *z, int64_t lat_q61, int64_t lon_q61, int64_t *gamma_q61, int64_t *k_q61)
+{
+    int64_t e, n;
+    CT_ASSERT(gamma_q61 != NULL && k_q61 != NULL);
+    if (gamma_q61 == NULL || k_q61 == NULL) {
+        return CT_ERR_ARG;
+    }
+    return forward(z, lat_q61, lon_q61, &e, &n, gamma_q61, k_q61);
+}
+
+/* The forward projection; with gamma_q61 != NULL also the meridian
+ * convergence and the point scale (Karney 2011, eqs. 27-28 with the series'
+ * derivative p - i q): gamma = atan2(tau' sin lam, sqrt(1 + tau'^2) cos lam)
+ * + atan2(q, p); k = k0 (A / a) sqrt(1 - e^2 sin^2 phi) sqrt(1 + tau^2) /
+ * sqrt(tau'^2 + cos^2 lam) * sqrt(p^2 + q^2). */
+static ct_status forward(const ct_utm *z, int64_t lat_q61, int64_t lon_q61, int64_t *e_nm, int64_t *n_nm,
+                         int64_t *gamma_q61, int64_t *k_q61)
 {
     int64_t phi, lam, sphi, cphi, slam, clam, tau, tp, r, sxi, cxi, sheta, cheta, xi, eta, s2, c2, sh2, ch2;
     CT_ASSERT(z != NULL && e_nm != NULL && n_nm != NULL);
@@ -311,6 +366,16 @@ ct_status ct_utm_forward(const ct_utm *z, int64_t lat_q61, int64_t lon_q61, int6
     c2 = qmul(cxi, cxi) - qmul(sxi, sxi);
     sh2 = 2 * qmul(sheta, cheta);
     ch2 = qmul(cheta, cheta) + qmul(sheta, sheta);
+    if (gamma_q61 != NULL) {
+        int64_t pp, qq, g, kk;
+        clenshaw_deriv(tm_alpha, s2, c2, sh2, ch2, &pp, &qq);
+        g = qatan2(qmul(tp, slam), qmul(qhypot(ONE, tp), clam)) + qatan2(qq, pp);
+        /* k / (k0 A / a): each factor < 10, the product formed step by step */
+        kk = qmul(qsqrt_one_minus(qmul(TM_E2, qmul(sphi, sphi))), qdiv(ONE, cphi));
+        kk = qmul(qdiv(kk, r), qhypot(pp, qq));
+        *gamma_q61 = g * 4;
+        *k_q61 = qmul(kk, TM_K0A_OVER_A) * 4;
+    }
     clenshaw(tm_alpha, 1, xi, eta, s2, c2, sh2, ch2, &xi, &eta);
     /* k0 A (nm, Q8, < 2^61) times xi, eta (Q59, |.| < 2): Q67 -> nm */
     *e_nm = INT64_C(500000000000000) + round_shr128(ct_i128_mul(TM_K0A_NM_Q8, eta), QB + 8u);

@@ -10,5 +10,6 @@ static const int64_t tm_beta[6] = {INT64_C(482919713521620), INT64_C(34045023510
 #define TM_PI_2 INT64_C(905502432259640355)       /* pi / 2 */
 #define TM_PI INT64_C(1811004864519280711)         /* pi */
 #define TM_K0A_NM_Q8 INT64_C(1629414954538262001)  /* k0 A in nm, Q8 */
+#define TM_K0A_OVER_A INT64_C(575264578206020851) /* k0 A / a */
 #define TM_DEG_Q59 INT64_C(10061138136218226)    /* one degree in radians */
 #endif

@@ -112,6 +112,8 @@ typedef struct {
     int64_t e_nm, n_nm;                   /* ct_utm_forward                  */
     ct_status inv_status;
     int64_t lat2_q61, lon2_q61;           /* ct_utm_inverse(e_nm, n_nm)      */
+    ct_status fac_status;
+    int64_t gamma_q61, k_q61;             /* ct_utm_factors(lat, lon)        */
 } ct_vec_geo;
 
 typedef struct {

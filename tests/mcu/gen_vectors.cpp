@@ -1000,14 +1000,16 @@ int main(int argc, char **argv)
                 v.n_nm = (int64_t)(gg.u64() % 10000000u) * INT64_C(1000000000);
             }
             v.inv_status = ct_utm_inverse(&v.zone, v.e_nm, v.n_nm, &v.lat2_q61, &v.lon2_q61);
+            v.fac_status = ct_utm_factors(&v.zone, v.lat_q61, v.lon_q61, &v.gamma_q61, &v.k_q61);
             geo.push_back(v);
         }
     }
     std::fprintf(f, "static const ct_vec_geo geo[%zu] = {\n", geo.size());
     for (const ct_vec_geo &v : geo)
-        std::fprintf(f, "  {{%d, %d}, %s, %s, %d, %s, %s, %d, %s, %s},\n", (int)v.zone.zone, (int)v.zone.south,
-                     i64(v.lat_q61).c_str(), i64(v.lon_q61).c_str(), (int)v.fwd_status, i64(v.e_nm).c_str(),
-                     i64(v.n_nm).c_str(), (int)v.inv_status, i64(v.lat2_q61).c_str(), i64(v.lon2_q61).c_str());
+        std::fprintf(f, "  {{%d, %d}, %s, %s, %d, %s, %s, %d, %s, %s, %d, %s, %s},\n", (int)v.zone.zone,
+                     (int)v.zone.south, i64(v.lat_q61).c_str(), i64(v.lon_q61).c_str(), (int)v.fwd_status,
+                     i64(v.e_nm).c_str(), i64(v.n_nm).c_str(), (int)v.inv_status, i64(v.lat2_q61).c_str(),
+                     i64(v.lon2_q61).c_str(), (int)v.fac_status, i64(v.gamma_q61).c_str(), i64(v.k_q61).c_str());
     std::fprintf(f, "};\n\n");
     std::fprintf(f,
                  "const ct_vec_set ct_vectors = {packages, %zuu, fixed, %zuu, dirs, %zuu, \"%s\", cameras, %zuu, geo, "

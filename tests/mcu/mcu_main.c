@@ -489,6 +489,12 @@ static void check_fixed(const ct_vec_set *vs)
             eq_i64("utm lat", v->lat2_q61, la);
             eq_i64("utm lon", v->lon2_q61, lo);
         }
+        la = lo = 0;
+        eq_i64("utm factors status", v->fac_status, ct_utm_factors(&v->zone, v->lat_q61, v->lon_q61, &la, &lo));
+        if (v->fac_status == CT_OK) {
+            eq_i64("utm gamma", v->gamma_q61, la);
+            eq_i64("utm k", v->k_q61, lo);
+        }
     }
     g_where = "status names";
     for (k = 0u; k < 31u; ++k) {
