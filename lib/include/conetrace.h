@@ -522,6 +522,10 @@ typedef struct {
 typedef struct {
     int64_t e_nm, n_nm, h_nm;  /* camera centre, map frame, nm              */
     int32_t R_map_cam_q30[9];  /* row-major, Q30                            */
+    int32_t hscale_q30;        /* map metres per ground metre horizontally
+                                  at the camera, Q30: 2^30 from
+                                  ct_pose_init; k R / (R + h) from
+                                  ct_pose_from_wgs84                        */
     uint32_t ready;            /* set by ct_pose_init                        */
 } ct_pose;
 
@@ -663,6 +667,27 @@ ct_status ct_utm_forward(const ct_utm *zone, int64_t lat_q61, int64_t lon_q61,
  * frame, and ground distances into map distances.                         */
 ct_status ct_utm_factors(const ct_utm *zone, int64_t lat_q61, int64_t lon_q61,
                          int64_t *gamma_q61, int64_t *k_q61);
+
+/* A camera pose from the navigation solution: the camera centre in WGS84
+ * (lat, lon: Q61 radians; h_nm: height in the package's vertical datum --
+ * ellipsoidal until the datum is carried, see README) and its attitude
+ * w.r.t. local north-east-down as a unit quaternion q = (w, x, y, z), Q30,
+ * rotating camera-frame vectors into NED.  The map frame's axes at the
+ * camera are grid east, grid north and up: NED turned by the meridian
+ * convergence, and horizontal lengths scaled by k R / (R + h) (the point
+ * scale and the elevation factor, R the Gaussian mean radius there) into
+ * pose->hscale_q30.  CT_ERR_POSE for a quaternion off unit length by more
+ * than 2^-20, CT_ERR_RANGE / CT_ERR_ARG as ct_utm_forward.               */
+ct_status ct_pose_from_wgs84(ct_pose *pose, const ct_utm *zone, int64_t lat_q61,
+                             int64_t lon_q61, int64_t h_nm, const int32_t q_ned_cam_q30[4]);
+
+/* The attitude quaternion (Q30) of aerospace yaw, pitch, roll (Z-Y-X, Q61
+ * radians, |.| <= pi) for a camera whose mrcal axes x right, y down, z
+ * forward point east, down, north at zero; yaw turns it clockwise seen
+ * from above, pitch raises its forward axis, roll turns it about that
+ * axis.                                                                    */
+ct_status ct_quat_from_ypr(int64_t yaw_q61, int64_t pitch_q61, int64_t roll_q61,
+                           int32_t q_ned_cam_q30[4]);
 
 /* UTM (nm) to geodetic (Q61 radians).                                      */
 ct_status ct_utm_inverse(const ct_utm *zone, int64_t e_nm, int64_t n_nm,

@@ -627,6 +627,7 @@ ct_status ct_pose_init(ct_pose *pose, const int32_t R[9], int64_t e, int64_t n, 
     pose->e_nm = e;
     pose->n_nm = n;
     pose->h_nm = h;
+    pose->hscale_q30 = (int32_t)1 << 30;
     pose->ready = POSE_READY;
     return CT_OK;
 }
@@ -644,6 +645,15 @@ ct_status ct_pose_rotate(const ct_pose *pose, const int32_t ray[3], int64_t out[
         const int32_t *row = pose->R_map_cam_q30 + 3u * i;
         int64_t s = (int64_t)row[0] * ray[0] + (int64_t)row[1] * ray[1] + (int64_t)row[2] * ray[2];
         out[i] = ct_floor_div(s + (INT64_C(1) << 20), INT64_C(1) << 21);
+    }
+    if (pose->hscale_q30 != ((int32_t)1 << 30)) {
+        /* a geodetic pose: horizontal map metres per ground metre (|out| <=
+         * 2^39.1, hscale in [2^29, 2^31): products < 2^70.1, 128-bit; the
+         * results stay < 2^40) */
+        for (i = 0u; i < 2u; ++i) {
+            ct_i128 m = ct_i128_add(ct_i128_mul(out[i], pose->hscale_q30), ct_i128_from64(INT64_C(1) << 29));
+            out[i] = ct_i128_floor_div(m, INT64_C(1) << 30);
+        }
     }
     return CT_OK;
 }

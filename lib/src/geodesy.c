@@ -448,3 +448,149 @@ ct_status ct_utm_inverse(const ct_utm *z, int64_t e_nm, int64_t n_nm, int64_t *l
     *lon_q61 = lam * 4;
     return CT_OK;
 }
+
+/* ------------------------------------------------------------------------ */
+/* Poses from the navigation solution.                                       */
+
+/* round(v / 2^30) without the implementation-defined shift of negatives */
+static int64_t shr30(int64_t v)
+{
+    const int64_t h = INT64_C(1) << 29;
+    return v >= 0 ? (v + h) >> 30 : -((-v + h) >> 30);
+}
+
+/* Hamilton product a b (Q30 in, Q30 out, rounded; |components| <= 2^30:
+ * products <= 2^60, sums of four < 2^62) */
+static void quat_mul(const int64_t a[4], const int64_t b[4], int64_t r[4])
+{
+    r[0] = shr30(a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3]);
+    r[1] = shr30(a[0] * b[1] + a[1] * b[0] + a[2] * b[3] - a[3] * b[2]);
+    r[2] = shr30(a[0] * b[2] - a[1] * b[3] + a[2] * b[0] + a[3] * b[1]);
+    r[3] = shr30(a[0] * b[3] + a[1] * b[2] - a[2] * b[1] + a[3] * b[0]);
+}
+
+/* Q59 -> Q30, rounded (|v| <= 2^59) */
+static int64_t q59_to_30(int64_t v) { return v >= 0 ? (v + (INT64_C(1) << 28)) >> 29 : -((-v + (INT64_C(1) << 28)) >> 29); }
+
+ct_status ct_quat_from_ypr(int64_t yaw_q61, int64_t pitch_q61, int64_t roll_q61, int32_t q[4])
+{
+    /* q = q_z(yaw) q_y(pitch) q_x(roll) q_P, q_P = (1, 1, 1, 1) / 2 the
+     * camera-to-body turn (x -> y, y -> z, z -> x: 120 deg about (1,1,1)),
+     * each axis quaternion (cos a/2, sin a/2 along the axis).  Products of
+     * Q30 values (< 2^60, sums of four < 2^62) rounded to Q30. */
+    int64_t a[3], qz[4], qy[4], qx[4], t1[4], t2[4], r[4];
+    const int64_t qp[4] = {INT64_C(1) << 29, INT64_C(1) << 29, INT64_C(1) << 29, INT64_C(1) << 29};
+    int64_t sv, cv;
+    int k;
+    CT_ASSERT(q != NULL);
+    if (q == NULL) {
+        return CT_ERR_ARG;
+    }
+    a[0] = yaw_q61;
+    a[1] = pitch_q61;
+    a[2] = roll_q61;
+    for (k = 0; k < 3; ++k) { /* bound: 3 angles */
+        if (ct_abs64(a[k]) > CT_PI_Q61) {
+            return CT_ERR_RANGE;
+        }
+    }
+    qsincos(q61_to_59(yaw_q61) / 2, &sv, &cv);
+    qz[0] = q59_to_30(cv);
+    qz[1] = 0;
+    qz[2] = 0;
+    qz[3] = q59_to_30(sv);
+    qsincos(q61_to_59(pitch_q61) / 2, &sv, &cv);
+    qy[0] = q59_to_30(cv);
+    qy[1] = 0;
+    qy[2] = q59_to_30(sv);
+    qy[3] = 0;
+    qsincos(q61_to_59(roll_q61) / 2, &sv, &cv);
+    qx[0] = q59_to_30(cv);
+    qx[1] = q59_to_30(sv);
+    qx[2] = 0;
+    qx[3] = 0;
+    quat_mul(qz, qy, t1);
+    quat_mul(t1, qx, t2);
+    quat_mul(t2, qp, r);
+    for (k = 0; k < 4; ++k) { /* bound: 4 components, |r| <= 2^30 + 4 */
+        q[k] = (int32_t)ct_max64(ct_min64(r[k], INT64_C(1) << 30), -(INT64_C(1) << 30));
+    }
+    return CT_OK;
+}
+
+ct_status ct_pose_from_wgs84(ct_pose *pose, const ct_utm *zone, int64_t lat_q61, int64_t lon_q61, int64_t h_nm,
+                             const int32_t qin[4])
+{
+    int64_t e, n, g, k, w, x, y, zq, n2, sg, cg, sphi, cphi, hs;
+    int64_t ned[9]; /* R_ned_cam, Q30 */
+    int32_t R[9];
+    ct_status st;
+    int i;
+    CT_ASSERT(pose != NULL && zone != NULL && qin != NULL);
+    if (pose == NULL || zone == NULL || qin == NULL) {
+        return CT_ERR_ARG;
+    }
+    pose->ready = 0u;
+    w = qin[0];
+    x = qin[1];
+    y = qin[2];
+    zq = qin[3];
+    /* |q|^2 = 2^60 within 2^40 (components <= 2^31: squares < 2^62,
+     * their sum < 2^64 -- formed unsigned) */
+    {
+        uint64_t s2 = (uint64_t)(w * w) + (uint64_t)(x * x) + (uint64_t)(y * y) + (uint64_t)(zq * zq);
+        uint64_t one = (uint64_t)1 << 60;
+        if ((s2 > one ? s2 - one : one - s2) > ((uint64_t)1 << 40)) {
+            return CT_ERR_POSE;
+        }
+    }
+    st = forward(zone, lat_q61, lon_q61, &e, &n, &g, &k);
+    if (st != CT_OK) {
+        return st;
+    }
+    /* R_ned_cam from q (rotating camera vectors into NED), Q30: entries
+     * 2^30 - 2 (y^2 + z^2) / 2^30 ..., products < 2^62 */
+    ned[0] = (INT64_C(1) << 30) - shr30(2 * (y * y + zq * zq));
+    ned[1] = shr30(2 * (x * y - w * zq));
+    ned[2] = shr30(2 * (x * zq + w * y));
+    ned[3] = shr30(2 * (x * y + w * zq));
+    ned[4] = (INT64_C(1) << 30) - shr30(2 * (x * x + zq * zq));
+    ned[5] = shr30(2 * (y * zq - w * x));
+    ned[6] = shr30(2 * (x * zq - w * y));
+    ned[7] = shr30(2 * (y * zq + w * x));
+    ned[8] = (INT64_C(1) << 30) - shr30(2 * (x * x + y * y));
+    /* map = (grid east, grid north, up): east' = E cos g - N sin g,
+     * north' = E sin g + N cos g (true north lies at grid azimuth -g), up =
+     * -down; E = ned row 1, N = ned row 0 */
+    qsincos(q61_to_59(g), &sg, &cg);
+    sg = q59_to_30(sg);
+    cg = q59_to_30(cg);
+    for (i = 0; i < 3; ++i) { /* bound: 3 columns (camera axes) */
+        int64_t nn = ned[i], ee = ned[3 + i], dd = ned[6 + i];
+        R[i] = (int32_t)shr30(ee * cg - nn * sg);
+        R[3 + i] = (int32_t)shr30(ee * sg + nn * cg);
+        R[6 + i] = (int32_t)(-dd);
+    }
+    st = ct_pose_init(pose, R, e, n, h_nm);
+    if (st != CT_OK) {
+        return st;
+    }
+    /* hscale = k R / (R + h), R = sqrt(M N) = a sqrt(1 - e^2) / (1 - e^2
+     * sin^2 phi) the Gaussian mean radius (nm: < 2^53): k (Q61 -> Q59)
+     * times R / (R + h) (Q59, |h| < R / 2 required) -> Q30 */
+    qsincos(q61_to_59(lat_q61), &sphi, &cphi);
+    (void)cphi;
+    n2 = ONE - qmul(TM_E2, qmul(sphi, sphi));
+    {
+        int64_t rr = round_shr128(ct_i128_mul(INT64_C(6378137000000000), qdiv(qsqrt_one_minus(TM_E2), n2)), QB);
+        int64_t ratio;
+        if (ct_abs64(h_nm) > rr / 2) {
+            pose->ready = 0u;
+            return CT_ERR_POSE;
+        }
+        ratio = qdiv(rr, rr + h_nm); /* < 2 */
+        hs = qmul(q61_to_59(k), ratio);
+    }
+    pose->hscale_q30 = (int32_t)q59_to_30(hs);
+    return CT_OK;
+}
