@@ -1,6 +1,7 @@
 // cmd_geoloc.cpp -- `conetrace geoloc`: pixels of a camera to map points.
 //
 //   conetrace geoloc PKG --camera C.cameramodel --pixels px.csv [--method M]
+//                        [--pose-wgs84 LAT,LON,H,YAW,PITCH,ROLL | --pose-map E,N,H,YAW,PITCH,ROLL]
 //                        [--effects LIST] [--refraction-k K] [--earth-radius M]
 //                        [--grid-step PX] [--threads T] -o g.csv
 //
@@ -12,9 +13,19 @@
 //   with --grid-step PX (default 16) between nodes.
 // px.csv: header naming u and v, one pixel per line (mrcal convention:
 //   (0,0) is the centre of the top-left pixel).
-// g.csv: header u,v,status,E,N,h,steps; one row per pixel, in input order;
-//   u,v echoed as given; E,N,h in metres with all nine decimals of the library's nanometres
-//   (nan when nothing is hit); steps as in `trace`.
+// --pose-wgs84 LAT,LON,H,YAW,PITCH,ROLL: the camera centre in WGS84 (degrees;
+//   H metres in the package's vertical datum) and its attitude w.r.t. local
+//   north-east-down, aerospace yaw-pitch-roll in degrees (at zero the
+//   camera's x, y, z point east, down, north); the model's extrinsics are
+//   ignored.  Needs a UTM package (EPSG 326zz/327zz): ct_pose_from_wgs84.
+// --pose-map E,N,H,YAW,PITCH,ROLL: the same in the package's map frame
+//   (metres; the attitude w.r.t. grid north, grid east, down):
+//   ct_pose_from_map.
+// g.csv: header u,v,status,E,N,h,steps,lat,lon; one row per pixel, in input
+//   order; u,v echoed as given; E,N,h in metres with all nine decimals of the
+//   library's nanometres (nan when nothing is hit); steps as in `trace`;
+//   lat,lon the hit in WGS84 degrees with 9 decimals (ct_utm_inverse; nan
+//   unless the package is UTM and something is hit).
 // --effects LIST: scene effects, comma-separated: curvature, refraction
 //   (empty: a straight line of sight).  The library's model (ct_effects):
 //   the line of sight's height above the datum gains c rho^2 / 2R at
@@ -46,8 +57,8 @@ int cmd_geoloc(int argc, char **argv)
 {
     std::vector<std::string> pos;
     std::map<std::string, std::string> opt;
-    const char *valued[] = {"--camera", "--pixels",       "--method",       "--effects",
-                            "--grid-step", "--refraction-k", "--earth-radius", "--threads", "-o"};
+    const char *valued[] = {"--camera",       "--pixels",  "--method",     "--effects",  "--grid-step",
+                            "--refraction-k", "--earth-radius", "--threads", "--pose-wgs84", "--pose-map", "-o"};
     for (int k = 2; k < argc; ++k) {
         std::string s = argv[k];
         if (s.size() > 1 && s[0] == '-') {
@@ -121,6 +132,49 @@ int cmd_geoloc(int argc, char **argv)
     if (st != CT_OK) throw Error(pos[0] + ": not a valid package (" + status_name(st) + ")");
     const std::string &cpath = opt["--camera"];
     LibCamera cam = lib_camera(read_cameramodel(cpath), cpath, grid_step);
+    ct_utm zone = {0, 0};
+    const bool utm = ct_utm_zone_of_epsg((int32_t)p.epsg, &zone) == CT_OK;
+    if (opt.count("--pose-wgs84") && opt.count("--pose-map"))
+        throw Error("geoloc: give --pose-wgs84 or --pose-map, not both");
+    for (const char *flag : {"--pose-wgs84", "--pose-map"}) {
+        if (!opt.count(flag)) continue;
+        std::vector<double> v;
+        std::stringstream ss(opt[flag]);
+        std::string tok;
+        while (std::getline(ss, tok, ',')) {
+            char *end = nullptr;
+            double x = std::strtod(tok.c_str(), &end);
+            if (tok.empty() || *end != '\0' || !std::isfinite(x))
+                throw Error(std::string(flag) + " '" + opt[flag] + "': '" + tok + "' is not a number");
+            v.push_back(x);
+        }
+        if (v.size() != 6)
+            throw Error(std::string(flag) + " '" + opt[flag] + "': needs six numbers (" +
+                        (flag[7] == 'w' ? "LAT,LON,H" : "E,N,H") + ",YAW,PITCH,ROLL)");
+        for (int k = 3; k < 6; ++k)
+            if (std::fabs(v[k]) > 180) throw Error(std::string(flag) + ": angles are degrees in [-180, 180]");
+        auto rad_q61 = [](double deg) { return (int64_t)std::llround((long double)deg * M_PIl / 180 * 2305843009213693952.0L); };
+        int32_t q[4];
+        if (ct_quat_from_ypr(rad_q61(v[3]), rad_q61(v[4]), rad_q61(v[5]), q) != CT_OK)
+            throw Error(std::string(flag) + ": angles out of range");
+        if (std::fabs(v[2]) > 1e7) throw Error(std::string(flag) + ": height beyond 10,000 km");
+        const int64_t h_nm = std::llround(v[2] * 1e9);
+        if (flag[7] == 'w') {
+            if (!utm)
+                throw Error(pos[0] + ": --pose-wgs84 needs a UTM package (EPSG 326zz/327zz); this one is EPSG:" +
+                            std::to_string(p.epsg));
+            if (std::fabs(v[0]) > 90 || std::fabs(v[1]) > 180)
+                throw Error("--pose-wgs84: latitude must be in [-90, 90] and longitude in [-180, 180] degrees");
+            st = ct_pose_from_wgs84(&cam.pose, &zone, rad_q61(v[0]), rad_q61(v[1]), h_nm, q);
+            if (st == CT_ERR_RANGE)
+                throw Error("--pose-wgs84: the position is off UTM zone " + std::to_string(zone.zone) +
+                            (zone.south ? "S" : "N") + " (more than 9 degrees from its central meridian, or beyond 84.5 degrees)");
+        } else {
+            if (std::fabs(v[0]) > 1e9 || std::fabs(v[1]) > 1e9) throw Error("--pose-map: E, N beyond 10^9 m");
+            st = ct_pose_from_map(&cam.pose, std::llround(v[0] * 1e9), std::llround(v[1] * 1e9), h_nm, q);
+        }
+        if (st != CT_OK) throw Error(std::string(flag) + ": not a valid pose (" + status_name(st) + ")");
+    }
     std::vector<PixelRow> px = read_pixels_csv(opt["--pixels"]);
 
     std::vector<int64_t> uv(2 * px.size());
@@ -163,14 +217,24 @@ int cmd_geoloc(int argc, char **argv)
                 append_nm_decimal(o, g[k].hit.h_nm);
                 o += ',';
                 o += std::to_string(g[k].hit.steps);
+                int64_t la, lo;
+                if (utm && ct_utm_inverse(&zone, g[k].hit.e_nm, g[k].hit.n_nm, &la, &lo) == CT_OK) {
+                    char ll[64];
+                    std::snprintf(ll, sizeof ll, ",%.9Lf,%.9Lf", (long double)la * 180 / M_PIl / 2305843009213693952.0L,
+                                  (long double)lo * 180 / M_PIl / 2305843009213693952.0L);
+                    o += ll;
+                } else {
+                    o += ",nan,nan";
+                }
             } else {
                 o += "nan,nan,nan,";
                 o += std::to_string(s >= 0 ? g[k].hit.steps : 0u);
+                o += ",nan,nan";
             }
             o += '\n';
         }
     });
-    std::string txt = "u,v,status,E,N,h,steps\n";
+    std::string txt = "u,v,status,E,N,h,steps,lat,lon\n";
     for (const std::string &part : parts) txt += part;
     write_file_atomic(opt["-o"], std::vector<uint8_t>(txt.begin(), txt.end()));
     return 0;

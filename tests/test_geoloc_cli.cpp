@@ -215,7 +215,7 @@ void test_geoloc_end_to_end()
     TEST_ASSERT_MSG(r.err.empty(), "stderr: %s", r.err.c_str());
     std::vector<std::string> rows = lines_of(slurp(g_dir + "/g.csv"));
     TEST_ASSERT_EQUAL_INT(10, rows.size());
-    TEST_ASSERT_MSG(rows[0] == "u,v,status,E,N,h,steps", "header '%s'", rows[0].c_str());
+    TEST_ASSERT_MSG(rows[0] == "u,v,status,E,N,h,steps,lat,lon", "header '%s'", rows[0].c_str());
     // the library on the same camera, in-process
     ct_host::CameraModel cm = ct_host::read_cameramodel(g_dir + "/cam.cameramodel");
     ct_host::LibCamera lc = ct_host::lib_camera(cm, "cam");
@@ -227,7 +227,9 @@ void test_geoloc_end_to_end()
     int hits = 0;
     for (size_t k = 0; k < px.size(); ++k) {
         std::vector<std::string> f = split(rows[k + 1]);
-        TEST_ASSERT_MSG(f.size() == 7, "row %zu: '%s'", k + 1, rows[k + 1].c_str());
+        TEST_ASSERT_MSG(f.size() == 9, "row %zu: '%s'", k + 1, rows[k + 1].c_str());
+        // the package has no EPSG code: no geodetic columns
+        TEST_ASSERT(f[7] == "nan" && f[8] == "nan");
         TEST_ASSERT_MSG(f[0] == echo[k][0] && f[1] == echo[k][1], "row %zu echoes '%s,%s'", k + 1, f[0].c_str(),
                         f[1].c_str());
         int64_t uq, vq;
@@ -324,6 +326,104 @@ void test_geoloc_threads()
     TEST_ASSERT_MSG(hits > 20, "only %d hits", hits);
     fs::remove(g_dir + "/gt.csv");
     fs::remove(g_dir + "/pxt.csv");
+}
+
+// --pose-map and --pose-wgs84: the rows are the library's ct_geolocate with
+// ct_pose_from_map / ct_pose_from_wgs84 of the same numbers (the model's
+// extrinsics ignored), bit for bit; lat,lon are ct_utm_inverse of E,N on a
+// UTM package (checked against the hit's forward projection); bad poses are
+// one-line errors.
+void test_geoloc_poses()
+{
+    Setup *s = setup();
+    TEST_ASSERT(s != nullptr);
+    // the same terrain as a UTM zone 17N package
+    ct_host::Terrain t = s->c.t;
+    t.geo.epsg = 32617;
+    auto cu = dem_cases::make_case("cli-utm", t, 8, 1);
+    spit(g_dir + "/tu.ctp", std::string(cu.pkg.begin(), cu.pkg.end()));
+    ct_package pu;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_package_open(&pu, cu.pkg.data(), cu.pkg.size()));
+    spit(g_dir + "/pxp.csv", kPixels);
+    std::vector<ct_host::PixelRow> px = ct_host::read_pixels_csv(g_dir + "/pxp.csv");
+    ct_host::CameraModel cm = ct_host::read_cameramodel(g_dir + "/cam.cameramodel");
+    ct_host::LibCamera lc = ct_host::lib_camera(cm, "cam");
+    auto q61 = [](double deg) { return (int64_t)std::llround((long double)deg * M_PIl / 180 * std::ldexp(1.0L, 61)); };
+    // looking 75 deg below the horizon towards the north-west, from above
+    // the tile's middle: centre (E, N) of the tile, 2.5 km up
+    const double E0 = 500000 + 32 * 30, N0 = 4000000 - 28 * 30, H0 = 2500;
+    const double yaw = -40, pitch = -75, roll = 3;
+    int32_t q[4];
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_quat_from_ypr(q61(yaw), q61(pitch), q61(roll), q));
+    for (int mode = 0; mode < 2; ++mode) {
+        ct_pose pose;
+        char arg[160];
+        std::string pkgname = mode == 0 ? "t.ctp" : "tu.ctp";
+        const ct_package *pk = mode == 0 ? &s->p : &pu;
+        ct_utm z = {17, 0};
+        if (mode == 0) {
+            TEST_ASSERT_EQUAL_INT(CT_OK, ct_pose_from_map(&pose, std::llround(E0 * 1e9), std::llround(N0 * 1e9),
+                                                          std::llround(H0 * 1e9), q));
+            std::snprintf(arg, sizeof arg, "%.9f,%.9f,%.9f,%g,%g,%g", E0, N0, H0, yaw, pitch, roll);
+        } else {
+            // the geodetic point of the tile's middle (the library's inverse)
+            int64_t la, lo;
+            TEST_ASSERT_EQUAL_INT(CT_OK, ct_utm_inverse(&z, std::llround(E0 * 1e9), std::llround(N0 * 1e9), &la, &lo));
+            long double lat = (long double)la / std::ldexp(1.0L, 61) * 180 / M_PIl;
+            long double lon = (long double)lo / std::ldexp(1.0L, 61) * 180 / M_PIl;
+            std::snprintf(arg, sizeof arg, "%.12Lf,%.12Lf,%.9f,%g,%g,%g", lat, lon, H0, yaw, pitch, roll);
+            TEST_ASSERT_EQUAL_INT(CT_OK, ct_pose_from_wgs84(&pose, &z, q61((double)lat), q61((double)lon),
+                                                           std::llround(H0 * 1e9), q));
+        }
+        Run r = run({"geoloc", pkgname, "--camera", "cam.cameramodel", "--pixels", "pxp.csv",
+                     mode == 0 ? "--pose-map" : "--pose-wgs84", arg, "-o", "gp.csv"});
+        TEST_ASSERT_MSG(r.code == 0, "exit %d: %s", r.code, r.err.c_str());
+        std::vector<std::string> rows = lines_of(slurp(g_dir + "/gp.csv"));
+        TEST_ASSERT_EQUAL_INT(px.size() + 1, rows.size());
+        int hits = 0;
+        for (size_t k = 0; k < px.size(); ++k) {
+            std::vector<std::string> f = split(rows[k + 1]);
+            int64_t uq, vq;
+            ct_geo g;
+            ct_status want = CT_ERR_UNPROJECT;
+            if (ct_host::pixel_to_q16(px[k].u, px[k].v, &uq, &vq))
+                want = ct_geolocate(pk, &lc.cam, &pose, CT_METHOD_DIRECTIONAL, nullptr, uq, vq, &g);
+            check_row(f, mode == 0 ? "--pose-map " : "--pose-wgs84 ", k + 1, want, g, &hits);
+            if (want == CT_HIT && mode == 1) {
+                // lat,lon: forward-projected back onto the hit's E,N
+                long double la = std::stold(f[7]), lo = std::stold(f[8]);
+                int64_t e, n;
+                TEST_ASSERT_EQUAL_INT(CT_OK, ct_utm_forward(&z, q61((double)la), q61((double)lo), &e, &n));
+                TEST_ASSERT_MSG(std::llabs(e - g.hit.e_nm) < 200000 && std::llabs(n - g.hit.n_nm) < 200000,
+                                "row %zu: lat,lon %s,%s are %lld / %lld nm from the hit", k + 1, f[7].c_str(),
+                                f[8].c_str(), (long long)(e - g.hit.e_nm), (long long)(n - g.hit.n_nm));
+            } else if (mode == 0) {
+                TEST_ASSERT(f[7] == "nan" && f[8] == "nan");
+            }
+        }
+        TEST_ASSERT_MSG(hits >= 3, "%s: only %d hits", mode == 0 ? "--pose-map" : "--pose-wgs84", hits);
+    }
+    // bad poses: one line each, non-zero exit, no output
+    const std::vector<std::vector<std::string>> bad = {
+        {"tu.ctp", "--pose-wgs84", "36.1,-60,2500,0,0,0"},   // off zone 17
+        {"tu.ctp", "--pose-wgs84", "95,-81,2500,0,0,0"},     // latitude beyond 90
+        {"tu.ctp", "--pose-wgs84", "36,-81,2500,0,0"},       // five numbers
+        {"tu.ctp", "--pose-wgs84", "36,-81,2500,0,x,0"},     // not a number
+        {"tu.ctp", "--pose-wgs84", "36,-81,2500,0,0,270"},   // angle beyond 180
+        {"t.ctp", "--pose-wgs84", "36,-81,2500,0,0,0"},      // not a UTM package
+    };
+    for (const auto &b : bad) {
+        fs::remove(g_dir + "/gb.csv");
+        Run r = run({"geoloc", b[0], "--camera", "cam.cameramodel", "--pixels", "pxp.csv", b[1], b[2], "-o", "gb.csv"});
+        TEST_ASSERT_MSG(r.code != 0 && r.err_lines.size() == 1, "%s %s: exit %d, stderr '%s'", b[1].c_str(),
+                        b[2].c_str(), r.code, r.err.c_str());
+        TEST_ASSERT(!fs::exists(g_dir + "/gb.csv"));
+    }
+    Run r2 = run({"geoloc", "tu.ctp", "--camera", "cam.cameramodel", "--pixels", "pxp.csv", "--pose-map",
+                  "1,2,3,0,0,0", "--pose-wgs84", "36,-81,2500,0,0,0", "-o", "gb.csv"});
+    TEST_ASSERT(r2.code != 0 && r2.err_lines.size() == 1);
+    fs::remove(g_dir + "/gp.csv");
+    fs::remove(g_dir + "/tu.ctp");
 }
 
 // --effects curvature,refraction with --refraction-k and --earth-radius:
@@ -546,6 +646,7 @@ int main()
     RUN_TEST(test_nm_decimal);
     RUN_TEST(test_geoloc_end_to_end);
     RUN_TEST(test_geoloc_effects);
+    RUN_TEST(test_geoloc_poses);
     RUN_TEST(test_geoloc_threads);
     RUN_TEST(test_geoloc_splined_grid);
     RUN_TEST(test_geoloc_bad_inputs);

@@ -681,6 +681,11 @@ ct_status ct_utm_factors(const ct_utm *zone, int64_t lat_q61, int64_t lon_q61,
 ct_status ct_pose_from_wgs84(ct_pose *pose, const ct_utm *zone, int64_t lat_q61,
                              int64_t lon_q61, int64_t h_nm, const int32_t q_ned_cam_q30[4]);
 
+/* A pose in the map frame with an attitude quaternion (Q30) w.r.t. grid
+ * north, grid east and down (no convergence, no scale: hscale 2^30).      */
+ct_status ct_pose_from_map(ct_pose *pose, int64_t e_nm, int64_t n_nm, int64_t h_nm,
+                           const int32_t q_ned_cam_q30[4]);
+
 /* The attitude quaternion (Q30) of aerospace yaw, pitch, roll (Z-Y-X, Q61
  * radians, |.| <= pi) for a camera whose mrcal axes x right, y down, z
  * forward point east, down, north at zero; yaw turns it clockwise seen

@@ -518,38 +518,27 @@ ct_status ct_quat_from_ypr(int64_t yaw_q61, int64_t pitch_q61, int64_t roll_q61,
     return CT_OK;
 }
 
-ct_status ct_pose_from_wgs84(ct_pose *pose, const ct_utm *zone, int64_t lat_q61, int64_t lon_q61, int64_t h_nm,
-                             const int32_t qin[4])
+/* The pose for attitude quaternion q (Q30, NED) with grid north at
+ * convergence (sin, cos: Q30) from true north, the centre (e, n, h). */
+static ct_status pose_from_q(ct_pose *pose, const int32_t qin[4], int64_t sg, int64_t cg, int64_t e, int64_t n,
+                             int64_t h_nm)
 {
-    int64_t e, n, g, k, w, x, y, zq, n2, sg, cg, sphi, cphi, hs;
+    int64_t w = qin[0], x = qin[1], y = qin[2], zq = qin[3];
     int64_t ned[9]; /* R_ned_cam, Q30 */
     int32_t R[9];
-    ct_status st;
     int i;
-    CT_ASSERT(pose != NULL && zone != NULL && qin != NULL);
-    if (pose == NULL || zone == NULL || qin == NULL) {
-        return CT_ERR_ARG;
-    }
-    pose->ready = 0u;
-    w = qin[0];
-    x = qin[1];
-    y = qin[2];
-    zq = qin[3];
     /* |q|^2 = 2^60 within 2^40 (components <= 2^31: squares < 2^62,
      * their sum < 2^64 -- formed unsigned) */
     {
         uint64_t s2 = (uint64_t)(w * w) + (uint64_t)(x * x) + (uint64_t)(y * y) + (uint64_t)(zq * zq);
         uint64_t one = (uint64_t)1 << 60;
         if ((s2 > one ? s2 - one : one - s2) > ((uint64_t)1 << 40)) {
+            pose->ready = 0u;
             return CT_ERR_POSE;
         }
     }
-    st = forward(zone, lat_q61, lon_q61, &e, &n, &g, &k);
-    if (st != CT_OK) {
-        return st;
-    }
-    /* R_ned_cam from q (rotating camera vectors into NED), Q30: entries
-     * 2^30 - 2 (y^2 + z^2) / 2^30 ..., products < 2^62 */
+    /* R_ned_cam from q (rotating camera vectors into NED), Q30; products
+     * < 2^62 */
     ned[0] = (INT64_C(1) << 30) - shr30(2 * (y * y + zq * zq));
     ned[1] = shr30(2 * (x * y - w * zq));
     ned[2] = shr30(2 * (x * zq + w * y));
@@ -562,16 +551,40 @@ ct_status ct_pose_from_wgs84(ct_pose *pose, const ct_utm *zone, int64_t lat_q61,
     /* map = (grid east, grid north, up): east' = E cos g - N sin g,
      * north' = E sin g + N cos g (true north lies at grid azimuth -g), up =
      * -down; E = ned row 1, N = ned row 0 */
-    qsincos(q61_to_59(g), &sg, &cg);
-    sg = q59_to_30(sg);
-    cg = q59_to_30(cg);
     for (i = 0; i < 3; ++i) { /* bound: 3 columns (camera axes) */
         int64_t nn = ned[i], ee = ned[3 + i], dd = ned[6 + i];
         R[i] = (int32_t)shr30(ee * cg - nn * sg);
         R[3 + i] = (int32_t)shr30(ee * sg + nn * cg);
         R[6 + i] = (int32_t)(-dd);
     }
-    st = ct_pose_init(pose, R, e, n, h_nm);
+    return ct_pose_init(pose, R, e, n, h_nm);
+}
+
+ct_status ct_pose_from_map(ct_pose *pose, int64_t e_nm, int64_t n_nm, int64_t h_nm, const int32_t q[4])
+{
+    CT_ASSERT(pose != NULL && q != NULL);
+    if (pose == NULL || q == NULL) {
+        return CT_ERR_ARG;
+    }
+    return pose_from_q(pose, q, 0, INT64_C(1) << 30, e_nm, n_nm, h_nm);
+}
+
+ct_status ct_pose_from_wgs84(ct_pose *pose, const ct_utm *zone, int64_t lat_q61, int64_t lon_q61, int64_t h_nm,
+                             const int32_t qin[4])
+{
+    int64_t e, n, g, k, n2, sg, cg, sphi, cphi, hs;
+    ct_status st;
+    CT_ASSERT(pose != NULL && zone != NULL && qin != NULL);
+    if (pose == NULL || zone == NULL || qin == NULL) {
+        return CT_ERR_ARG;
+    }
+    pose->ready = 0u;
+    st = forward(zone, lat_q61, lon_q61, &e, &n, &g, &k);
+    if (st != CT_OK) {
+        return st;
+    }
+    qsincos(q61_to_59(g), &sg, &cg);
+    st = pose_from_q(pose, qin, q59_to_30(sg), q59_to_30(cg), e, n, h_nm);
     if (st != CT_OK) {
         return st;
     }
