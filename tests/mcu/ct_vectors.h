@@ -114,6 +114,12 @@ typedef struct {
     int64_t lat2_q61, lon2_q61;           /* ct_utm_inverse(e_nm, n_nm)      */
     ct_status fac_status;
     int64_t gamma_q61, k_q61;             /* ct_utm_factors(lat, lon)        */
+    int64_t ypr_q61[3], h_nm;
+    ct_status quat_status;
+    int32_t q_q30[4];                     /* ct_quat_from_ypr(ypr)           */
+    ct_status pose_status;
+    int32_t R_q30[9];                     /* ct_pose_from_wgs84(lat, lon, h, q) */
+    int32_t hscale_q30;
 } ct_vec_geo;
 
 typedef struct {

@@ -1001,15 +1001,36 @@ int main(int argc, char **argv)
             }
             v.inv_status = ct_utm_inverse(&v.zone, v.e_nm, v.n_nm, &v.lat2_q61, &v.lon2_q61);
             v.fac_status = ct_utm_factors(&v.zone, v.lat_q61, v.lon_q61, &v.gamma_q61, &v.k_q61);
+            for (int a = 0; a < 3; ++a)
+                v.ypr_q61[a] = (int64_t)((long double)((int64_t)(gg.u64() % 2000001u) - 1000000) * 1e-6L *
+                                         3.14159265358979323846264338L * std::ldexp(1.0L, 61));
+            v.h_nm = (int64_t)(gg.u64() % 20000000u) * INT64_C(1000000) - INT64_C(1000000000000);
+            v.quat_status = ct_quat_from_ypr(v.ypr_q61[0], v.ypr_q61[1], v.ypr_q61[2], v.q_q30);
+            {
+                ct_pose pose{};
+                v.pose_status = ct_pose_from_wgs84(&pose, &v.zone, v.lat_q61, v.lon_q61, v.h_nm, v.q_q30);
+                if (v.pose_status == CT_OK) {
+                    for (int a = 0; a < 9; ++a) v.R_q30[a] = pose.R_map_cam_q30[a];
+                    v.hscale_q30 = pose.hscale_q30;
+                }
+            }
             geo.push_back(v);
         }
     }
     std::fprintf(f, "static const ct_vec_geo geo[%zu] = {\n", geo.size());
     for (const ct_vec_geo &v : geo)
-        std::fprintf(f, "  {{%d, %d}, %s, %s, %d, %s, %s, %d, %s, %s, %d, %s, %s},\n", (int)v.zone.zone,
+    {
+        std::fprintf(f, "  {{%d, %d}, %s, %s, %d, %s, %s, %d, %s, %s, %d, %s, %s,\n   {%s, %s, %s}, %s, %d, {", (int)v.zone.zone,
                      (int)v.zone.south, i64(v.lat_q61).c_str(), i64(v.lon_q61).c_str(), (int)v.fwd_status,
                      i64(v.e_nm).c_str(), i64(v.n_nm).c_str(), (int)v.inv_status, i64(v.lat2_q61).c_str(),
-                     i64(v.lon2_q61).c_str(), (int)v.fac_status, i64(v.gamma_q61).c_str(), i64(v.k_q61).c_str());
+                     i64(v.lon2_q61).c_str(), (int)v.fac_status, i64(v.gamma_q61).c_str(), i64(v.k_q61).c_str(),
+                     i64(v.ypr_q61[0]).c_str(), i64(v.ypr_q61[1]).c_str(), i64(v.ypr_q61[2]).c_str(),
+                     i64(v.h_nm).c_str(), (int)v.quat_status);
+        for (int a = 0; a < 4; ++a) std::fprintf(f, "%s, ", i32(v.q_q30[a]).c_str());
+        std::fprintf(f, "}, %d, {", (int)v.pose_status);
+        for (int a = 0; a < 9; ++a) std::fprintf(f, "%s, ", i32(v.R_q30[a]).c_str());
+        std::fprintf(f, "}, %s},\n", i32(v.hscale_q30).c_str());
+    }
     std::fprintf(f, "};\n\n");
     std::fprintf(f,
                  "const ct_vec_set ct_vectors = {packages, %zuu, fixed, %zuu, dirs, %zuu, \"%s\", cameras, %zuu, geo, "

@@ -495,6 +495,22 @@ static void check_fixed(const ct_vec_set *vs)
             eq_i64("utm gamma", v->gamma_q61, la);
             eq_i64("utm k", v->k_q61, lo);
         }
+        {
+            int32_t q[4] = {0, 0, 0, 0};
+            ct_pose pose;
+            uint32_t a;
+            eq_i64("quat status", v->quat_status, ct_quat_from_ypr(v->ypr_q61[0], v->ypr_q61[1], v->ypr_q61[2], q));
+            for (a = 0u; a < 4u; ++a) { /* bound: 4 */
+                eq_i64("quat", v->q_q30[a], q[a]);
+            }
+            eq_i64("pose status", v->pose_status, ct_pose_from_wgs84(&pose, &v->zone, v->lat_q61, v->lon_q61, v->h_nm, v->q_q30));
+            if (v->pose_status == CT_OK) {
+                for (a = 0u; a < 9u; ++a) { /* bound: 9 */
+                    eq_i64("pose R", v->R_q30[a], pose.R_map_cam_q30[a]);
+                }
+                eq_i64("pose hscale", v->hscale_q30, pose.hscale_q30);
+            }
+        }
     }
     g_where = "status names";
     for (k = 0u; k < 31u; ++k) {
@@ -521,7 +537,7 @@ int main(void)
         check_fixed(vs);
         put_str("  fixed point, directions, UTM (");
         put_u64(vs->ngeo);
-        put_str(" points forward and back): ");
+        put_str(" points: forward, inverse, factors, geodetic poses): ");
         put_u64(g_fail - before);
         put_str(" mismatching fields");
         flush_line();
