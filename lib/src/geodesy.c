@@ -412,11 +412,14 @@ ct_status ct_utm_inverse(const ct_utm *z, int64_t e_nm, int64_t n_nm, int64_t *l
     if (z == NULL || lat_q61 == NULL || lon_q61 == NULL || z->zone < 1 || z->zone > 60) {
         return CT_ERR_ARG;
     }
+    if (ct_abs64(e_nm) > (INT64_C(1) << 60) || ct_abs64(n_nm) > (INT64_C(1) << 60)) {
+        return CT_ERR_RANGE; /* far off any zone; keeps the differences below in range */
+    }
     de = e_nm - INT64_C(500000000000000);
     dn = n_nm - (z->south ? INT64_C(10000000000000000) : 0);
-    /* |de| <= 1100 km (eta <= 0.173), |dn| <= 9,400 km (lat <= 84.5 deg):
-     * d 2^67 < 2^120, quotients < 2^62 */
-    if (ct_abs64(de) > INT64_C(1100000000000000) || ct_abs64(dn) > INT64_C(9400000000000000)) {
+    /* |de| <= 1100 km (eta <= 0.173), |dn| <= 9,500 km (xi < 1.5; lat
+     * 84.5 deg is at 9,390 km): d 2^67 < 2^120, quotients < 2^62 */
+    if (ct_abs64(de) > INT64_C(1100000000000000) || ct_abs64(dn) > INT64_C(9500000000000000)) {
         return CT_ERR_RANGE;
     }
     xi = ct_i128_floor_div(ct_i128_shl(ct_i128_shl(ct_i128_from64(dn), QB), 8u), TM_K0A_NM_Q8);
@@ -434,7 +437,10 @@ ct_status ct_utm_inverse(const ct_utm *z, int64_t e_nm, int64_t n_nm, int64_t *l
     }
     tp = qdiv(sxi, r);
     lam = qatan2(sheta, cxi);
-    if (ct_abs64(lam) > CT_UTM_MAX_DLON_DEG * TM_DEG_Q59 || ct_abs64(tp) > 10 * ONE) {
+    /* the forward domain (|lat| <= 84.5 deg: tau' < 10.4; <= 9 deg from the
+     * meridian) with a margin, so that every point it maps inverts; tau' <
+     * 10.5 keeps qhypot's arguments below 11.3 */
+    if (ct_abs64(lam) > CT_UTM_MAX_DLON_DEG * TM_DEG_Q59 + TM_DEG_Q59 / 64 || ct_abs64(tp) > 10 * ONE + ONE / 2) {
         return CT_ERR_RANGE;
     }
     phi = qatan2(tau_of_taup(tp), ONE);

@@ -12,7 +12,13 @@
  *   mode 1 (package): edits (u16 offset, u8 value) applied to a copy of the
  *                     package, its CRC re-stamped (unless bit 7 of byte 1
  *                     is set), then ct_package_open / ct_package_verify and
- *                     a few rays from the bytes that follow the edits.
+ *                     a few rays from the bytes that follow the edits;
+ *   mode 3 (geodesy, byte 0 = 3 mod 4): int64 lat, lon, e, n, yaw, pitch,
+ *                     roll, h and a zone byte through ct_utm_forward,
+ *                     ct_utm_inverse, ct_utm_factors, ct_quat_from_ypr and
+ *                     ct_pose_from_wgs84: documented statuses only, and
+ *                     where the forward projection succeeds, its inverse
+ *                     succeeds and projects back to the same nanometre.
  * Contracts asserted (abort on violation):
  *   - every status is one the API documents for the call;
  *   - on a package that opens and verifies, the four methods return the same
@@ -206,6 +212,64 @@ static void package_mode(const ct_vec_package *vp, int stamp_crc, const uint8_t 
     }
 }
 
+static void geodesy_mode(const uint8_t *d, size_t n)
+{
+    size_t pos = 0u;
+    int64_t v[8], e, nn, la, lo, g, k;
+    int32_t q[4];
+    ct_utm z;
+    ct_pose pose;
+    ct_status s;
+    int i;
+    for (i = 0; i < 8; ++i) { /* bound: 8 values */
+        v[i] = rd64(d, n, &pos);
+    }
+    z.zone = pos < n ? (int32_t)(d[pos] % 64u) : 17;
+    z.south = pos + 1u < n ? (int32_t)(d[pos + 1u] & 1u) : 0;
+    /* arbitrary values, and values scaled into the domain (most arbitrary
+     * int64 angles are out of range) */
+    for (i = 0; i < 2; ++i) { /* bound: 2 passes */
+        int64_t lat = i == 0 ? v[0] : v[0] % CT_UTM_MAX_LAT_Q61;
+        int64_t lon = i == 0 ? v[1] : (int64_t)(6 * z.zone - 183) * INT64_C(40244552544872904) + v[1] % (INT64_C(40244552544872904) * 10);
+        s = ct_utm_forward(&z, lat, lon, &e, &nn);
+        CHECK(s == CT_OK || s == CT_ERR_RANGE || s == CT_ERR_ARG);
+        if (s == CT_OK) {
+            /* the round trip, away from the domain's edge (within 2^-40 rad
+             * of it the inverse may come back a few Q59 units outside) */
+            const int64_t deg = INT64_C(40244552544872904), edge = INT64_C(1) << 21;
+            int64_t dl = lon - (int64_t)(6 * z.zone - 183) * deg;
+            int64_t e2, n2;
+            while (dl > 180 * deg) { /* bound: |lon| <= pi after the forward's check */
+                dl -= 360 * deg;
+            }
+            while (dl < -180 * deg) { /* bound: as above */
+                dl += 360 * deg;
+            }
+            s = ct_utm_inverse(&z, e, nn, &la, &lo);
+            CHECK(s == CT_OK);
+            s = ct_utm_forward(&z, la, lo, &e2, &n2);
+            if ((dl < 0 ? -dl : dl) < CT_UTM_MAX_DLON_DEG * deg - edge &&
+                (lat < 0 ? -lat : lat) < CT_UTM_MAX_LAT_Q61 - edge) {
+                CHECK(s == CT_OK);
+                CHECK(e2 - e <= 1 && e - e2 <= 1 && n2 - nn <= 1 && nn - n2 <= 1);
+            } else {
+                CHECK(s == CT_OK || s == CT_ERR_RANGE);
+            }
+            CHECK(ct_utm_factors(&z, lat, lon, &g, &k) == CT_OK);
+            CHECK(k > INT64_C(2300000000000000000) && k < INT64_C(2340000000000000000)); /* 0.9975..1.015 */
+        }
+        s = ct_utm_inverse(&z, v[2], v[3], &la, &lo);
+        CHECK(s == CT_OK || s == CT_ERR_RANGE || s == CT_ERR_ARG);
+        s = ct_quat_from_ypr(v[4] % (i == 0 ? INT64_MAX : CT_PI_Q61), v[5] % (i == 0 ? INT64_MAX : CT_PI_Q61),
+                             v[6] % (i == 0 ? INT64_MAX : CT_PI_Q61), q);
+        CHECK(s == CT_OK || s == CT_ERR_RANGE);
+        if (s == CT_OK) {
+            s = ct_pose_from_wgs84(&pose, &z, lat, lon, v[7], q);
+            CHECK(s == CT_OK || s == CT_ERR_RANGE || s == CT_ERR_ARG || s == CT_ERR_POSE);
+        }
+    }
+}
+
 int LLVMFuzzerTestOneInput(const uint8_t *d, size_t n);
 int LLVMFuzzerTestOneInput(const uint8_t *d, size_t n)
 {
@@ -219,7 +283,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *d, size_t n)
     if (vp->size > sizeof g_buf) {
         return 0;
     }
-    if ((d[0] & 1u) == 0u) {
+    if ((d[0] & 3u) == 3u) {
+        geodesy_mode(d + 2, n - 2u);
+    } else if ((d[0] & 1u) == 0u) {
         ray_mode(vp, idx, d + 2, n - 2u);
     } else {
         package_mode(vp, (d[1] & 0x80u) == 0u, d + 2, n - 2u);
