@@ -19,6 +19,7 @@ struct Georef {
     double origin_e = 0.0, origin_n = 0.0;  // metres, top-left corner of pixel (0,0)
     double posting_e = 30.0, posting_n = -30.0;  // metres; |e| == |n|
     int epsg = 0;                                // 0 = unknown
+    int source_epsg = 0;  // the source DEM's CRS when it was resampled onto epsg (0: not resampled)
 };
 
 struct Terrain {
