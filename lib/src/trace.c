@@ -30,8 +30,8 @@
  * Exactness: whether the ray meets the surface in a cell is decided with
  * exact integer arithmetic (the sign of f = z_ray - S at cell faces in
  * 64-bit; the interior minimum of the quadratic f in 128-bit).  Only the
- * reported hit position is rounded: the root is computed to 2^-32 of the
- * cell and the position reported at t_q26 = floor(t * 2^26).
+ * reported hit position is rounded: the root is computed to 2^-60 of the
+ * cell (W_BITS) and the position reported at t_q26 = floor(t * 2^26).
  */
 #include "bend.h"
 #include "conetrace.h"
@@ -171,7 +171,6 @@ static int32_t axis_cell(int64_t num, int64_t den16, int32_t s, int32_t ncell)
     return (int32_t)k;
 }
 
-/* Cell holding the ray at t.  ox*d < 2^31 * 2^26, n*dx < 2^60. */
 /* Cell index for a Q26 t (den 2^42): shifts instead of divisions. */
 static int32_t axis_cell_q26(int64_t num, int32_t s, int32_t ncell)
 {
@@ -192,6 +191,7 @@ static int32_t axis_cell_q26(int64_t num, int32_t s, int32_t ncell)
     return (int32_t)k;
 }
 
+/* Cell holding the ray at t.  ox*d < 2^31 * 2^26, n*dx < 2^60. */
 static void locate(const ctx *c, rt t, int32_t *i, int32_t *j)
 {
     if (t.d == T_ONE) {
@@ -710,9 +710,9 @@ static ct_i128 sar128(ct_i128 a, unsigned n)
 
 /* The hit's position only (the decision above is exact): the coefficients
  * scaled by one power of two into make_quad's ranges (|A|, |B|, |C| <
- * 2^59), which moves the root by far less than its 2^-32 cell resolution
- * except where the ray is tangent to the surface; root_t_q26 clamps it to
- * [tin, tout] exactly either way. */
+ * 2^59), which moves the root by far less than the reported position's
+ * resolution (t_q26, Q16 cells) except where the ray is tangent to the
+ * surface; root_t_q26 clamps it to [tin, tout] exactly either way. */
 static int64_t root_low(const ctx *c, wquad *W, rt tin, rt tout)
 {
     ct_i128 m = abs128(W->A);
