@@ -3,7 +3,8 @@
 //
 // For every coarse cell F (closed footprint of r x r fine cells), apex a =
 // the tallest corner over F (rounded up to a slice level when K > 0), and
-// every sector s, the opening angle must satisfy DESIGN.md's promise:
+// every sector s, the opening angle must satisfy the cone promise
+// (docs/builders.md):
 //   S(q) <= a + rho_s(q) * cot(omega)   for every terrain point q,
 // rho_s(q) = min |q - p| over p in F with q - p in the closed wedge W_s.
 // We bound sup_q (S(q) - a) / rho_s(q) from above (all in grid units: LSB
@@ -21,8 +22,8 @@
 //  below  for cells not higher than a: (hmax(Q) - a) / far_s(F, Q) <= 0.
 // Cells whose intersection with F (+) W_s has zero area are skipped: their
 // points in the region are limits of points of neighbouring cells that do
-// count (DESIGN.md pitfall: "a neighbour that only shares an edge or a
-// corner ... must not count").  The far/below maxima are found by
+// count (docs/builders.md, the cone promise: "a neighbour that only shares
+// an edge or a corner ... must not count").  The far/below maxima are found by
 // best-first branch and bound over a max pyramid.  The angle code is then
 // the widest whose tracer cot (lib's ct_cot_table, rounded up) is >= the
 // bound plus a margin for double rounding.

@@ -1,8 +1,8 @@
 // builder_common.hpp -- geometry shared by the PPT builders (host, C++17):
 // exact sector (wedge) tests on integer vectors, distances from a coarse
 // cell's footprint to a rectangle within a wedge, the max pyramid, the
-// bilinear patches' directional slopes (the "near" term of DESIGN.md's
-// promise) and the angle-code choice.  Units: fine cells horizontally, height
+// bilinear patches' directional slopes (the "near" term of the cone
+// promise, docs/builders.md) and the angle-code choice.  Units: fine cells horizontally, height
 // LSB vertically.  Internal to host_tools (builder_brute.cpp,
 // builder_slices.cpp).
 #pragma once

@@ -1,6 +1,7 @@
 // builder_slices.cpp -- the paper's PPT builder (Paglieroni 1997, sec. 2.3):
 // directional distance transforms of horizontal cross-sections, processed
-// bottom-up one slice at a time, made conservative for DESIGN.md's promise.
+// bottom-up one slice at a time, made conservative for the cone promise
+// (docs/builders.md).
 //
 // Grid: coarse cells G (r x r fine cells, height Hc(G) = max over its fine
 // cells of the tallest corner).  Levels L_0 < L_1 < ... < L_K (integer height
@@ -10,7 +11,7 @@
 //
 // The needed cot C(F, s) (LSB per fine cell) must bound (S(q) - a) / rho_s(q)
 // for every terrain point q with S(q) > a, rho_s(q) = min |q - p| over p in
-// F's footprint with q - p in the closed wedge W_s (DESIGN.md).  Three parts,
+// F's footprint with q - p in the closed wedge W_s (docs/builders.md).  Three parts,
 // each a valid bound for the points it covers:
 //  near    rho_s(q) <= K_NEAR: the surface's directional slopes (shared with
 //          the brute-force builder, builder_common.hpp);

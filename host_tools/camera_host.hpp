@@ -66,7 +66,7 @@ struct BakedGrid {
 BakedGrid bake_grid(const CameraModel &m, double step_px);
 
 // Default grid step for models the library has no closed form for (see
-// README "Geolocation": accuracy vs step).
+// docs/geolocation.md, "Unprojection grids": accuracy vs step).
 constexpr double kDefaultGridStepPx = 16.0;
 
 // A camera ready for the library: lens checked by ct_camera_init (PINHOLE,

@@ -40,7 +40,8 @@ typedef long double ld;
 
 namespace {
 
-// Bounds stated in README "Geolocation" (measured values printed below).
+// Bounds stated in docs/geolocation.md, "Measured accuracy" (measured values
+// printed below).
 const double ANGLE_TOL_RAD = 2.5e-9;   // ours vs mrcal_unproject (well conditioned)
 const double REPROJ_TOL_PX = 3e-5;     // mrcal_project(our ray) vs pixel
 const double PROJECT_TOL_PX = 2e-5;    // ct_camera_project vs mrcal_project
@@ -508,7 +509,7 @@ double grid_error(const ct_host::CameraModel &m, double step, int n, long *refus
 
 void test_grid_accuracy_vs_step()
 {
-    const double GRID16_TOL_RAD = 3e-7;  // at a 16 px step (README)
+    const double GRID16_TOL_RAD = 3e-7;  // at a 16 px step (docs/geolocation.md)
     for (const ct_host::CameraModel &m : {opencv8_wide_model(), splined_model()}) {
         double prev = 0;
         for (double step : {64.0, 32.0, 16.0, 8.0, 4.0}) {

@@ -3,8 +3,9 @@
 // ct_ray_prepare clips the caller's ray to the tile's box with exact
 // rationals, rounds the entry point to Q16 (z to units of 2^zshift Q16) and
 // scales the direction (x, y, z / 2^zshift) so its largest component is
-// 2^26 - 1 or 2^26.  The README states the resulting bound: a point of the
-// prepared ray at parameter t lies within
+// 2^26 - 1 or 2^26.  docs/library.md ("Exactness and the error bound")
+// states the resulting bound: a point of the prepared ray at parameter t
+// lies within
 //     | (u_x (1/2 + c t), u_y (1/2 + c t), u_z ((2^k + 1)/2 + 2^k c t)) |
 // metres of the caller's line (u: metres per Q16 unit, k = zshift,
 // c = 1/2 + 2^-6: each direction component's rounding), which keeps it within

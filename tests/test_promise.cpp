@@ -1,4 +1,4 @@
-// test_promise.cpp -- DESIGN.md's promise checked directly.
+// test_promise.cpp -- the cone promise (docs/builders.md) checked directly.
 //
 // For every coarse cell F, sector s and fine cell Q of small DEMs, and every
 // point q of Q reachable from F in the closed wedge W_s, the package as the

@@ -27,7 +27,8 @@
 //     (distortion: the same camera as a pinhole) fails the acceptance above
 //     (the effect is needed), and each effect the scene does not list
 //     (curvature, refraction), if simulated, would pass it (the omission is
-//     justified).  The table is printed (README "Geolocation").
+//     justified).  The table is printed (docs/geolocation.md, "Scenes,
+//     accuracy and the error budget").
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
