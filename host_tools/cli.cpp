@@ -28,6 +28,7 @@
 #include "emit_c.hpp"
 #include "host_io.hpp"
 #include "terrain.hpp"
+#include "warp.hpp"
 
 using namespace ct_host;
 
@@ -40,6 +41,7 @@ void print_usage(std::FILE *f)
                  "                       [--height-scale M] [--posting M] [--threads T]\n"
                  "                       [--builder slices|brute] [--window R] [--levels H1,H2,...]\n"
                  "                       [--emit-c NAME]\n"
+                 "                       [--utm ZONE{N|S}]   (geographic DEMs: resampled onto UTM at --posting M)\n"
                  "       conetrace info PKG\n"
                  "       conetrace trace PKG --rays rays.csv [--method M] [--threads T] -o hits.csv\n"
                  "       conetrace demo DEM\n"
@@ -118,16 +120,22 @@ ct_method parse_method(const std::string &m)
     usage("unknown method '" + m + "'");
 }
 
-Terrain load_terrain(const std::string &path, double posting, double hscale)
+Terrain load_terrain(const std::string &path, double posting, double hscale,
+                     const WarpOptions &utm = WarpOptions(), std::string *resampled = nullptr)
 {
-    DemRaster r = read_dem(path);
+    // a DEM on a geographic CRS (with --utm: on any CRS but that zone) is resampled onto UTM
+    const bool warp = dem_needs_warp(path, utm);
+    WarpOptions w = utm;
+    w.posting_m = posting;
+    DemRaster r = warp ? warp_dem(path, w) : read_dem(path);
+    if (warp && resampled) *resampled = " (" + warp_summary(r) + ")";
     Georef g = r.geo;
     if (!r.has_georef) {
         if (posting <= 0) throw Error(path + ": no georeference in the file; give --posting METRES");
         g = Georef{};
         g.posting_e = posting;
         g.posting_n = -posting;
-    } else if (posting > 0) {
+    } else if (posting > 0 && !warp) {
         g.posting_e = std::copysign(posting, g.posting_e);
         g.posting_n = std::copysign(posting, g.posting_n);
     }
@@ -141,7 +149,7 @@ Terrain load_terrain(const std::string &path, double posting, double hscale)
 int cmd_build(int argc, char **argv)
 {
     Args a = parse(argc, argv, 2,
-                   {"-o", "--sectors", "--reduce", "--slices", "--height-scale", "--posting", "--threads", "--emit-c", "--builder", "--window", "--levels"});
+                   {"-o", "--sectors", "--reduce", "--slices", "--height-scale", "--posting", "--threads", "--emit-c", "--builder", "--window", "--levels", "--utm"});
     if (a.pos.size() != 1) usage("build needs exactly one DEM file");
     if (!a.opt.count("-o")) usage("build needs -o OUT.ctp");
     BuildOptions o;
@@ -177,7 +185,16 @@ int cmd_build(int argc, char **argv)
     if (a.opt.count("--emit-c") && !is_c_identifier(a.opt["--emit-c"]))
         usage("--emit-c " + a.opt["--emit-c"] + ": not a C identifier (letters, digits, _; at most 31)");
     auto t0 = std::chrono::steady_clock::now();
-    Terrain t = load_terrain(a.pos[0], to_double(a, "--posting", 0), to_double(a, "--height-scale", 0));
+    WarpOptions utm;
+    if (a.opt.count("--utm")) {
+        try {
+            parse_utm_zone(a.opt["--utm"], &utm);
+        } catch (const Error &e) {
+            throw Error(std::string("--utm: ") + e.what());
+        }
+    }
+    std::string resampled;
+    Terrain t = load_terrain(a.pos[0], to_double(a, "--posting", 0), to_double(a, "--height-scale", 0), utm, &resampled);
     Progress bar("building cones");
     o.progress = [&](size_t d, size_t n) { bar.update(d, n); };
     BuildStats st;
@@ -211,9 +228,9 @@ int cmd_build(int argc, char **argv)
                       st.seconds_dt);
         how = buf;
     }
-    std::printf("%s: %dx%d posts, %d sectors, r=%d, package %zu bytes (%.2fx the 16-bit DEM), "
+    std::printf("%s: %dx%d posts%s, %d sectors, r=%d, package %zu bytes (%.2fx the 16-bit DEM), "
                 "%.1f%% degenerate cones, built in %.2f s (%s), working memory %.1f MB (%.2fx the DEM)\n",
-                out.c_str(), t.width, t.height, o.sectors, o.reduce, st.bytes, (double)st.bytes / dem_bytes,
+                out.c_str(), t.width, t.height, resampled.c_str(), o.sectors, o.reduce, st.bytes, (double)st.bytes / dem_bytes,
                 100.0 * st.degenerate_cones / std::max<size_t>(1, st.cones), secs, how.c_str(), work / 1e6,
                 work / dem_bytes);
     return 0;

@@ -6,7 +6,8 @@ PKGS="cmake make g++ gcc clang libclang-rt-14-dev valgrind
       libopenimageio-dev libgeotiff-dev libtiff-dev
       gcc-arm-none-eabi libnewlib-arm-none-eabi qemu-system-arm
       libembree-dev python3-numpy python3-mpmath python-matplotlib-data
-      libmrcal-dev python3-opencv pkg-config gcovr libproj-dev proj-data"
+      libmrcal-dev python3-opencv pkg-config gcovr libproj-dev proj-data
+      libgdal-dev gdal-bin"
 missing=""
 for p in $PKGS; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"
