@@ -28,6 +28,7 @@
 #include "emit_c.hpp"
 #include "host_io.hpp"
 #include "terrain.hpp"
+#include "vdatum.hpp"
 #include "warp.hpp"
 
 using namespace ct_host;
@@ -40,7 +41,7 @@ void print_usage(std::FILE *f)
                  "usage: conetrace build DEM -o OUT.ctp [--sectors N] [--reduce r] [--slices K]\n"
                  "                       [--height-scale M] [--posting M] [--threads T]\n"
                  "                       [--builder slices|brute] [--window R] [--levels H1,H2,...]\n"
-                 "                       [--emit-c NAME]\n"
+                 "                       [--emit-c NAME] [--vdatum egm96|ellipsoid|unknown]\n"
                  "                       [--utm ZONE{N|S}]   (geographic DEMs: resampled onto UTM at --posting M)\n"
                  "       conetrace info PKG\n"
                  "       conetrace trace PKG --rays rays.csv [--method M] [--threads T] -o hits.csv\n"
@@ -120,7 +121,7 @@ ct_method parse_method(const std::string &m)
     usage("unknown method '" + m + "'");
 }
 
-Terrain load_terrain(const std::string &path, double posting, double hscale,
+Terrain load_terrain(const std::string &path, double posting, double hscale, int vdatum = CT_VDATUM_UNKNOWN,
                      const WarpOptions &utm = WarpOptions(), std::string *resampled = nullptr)
 {
     // a DEM on a geographic CRS (with --utm: on any CRS but that zone) is resampled onto UTM
@@ -140,7 +141,12 @@ Terrain load_terrain(const std::string &path, double posting, double hscale,
         g.posting_n = std::copysign(posting, g.posting_n);
     }
     try {
-        return terrain_from_heights(r.width, r.height, r.h, r.valid, g, hscale);
+        GeoidGrid geoid;
+        apply_vdatum(r.h, r.valid, r.width, r.height, g, vdatum, geoid);  // heights -> ellipsoidal
+        Terrain t = terrain_from_heights(r.width, r.height, r.h, r.valid, g, hscale);
+        t.vdatum = vdatum;
+        t.geoid = std::move(geoid);
+        return t;
     } catch (const Error &e) {
         throw Error(path + ": " + e.what());
     }
@@ -149,7 +155,7 @@ Terrain load_terrain(const std::string &path, double posting, double hscale,
 int cmd_build(int argc, char **argv)
 {
     Args a = parse(argc, argv, 2,
-                   {"-o", "--sectors", "--reduce", "--slices", "--height-scale", "--posting", "--threads", "--emit-c", "--builder", "--window", "--levels", "--utm"});
+                   {"-o", "--sectors", "--reduce", "--slices", "--height-scale", "--posting", "--threads", "--emit-c", "--builder", "--window", "--levels", "--vdatum", "--utm"});
     if (a.pos.size() != 1) usage("build needs exactly one DEM file");
     if (!a.opt.count("-o")) usage("build needs -o OUT.ctp");
     BuildOptions o;
@@ -185,6 +191,14 @@ int cmd_build(int argc, char **argv)
     if (a.opt.count("--emit-c") && !is_c_identifier(a.opt["--emit-c"]))
         usage("--emit-c " + a.opt["--emit-c"] + ": not a C identifier (letters, digits, _; at most 31)");
     auto t0 = std::chrono::steady_clock::now();
+    int vdatum = CT_VDATUM_UNKNOWN;
+    if (a.opt.count("--vdatum")) {
+        try {
+            vdatum = parse_vdatum(a.opt["--vdatum"]);
+        } catch (const Error &e) {
+            usage(std::string("--vdatum: ") + e.what());
+        }
+    }
     WarpOptions utm;
     if (a.opt.count("--utm")) {
         try {
@@ -194,7 +208,8 @@ int cmd_build(int argc, char **argv)
         }
     }
     std::string resampled;
-    Terrain t = load_terrain(a.pos[0], to_double(a, "--posting", 0), to_double(a, "--height-scale", 0), utm, &resampled);
+    Terrain t = load_terrain(a.pos[0], to_double(a, "--posting", 0), to_double(a, "--height-scale", 0), vdatum, utm,
+                             &resampled);
     Progress bar("building cones");
     o.progress = [&](size_t d, size_t n) { bar.update(d, n); };
     BuildStats st;
@@ -257,6 +272,14 @@ int cmd_info(int argc, char **argv)
     std::printf("origin        E %.9f N %.9f (corner of pixel 0,0)\n", p.origin_e_nm * 1e-9, p.origin_n_nm * 1e-9);
     std::printf("posting       %.9f x %.9f m\n", p.posting_e_nm * 1e-9, p.posting_n_nm * 1e-9);
     std::printf("epsg          %u\nvoids         %s\n", p.epsg, p.voids ? "yes" : "no");
+    if (p.source_epsg != 0) std::printf("resampled     from EPSG:%u\n", p.source_epsg);
+    if (p.vdatum == CT_VDATUM_UNKNOWN)
+        std::printf("vertical      unknown datum (heights as in the DEM)\n");
+    else
+        std::printf("vertical      WGS84 ellipsoidal heights (the DEM's were %s)\n",
+                    p.vdatum == CT_VDATUM_EGM96 ? "above the EGM96 geoid" : "ellipsoidal");
+    if (p.geoid.w > 0)
+        std::printf("geoid         EGM96, %u x %u nodes every %.4g deg\n", p.geoid.w, p.geoid.h, (double)p.geoid.step_q61 / 2305843009213693952.0 * 180 / M_PI);
     std::printf("degenerate    %.2f%% of %zu sector cones\n", 100.0 * deg / std::max<size_t>(1, cones), cones);
     std::printf("verify        %s\n", ct_package_verify(&p) == CT_OK ? "ok" : "FAILED");
     return 0;

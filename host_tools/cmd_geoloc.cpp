@@ -14,18 +14,22 @@
 // px.csv: header naming u and v, one pixel per line (mrcal convention:
 //   (0,0) is the centre of the top-left pixel).
 // --pose-wgs84 LAT,LON,H,YAW,PITCH,ROLL: the camera centre in WGS84 (degrees;
-//   H metres in the package's vertical datum) and its attitude w.r.t. local
+//   H metres above the ellipsoid on a package whose datum is known, else in
+//   the DEM's heights) and its attitude w.r.t. local
 //   north-east-down, aerospace yaw-pitch-roll in degrees (at zero the
 //   camera's x, y, z point east, down, north); the model's extrinsics are
 //   ignored.  Needs a UTM package (EPSG 326zz/327zz): ct_pose_from_wgs84.
 // --pose-map E,N,H,YAW,PITCH,ROLL: the same in the package's map frame
 //   (metres; the attitude w.r.t. grid north, grid east, down):
 //   ct_pose_from_map.
-// g.csv: header u,v,status,E,N,h,steps,lat,lon; one row per pixel, in input
-//   order; u,v echoed as given; E,N,h in metres with all nine decimals of the
-//   library's nanometres (nan when nothing is hit); steps as in `trace`;
-//   lat,lon the hit in WGS84 degrees with 9 decimals (ct_utm_inverse; nan
-//   unless the package is UTM and something is hit).
+// g.csv: header u,v,status,E,N,h,steps,lat,lon,h_ell; one row per pixel, in
+//   input order; u,v echoed as given; E,N,h in metres with all nine decimals
+//   of the library's nanometres (nan when nothing is hit), h in the DEM's own
+//   vertical datum (above EGM96 for an EGM96 DEM: the package's ellipsoidal
+//   height less ct_package_geoid); steps as in `trace`; lat,lon the hit in
+//   WGS84 degrees with 9 decimals (ct_utm_inverse; nan unless the package is
+//   UTM and something is hit); h_ell the WGS84 ellipsoidal height (nan when
+//   the package's vertical datum is unknown).
 // --effects LIST: scene effects, comma-separated: curvature, refraction
 //   (empty: a straight line of sight).  The library's model (ct_effects):
 //   the line of sight's height above the datum gains c rho^2 / 2R at
@@ -214,7 +218,15 @@ int cmd_geoloc(int argc, char **argv)
                 o += ',';
                 append_nm_decimal(o, g[k].hit.n_nm);
                 o += ',';
-                append_nm_decimal(o, g[k].hit.h_nm);
+                // h in the DEM's own datum: the package's (ellipsoidal when
+                // the datum is known) less the geoid for EGM96 DEMs
+                int64_t und = 0;
+                const bool geoid_ok = p.vdatum == CT_VDATUM_EGM96 &&
+                                      ct_package_geoid(&p, g[k].hit.e_nm, g[k].hit.n_nm, &und) == CT_OK;
+                if (p.vdatum == CT_VDATUM_EGM96 && !geoid_ok)
+                    o += "nan";
+                else
+                    append_nm_decimal(o, g[k].hit.h_nm - und);
                 o += ',';
                 o += std::to_string(g[k].hit.steps);
                 int64_t la, lo;
@@ -226,15 +238,20 @@ int cmd_geoloc(int argc, char **argv)
                 } else {
                     o += ",nan,nan";
                 }
+                o += ',';
+                if (p.vdatum != CT_VDATUM_UNKNOWN)
+                    append_nm_decimal(o, g[k].hit.h_nm);
+                else
+                    o += "nan";
             } else {
                 o += "nan,nan,nan,";
                 o += std::to_string(s >= 0 ? g[k].hit.steps : 0u);
-                o += ",nan,nan";
+                o += ",nan,nan,nan";
             }
             o += '\n';
         }
     });
-    std::string txt = "u,v,status,E,N,h,steps,lat,lon\n";
+    std::string txt = "u,v,status,E,N,h,steps,lat,lon,h_ell\n";
     for (const std::string &part : parts) txt += part;
     write_file_atomic(opt["-o"], std::vector<uint8_t>(txt.begin(), txt.end()));
     return 0;

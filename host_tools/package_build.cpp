@@ -166,6 +166,16 @@ void build_package_to(const Terrain &t, const BuildOptions &opt, PackageSink &si
     if (ct_package_layout((uint32_t)t.width, (uint32_t)t.height, (uint32_t)c.r, (uint32_t)c.n, voids ? 1u : 0u, so, ss,
                           &levels, &total) != CT_OK)
         throw Error("package layout failed (size limits)");
+    // the datum section (conetrace.h), after the fixed sections
+    const bool datum = t.vdatum != CT_VDATUM_UNKNOWN || t.geo.source_epsg != 0 || t.geoid.w > 0;
+    const uint32_t datum_off = total;
+    if (datum) {
+        if (t.geoid.um.size() != (size_t)t.geoid.w * (size_t)t.geoid.h) throw Error("geoid grid size mismatch");
+        uint64_t end = (uint64_t)total + CT_DATUM_HEADER_SIZE + 4u * (uint64_t)t.geoid.um.size();
+        end = (end + 7u) & ~(uint64_t)7u;
+        if (end > 0xffffffffu) throw Error("package layout failed (size limits)");
+        total = (uint32_t)end;
+    }
     uint16_t hmin = 65535, hmax = 0;
     for (uint16_t v : t.codes) {
         hmin = std::min(hmin, v);
@@ -219,7 +229,7 @@ void build_package_to(const Terrain &t, const BuildOptions &opt, PackageSink &si
         h[20] = (uint8_t)c.r;
         h[21] = (uint8_t)c.n;
         h[22] = (uint8_t)levels;
-        h[23] = voids ? CT_PKG_FLAG_VOIDS : 0;
+        h[23] = (uint8_t)((voids ? CT_PKG_FLAG_VOIDS : 0u) | (datum ? CT_PKG_FLAG_DATUM : 0u));
         put16(h, 24, hmin);
         put16(h, 26, hmax);
         put32(h, 28, (uint32_t)slices_header);
@@ -230,6 +240,7 @@ void build_package_to(const Terrain &t, const BuildOptions &opt, PackageSink &si
         put64(h, 64, metres_to_nm(t.height_offset_m));
         put64(h, 72, sc);
         put32(h, 80, (uint32_t)std::max(0, t.geo.epsg));
+        put32(h, CT_HDR_DATUM, datum ? datum_off : 0u);
         for (int k = 0; k < CT_SEC_COUNT; ++k) {
             put32(h, CT_HDR_SECTION_TABLE + 8 * k, so[k]);
             put32(h, CT_HDR_SECTION_TABLE + 8 * k + 4, ss[k]);
@@ -334,6 +345,23 @@ void build_package_to(const Terrain &t, const BuildOptions &opt, PackageSink &si
                     byte |= (uint8_t)(1u << (k - k0));
             }
             w.byte(byte);
+        }
+    }
+    if (datum) {
+        w.pad_to(datum_off);
+        std::vector<uint8_t> d(CT_DATUM_HEADER_SIZE, 0);
+        put16(d, 0, (uint32_t)t.vdatum);
+        put16(d, 2, (uint32_t)t.geoid.w);
+        put16(d, 4, (uint32_t)t.geoid.h);
+        put32(d, 8, (uint32_t)std::max(0, t.geo.source_epsg));
+        put64(d, 16, t.geoid.lat0_q61);
+        put64(d, 24, t.geoid.lon0_q61);
+        put64(d, 32, t.geoid.step_q61);
+        w.bytes(d.data(), d.size());
+        for (int32_t v : t.geoid.um) {
+            const uint32_t u = (uint32_t)v;
+            const uint8_t b[4] = {(uint8_t)u, (uint8_t)(u >> 8), (uint8_t)(u >> 16), (uint8_t)(u >> 24)};
+            w.bytes(b, 4);
         }
     }
     w.pad_to(total);

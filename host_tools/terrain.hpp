@@ -22,6 +22,15 @@ struct Georef {
     int source_epsg = 0;  // the source DEM's CRS when it was resampled onto epsg (0: not resampled)
 };
 
+// A geoid grid as a package's datum section stores it (conetrace.h): node
+// (i, j) at (lat0 - j step, lon0 + i step), Q61 radians; undulation in
+// micrometres.
+struct GeoidGrid {
+    int w = 0, h = 0;                             // 0: no grid
+    int64_t lat0_q61 = 0, lon0_q61 = 0, step_q61 = 0;
+    std::vector<int32_t> um;                      // w * h, row 0 north
+};
+
 struct Terrain {
     int width = 0, height = 0;           // posts
     std::vector<uint16_t> codes;         // row-major, width * height
@@ -29,6 +38,9 @@ struct Terrain {
     Georef geo;
     double height_offset_m = 0.0;        // h = offset + code * scale
     double height_scale_m = 1.0;         // metres per LSB (> 0)
+    int vdatum = 0;                      // CT_VDATUM_* of the source heights; when
+                                         // known, the codes are ellipsoidal heights
+    GeoidGrid geoid;                     // carried in the datum section
 
     uint16_t at(int i, int j) const { return codes[(size_t)j * (size_t)width + (size_t)i]; }
 };

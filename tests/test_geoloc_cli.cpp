@@ -31,6 +31,7 @@
 #include "dem_cases.hpp"
 #include "harness.h"
 #include "host_io.hpp"
+#include "vdatum.hpp"
 
 #ifndef CT_CLI
 #error "CT_CLI must be defined (path of the conetrace binary)"
@@ -82,15 +83,29 @@ std::vector<std::string> split(const std::string &s)
 // A geoloc row (fields f, row number `row`) against the library's answer for
 // its pixel: the status, and for a hit E, N, h to the nanometre (counted in
 // *hits).  `what` prefixes the messages.
+// a row against the library's result; h is the package's height less the
+// geoid (ct_package_geoid) for an EGM96 package, h_ell the package's height
+// when its datum is known, else nan
 void check_row(const std::vector<std::string> &f, const std::string &what, size_t row, ct_status want,
-               const ct_geo &g, int *hits)
+               const ct_geo &g, int *hits, const ct_package *pk = nullptr)
 {
+    TEST_ASSERT_MSG(f.size() == 10, "%srow %zu: %zu fields", what.c_str(), row, f.size());
     TEST_ASSERT_MSG(f[2] == ct_host::status_name(want), "%srow %zu: status %s, library %s", what.c_str(), row,
                     f[2].c_str(), ct_host::status_name(want).c_str());
     if (want == CT_HIT) {
         ++*hits;
-        TEST_ASSERT(f[3] == ct_host::nm_to_decimal(g.hit.e_nm) && f[4] == ct_host::nm_to_decimal(g.hit.n_nm) &&
-                    f[5] == ct_host::nm_to_decimal(g.hit.h_nm));
+        int64_t und = 0;
+        if (pk && pk->vdatum == CT_VDATUM_EGM96)
+            TEST_ASSERT_EQUAL_INT(CT_OK, ct_package_geoid(pk, g.hit.e_nm, g.hit.n_nm, &und));
+        TEST_ASSERT(f[3] == ct_host::nm_to_decimal(g.hit.e_nm) && f[4] == ct_host::nm_to_decimal(g.hit.n_nm));
+        TEST_ASSERT_MSG(f[5] == ct_host::nm_to_decimal(g.hit.h_nm - und), "%srow %zu: h %s, library %s less N %s",
+                        what.c_str(), row, f[5].c_str(), ct_host::nm_to_decimal(g.hit.h_nm).c_str(),
+                        ct_host::nm_to_decimal(und).c_str());
+        const bool known = pk && pk->vdatum != CT_VDATUM_UNKNOWN;
+        TEST_ASSERT(f[9] == (known ? ct_host::nm_to_decimal(g.hit.h_nm) : std::string("nan")));
+        if (pk && pk->vdatum == CT_VDATUM_EGM96) TEST_ASSERT(und < -20000000000 && und > -40000000000);  // Tennessee: N ~ -30 m
+    } else {
+        TEST_ASSERT(f[9] == "nan");
     }
 }
 
@@ -215,7 +230,7 @@ void test_geoloc_end_to_end()
     TEST_ASSERT_MSG(r.err.empty(), "stderr: %s", r.err.c_str());
     std::vector<std::string> rows = lines_of(slurp(g_dir + "/g.csv"));
     TEST_ASSERT_EQUAL_INT(10, rows.size());
-    TEST_ASSERT_MSG(rows[0] == "u,v,status,E,N,h,steps,lat,lon", "header '%s'", rows[0].c_str());
+    TEST_ASSERT_MSG(rows[0] == "u,v,status,E,N,h,steps,lat,lon,h_ell", "header '%s'", rows[0].c_str());
     // the library on the same camera, in-process
     ct_host::CameraModel cm = ct_host::read_cameramodel(g_dir + "/cam.cameramodel");
     ct_host::LibCamera lc = ct_host::lib_camera(cm, "cam");
@@ -227,9 +242,9 @@ void test_geoloc_end_to_end()
     int hits = 0;
     for (size_t k = 0; k < px.size(); ++k) {
         std::vector<std::string> f = split(rows[k + 1]);
-        TEST_ASSERT_MSG(f.size() == 9, "row %zu: '%s'", k + 1, rows[k + 1].c_str());
-        // the package has no EPSG code: no geodetic columns
-        TEST_ASSERT(f[7] == "nan" && f[8] == "nan");
+        TEST_ASSERT_MSG(f.size() == 10, "row %zu: '%s'", k + 1, rows[k + 1].c_str());
+        // the package has no EPSG code and no datum: no geodetic columns
+        TEST_ASSERT(f[7] == "nan" && f[8] == "nan" && f[9] == "nan");
         TEST_ASSERT_MSG(f[0] == echo[k][0] && f[1] == echo[k][1], "row %zu echoes '%s,%s'", k + 1, f[0].c_str(),
                         f[1].c_str());
         int64_t uq, vq;
@@ -344,6 +359,19 @@ void test_geoloc_poses()
     spit(g_dir + "/tu.ctp", std::string(cu.pkg.begin(), cu.pkg.end()));
     ct_package pu;
     TEST_ASSERT_EQUAL_INT(CT_OK, ct_package_open(&pu, cu.pkg.data(), cu.pkg.size()));
+    // and with a datum: its heights taken as ellipsoidal ones converted from
+    // EGM96, the geoid grid over it from PROJ
+    ct_host::Terrain tv = t;
+    tv.vdatum = CT_VDATUM_EGM96;
+    {
+        ct_host::Egm96 egm;
+        tv.geoid = ct_host::make_geoid_grid(egm, tv.geo, tv.width, tv.height);
+    }
+    auto cv = dem_cases::make_case("cli-utm-egm96", tv, 8, 1);
+    spit(g_dir + "/tv.ctp", std::string(cv.pkg.begin(), cv.pkg.end()));
+    ct_package pv;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_package_open(&pv, cv.pkg.data(), cv.pkg.size()));
+    TEST_ASSERT_EQUAL_INT(CT_VDATUM_EGM96, (int)pv.vdatum);
     spit(g_dir + "/pxp.csv", kPixels);
     std::vector<ct_host::PixelRow> px = ct_host::read_pixels_csv(g_dir + "/pxp.csv");
     ct_host::CameraModel cm = ct_host::read_cameramodel(g_dir + "/cam.cameramodel");
@@ -355,11 +383,11 @@ void test_geoloc_poses()
     const double yaw = -40, pitch = -75, roll = 3;
     int32_t q[4];
     TEST_ASSERT_EQUAL_INT(CT_OK, ct_quat_from_ypr(q61(yaw), q61(pitch), q61(roll), q));
-    for (int mode = 0; mode < 2; ++mode) {
+    for (int mode = 0; mode < 3; ++mode) {
         ct_pose pose;
         char arg[160];
-        std::string pkgname = mode == 0 ? "t.ctp" : "tu.ctp";
-        const ct_package *pk = mode == 0 ? &s->p : &pu;
+        std::string pkgname = mode == 0 ? "t.ctp" : mode == 1 ? "tu.ctp" : "tv.ctp";
+        const ct_package *pk = mode == 0 ? &s->p : mode == 1 ? &pu : &pv;
         ct_utm z = {17, 0};
         if (mode == 0) {
             TEST_ASSERT_EQUAL_INT(CT_OK, ct_pose_from_map(&pose, std::llround(E0 * 1e9), std::llround(N0 * 1e9),
@@ -388,8 +416,8 @@ void test_geoloc_poses()
             ct_status want = CT_ERR_UNPROJECT;
             if (ct_host::pixel_to_q16(px[k].u, px[k].v, &uq, &vq))
                 want = ct_geolocate(pk, &lc.cam, &pose, CT_METHOD_DIRECTIONAL, nullptr, uq, vq, &g);
-            check_row(f, mode == 0 ? "--pose-map " : "--pose-wgs84 ", k + 1, want, g, &hits);
-            if (want == CT_HIT && mode == 1) {
+            check_row(f, mode == 0 ? "--pose-map " : "--pose-wgs84 ", k + 1, want, g, &hits, pk);
+            if (want == CT_HIT && mode >= 1) {
                 // lat,lon: forward-projected back onto the hit's E,N
                 long double la = std::stold(f[7]), lo = std::stold(f[8]);
                 int64_t e, n;

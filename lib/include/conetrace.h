@@ -106,6 +106,8 @@ enum {
 #define CT_PKG_HEADER_SIZE 128u
 #define CT_PKG_ALIGN 8u
 #define CT_PKG_FLAG_VOIDS 1u     /* a void (nodata) cell bitmap is present   */
+#define CT_PKG_FLAG_DATUM 2u     /* a datum section is present (header word 84
+                                    holds its offset)                        */
 
 /* Section indices in the header's section table.                           */
 enum {
@@ -130,10 +132,42 @@ enum {
  *  32  i64 origin_e_nm              40  i64 origin_n_nm   (GDAL top-left corner)
  *  48  i64 posting_e_nm             56  i64 posting_n_nm  (|e| == |n|)
  *  64  i64 height_offset_nm         72  i64 height_scale_nm (> 0, per LSB)
- *  80  u32 EPSG code (0 = unknown)  84  u32 reserved (0)
+ *  80  u32 EPSG code (0 = unknown)  84  u32 datum section offset (flag
+ *                                       CT_PKG_FLAG_DATUM; else 0)
  *  88  5 x { u32 offset, u32 size } section table (bytes from package start)
  */
 #define CT_HDR_SECTION_TABLE 88u
+#define CT_HDR_DATUM 84u
+
+/* The datum section (optional; flag CT_PKG_FLAG_DATUM): where the heights
+ * and the grid came from, and the geoid over the tile.  8-aligned, after
+ * the other sections, inside the package (so under the CRC):
+ *   0  u16 source vertical datum (CT_VDATUM_*)   2  u16 geoid nodes per row gw
+ *   4  u16 geoid rows gh                         6  u16 reserved (0)
+ *   8  u32 source EPSG: the CRS the DEM was resampled from (0 = not resampled)
+ *  12  u32 reserved (0)
+ *  16  i64 lat0_q61  24  i64 lon0_q61   geoid node (0, 0), WGS84, Q61 radians
+ *  32  i64 step_q61  node (i, j) lies at (lat0 - j step, lon0 + i step)
+ *  40  gw * gh i32   geoid undulation N at the nodes, micrometres, row-major,
+ *                    row 0 north (h_ellipsoid = h_geoid + N)
+ * The nodes are the geoid model's own (EGM96: every 15'), so bilinear
+ * interpolation between them is the model's interpolation (PROJ's).
+ * gw = gh = 0: no geoid grid.  Otherwise 2 <= gw, gh <= CT_GEOID_MAX_NODES,
+ * step in [CT_GEOID_MIN_STEP_Q61, CT_GEOID_MAX_STEP_Q61], (max(gw, gh) - 1)
+ * step <= 2^62, |lat0| <= pi / 2 and |lon0| <= pi.
+ * When the source vertical datum is known (not CT_VDATUM_UNKNOWN) the
+ * package's heights are ellipsoidal (WGS84): the builder converted them.  */
+#define CT_DATUM_HEADER_SIZE 40u
+#define CT_GEOID_MAX_NODES 4096u
+#define CT_GEOID_MIN_STEP_Q61 (INT64_C(1) << 40)  /* 2^-21 rad: 3 m          */
+#define CT_GEOID_MAX_STEP_Q61 (INT64_C(1) << 58)  /* 1/8 rad: 7.2 deg        */
+enum {
+    CT_VDATUM_UNKNOWN = 0, /* heights in the DEM's own, unstated datum       */
+    CT_VDATUM_WGS84 = 1,   /* the DEM's heights were ellipsoidal (WGS84)     */
+    CT_VDATUM_EGM96 = 2,   /* the DEM's heights were above the EGM96 geoid;
+                              the builder added N (PROJ's egm96_15 grid)     */
+    CT_VDATUM_COUNT = 3
+};
 
 /* Sector convention: sector s covers the closed wedge of horizontal grid
  * directions between boundary vectors b_s and b_{s+1}, b_k at grid azimuth
@@ -161,6 +195,17 @@ typedef enum {
     CT_METHOD_DIRECTIONAL = 3, /* N sector cones per coarse cell             */
     CT_METHOD_COUNT = 4
 } ct_method;
+
+/* A geoid-undulation grid on geodetic nodes: bilinear between them
+ * (ct_geoid_at).  A view of little-endian bytes, as in a package's datum
+ * section.                                                                 */
+typedef struct {
+    uint32_t w, h;           /* nodes per row, rows; 0 = no grid             */
+    int64_t lat0_q61;        /* node (0, 0): the north-west node, Q61 rad    */
+    int64_t lon0_q61;
+    int64_t step_q61;        /* node spacing in latitude and longitude       */
+    const uint8_t *values;   /* w * h int32 LE, micrometres, row 0 north     */
+} ct_geoid_grid;
 
 /* An opened package: a zero-copy view of caller bytes plus derived tables.
  * Transparent so it can live in static memory; fill it with ct_package_open.
@@ -196,6 +241,10 @@ typedef struct {
     int32_t bound_y[CT_MAX_SECTORS + 1];
     int64_t cot_q16[256];        /* per angle code; see CT_COT_MAX_Q16         */
     uint8_t cot_ok[256];         /* 0: code is degenerate for this package     */
+    uint32_t vdatum;             /* source vertical datum, CT_VDATUM_*; when not
+                                    UNKNOWN the heights are WGS84 ellipsoidal */
+    uint32_t source_epsg;        /* CRS the DEM was resampled from (0: none)   */
+    ct_geoid_grid geoid;         /* geoid over the tile (w = 0: none)          */
 } ct_package;
 
 /* A ray as the caller gives it, grid frame.                                 */
@@ -669,8 +718,8 @@ ct_status ct_utm_factors(const ct_utm *zone, int64_t lat_q61, int64_t lon_q61,
                          int64_t *gamma_q61, int64_t *k_q61);
 
 /* A camera pose from the navigation solution: the camera centre in WGS84
- * (lat, lon: Q61 radians; h_nm: height in the package's vertical datum --
- * ellipsoidal until the datum is carried, see README) and its attitude
+ * (lat, lon: Q61 radians; h_nm: ellipsoidal height, which is the package's
+ * height frame when its source datum is known, pkg->vdatum) and its attitude
  * w.r.t. local north-east-down as a unit quaternion q = (w, x, y, z), Q30,
  * rotating camera-frame vectors into NED.  The map frame's axes at the
  * camera are grid east, grid north and up: NED turned by the meridian
@@ -693,6 +742,25 @@ ct_status ct_pose_from_map(ct_pose *pose, int64_t e_nm, int64_t n_nm, int64_t h_
  * axis.                                                                    */
 ct_status ct_quat_from_ypr(int64_t yaw_q61, int64_t pitch_q61, int64_t roll_q61,
                            int32_t q_ned_cam_q30[4]);
+
+/* The geoid undulation N (nm; h_ellipsoid = h_geoid + N) at a geodetic
+ * point (Q61 radians), bilinear in latitude and longitude between the
+ * grid's nodes (longitude wraps at +-pi).  CT_ERR_RANGE outside the grid
+ * (its last row and column included) or with no grid.
+ * Scaling: the position within a cell is a Q19 fraction of the step (at
+ * EGM96's 15', < 0.06 m on the ground; times the geoid's slope < 1e-3:
+ * < 0.06 mm); the first interpolation is rounded to nm (|N| < 2^31 um:
+ * < 2^41 nm), so every product stays below 2^61.                          */
+ct_status ct_geoid_at(const ct_geoid_grid *grid, int64_t lat_q61, int64_t lon_q61,
+                      int64_t *n_geoid_nm);
+
+/* The same at a map point of a package (ct_utm_inverse, then
+ * ct_geoid_at on pkg->geoid): what turns the ellipsoidal heights of a
+ * package with a known source datum into orthometric ones (h - N).
+ * CT_ERR_CRS when the package is not on a UTM zone, CT_ERR_RANGE as
+ * ct_utm_inverse and ct_geoid_at.                                          */
+ct_status ct_package_geoid(const ct_package *pkg, int64_t e_nm, int64_t n_nm,
+                           int64_t *n_geoid_nm);
 
 /* UTM (nm) to geodetic (Q61 radians).                                      */
 ct_status ct_utm_inverse(const ct_utm *zone, int64_t e_nm, int64_t n_nm,

@@ -613,3 +613,88 @@ ct_status ct_pose_from_wgs84(ct_pose *pose, const ct_utm *zone, int64_t lat_q61,
     pose->hscale_q30 = (int32_t)q59_to_30(hs);
     return CT_OK;
 }
+
+/* ------------------------------------------------------------------------ */
+/* The geoid grid (conetrace.h: ct_geoid_grid, the datum section)           */
+
+#define GEOID_FRAC_BITS 19u
+#define TWO_PI_Q61_U ((uint64_t)CT_PI_Q61 * 2u)
+
+/* the node index and the Q19 fraction of an offset d (>= 0) along an axis
+ * of n nodes, the last node included; 0 if outside.  d and (n - 1) step
+ * are below 2^64 (open: (n - 1) step <= 2^62).                            */
+static int geoid_axis(uint64_t d, int64_t step, uint32_t n, uint32_t *idx, int64_t *frac)
+{
+    uint64_t i = d / (uint64_t)step, r = d - i * (uint64_t)step;
+    if (i > (uint64_t)n - 1u || (i == (uint64_t)n - 1u && r != 0u)) {
+        return 0;
+    }
+    if (i == (uint64_t)n - 1u) {
+        i--;
+        r = (uint64_t)step;
+    }
+    *idx = (uint32_t)i;
+    /* r <= step <= 2^58: shifted in 128 bits */
+    *frac = ct_i128_floor_div(ct_i128_shl(ct_i128_from64((int64_t)r), GEOID_FRAC_BITS), step);
+    return 1;
+}
+
+static int64_t geoid_node_nm(const ct_geoid_grid *g, uint32_t i, uint32_t j)
+{
+    uint32_t u = ct_ld32(g->values + 4u * ((size_t)j * g->w + i));
+    return (int64_t)(int32_t)u * 1000;
+}
+
+ct_status ct_geoid_at(const ct_geoid_grid *g, int64_t lat_q61, int64_t lon_q61, int64_t *n_geoid_nm)
+{
+    const int64_t one = INT64_C(1) << GEOID_FRAC_BITS, half = one / 2;
+    uint32_t i, j, most;
+    int64_t fx, fy, a, c;
+    uint64_t dlon;
+    if (g == NULL || n_geoid_nm == NULL) {
+        return CT_ERR_ARG;
+    }
+    most = g->w > g->h ? g->w : g->h;
+    if (g->w < 2u || g->h < 2u || most > CT_GEOID_MAX_NODES || g->values == NULL ||
+        g->step_q61 < CT_GEOID_MIN_STEP_Q61 || g->step_q61 > CT_GEOID_MAX_STEP_Q61 ||
+        (uint64_t)(most - 1u) > ((uint64_t)1 << 62) / (uint64_t)g->step_q61 ||
+        ct_abs64(g->lat0_q61) > CT_PI_Q61 / 2 || ct_abs64(g->lon0_q61) > CT_PI_Q61) {
+        return CT_ERR_RANGE;
+    }
+    if (ct_abs64(lat_q61) > CT_PI_Q61 / 2 || ct_abs64(lon_q61) > CT_PI_Q61 || g->lat0_q61 < lat_q61) {
+        return CT_ERR_RANGE;
+    }
+    /* lon - lon0 in [0, 2 pi): modulo 2^64, then one turn added when
+     * negative (2 pi < 2^64 in Q61) */
+    dlon = (uint64_t)lon_q61 - (uint64_t)g->lon0_q61;
+    if (lon_q61 < g->lon0_q61) {
+        dlon += TWO_PI_Q61_U;
+    }
+    if (!geoid_axis(dlon, g->step_q61, g->w, &i, &fx) ||
+        !geoid_axis((uint64_t)(g->lat0_q61 - lat_q61), g->step_q61, g->h, &j, &fy)) {
+        return CT_ERR_RANGE;
+    }
+    /* along the row, rounded to nm: |N| < 2^41 nm, times <= 2^19 */
+    a = ct_floor_div(geoid_node_nm(g, i, j) * (one - fx) + geoid_node_nm(g, i + 1u, j) * fx + half, one);
+    c = ct_floor_div(geoid_node_nm(g, i, j + 1u) * (one - fx) + geoid_node_nm(g, i + 1u, j + 1u) * fx + half, one);
+    *n_geoid_nm = ct_floor_div(a * (one - fy) + c * fy + half, one);
+    return CT_OK;
+}
+
+ct_status ct_package_geoid(const ct_package *pkg, int64_t e_nm, int64_t n_nm, int64_t *n_geoid_nm)
+{
+    ct_utm z;
+    int64_t lat, lon;
+    ct_status st;
+    if (pkg == NULL || n_geoid_nm == NULL) {
+        return CT_ERR_ARG;
+    }
+    if (pkg->epsg > 0x7fffffffu || ct_utm_zone_of_epsg((int32_t)pkg->epsg, &z) != CT_OK) {
+        return CT_ERR_CRS;
+    }
+    st = ct_utm_inverse(&z, e_nm, n_nm, &lat, &lon);
+    if (st != CT_OK) {
+        return st;
+    }
+    return ct_geoid_at(&pkg->geoid, lat, lon, n_geoid_nm);
+}

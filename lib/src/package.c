@@ -251,10 +251,67 @@ ct_status ct_sector_of(const ct_package *pkg, int64_t dx, int64_t dy,
 
 /* ------------------------------------------------------------------------ */
 
+/* The datum section (conetrace.h): its fields into pkg, or the status of
+ * the first thing wrong.  `end` is where the last fixed section ends.     */
+static ct_status open_datum(ct_package *pkg, const uint8_t *b, uint32_t total,
+                            uint64_t end, int present)
+{
+    uint32_t off = ct_ld32(b + CT_HDR_DATUM), vd, gw, gh;
+    const uint8_t *d;
+    pkg->vdatum = CT_VDATUM_UNKNOWN;
+    pkg->source_epsg = 0u;
+    pkg->geoid.w = 0u;
+    pkg->geoid.h = 0u;
+    pkg->geoid.lat0_q61 = 0;
+    pkg->geoid.lon0_q61 = 0;
+    pkg->geoid.step_q61 = 0;
+    pkg->geoid.values = NULL;
+    if (!present) {
+        return off == 0u ? CT_OK : CT_ERR_FLAGS;
+    }
+    if ((off % CT_PKG_ALIGN) != 0u || (uint64_t)off < end ||
+        (uint64_t)off + CT_DATUM_HEADER_SIZE > (uint64_t)total) {
+        return CT_ERR_OFFSET;
+    }
+    d = b + off;
+    vd = ct_ld16(d);
+    gw = ct_ld16(d + 2);
+    gh = ct_ld16(d + 4);
+    if (vd >= (uint32_t)CT_VDATUM_COUNT || ct_ld16(d + 6) != 0u || ct_ld32(d + 12) != 0u) {
+        return CT_ERR_RANGE;
+    }
+    if (gw != 0u || gh != 0u) {
+        int64_t step = ct_ld64s(d + 32), lat0 = ct_ld64s(d + 16), lon0 = ct_ld64s(d + 24);
+        uint32_t most = gw > gh ? gw : gh;
+        if (gw < 2u || gh < 2u || gw > CT_GEOID_MAX_NODES || gh > CT_GEOID_MAX_NODES) {
+            return CT_ERR_DIMS;
+        }
+        if (step < CT_GEOID_MIN_STEP_Q61 || step > CT_GEOID_MAX_STEP_Q61 ||
+            (uint64_t)(most - 1u) > ((uint64_t)1 << 62) / (uint64_t)step ||
+            ct_abs64(lat0) > CT_PI_Q61 / 2 || ct_abs64(lon0) > CT_PI_Q61) {
+            return CT_ERR_GEOREF;
+        }
+        /* 4 gw gh <= 2^26: no overflow in 64 bits */
+        if ((uint64_t)off + CT_DATUM_HEADER_SIZE + 4u * (uint64_t)gw * gh > (uint64_t)total) {
+            return CT_ERR_SIZE;
+        }
+        pkg->geoid.w = gw;
+        pkg->geoid.h = gh;
+        pkg->geoid.lat0_q61 = lat0;
+        pkg->geoid.lon0_q61 = lon0;
+        pkg->geoid.step_q61 = step;
+        pkg->geoid.values = d + CT_DATUM_HEADER_SIZE;
+    }
+    pkg->vdatum = vd;
+    pkg->source_epsg = ct_ld32(d + 8);
+    return CT_OK;
+}
+
 ct_status ct_package_open(ct_package *pkg, const uint8_t *b, size_t len)
 {
     uint32_t total, crc_stored, crc, w, h, r, n, lv, flags, k;
     uint32_t so[CT_SEC_COUNT], ss[CT_SEC_COUNT], lv_expect, total_expect;
+    uint64_t prev_end = CT_PKG_HEADER_SIZE;
     const uint8_t zero4[4] = {0u, 0u, 0u, 0u};
     ct_status st;
     int64_t pe, pn;
@@ -301,7 +358,7 @@ ct_status ct_package_open(ct_package *pkg, const uint8_t *b, size_t len)
     if (r < 1u || r > CT_MAX_REDUCE) {
         return CT_ERR_REDUCE;
     }
-    if ((flags & ~CT_PKG_FLAG_VOIDS) != 0u) {
+    if ((flags & ~(CT_PKG_FLAG_VOIDS | CT_PKG_FLAG_DATUM)) != 0u) {
         return CT_ERR_FLAGS;
     }
     st = ct_package_layout(w, h, r, n, flags & CT_PKG_FLAG_VOIDS, so, ss,
@@ -315,7 +372,6 @@ ct_status ct_package_open(ct_package *pkg, const uint8_t *b, size_t len)
     /* Section table: sizes must be exactly the implied ones; offsets
      * aligned, after the header, in order, and inside the package.        */
     {
-        uint64_t prev_end = CT_PKG_HEADER_SIZE;
         /* bound: CT_SEC_COUNT sections */
         for (k = 0u; k < CT_SEC_COUNT; ++k) {
             uint32_t off = ct_ld32(b + CT_HDR_SECTION_TABLE + 8u * k);
@@ -331,8 +387,9 @@ ct_status ct_package_open(ct_package *pkg, const uint8_t *b, size_t len)
             prev_end = (uint64_t)off + sz;
         }
     }
-    if (ct_ld32(b + 84) != 0u) {
-        return CT_ERR_FLAGS;
+    st = open_datum(pkg, b, total, prev_end, (flags & CT_PKG_FLAG_DATUM) != 0u);
+    if (st != CT_OK) {
+        return st;
     }
     pkg->hmin = (int32_t)ct_ld16(b + 24);
     pkg->hmax = (int32_t)ct_ld16(b + 26);

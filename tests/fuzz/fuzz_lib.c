@@ -23,7 +23,8 @@
  *   - every status is one the API documents for the call;
  *   - on a package that opens and verifies, the four methods return the same
  *     status and the same hit, bit for bit, straight and bent -- except the
- *     cone methods when an edit changed an angle code: ct_package_verify
+ *     cone methods when an edit changed an angle code or the posting or
+ *     height scale the codes are measured in: ct_package_verify
  *     checks the heights, the mipmap and the apexes, but a cone's opening
  *     (which only the builder's whole computation can confirm) is trusted,
  *     as the CRC that guards it; such a package may then lead the cone
@@ -175,7 +176,10 @@ static void package_mode(const ct_vec_package *vp, int stamp_crc, const uint8_t 
     pos = 1u;
     for (k = 0u; k < edits && pos + 3u <= n; ++k, pos += 3u) {
         size_t off = ((size_t)d[pos] | ((size_t)d[pos + 1u] << 8)) % vp->size;
-        if (off >= a0 && off < a1 && g_buf[off] != d[pos + 2u]) {
+        /* an angle code, or the posting or the height scale its opening is
+         * measured in (header bytes 48..63, 72..79): the cone's promise */
+        if (((off >= a0 && off < a1) || (off >= 48u && off < 64u) || (off >= 72u && off < 80u)) &&
+            g_buf[off] != d[pos + 2u]) {
             angles_edited = 1;
         }
         g_buf[off] = d[pos + 2u];
@@ -237,14 +241,17 @@ static void geodesy_mode(const uint8_t *d, size_t n)
             /* the round trip, away from the domain's edge (within 2^-40 rad
              * of it the inverse may come back a few Q59 units outside) */
             const int64_t deg = INT64_C(40244552544872904), edge = INT64_C(1) << 21;
-            int64_t dl = lon - (int64_t)(6 * z.zone - 183) * deg;
+            /* lon - the central meridian, in half units (the difference of
+             * two angles up to pi each may reach 2 pi: beyond int64 in Q61) */
+            int64_t dl = lon / 2 - (int64_t)(6 * z.zone - 183) * (deg / 2);
             int64_t e2, n2;
-            while (dl > 180 * deg) { /* bound: |lon| <= pi after the forward's check */
-                dl -= 360 * deg;
+            while (dl > 90 * deg) { /* bound: |lon| <= pi after the forward's check */
+                dl -= 180 * deg;
             }
-            while (dl < -180 * deg) { /* bound: as above */
-                dl += 360 * deg;
+            while (dl < -90 * deg) { /* bound: as above */
+                dl += 180 * deg;
             }
+            dl *= 2;
             s = ct_utm_inverse(&z, e, nn, &la, &lo);
             CHECK(s == CT_OK);
             s = ct_utm_forward(&z, la, lo, &e2, &n2);
