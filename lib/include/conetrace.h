@@ -5,7 +5,7 @@
  * (a DEM plus a directional parameter plane transform, Paglieroni 1997).
  * C99, freestanding, integer-only, no heap, no recursion, every loop bounded.
  *
- * Frames and units (see README "Frames and formats"):
+ * Frames and units (see docs/library.md, "Frames and fixed-point formats"):
  *   grid frame   x = column, y = row, in fine cells; post (i, j) sits at
  *                (x, y) = (i, j); z is in height LSB (package code units).
  *   map frame    the DEM's projected CRS in nanometres (int64): E east,
@@ -89,10 +89,11 @@ enum {
 #define CT_ZSHIFT_MAX 16          /* prepared z unit: at most 2^16 Q16 units  */
 #define CT_T_FRAC_BITS 26         /* t_q26                                    */
 
-/* Worst-case loop iterations, published per method (DESIGN.md): every
- * INCREMENTAL, CONE and DIRECTIONAL iteration leaves at least one fine
- * cell, so iterations <= cells_x + cells_y + 1; HIERARCHICAL needs at most
- * (levels + 2) iterations per fine cell left.  Exceeding a bound returns
+/* Worst-case loop iterations, published per method (docs/library.md,
+ * "Methods"; the cone step: docs/builders.md): every INCREMENTAL, CONE
+ * and DIRECTIONAL iteration leaves at least one fine cell, so iterations
+ * <= cells_x + cells_y + 1; HIERARCHICAL needs at most (levels + 2)
+ * iterations per fine cell left.  Exceeding a bound returns
  * CT_ERR_INTERNAL.                                                          */
 #define CT_WCET_CELL_ITERS(cx, cy) ((uint32_t)(cx) + (uint32_t)(cy) + 2u)
 #define CT_WCET_HIER_ITERS(cx, cy, levels) \
@@ -264,7 +265,7 @@ typedef struct {
  * scaled as one vector would keep only ~16 bits in dx and dy; with z in
  * coarser units (never coarser than a Q16 cell unit in metres, see
  * ct_package.zshift_max) every component keeps ~26 bits and the prepared
- * ray stays within 1 mm of the caller's (README, "Exactness").             */
+ * ray stays within 1 mm of the caller's (docs/library.md, "Exactness").    */
 typedef struct {
     int64_t ox, oy, oz;    /* origin (the entry point): x, y Q16; z in units
                               of 2^zshift Q16                                 */
@@ -453,7 +454,10 @@ ct_status ct_status_name(ct_status s, const char **out);
 /* reference-frame (here: map-frame) points into the camera frame; the      */
 /* library takes the inverse pose, R_map_cam and the camera centre in nm.   */
 /* The conversion rt_cam_ref -> (R_map_cam, centre) runs on the host in     */
-/* long double (host_tools/camera_host.cpp, ct_host::pose_from_rt).         */
+/* long double (host_tools/camera_host.cpp,                                 */
+/* ct_host::pose_from_rt_cam_ref) and stored with ct_pose_init; a           */
+/* navigation solution gives the pose through ct_pose_from_wgs84 or         */
+/* ct_pose_from_map (below).                                                */
 /*                                                                          */
 /* Fixed-point formats:                                                     */
 /*   pixel       u, v: int64 Q16 pixels, |u|, |v| <= CT_CAM_MAX_PIXEL px.   */
@@ -491,7 +495,7 @@ ct_status ct_status_name(ct_status s, const char **out);
 /* >= 2^-8 (ct_camera_init finds the first radius where that fails: the     */
 /* lens "folds over" there).  Anything else is CT_ERR_UNPROJECT, never a    */
 /* silently wrong ray.  PINHOLE needs no iteration.                         */
-/* Measured (tests/test_camera.cpp): see README "Geolocation".              */
+/* Measured (tests/test_camera.cpp): see docs/geolocation.md.               */
 
 /* Status codes, continued (errors, < 0). */
 enum {
@@ -548,7 +552,7 @@ typedef struct {
  * whose interpolated vector is shorter than half a unit or more than 60 deg
  * from any of those nodes (rays that disagree), is CT_ERR_UNPROJECT.  Rays
  * may point anywhere (fields of view beyond 180 deg).  Accuracy vs step:
- * README "Geolocation" (1.3e-7 rad at a 16 px step on a 160 deg lens).    */
+ * docs/geolocation.md (1.3e-7 rad at a 16 px step on a 160 deg lens).     */
 #define CT_GRID_MAX_NODES 16384u          /* per side                     */
 typedef struct {
     uint32_t nu, nv;           /* nodes per row / column, 4..CT_GRID_MAX_NODES */
@@ -690,9 +694,9 @@ ct_status ct_geolocate_batch(const ct_package *pkg, const ct_camera *cam,
  * angles are radians in Q61 (int64: value * 2^61; 2^-61 rad is 3 pm on the
  * ground); map coordinates are nm with UTM's false easting (500 km) and,
  * south, false northing (10,000 km).  Accuracy (tests/test_geodesy.cpp,
- * against PROJ): see README "Geodesy".  Domain: |lat| <= 84.5 deg and
- * |lon - the zone's central meridian| <= CT_UTM_MAX_DLON_DEG; outside,
- * CT_ERR_RANGE.                                                            */
+ * against PROJ): see docs/geolocation.md, "Geodesy".  Domain: |lat| <=
+ * 84.5 deg and |lon - the zone's central meridian| <= CT_UTM_MAX_DLON_DEG;
+ * outside, CT_ERR_RANGE.                                                   */
 typedef struct {
     int32_t zone;   /* 1..60 */
     int32_t south;  /* 0: north (EPSG 326zz), 1: south (EPSG 327zz) */
