@@ -766,6 +766,17 @@ ct_status ct_geoid_at(const ct_geoid_grid *grid, int64_t lat_q61, int64_t lon_q6
 ct_status ct_package_geoid(const ct_package *pkg, int64_t e_nm, int64_t n_nm,
                            int64_t *n_geoid_nm);
 
+/* WGS84 geodetic (lat, lon: Q61 radians; h: ellipsoidal height, nm) to
+ * Earth-centred, Earth-fixed Cartesian coordinates (EPSG:4978; nm, rounded).
+ * Domain: |lat| <= pi/2, |lon| <= pi, h in [-2^52, 2^54] nm (-4,500 km ..
+ * 18,000 km); outside, CT_ERR_RANGE.                                       */
+ct_status ct_ecef_from_wgs84(int64_t lat_q61, int64_t lon_q61, int64_t h_nm, int64_t xyz_nm[3]);
+
+/* Earth-fixed (nm) to WGS84 geodetic (lat, lon: Q61 radians; h: nm).
+ * Domain: |x|, |y|, |z| <= 2^55 nm and at least 2^50 nm (1,100 km) from
+ * the Earth's centre; outside, CT_ERR_RANGE.  On the polar axis lon = 0.  */
+ct_status ct_wgs84_from_ecef(const int64_t xyz_nm[3], int64_t *lat_q61, int64_t *lon_q61, int64_t *h_nm);
+
 /* UTM (nm) to geodetic (Q61 radians).                                      */
 ct_status ct_utm_inverse(const ct_utm *zone, int64_t e_nm, int64_t n_nm,
                          int64_t *lat_q61, int64_t *lon_q61);
