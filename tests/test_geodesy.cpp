@@ -313,6 +313,280 @@ void test_pose_from_wgs84_vs_proj()
     TEST_ASSERT_EQUAL_INT(CT_ERR_RANGE, ct_quat_from_ypr(q61(181), 0, 0, q));
 }
 
+// ---- Earth-centred, Earth-fixed (ct_ecef_from_wgs84 / ct_wgs84_from_ecef) --
+
+// Independent long double references (64-bit mantissa: 5e-20 relative,
+// 1e-12 m at 2.4e7 m): the closed forward formula, and the inverse by the
+// plain fixed-point iteration phi <- atan2(Z + e^2 N sin phi, p) (a
+// different method from the library's Bowring iteration), 80 steps
+// (contraction <= 0.04 within the domain).
+const ld kA = 6378137, kF = 1 / 298.257223563L, kE2 = kF * (2 - kF);
+
+void ecef_ref(ld lat, ld lon, ld h, ld out[3])
+{
+    ld s = std::sin(lat), c = std::cos(lat), n = kA / std::sqrt(1 - kE2 * s * s);
+    out[0] = (n + h) * c * std::cos(lon);
+    out[1] = (n + h) * c * std::sin(lon);
+    out[2] = (n * (1 - kE2) + h) * s;
+}
+
+void geo_ref(ld x, ld y, ld z, ld *lat, ld *lon, ld *h)
+{
+    ld p = std::hypot(x, y), phi = std::atan2(z, p * (1 - kE2));
+    for (int k = 0; k < 80; ++k) {
+        ld s = std::sin(phi);
+        phi = std::atan2(z + kE2 * kA / std::sqrt(1 - kE2 * s * s) * s, p);
+    }
+    ld s = std::sin(phi), c = std::cos(phi);
+    *lat = phi;
+    *lon = (x == 0 && y == 0) ? 0 : std::atan2(y, x);
+    *h = p * c + z * s - kA * std::sqrt(1 - kE2 * s * s);
+}
+
+ld rad_of(int64_t q) { return (ld)q / std::ldexp(1.0L, 61); }
+
+struct Proj3 {
+    PJ_CONTEXT *ctx = nullptr;
+    PJ *pj = nullptr;  // EPSG:4979 (lon, lat deg, h m) <-> EPSG:4978 (m)
+    Proj3()
+    {
+        ctx = proj_context_create();
+        PJ *p = proj_create_crs_to_crs(ctx, "EPSG:4979", "EPSG:4978", nullptr);
+        if (p) {
+            pj = proj_normalize_for_visualization(ctx, p);
+            proj_destroy(p);
+        }
+    }
+    ~Proj3()
+    {
+        if (pj) proj_destroy(pj);
+        proj_context_destroy(ctx);
+    }
+};
+
+// a seeded geodetic point: every latitude (poles and the equator exactly
+// now and then), longitudes incl. +-180, heights by class: 0 near the
+// surface (-1 km .. 10 km), 1 up to 2,000 km, 2 up to hmax_km, 3 deep
+// (down to -4,500 km, the forward domain's floor)
+void seeded_geo(ct_rng *rng, int cls, double hmax_km, int64_t *la, int64_t *lo, int64_t *h)
+{
+    const int64_t half_pi = CT_PI_Q61 / 2;
+    uint64_t pick = ct_rng_u64(rng) % 16u;
+    *la = pick == 0 ? half_pi : pick == 1 ? -half_pi : pick == 2 ? 0 : ct_rng_range(rng, -half_pi, half_pi);
+    pick = ct_rng_u64(rng) % 16u;
+    *lo = pick == 0 ? CT_PI_Q61 : pick == 1 ? -CT_PI_Q61 : ct_rng_range(rng, -CT_PI_Q61, CT_PI_Q61);
+    double hm = cls == 0 ? -1e3 + 11e3 * ct_rng_unit(rng)
+              : cls == 1 ? 2e6 * ct_rng_unit(rng)
+              : cls == 2 ? hmax_km * 1e3 * ct_rng_unit(rng)
+                         : -4.5e6 * ct_rng_unit(rng);
+    *h = std::llround(hm * 1e9);
+}
+
+void test_ecef_forward_vs_proj()
+{
+    Proj3 pr;
+    TEST_ASSERT_MSG(pr.pj != nullptr, "PROJ cannot create EPSG:4979 -> EPSG:4978");
+    ct_rng rng;
+    ct_rng_seed(&rng, ct_test_seed() * 4978 + 1);
+    double worst_proj[4] = {0, 0, 0, 0}, worst_ref[4] = {0, 0, 0, 0};
+    long n = 0;
+    const long per = (long)(2000 * ct_test_scale());
+    for (int cls = 0; cls < 4; ++cls)
+        for (long k = 0; k < per; ++k) {
+            int64_t la, lo, h, xyz[3];
+            seeded_geo(&rng, cls, 18000, &la, &lo, &h);
+            TEST_ASSERT_EQUAL_INT(CT_OK, ct_ecef_from_wgs84(la, lo, h, xyz));
+            PJ_COORD c = proj_trans(pr.pj, PJ_FWD, proj_coord((double)deg_of(lo), (double)deg_of(la), (double)h * 1e-9, 0));
+            ld ref[3];
+            ecef_ref(rad_of(la), rad_of(lo), (ld)h * 1e-9L, ref);
+            double dp = std::sqrt(std::pow((double)xyz[0] * 1e-9 - c.xyz.x, 2) + std::pow((double)xyz[1] * 1e-9 - c.xyz.y, 2) +
+                                  std::pow((double)xyz[2] * 1e-9 - c.xyz.z, 2));
+            double dr = (double)std::sqrt(std::pow((ld)xyz[0] * 1e-9L - ref[0], 2) + std::pow((ld)xyz[1] * 1e-9L - ref[1], 2) +
+                                          std::pow((ld)xyz[2] * 1e-9L - ref[2], 2));
+            worst_proj[cls] = std::max(worst_proj[cls], dp);
+            worst_ref[cls] = std::max(worst_ref[cls], dr);
+            n++;
+        }
+    std::printf("  forward, %ld points (-1..10 km / ..2,000 km / ..18,000 km / -4,500..0 km): from PROJ %.2f / %.2f / "
+                "%.2f / %.2f nm, from the long double formula %.2f / %.2f / %.2f / %.2f nm\n",
+                n, worst_proj[0] * 1e9, worst_proj[1] * 1e9, worst_proj[2] * 1e9, worst_proj[3] * 1e9, worst_ref[0] * 1e9,
+                worst_ref[1] * 1e9, worst_ref[2] * 1e9, worst_ref[3] * 1e9);
+    // PROJ works in double: its input angles in degrees (ulp 1.4e-14 deg at
+    // 90: 6 nm at 2.4e7 m) and its output (ulp 3.7 nm at 2.4e7 m) carry a
+    // few nm themselves (measured up to 13 nm at 10x the points)
+    for (int cls = 0; cls < 4; ++cls) {
+        TEST_ASSERT(worst_proj[cls] < 30e-9);
+        TEST_ASSERT(worst_ref[cls] < 1.5e-9);  // the nm rounding plus the Q59 factors
+    }
+    // poles: on the axis exactly; the equator at lon 0: (a + h, 0, 0)
+    int64_t xyz[3];
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_ecef_from_wgs84(CT_PI_Q61 / 2, q61(37), 0, xyz));
+    TEST_ASSERT(xyz[0] == 0 && xyz[1] == 0 && xyz[2] == INT64_C(6356752314245179));  // b = 6356752.314245179 m
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_ecef_from_wgs84(0, 0, INT64_C(1000000000), xyz));
+    TEST_ASSERT(xyz[0] == INT64_C(6378138000000000) && xyz[1] == 0 && xyz[2] == 0);
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_ecef_from_wgs84(0, CT_PI_Q61, 0, xyz));
+    TEST_ASSERT(xyz[0] == -INT64_C(6378137000000000) && std::llabs(xyz[1]) <= 1 && xyz[2] == 0);
+}
+
+struct InvStats {
+    long n = 0, rt_n = 0;
+    double lat_proj = 0, lon_proj = 0, h_proj = 0;  // rad, rad (times cos lat), m
+    double lat_ref = 0, lon_ref = 0, h_ref = 0;
+    double proj_lat_ref = 0, proj_h_ref = 0;  // PROJ's own inverse vs the reference
+    double resid = 0;  // PROJ's forward of the library's result vs the input, m
+    long rt_nm = 0;  // ECEF -> geodetic -> ECEF, worst |dx| + |dy| + |dz|
+};
+
+void check_inverse(const Proj3 &pr, const int64_t xyz[3], InvStats *st)
+{
+    int64_t la, lo, h;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_wgs84_from_ecef(xyz, &la, &lo, &h));
+    TEST_ASSERT(std::llabs(la) <= CT_PI_Q61 / 2 && std::llabs(lo) <= CT_PI_Q61);
+    ld rla, rlo, rh;
+    geo_ref((ld)xyz[0] * 1e-9L, (ld)xyz[1] * 1e-9L, (ld)xyz[2] * 1e-9L, &rla, &rlo, &rh);
+    PJ_COORD g = proj_trans(pr.pj, PJ_INV, proj_coord((double)xyz[0] * 1e-9, (double)xyz[1] * 1e-9, (double)xyz[2] * 1e-9, 0));
+    const ld cl = std::cos(rad_of(la));
+    // longitude differences wrapped (+-pi are one meridian), weighted by
+    // cos(lat) (at the poles any longitude is right)
+    auto dlon = [](ld a, ld b) {
+        ld d = std::fabs(a - b);
+        return std::min(d, 2 * M_PIl - d);
+    };
+    st->lat_ref = std::max(st->lat_ref, (double)std::fabs(rad_of(la) - rla));
+    st->lon_ref = std::max(st->lon_ref, (double)(dlon(rad_of(lo), rlo) * cl));
+    st->h_ref = std::max(st->h_ref, (double)std::fabs((ld)h * 1e-9L - rh));
+    st->lat_proj = std::max(st->lat_proj, (double)std::fabs(rad_of(la) - (ld)g.lpz.phi * M_PIl / 180));
+    st->lon_proj = std::max(st->lon_proj, (double)(dlon(rad_of(lo), (ld)g.lpz.lam * M_PIl / 180) * cl));
+    st->h_proj = std::max(st->h_proj, std::fabs((double)h * 1e-9 - g.lpz.z));
+    st->proj_lat_ref = std::max(st->proj_lat_ref, (double)std::fabs((ld)g.lpz.phi * M_PIl / 180 - rla));
+    st->proj_h_ref = std::max(st->proj_h_ref, (double)std::fabs((ld)g.lpz.z - rh));
+    PJ_COORD f = proj_trans(pr.pj, PJ_FWD, proj_coord((double)deg_of(lo), (double)deg_of(la), (double)h * 1e-9, 0));
+    st->resid = std::max(st->resid, std::sqrt(std::pow(f.xyz.x - (double)xyz[0] * 1e-9, 2) + std::pow(f.xyz.y - (double)xyz[1] * 1e-9, 2) +
+                                              std::pow(f.xyz.z - (double)xyz[2] * 1e-9, 2)));
+    st->n++;
+    int64_t back[3];
+    if (ct_ecef_from_wgs84(la, lo, h, back) == CT_OK) {
+        st->rt_nm = std::max(st->rt_nm, (long)(std::llabs(back[0] - xyz[0]) + std::llabs(back[1] - xyz[1]) +
+                                                std::llabs(back[2] - xyz[2])));
+        st->rt_n++;
+    }
+}
+
+void test_ecef_inverse_vs_proj()
+{
+    Proj3 pr;
+    TEST_ASSERT(pr.pj != nullptr);
+    ct_rng rng;
+    ct_rng_seed(&rng, ct_test_seed() * 4978 + 2);
+    const long per = (long)(2000 * ct_test_scale());
+    InvStats st[5];
+    // classes 0-3: geodetic points (heights as the forward test, up to
+    // 29,000 km: every coordinate stays below 2^55 nm), through PROJ's
+    // forward, rounded to nm
+    for (int cls = 0; cls < 4; ++cls)
+        for (long k = 0; k < per; ++k) {
+            int64_t la, lo, h;
+            seeded_geo(&rng, cls, 29000, &la, &lo, &h);
+            PJ_COORD c = proj_trans(pr.pj, PJ_FWD, proj_coord((double)deg_of(lo), (double)deg_of(la), (double)h * 1e-9, 0));
+            int64_t xyz[3] = {std::llround(c.xyz.x * 1e9), std::llround(c.xyz.y * 1e9), std::llround(c.xyz.z * 1e9)};
+            check_inverse(pr, xyz, &st[cls]);
+        }
+    // class 4: anywhere in the inverse's domain: uniform in the cube
+    // |.| <= 2^55 nm, at least 2^50 nm from the centre
+    for (long k = 0; k < per; ++k) {
+        const int64_t m = INT64_C(1) << 55;
+        int64_t xyz[3];
+        long double r2;
+        do {
+            for (int i = 0; i < 3; ++i) xyz[i] = ct_rng_range(&rng, -m, m) >> (ct_rng_u64(&rng) % 6u);
+            r2 = (ld)xyz[0] * xyz[0] + (ld)xyz[1] * xyz[1] + (ld)xyz[2] * xyz[2];
+        } while (r2 < std::ldexp(1.0L, 100));
+        check_inverse(pr, xyz, &st[4]);
+    }
+    const char *names[5] = {"-1..10 km", "..2,000 km", "..29,000 km", "-4,500..0 km", "the whole cube"};
+    for (int cls = 0; cls < 5; ++cls)
+        std::printf("  inverse, %ld points %s: from the long double iteration lat %.2g, lon %.2g rad, h %.2f nm; "
+                    "PROJ's forward of the result %.2f nm from the input; round trip (%ld) %ld nm; from PROJ's "
+                    "inverse lat %.2g, lon %.2g rad, h %.3g nm (PROJ's own from the reference: lat %.2g rad, h %.3g nm)\n",
+                    st[cls].n, names[cls], st[cls].lat_ref, st[cls].lon_ref, st[cls].h_ref * 1e9, st[cls].resid * 1e9,
+                    st[cls].rt_n, st[cls].rt_nm, st[cls].lat_proj, st[cls].lon_proj, st[cls].h_proj * 1e9,
+                    st[cls].proj_lat_ref, st[cls].proj_h_ref * 1e9);
+    for (int cls = 0; cls < 5; ++cls) {
+        // lon weighted by cos(lat); 1e-17 rad is 0.06 nm on the ground
+        TEST_ASSERT(st[cls].lat_ref < 5e-17 && st[cls].lon_ref < 5e-17 && st[cls].h_ref < 1e-9);
+        // PROJ's double input (1.4e-14 deg: 15 nm at the cube's corners,
+        // 6.2e7 m) and output (7.5 nm there) limit this (measured 21 nm)
+        TEST_ASSERT(st[cls].resid < 50e-9);
+        TEST_ASSERT(st[cls].rt_nm <= 3);
+        // longitude is atan2 in both
+        TEST_ASSERT(st[cls].lon_proj < 1e-15);
+    }
+    // PROJ's own inverse (cart.cpp: one Bowring step, h = p / cos(lat) - N)
+    // is the coarser one: ~1e-13 rad and ~1 um (near the poles) at the
+    // surface, ~1e-8 rad and ~0.3 m at satellite heights, more deep inside
+    // (measured, printed above); the library agrees with it that far
+    TEST_ASSERT(st[0].lat_proj < 1e-12 && st[0].h_proj < 1e-5);
+    for (int cls = 0; cls < 5; ++cls)
+        TEST_ASSERT(st[cls].lat_proj <= st[cls].proj_lat_ref + 1e-16 && st[cls].h_proj <= st[cls].proj_h_ref + 2e-9);
+}
+
+void test_ecef_domain()
+{
+    const int64_t half_pi = CT_PI_Q61 / 2, lo_h = -(INT64_C(1) << 52), hi_h = INT64_C(1) << 54;
+    int64_t xyz[3], la, lo, h;
+    // forward: the edges themselves, and one unit beyond
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_ecef_from_wgs84(half_pi, CT_PI_Q61, hi_h, xyz));
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_ecef_from_wgs84(-half_pi, -CT_PI_Q61, lo_h, xyz));
+    TEST_ASSERT_EQUAL_INT(CT_ERR_RANGE, ct_ecef_from_wgs84(half_pi + 1, 0, 0, xyz));
+    TEST_ASSERT_EQUAL_INT(CT_ERR_RANGE, ct_ecef_from_wgs84(-half_pi - 1, 0, 0, xyz));
+    TEST_ASSERT_EQUAL_INT(CT_ERR_RANGE, ct_ecef_from_wgs84(0, CT_PI_Q61 + 1, 0, xyz));
+    TEST_ASSERT_EQUAL_INT(CT_ERR_RANGE, ct_ecef_from_wgs84(0, -CT_PI_Q61 - 1, 0, xyz));
+    TEST_ASSERT_EQUAL_INT(CT_ERR_RANGE, ct_ecef_from_wgs84(0, 0, hi_h + 1, xyz));
+    TEST_ASSERT_EQUAL_INT(CT_ERR_RANGE, ct_ecef_from_wgs84(0, 0, lo_h - 1, xyz));
+    TEST_ASSERT_EQUAL_INT(CT_ERR_RANGE, ct_ecef_from_wgs84(INT64_MIN, INT64_MIN, INT64_MIN, xyz));
+    TEST_ASSERT_EQUAL_INT(CT_ERR_RANGE, ct_ecef_from_wgs84(0, 0, INT64_MAX, xyz));
+    TEST_ASSERT_EQUAL_INT(CT_ERR_ARG, ct_ecef_from_wgs84(0, 0, 0, nullptr));
+    // inverse: |x|, |y|, |z| <= 2^55, at least 2^50 from the centre
+    const int64_t m = INT64_C(1) << 55, r0 = INT64_C(1) << 50;
+    for (int i = 0; i < 3; ++i) {
+        int64_t p[3] = {0, 0, 0};
+        p[i] = m;
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_wgs84_from_ecef(p, &la, &lo, &h));
+        p[i] = -m - 1;
+        TEST_ASSERT_EQUAL_INT(CT_ERR_RANGE, ct_wgs84_from_ecef(p, &la, &lo, &h));
+        p[i] = r0;
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_wgs84_from_ecef(p, &la, &lo, &h));
+        p[i] = -(r0 - 1);
+        TEST_ASSERT_EQUAL_INT(CT_ERR_RANGE, ct_wgs84_from_ecef(p, &la, &lo, &h));
+        p[i] = INT64_MIN;
+        TEST_ASSERT_EQUAL_INT(CT_ERR_RANGE, ct_wgs84_from_ecef(p, &la, &lo, &h));
+    }
+    const int64_t corner[3] = {m, -m, m}, origin[3] = {0, 0, 0};
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_wgs84_from_ecef(corner, &la, &lo, &h));
+    TEST_ASSERT_EQUAL_INT(CT_ERR_RANGE, ct_wgs84_from_ecef(origin, &la, &lo, &h));
+    // off the axes, either side of the 2^50 sphere: 2^44 (37, 37, 37) has
+    // r = 1.0014 2^50, 2^44 (36, 36, 36) r = 0.974 2^50
+    const int64_t out_r[3] = {INT64_C(37) << 44, INT64_C(37) << 44, -(INT64_C(37) << 44)};
+    const int64_t in_r[3] = {INT64_C(36) << 44, INT64_C(36) << 44, -(INT64_C(36) << 44)};
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_wgs84_from_ecef(out_r, &la, &lo, &h));
+    TEST_ASSERT_EQUAL_INT(CT_ERR_RANGE, ct_wgs84_from_ecef(in_r, &la, &lo, &h));
+    // the poles: lon 0 on the axis, lat +-90 deg, h = |z| - b
+    const int64_t np[3] = {0, 0, INT64_C(6356752314245179) + 5}, sp[3] = {0, 0, -INT64_C(6356752314245179) - 5};
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_wgs84_from_ecef(np, &la, &lo, &h));
+    TEST_ASSERT(lo == 0 && std::llabs(la - half_pi) <= 4 && std::llabs(h - 5) <= 1);
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_wgs84_from_ecef(sp, &la, &lo, &h));
+    TEST_ASSERT(lo == 0 && std::llabs(la + half_pi) <= 4 && std::llabs(h - 5) <= 1);
+    // the antimeridian: +pi (y = 0 and x < 0)
+    const int64_t am[3] = {-INT64_C(6378137000000000), 0, 0};
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_wgs84_from_ecef(am, &la, &lo, &h));
+    TEST_ASSERT(lo == CT_PI_Q61 && la == 0 && h == 0);
+    // NULL pointers
+    TEST_ASSERT_EQUAL_INT(CT_ERR_ARG, ct_wgs84_from_ecef(nullptr, &la, &lo, &h));
+    TEST_ASSERT_EQUAL_INT(CT_ERR_ARG, ct_wgs84_from_ecef(am, nullptr, &lo, &h));
+    TEST_ASSERT_EQUAL_INT(CT_ERR_ARG, ct_wgs84_from_ecef(am, &la, nullptr, &h));
+    TEST_ASSERT_EQUAL_INT(CT_ERR_ARG, ct_wgs84_from_ecef(am, &la, &lo, nullptr));
+}
+
 }  // namespace
 
 int main()
@@ -323,5 +597,8 @@ int main()
     RUN_TEST(test_utm_vs_proj);
     RUN_TEST(test_utm_factors_vs_proj);
     RUN_TEST(test_pose_from_wgs84_vs_proj);
+    RUN_TEST(test_ecef_domain);
+    RUN_TEST(test_ecef_forward_vs_proj);
+    RUN_TEST(test_ecef_inverse_vs_proj);
     return TEST_END();
 }

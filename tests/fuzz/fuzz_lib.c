@@ -18,7 +18,13 @@
  *                     ct_utm_inverse, ct_utm_factors, ct_quat_from_ypr and
  *                     ct_pose_from_wgs84: documented statuses only, and
  *                     where the forward projection succeeds, its inverse
- *                     succeeds and projects back to the same nanometre.
+ *                     succeeds and projects back to the same nanometre;
+ *                     then lat, lon, h and e, n, yaw as Earth-fixed x, y, z
+ *                     through ct_ecef_from_wgs84 / ct_wgs84_from_ecef, raw
+ *                     and folded into their domains: the status is the one
+ *                     the domain implies, and the round trips (geodetic ->
+ *                     Earth-fixed -> geodetic -> Earth-fixed, and Earth-fixed
+ *                     -> geodetic -> Earth-fixed) come back within 2 nm.
  * Contracts asserted (abort on violation):
  *   - every status is one the API documents for the call;
  *   - on a package that opens and verifies, the four methods return the same
@@ -216,6 +222,93 @@ static void package_mode(const ct_vec_package *vp, int stamp_crc, const uint8_t 
     }
 }
 
+/* ct_ecef_from_wgs84 / ct_wgs84_from_ecef: the documented domains give
+ * the status exactly; inside, the round trips within 2 nm per axis. */
+#define ECEF_HMIN (-(INT64_C(1) << 52))
+#define ECEF_HMAX (INT64_C(1) << 54)
+#define ECEF_MAX (INT64_C(1) << 55)
+
+static int64_t fold(int64_t v, int64_t lo, int64_t hi) /* into [lo, hi] */
+{
+    uint64_t span = (uint64_t)hi - (uint64_t)lo + 1u;
+    return (int64_t)((uint64_t)lo + (uint64_t)v % span);
+}
+
+static int64_t dist(int64_t a, int64_t b) { return a > b ? a - b : b - a; }
+
+/* the inverse of xyz; its status as the domain implies (the 2^50 nm sphere
+ * judged in double with a margin), the forward back within 2 nm */
+static void ecef_inverse(const int64_t xyz[3])
+{
+    int64_t la, lo, h, back[3];
+    int i, inside = 1;
+    double r2 = 0.0, s = 1125899906842624.0; /* 2^50 */
+    ct_status st;
+    for (i = 0; i < 3; ++i) { /* bound: 3 axes */
+        if (xyz[i] > ECEF_MAX || xyz[i] < -ECEF_MAX) {
+            inside = 0;
+        }
+        r2 += (double)xyz[i] * (double)xyz[i];
+    }
+    st = ct_wgs84_from_ecef(xyz, &la, &lo, &h);
+    CHECK(st == CT_OK || st == CT_ERR_RANGE);
+    if (!inside) {
+        CHECK(st == CT_ERR_RANGE);
+        return;
+    }
+    if (r2 > s * s * (1.0 + 1e-9)) {
+        CHECK(st == CT_OK);
+    } else if (r2 < s * s * (1.0 - 1e-9)) {
+        CHECK(st == CT_ERR_RANGE);
+    }
+    if (st != CT_OK) {
+        return;
+    }
+    CHECK(la <= CT_PI_Q61 / 2 && la >= -(CT_PI_Q61 / 2) && lo <= CT_PI_Q61 && lo >= -CT_PI_Q61);
+    CHECK(h >= -(INT64_C(6400000) * INT64_C(1000000000)) && h < INT64_C(3) * ECEF_MAX);
+    st = ct_ecef_from_wgs84(la, lo, h, back);
+    if (h >= ECEF_HMIN && h <= ECEF_HMAX) {
+        CHECK(st == CT_OK);
+        for (i = 0; i < 3; ++i) { /* bound: 3 axes */
+            CHECK(dist(back[i], xyz[i]) <= 2);
+        }
+    } else {
+        CHECK(st == CT_ERR_RANGE);
+    }
+}
+
+static void ecef_mode(const int64_t *v)
+{
+    int64_t xyz[3], la, lo, h;
+    ct_status st;
+    int i, j;
+    for (i = 0; i < 2; ++i) { /* bound: 2 passes: raw, folded into the domains */
+        int64_t lat = i == 0 ? v[0] : fold(v[0], -(CT_PI_Q61 / 2), CT_PI_Q61 / 2);
+        int64_t lon = i == 0 ? v[1] : fold(v[1], -CT_PI_Q61, CT_PI_Q61);
+        int64_t hh = i == 0 ? v[7] : fold(v[7], ECEF_HMIN, ECEF_HMAX);
+        int inside = lat >= -(CT_PI_Q61 / 2) && lat <= CT_PI_Q61 / 2 && lon >= -CT_PI_Q61 && lon <= CT_PI_Q61 &&
+                     hh >= ECEF_HMIN && hh <= ECEF_HMAX;
+        st = ct_ecef_from_wgs84(lat, lon, hh, xyz);
+        CHECK(st == (inside ? CT_OK : CT_ERR_RANGE));
+        if (st == CT_OK) {
+            /* the forward's image lies in the inverse's domain (|.| <= N +
+             * h < 2^54.5, >= b - 2^52 > 2^50 from the centre) */
+            for (j = 0; j < 3; ++j) { /* bound: 3 axes */
+                CHECK(xyz[j] <= ECEF_MAX && xyz[j] >= -ECEF_MAX);
+            }
+            CHECK(ct_wgs84_from_ecef(xyz, &la, &lo, &h) == CT_OK);
+            CHECK(dist(h, hh) <= 2);
+            ecef_inverse(xyz);
+        }
+        for (j = 0; j < 3; ++j) { /* bound: 3 axes */
+            xyz[j] = i == 0 ? v[2 + j] : fold(v[2 + j], -ECEF_MAX, ECEF_MAX) / (INT64_C(1) << (v[5] & 7));
+        }
+        ecef_inverse(xyz);
+    }
+    CHECK(ct_ecef_from_wgs84(0, 0, 0, NULL) == CT_ERR_ARG);
+    CHECK(ct_wgs84_from_ecef(xyz, NULL, &lo, &h) == CT_ERR_ARG);
+}
+
 static void geodesy_mode(const uint8_t *d, size_t n)
 {
     size_t pos = 0u;
@@ -275,6 +368,7 @@ static void geodesy_mode(const uint8_t *d, size_t n)
             CHECK(s == CT_OK || s == CT_ERR_RANGE || s == CT_ERR_ARG || s == CT_ERR_POSE);
         }
     }
+    ecef_mode(v);
 }
 
 int LLVMFuzzerTestOneInput(const uint8_t *d, size_t n);

@@ -122,6 +122,17 @@ typedef struct {
     int32_t hscale_q30;
 } ct_vec_geo;
 
+/* WGS84 geodetic <-> Earth-fixed (lib/src/geodesy.c): the host's results. */
+typedef struct {
+    int64_t lat_q61, lon_q61, h_nm;
+    ct_status fwd_status;
+    int64_t xyz_nm[3];                    /* ct_ecef_from_wgs84               */
+    int64_t in_nm[3];                     /* the inverse's input: xyz_nm when
+                                             fwd_status == CT_OK, else made up */
+    ct_status inv_status;
+    int64_t lat2_q61, lon2_q61, h2_nm;    /* ct_wgs84_from_ecef(in_nm)        */
+} ct_vec_ecef;
+
 typedef struct {
     const ct_vec_package *packages;
     uint32_t npackages;
@@ -134,6 +145,8 @@ typedef struct {
     uint32_t ncameras;
     const ct_vec_geo *geo;
     uint32_t ngeo;
+    const ct_vec_ecef *ecef;
+    uint32_t necef;
 } ct_vec_set;
 
 extern const ct_vec_set ct_vectors;

@@ -1032,10 +1032,47 @@ int main(int argc, char **argv)
         std::fprintf(f, "}, %s},\n", i32(v.hscale_q30).c_str());
     }
     std::fprintf(f, "};\n\n");
+    // geodetic <-> Earth-fixed: every latitude (the poles exactly), every
+    // longitude (+-180 exactly), heights -5,000 .. 22,000 km (some beyond
+    // the forward's domain), the forward's result inverted; where the
+    // forward refuses, a made-up point of the cube |.| <= 2^55.3 (some
+    // outside the inverse's domain, or within 2^50 nm of the centre)
+    std::vector<ct_vec_ecef> ecef;
+    {
+        Rng gg(4978u);
+        for (int k = 0; k < 48; ++k) {
+            ct_vec_ecef v{};
+            const uint64_t pi = (uint64_t)CT_PI_Q61;
+            uint64_t pick = gg.u64() % 12u;
+            v.lat_q61 = pick == 0 ? CT_PI_Q61 / 2 : pick == 1 ? -(CT_PI_Q61 / 2) : (int64_t)(gg.u64() % (pi + 1u)) - CT_PI_Q61 / 2;
+            pick = gg.u64() % 12u;
+            v.lon_q61 = pick == 0 ? CT_PI_Q61 : pick == 1 ? -CT_PI_Q61 : (int64_t)(gg.u64() % (2u * pi + 1u)) - CT_PI_Q61;
+            v.h_nm = (int64_t)(gg.u64() % 27000000u) * INT64_C(1000000000) - INT64_C(5000000000000000) +
+                     (int64_t)(gg.u64() % 1000000000u);
+            v.fwd_status = ct_ecef_from_wgs84(v.lat_q61, v.lon_q61, v.h_nm, v.xyz_nm);
+            for (int a = 0; a < 3; ++a)
+                v.in_nm[a] = v.fwd_status == CT_OK ? v.xyz_nm[a]
+                                                   : (int64_t)(gg.u64() % (UINT64_C(5) << 54)) - (INT64_C(5) << 53);
+            if (k % 16 == 15) {  // near the centre: 2^49.5 .. 2^50.5 on one axis
+                v.in_nm[0] = v.in_nm[1] = 0;
+                v.in_nm[2] = (INT64_C(3) << 48) + (int64_t)(gg.u64() % (UINT64_C(3) << 48));
+            }
+            v.inv_status = ct_wgs84_from_ecef(v.in_nm, &v.lat2_q61, &v.lon2_q61, &v.h2_nm);
+            ecef.push_back(v);
+        }
+    }
+    std::fprintf(f, "static const ct_vec_ecef ecef[%zu] = {\n", ecef.size());
+    for (const ct_vec_ecef &v : ecef)
+        std::fprintf(f, "  {%s, %s, %s, %d, {%s, %s, %s},\n   {%s, %s, %s}, %d, %s, %s, %s},\n", i64(v.lat_q61).c_str(),
+                     i64(v.lon_q61).c_str(), i64(v.h_nm).c_str(), (int)v.fwd_status, i64(v.xyz_nm[0]).c_str(),
+                     i64(v.xyz_nm[1]).c_str(), i64(v.xyz_nm[2]).c_str(), i64(v.in_nm[0]).c_str(), i64(v.in_nm[1]).c_str(),
+                     i64(v.in_nm[2]).c_str(), (int)v.inv_status, i64(v.lat2_q61).c_str(), i64(v.lon2_q61).c_str(),
+                     i64(v.h2_nm).c_str());
+    std::fprintf(f, "};\n\n");
     std::fprintf(f,
                  "const ct_vec_set ct_vectors = {packages, %zuu, fixed, %zuu, dirs, %zuu, \"%s\", cameras, %zuu, geo, "
-                 "%zuu};\n",
-                 pkgs.size(), fx.size(), dirs.size(), generator.c_str(), cams.size(), geo.size());
+                 "%zuu, ecef, %zuu};\n",
+                 pkgs.size(), fx.size(), dirs.size(), generator.c_str(), cams.size(), geo.size(), ecef.size());
     if (std::fclose(f) != 0) die("write error");
     return 0;
 }

@@ -512,6 +512,25 @@ static void check_fixed(const ct_vec_set *vs)
             }
         }
     }
+    g_where = "ecef";
+    for (k = 0u; k < vs->necef; ++k) {
+        const ct_vec_ecef *v = &vs->ecef[k];
+        int64_t xyz[3] = {0, 0, 0}, la = 0, lo = 0, h = 0;
+        uint32_t a;
+        g_idx = k;
+        eq_i64("ecef forward status", v->fwd_status, ct_ecef_from_wgs84(v->lat_q61, v->lon_q61, v->h_nm, xyz));
+        if (v->fwd_status == CT_OK) {
+            for (a = 0u; a < 3u; ++a) { /* bound: 3 */
+                eq_i64("ecef xyz", v->xyz_nm[a], xyz[a]);
+            }
+        }
+        eq_i64("ecef inverse status", v->inv_status, ct_wgs84_from_ecef(v->in_nm, &la, &lo, &h));
+        if (v->inv_status == CT_OK) {
+            eq_i64("ecef lat", v->lat2_q61, la);
+            eq_i64("ecef lon", v->lon2_q61, lo);
+            eq_i64("ecef h", v->h2_nm, h);
+        }
+    }
     g_where = "status names";
     for (k = 0u; k < 31u; ++k) {
         const char *name = NULL;
@@ -537,7 +556,9 @@ int main(void)
         check_fixed(vs);
         put_str("  fixed point, directions, UTM (");
         put_u64(vs->ngeo);
-        put_str(" points: forward, inverse, factors, geodetic poses): ");
+        put_str(" points: forward, inverse, factors, geodetic poses), Earth-fixed (");
+        put_u64(vs->necef);
+        put_str(" points: forward, inverse): ");
         put_u64(g_fail - before);
         put_str(" mismatching fields");
         flush_line();
