@@ -1,0 +1,630 @@
+// test_earth.cpp -- geolocation with the earth's curvature: the library's
+// exact mode (ct_effects CT_EFFECT_CURVATURE with earth_radius_nm == 0 on a
+// UTM package: a line of sight straight in Earth-fixed coordinates, bent by
+// refraction k t^2 / 2R when asked) against the independent PROJ reference
+// of tests/earth_reference.hpp.
+//
+// The fixture jacksboro_fault_dem.tif (EPSG:32617, 30 m posting, ~12 x 10
+// km, ~300 km west of zone 17's central meridian: point scale 1.0008,
+// convergence -1.6 deg, map-frame lines of sight bent sideways) is built
+// into a package in-process; a pinhole camera looks at it from poses made
+// by ct_pose_from_wgs84 (nadir from 3 km; oblique 30 and 20 deg from 2.6
+// km; grazing 5 and 3 deg from ~1 km over the terrain in several azimuths;
+// long: 5 deg from 10 km outside the tile).  Seeded random pixels: the
+// library's hit (CT_METHOD_DIRECTIONAL) vs the reference, per pose family
+// (count, RMS and max 3D distance), with the same hit/miss status except
+// near-grazing rays (reference clearance at a local minimum before the hit
+// below kSkipClearM, counted and skipped; a ray that enters the tile's side
+// below the surface hits that wall in the reference, and the library may
+// call it CT_BELOW instead: counted, accepted), and the distance within
+// kMaxErrM.  The worst ray of each family is printed with where the
+// library's hit lies relative to the reference path (off it: a different
+// line of sight; on it but under/over the terrain: a different
+// intersection).  For the report only: the old sphere-parabola model (the
+// same call with earth_radius_nm = CT_EARTH_RADIUS_NM) against the
+// reference.  Note that at grazing incidence a vertical error e moves the
+// hit by e / tan(incidence) along the ray: kMaxErrM at 3 deg asks for
+// ~0.25 mm vertically.
+//
+// Sanity checks of the reference itself (they hold whatever the library's
+// exact mode does): the package georeference (post centres, heights) as the
+// reference reads it vs the DEM and ct_grid_to_map; the convergence it
+// measures from PROJ vs ct_utm_factors, and the line of sight from the
+// library's pose (R_map_cam turned by the convergence) vs the one from the
+// navigation solution's quaternion directly (no convergence involved);
+// a nadir ray hits straight below the camera at the surface height; on a
+// flat package the hit matches a closed-form intersection of the Earth-fixed
+// line (or refracted curve) with the surface h = H, and differs from the
+// parabola model by about rho^2 tan(depression) / R along track.
+#include <proj.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "conetrace.h"
+#include "dem_io.hpp"
+#include "earth_reference.hpp"
+#include "harness.h"
+#include "terrain.hpp"
+
+using namespace ct_host;
+using earth_ref::ld;
+
+namespace {
+
+// ---- tolerances -------------------------------------------------------------
+const double kMaxErrM = 0.005;      // library exact mode vs reference, 3D distance (m)
+const double kSkipClearM = 0.05;    // skip rays passing this close (m) over terrain before the hit
+const double kRefCheckM = 5e-5;     // reference vs closed form on a flat package (m)
+const double kNadirM = 1e-3;        // nadir hit vs the point below the camera (m)
+const double kDirAgreeRad = 2e-8;   // line of sight from the pose vs from the quaternion
+const int kPixelsPerPose = 50;
+
+const std::string kDem = std::string(CT_FIXTURES_DIR) + "/jacksboro_fault_dem.tif";
+const ld kPi = earth_ref::kPi;
+
+int64_t q61(ld deg) { return (int64_t)std::llround(deg * kPi / 180 * std::ldexp(1.0L, 61)); }
+ld deg_of_q61(int64_t v) { return (ld)v / std::ldexp(1.0L, 61) * 180 / kPi; }
+
+struct Cam {
+    ct_camera cam;
+    ld fx = 1400, fy = 1400, cx = 511.5, cy = 383.5;
+    int w = 1024, h = 768;
+};
+
+Cam make_camera()
+{
+    Cam c;
+    ct_lens lens;
+    std::memset(&lens, 0, sizeof lens);
+    lens.model = CT_LENS_PINHOLE;
+    lens.width = (uint32_t)c.w;
+    lens.height = (uint32_t)c.h;
+    lens.fx_q32 = std::llround(c.fx * std::ldexp(1.0L, 32));
+    lens.fy_q32 = std::llround(c.fy * std::ldexp(1.0L, 32));
+    lens.cx_q32 = std::llround(c.cx * std::ldexp(1.0L, 32));
+    lens.cy_q32 = std::llround(c.cy * std::ldexp(1.0L, 32));
+    if (ct_camera_init(&c.cam, &lens) != CT_OK) std::abort();
+    return c;
+}
+
+struct World {
+    std::vector<uint8_t> bytes;
+    ct_package p;
+    earth_ref::Surface sf;
+    DemRaster dem;
+    Terrain t;
+};
+
+World *jacksboro()
+{
+    static World *w = nullptr;
+    if (w) return w;
+    w = new World;
+    w->dem = read_dem(kDem);
+    w->t = terrain_from_heights(w->dem.width, w->dem.height, w->dem.h, w->dem.valid, w->dem.geo, 0.015625);
+    BuildOptions o;
+    o.sectors = 8;
+    w->bytes = build_package(w->t, o);
+    if (ct_package_open(&w->p, w->bytes.data(), w->bytes.size()) != CT_OK) std::abort();
+    w->sf = earth_ref::Surface::from_package(w->p);
+    return w;
+}
+
+// A flat package (constant height) with the fixture's origin, posting and
+// EPSG, 801 x 801 posts (24 km).
+World *flat()
+{
+    static World *w = nullptr;
+    if (w) return w;
+    w = new World;
+    Georef g = jacksboro()->dem.geo;
+    const int n = 801;
+    std::vector<double> h((size_t)n * n, 400.0);
+    std::vector<uint8_t> valid((size_t)n * n, 1);
+    w->t = terrain_from_heights(n, n, h, valid, g, 0.015625);
+    BuildOptions o;
+    o.sectors = 4;
+    o.reduce = 8;
+    w->bytes = build_package(w->t, o);
+    if (ct_package_open(&w->p, w->bytes.data(), w->bytes.size()) != CT_OK) std::abort();
+    w->sf = earth_ref::Surface::from_package(w->p);
+    return w;
+}
+
+earth_ref::Proj &proj()
+{
+    static earth_ref::Proj *p = new earth_ref::Proj(32617);
+    return *p;
+}
+
+// A pose: a map-frame place (E, N), height above the terrain there (or an
+// ellipsoidal height), yaw and pitch (deg).
+struct PoseDef {
+    const char *family;
+    ld e, n;         // map position (m)
+    ld above;        // metres above the surface under the camera (or the tile's mean outside)
+    ld yaw, pitch;   // deg
+};
+
+struct Pose {
+    PoseDef def;
+    ld lat, lon, h;  // as given to ct_pose_from_wgs84 (Q61 values converted back)
+    int32_t q[4];
+    ct_pose pose;
+};
+
+ld ground_under(const earth_ref::Surface &sf, ld e, ld n)
+{
+    ld x, y;
+    sf.grid(e, n, &x, &y);
+    if (sf.inside(x, y)) return sf.height(x, y);
+    ld s = 0;
+    for (ld v : sf.z) s += v;
+    return s / sf.z.size();
+}
+
+bool make_pose(const earth_ref::Surface &sf, const PoseDef &d, Pose *out)
+{
+    earth_ref::Proj &pj = proj();
+    ld lat, lon;
+    pj.utm_inverse(d.e, d.n, &lat, &lon);
+    out->def = d;
+    const int64_t la = q61(lat), lo = q61(lon);
+    const int64_t h_nm = std::llround((ground_under(sf, d.e, d.n) + d.above) * 1e9L);
+    out->lat = deg_of_q61(la);
+    out->lon = deg_of_q61(lo);
+    out->h = (ld)h_nm * 1e-9L;
+    ct_utm z = {17, 0};
+    const ld yaw = d.yaw > 180 ? d.yaw - 360 : d.yaw;  // ct_quat_from_ypr: |angle| <= pi
+    if (ct_quat_from_ypr(q61(yaw), q61(d.pitch), 0, out->q) != CT_OK) return false;
+    return ct_pose_from_wgs84(&out->pose, &z, la, lo, h_nm, out->q) == CT_OK;
+}
+
+ld dist3(ld e0, ld n0, ld h0, ld e1, ld n1, ld h1)
+{
+    return std::sqrt((e0 - e1) * (e0 - e1) + (n0 - n1) * (n0 - n1) + (h0 - h1) * (h0 - h1));
+}
+
+// ---------------------------------------------------------------------------
+// Sanity: the reference's reading of the package georeference.
+void test_reference_georef()
+{
+    World *w = jacksboro();
+    const earth_ref::Surface &sf = w->sf;
+    TEST_ASSERT_EQUAL_INT(w->dem.width, sf.w);
+    TEST_ASSERT_EQUAL_INT(w->dem.height, sf.h);
+    TEST_ASSERT_EQUAL_INT(32617, sf.epsg);
+    double worst_xy = 0, worst_h = 0, worst_lib = 0;
+    for (int j = 0; j < sf.h; j += 7)
+        for (int i = 0; i < sf.w; i += 5) {
+            ld E, N;
+            sf.map_of(i, j, &E, &N);
+            // GDAL: pixel (i, j)'s centre
+            const ld ge = w->dem.geo.origin_e + (i + 0.5L) * w->dem.geo.posting_e;
+            const ld gn = w->dem.geo.origin_n + (j + 0.5L) * w->dem.geo.posting_n;
+            worst_xy = std::max(worst_xy, (double)std::max(std::fabs(E - ge), std::fabs(N - gn)));
+            worst_h = std::max(worst_h, (double)std::fabs(sf.at(i, j) - (ld)w->dem.h[(size_t)j * sf.w + i]));
+            int64_t e_nm, n_nm, h_nm;
+            const uint32_t code = w->t.at(i, j);
+            TEST_ASSERT_EQUAL_INT(CT_OK, ct_grid_to_map(&w->p, (int64_t)i << 16, (int64_t)j << 16, (int64_t)code << 16,
+                                                        &e_nm, &n_nm, &h_nm));
+            worst_lib = std::max(worst_lib, (double)std::max({std::fabs(E - e_nm * 1e-9L), std::fabs(N - n_nm * 1e-9L),
+                                                              std::fabs(sf.at(i, j) - h_nm * 1e-9L)}));
+        }
+    // the bilinear surface between posts vs the library's (rounded up to 2^-16 LSB)
+    ct_rng rng;
+    ct_rng_seed(&rng, ct_test_seed() * 97 + 3);
+    double worst_s = 0;
+    for (int k = 0; k < 2000; ++k) {
+        const int64_t x = ct_rng_range(&rng, 0, (int64_t)(sf.w - 1) << 16), y = ct_rng_range(&rng, 0, (int64_t)(sf.h - 1) << 16);
+        int64_t z;
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_surface_height(&w->p, x, y, &z));
+        const ld lib = ((ld)w->p.height_offset_nm + (ld)z / 65536 * (ld)w->p.height_scale_nm) * 1e-9L;
+        worst_s = std::max(worst_s, (double)std::fabs(lib - sf.height((ld)x / 65536, (ld)y / 65536)));
+    }
+    std::printf("  post centres vs GDAL pixel centres %.3g m, vs ct_grid_to_map %.3g m; heights vs DEM %.3g m; "
+                "bilinear surface vs ct_surface_height %.3g m\n",
+                worst_xy, worst_lib, worst_h, worst_s);
+    TEST_ASSERT(worst_xy < 1e-6);
+    TEST_ASSERT(worst_lib < 2e-9);
+    TEST_ASSERT(worst_h <= 0.015625 / 2 + 1e-9);
+    TEST_ASSERT(worst_s < 1e-6);
+}
+
+// Sanity: the convergence the reference measures from PROJ, and the line of
+// sight from the library's pose vs from the quaternion.
+void test_reference_convergence()
+{
+    earth_ref::Proj &pj = proj();
+    World *w = jacksboro();
+    ct_utm z = {17, 0};
+    double worst_g = 0, gmin = 1e9, gmax = -1e9;
+    const ld pts[][2] = {{195000, 4071000}, {207090, 4060680}, {201045, 4065840}, {185000, 4065840}, {500000, 4065840},
+                         {800000, 4065840}};
+    for (auto &p : pts) {
+        ld lat, lon;
+        pj.utm_inverse(p[0], p[1], &lat, &lon);
+        int64_t g, k;
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_utm_factors(&z, q61(lat), q61(lon), &g, &k));
+        const ld mine = pj.convergence(lat, lon), lib = (ld)g / std::ldexp(1.0L, 61);
+        worst_g = std::max(worst_g, (double)std::fabs(mine - lib));
+        gmin = std::min(gmin, (double)(mine * 180 / kPi));
+        gmax = std::max(gmax, (double)(mine * 180 / kPi));
+        // PROJ's sign: east of the central meridian (north) grid north is east of true north
+        if (p[0] > 500001) TEST_ASSERT(mine > 0);
+        if (p[0] < 499999) TEST_ASSERT(mine < 0);
+    }
+    std::printf("  convergence from PROJ's projection (central differences) vs ct_utm_factors: %.2g rad "
+                "(%.3f .. %.3f deg over the points)\n",
+                worst_g, gmin, gmax);
+    TEST_ASSERT(worst_g < 1e-9);
+    // the two lines of sight: pose (R_map_cam + convergence) vs quaternion
+    const PoseDef defs[] = {{"a", 201045, 4065840, 3000, 0, -90}, {"b", 195500, 4065840, 1000, 90, -5},
+                            {"c", 206600, 4070500, 1000, 225, -3}, {"d", 201045, 4061000, 1000, 0, -5},
+                            {"e", 185000, 4065840, 1400, 90, -5}, {"f", 201045, 4061340, 2600, 137, -30}};
+    ct_rng rng;
+    ct_rng_seed(&rng, ct_test_seed() * 13 + 5);
+    double worst = 0, worst_c = 0;
+    for (const PoseDef &d : defs) {
+        Pose p;
+        TEST_ASSERT_MSG(make_pose(w->sf, d, &p), "pose %s", d.family);
+        for (int k = 0; k < 20; ++k) {
+            ld ray[3] = {ct_rng_unit(&rng) - 0.5, ct_rng_unit(&rng) - 0.5, 1};
+            earth_ref::normalise3(ray);
+            ld qd[4];
+            earth_ref::quat_of_q30(p.q, qd);
+            earth_ref::Los a = earth_ref::los_from_pose(pj, p.pose, ray, nullptr);
+            earth_ref::Los b = earth_ref::los_from_wgs84(pj, p.lat, p.lon, p.h, qd, ray, nullptr);
+            ld dd[3] = {a.d[0] - b.d[0], a.d[1] - b.d[1], a.d[2] - b.d[2]};
+            worst = std::max(worst, (double)std::sqrt(earth_ref::dot3(dd, dd)));
+            ld dc[3] = {a.C[0] - b.C[0], a.C[1] - b.C[1], a.C[2] - b.C[2]};
+            worst_c = std::max(worst_c, (double)std::sqrt(earth_ref::dot3(dc, dc)));
+        }
+    }
+    std::printf("  line of sight from the library's pose vs from the quaternion: direction %.2g rad, centre %.2g m\n",
+                worst, worst_c);
+    TEST_ASSERT_MSG(worst < kDirAgreeRad, "directions differ by %.3g rad (convergence sign?)", worst);
+    TEST_ASSERT(worst_c < 1e-6);
+}
+
+// Sanity: nadir rays hit straight below the camera at the surface height.
+void test_reference_nadir()
+{
+    earth_ref::Proj &pj = proj();
+    World *w = jacksboro();
+    const ld places[][2] = {{201045, 4065840}, {196000, 4070000}, {206000, 4061500}, {198765.4, 4064321.2}};
+    double worst = 0;
+    for (auto &pl : places)
+        for (int refr = 0; refr < 2; ++refr) {
+            Pose p;
+            TEST_ASSERT(make_pose(w->sf, {"nadir", pl[0], pl[1], 3000, 30, -90}, &p));
+            ct_effects fx = {CT_EFFECT_CURVATURE | (refr ? CT_EFFECT_REFRACTION : 0u), CT_REFRACTION_K_STD_Q16, 0, 0};
+            // the camera's optical axis is the local down (pitch -90 in NED): ray (0, 0, 1)
+            const ld ray[3] = {0, 0, 1};
+            ld qd[4];
+            earth_ref::quat_of_q30(p.q, qd);
+            // the exact normal (the Q30 quaternion is within 2^-30 of it)
+            earth_ref::Los L = earth_ref::los_from_wgs84(pj, p.lat, p.lon, p.h, qd, ray, &fx);
+            ld e[3], n[3], u[3];
+            earth_ref::enu_axes(p.lat, p.lon, e, n, u);
+            for (int k = 0; k < 3; ++k) L.d[k] = -u[k];
+            earth_ref::set_effects(L, &fx, u);
+            earth_ref::Result r = earth_ref::trace(pj, w->sf, L);
+            TEST_ASSERT_EQUAL_INT(CT_HIT, r.status);
+            ld E0, N0, x, y;
+            pj.utm(p.lat, p.lon, &E0, &N0);
+            w->sf.grid(E0, N0, &x, &y);
+            const ld d = dist3(r.e, r.n, r.h, E0, N0, w->sf.height(x, y));
+            worst = std::max(worst, (double)d);
+            TEST_ASSERT_MSG(d < kNadirM, "nadir hit %.4Lf m from the point below the camera", d);
+            // and through the pose (Q30 attitude: within 2^-30 rad of the normal)
+            earth_ref::Result r2 = earth_ref::geolocate(pj, w->sf, p.pose, ray, &fx);
+            TEST_ASSERT_EQUAL_INT(CT_HIT, r2.status);
+            TEST_ASSERT(dist3(r2.e, r2.n, r2.h, r.e, r.n, r.h) < 1e-4);
+        }
+    // a camera under the terrain
+    {
+        Pose p;
+        TEST_ASSERT(make_pose(w->sf, {"under", 201045, 4065840, -5, 0, -30}, &p));
+        const ld ray[3] = {0, 0, 1};
+        ct_effects fx = {CT_EFFECT_CURVATURE, 0, 0, 0};
+        TEST_ASSERT_EQUAL_INT(CT_BELOW, earth_ref::geolocate(pj, w->sf, p.pose, ray, &fx).status);
+    }
+    std::printf("  nadir: hit vs the surface point below the camera within %.3g m\n", worst);
+}
+
+// The closed form on a flat surface h = H: Newton on the own long-double
+// geodetic height of P(t), then P(t) to the map by PROJ.
+bool closed_form_flat(earth_ref::Proj &pj, const earth_ref::Los &L, ld H, ld *E, ld *N, ld *h, ld *t_out)
+{
+    auto height = [&](ld t) {
+        ld P[3], la, lo, hh;
+        L.at(t, P);
+        earth_ref::geodetic_ld(P, &la, &lo, &hh);
+        return hh;
+    };
+    ld t = 0;
+    for (int it = 0; it < 60; ++it) {
+        const ld f = height(t) - H, eps = 1e-3L;
+        const ld df = (height(t + eps) - height(t - eps)) / (2 * eps);
+        if (df >= 0) return false;
+        const ld step = f / df;
+        t -= step;
+        if (std::fabs(step) < 1e-9L) break;
+    }
+    ld P[3];
+    L.at(t, P);
+    pj.map(P, E, N, h);
+    *t_out = t;
+    return std::fabs(*h - H) < 1e-6L;
+}
+
+// Sanity: on a flat package the reference hit is the closed-form
+// intersection; its difference from the parabola model (the map-frame ray
+// of the library's pose with its horizontal scale, rising rho^2 / 2R' with
+// R' the ellipsoid's radius of curvature in the ray's azimuth plus the
+// camera's height) is about rho^2 tan(depression) / R along track.
+void test_reference_flat()
+{
+    earth_ref::Proj &pj = proj();
+    World *w = flat();
+    const ld H = w->sf.zmin;
+    TEST_ASSERT(w->sf.zmax == H);
+    struct Case {
+        ld e, n, above, yaw, pitch;
+    };
+    const Case cases[] = {{201045, 4050000, 1000, 0, -5},  {201045, 4050000, 1000, 0, -10},
+                          {201045, 4052000, 2600, 0, -20}, {201045, 4055000, 2600, 0, -45},
+                          {196000, 4060000, 1000, 90, -5}, {201045, 4050000, 1500, 20, -5},
+                          {216000, 4065000, 1000, 270, -4}, {214000, 4050000, 1200, 315, -6}};
+    double worst_cf = 0;
+    for (const Case &c : cases)
+        for (int refr = 0; refr < 2; ++refr) {
+            Pose p;
+            TEST_ASSERT(make_pose(w->sf, {"flat", c.e, c.n, c.above, c.yaw, c.pitch}, &p));
+            ct_effects fx = {CT_EFFECT_CURVATURE | (refr ? CT_EFFECT_REFRACTION : 0u), CT_REFRACTION_K_STD_Q16, 0, 0};
+            const ld ray[3] = {0, 0, 1};
+            earth_ref::Los L = earth_ref::los_from_pose(pj, p.pose, ray, &fx);
+            earth_ref::Result r = earth_ref::trace(pj, w->sf, L);
+            TEST_ASSERT_EQUAL_INT(CT_HIT, r.status);
+            ld E, N, h, t;
+            TEST_ASSERT(closed_form_flat(pj, L, H, &E, &N, &h, &t));
+            const ld dcf = dist3(r.e, r.n, r.h, E, N, h);
+            worst_cf = std::max(worst_cf, (double)dcf);
+            TEST_ASSERT_MSG(dcf < kRefCheckM, "flat: reference %.6Lf off the closed form", dcf);
+            // the parabola model in the map frame (from the library's pose)
+            const int32_t rc[3] = {0, 0, 1 << 30};
+            int64_t dq[3];
+            TEST_ASSERT_EQUAL_INT(CT_OK, ct_pose_rotate(&p.pose, rc, dq));
+            const ld de = dq[0] / std::ldexp(1.0L, 39), dn = dq[1] / std::ldexp(1.0L, 39), dh = dq[2] / std::ldexp(1.0L, 39);
+            const ld hor = std::hypot(de, dn), az = std::atan2(de, dn) + L.gamma;  // true azimuth
+            const ld la = p.lat * kPi / 180, s2 = std::sin(la) * std::sin(la);
+            const ld Nr = earth_ref::kWgsA / std::sqrt(1 - earth_ref::kWgsE2 * s2);
+            const ld Mr = earth_ref::kWgsA * (1 - earth_ref::kWgsE2) / std::pow(1 - earth_ref::kWgsE2 * s2, 1.5L);
+            const ld Raz = 1 / (std::cos(az) * std::cos(az) / Mr + std::sin(az) * std::sin(az) / Nr);
+            const ld Rp = Raz + p.h;
+            const ld kk = refr ? CT_REFRACTION_K_STD_Q16 / 65536.0L : 0;
+            const ld cc = 1 / (2 * Rp) - kk / (2 * earth_ref::kRefractionRadius);
+            // the rise in ground metres: the map range over the pose's
+            // horizontal scale k R / (R + h) (in map metres the rise would be
+            // 2 (k - 1) too large: ~(k - 1) rho^2 / (R tan) along track)
+            const ld hs = p.pose.hscale_q30 / std::ldexp(1.0L, 30), hg = hor / hs;
+            // h0 + t dh + cc (t hg)^2 = H: smallest positive root
+            const ld A = cc * hg * hg, B = dh, C0 = p.h - H;
+            const ld tp = (-B - std::sqrt(B * B - 4 * A * C0)) / (2 * A);
+            const ld pe = p.pose.e_nm * 1e-9L + tp * de, pn = p.pose.n_nm * 1e-9L + tp * dn;
+            const ld ue = de / hor, un = dn / hor;
+            const ld along = (r.e - pe) * ue + (r.n - pn) * un, cross = -(r.e - pe) * un + (r.n - pn) * ue;
+            const ld rho = r.range, tdep = -dh / hor;
+            // the Earth-fixed line's stretch, and with refraction: the spec
+            // bends the path k t^2 / 2R along w (perpendicular to the ray), the
+            // parabola k rho^2 / 2R vertically; over horizontal range s the
+            // former drops k s^2 / (2 R cos^3 dep) (to first order in k): the
+            // hit comes earlier by the excess over tan(dep)
+            const ld cdep = std::cos(std::atan(tdep));
+            // transverse Mercator, x = E - 500 km: the point scale k0 (1 +
+            // x^2 / 2R^2) changes along an east-west ray (the map range grows
+            // by (x / R^2) ue rho^2 / 2), and a geodesic's image bends
+            // sideways by (x / R^2) un rho^2 / 2 (R^2 = M N)
+            const ld x = p.pose.e_nm * 1e-9L - 500000, R2 = Mr * Nr;
+            const ld pred = rho * rho * tdep / Raz -
+                            kk * rho * rho * (1 / (cdep * cdep * cdep) - 1) / (2 * earth_ref::kRefractionRadius) / tdep +
+                            x / R2 * ue * rho * rho / 2;
+            const ld pred_cross = x / R2 * un * rho * rho / 2;
+            std::printf("  flat yaw %3.0Lf dep %4.1Lf%s: range %7.1Lf m, ref vs closed form %.2Lg m; vs parabola along "
+                        "%+.3Lf m (predicted %+.3Lf), across %+.3Lf m (predicted %+.3Lf)\n",
+                        c.yaw, -c.pitch, refr ? " refr" : "     ", rho, dcf, along, pred, cross, pred_cross);
+            TEST_ASSERT_MSG(std::fabs(along - pred) <= 0.03L * std::fabs(pred) + 0.03L,
+                            "along-track difference %.3Lf m vs predicted %.3Lf m", along, pred);
+            TEST_ASSERT_MSG(std::fabs(cross - pred_cross) <= 0.05L * std::fabs(pred_cross) + 0.03L,
+                            "cross-track difference %.3Lf m vs predicted %.3Lf m", cross, pred_cross);
+        }
+    std::printf("  flat: reference vs closed form within %.3g m\n", worst_cf);
+}
+
+// ---------------------------------------------------------------------------
+// The library's exact mode vs the reference.
+
+struct Stat {
+    long n = 0, miss_agree = 0, skipped = 0, mismatch = 0, wall_below = 0;
+    double sum2 = 0, max = 0;
+    std::vector<double> all;
+    char worst[300] = "";
+    void add(double d, const char *what)
+    {
+        n++;
+        sum2 += d * d;
+        all.push_back(d);
+        if (d > max) std::snprintf(worst, sizeof worst, "%s", what);
+        max = std::max(max, d);
+    }
+    double rms() const { return n ? std::sqrt(sum2 / n) : 0; }
+    double median()
+    {
+        if (all.empty()) return 0;
+        std::nth_element(all.begin(), all.begin() + all.size() / 2, all.end());
+        return all[all.size() / 2];
+    }
+};
+
+std::vector<PoseDef> pose_defs()
+{
+    const ld Ec = 201045, Nc = 4065840;
+    auto back = [&](ld dist, ld yaw, ld *e, ld *n) {
+        *e = Ec - dist * std::sin(yaw * kPi / 180);
+        *n = Nc - dist * std::cos(yaw * kPi / 180);
+    };
+    std::vector<PoseDef> v;
+    v.push_back({"nadir", Ec, Nc, 3000, 0, -90});
+    v.push_back({"nadir", Ec - 3000, Nc + 2000, 3000, 40, -90});
+    for (ld yaw : {0.0L, 135.0L}) {
+        ld e, n;
+        back(2600 / std::tan(30 * kPi / 180), yaw, &e, &n);
+        v.push_back({"oblique30", e, n, 2600, yaw, -30});
+    }
+    for (ld yaw : {270.0L, 45.0L}) {
+        ld e, n;
+        back(2600 / std::tan(20 * kPi / 180), yaw, &e, &n);
+        v.push_back({"oblique20", e, n, 2600, yaw, -20});
+    }
+    // grazing: north from the south edge, east from the west edge, south-west from the north-east corner
+    v.push_back({"grazing5", Ec, 4061000, 1000, 0, -5});
+    v.push_back({"grazing5", 195500, Nc, 1000, 90, -5});
+    v.push_back({"grazing5", 206600, 4070500, 1000, 225, -5});
+    v.push_back({"grazing3", Ec, 4061000, 1000, 0, -3});
+    v.push_back({"grazing3", 195500, Nc, 1000, 90, -3});
+    v.push_back({"grazing3", 206600, 4070500, 1000, 225, -3});
+    // long: 10 km outside the tile, 5 deg down towards its middle
+    v.push_back({"long", 185000, Nc, 1420, 90, -5});
+    v.push_back({"long", Ec, 4050680, 1350, 0, -5});
+    return v;
+}
+
+void compare(unsigned flags)
+{
+    earth_ref::Proj &pj = proj();
+    World *w = jacksboro();
+    Cam cam = make_camera();
+    const std::vector<PoseDef> defs = pose_defs();
+    const char *families[] = {"nadir", "oblique30", "oblique20", "grazing5", "grazing3", "long"};
+    const int nf = 6;
+    Stat exact[nf], old[nf];
+    ld rng_sum[nf] = {0};
+    long ref_hits[nf] = {0};
+    ct_rng rng;
+    ct_rng_seed(&rng, ct_test_seed() * 1009 + flags);
+    const int npix = std::max(1, (int)std::lround(kPixelsPerPose * ct_test_scale()));
+    const ct_effects fx = {flags, CT_REFRACTION_K_STD_Q16, 0, 0};
+    ct_effects fx_old = fx;
+    fx_old.earth_radius_nm = CT_EARTH_RADIUS_NM;
+    long first_reports = 0;
+    auto t0 = std::chrono::steady_clock::now();
+    for (const PoseDef &d : defs) {
+        int f = 0;
+        while (std::strcmp(families[f], d.family) != 0) f++;
+        Pose p;
+        TEST_ASSERT_MSG(make_pose(w->sf, d, &p), "pose %s", d.family);
+        for (int k = 0; k < npix; ++k) {
+            const int64_t u = ct_rng_range(&rng, 0, (int64_t)(cam.w - 1) << 16);
+            const int64_t v = ct_rng_range(&rng, 0, (int64_t)(cam.h - 1) << 16);
+            ld ray[3];
+            earth_ref::pinhole_ray(cam.fx, cam.fy, cam.cx, cam.cy, (ld)u / 65536, (ld)v / 65536, ray);
+            const earth_ref::Los L = earth_ref::los_from_pose(pj, p.pose, ray, &fx);
+            earth_ref::Result r = earth_ref::trace(pj, w->sf, L);
+            ct_geo g, go;
+            const ct_status st = ct_geolocate(&w->p, &cam.cam, &p.pose, CT_METHOD_DIRECTIONAL, &fx, u, v, &g);
+            const ct_status so = ct_geolocate(&w->p, &cam.cam, &p.pose, CT_METHOD_DIRECTIONAL, &fx_old, u, v, &go);
+            const int ls = st == CT_HIT_VOID ? CT_HIT : st, los = so == CT_HIT_VOID ? CT_HIT : so;
+            if (r.min_clear < kSkipClearM) {
+                exact[f].skipped++;
+                old[f].skipped++;
+                continue;
+            }
+            if (r.status == CT_HIT) {
+                rng_sum[f] += r.range;
+                ref_hits[f]++;
+            }
+            auto judge = [&](Stat &s, int status, const ct_geo &gg, bool report) {
+                if (r.wall && status == CT_BELOW) {
+                    // the path enters the tile's side below the surface: the
+                    // reference hits that wall; the library may call it BELOW
+                    s.wall_below++;
+                    return;
+                }
+                if (status != r.status) {
+                    s.mismatch++;
+                    if (report && first_reports++ < 8)
+                        std::printf("    %s yaw %.0Lf px (%.2f, %.2f): library status %d (%.3f %.3f %.3f), reference %d "
+                                    "(%.3Lf %.3Lf %.3Lf, range %.0Lf m, clearance %.3Lg m)\n",
+                                    d.family, d.yaw, u / 65536.0, v / 65536.0, status, gg.hit.e_nm * 1e-9,
+                                    gg.hit.n_nm * 1e-9, gg.hit.h_nm * 1e-9, r.status, r.e, r.n, r.h, r.range, r.min_clear);
+                    return;
+                }
+                if (status != CT_HIT) {
+                    s.miss_agree++;
+                    return;
+                }
+                const ld le = gg.hit.e_nm * 1e-9L, ln = gg.hit.n_nm * 1e-9L, lh = gg.hit.h_nm * 1e-9L;
+                char what[300];
+                const earth_ref::OffPath op = earth_ref::off_path(pj, w->sf, L, le, ln, lh);
+                std::snprintf(what, sizeof what,
+                              "yaw %.0Lf px (%.2f, %.2f): reference (%.3Lf, %.3Lf, %.3Lf) range %.0Lf m, library - "
+                              "reference (%+.4Lf, %+.4Lf, %+.4Lf) m; the library's hit is %.4Lf m off the path, "
+                              "%+.4Lf m along it, the path's clearance there %+.4Lf m",
+                              d.yaw, u / 65536.0, v / 65536.0, r.e, r.n, r.h, r.range, le - r.e, ln - r.n, lh - r.h,
+                              op.dist, op.t - r.t, op.clearance);
+                s.add((double)dist3(le, ln, lh, r.e, r.n, r.h), what);
+            };
+            judge(exact[f], ls, g, true);
+            judge(old[f], los, go, false);
+        }
+    }
+    const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    std::printf("  effects %s: %d pixels per pose, %zu poses; reference %.1f s, %ld PROJ samples\n",
+                flags & CT_EFFECT_REFRACTION ? "curvature+refraction (k 0.13)" : "curvature", npix, defs.size(), secs,
+                pj.calls);
+    std::printf("  hits: both hit (compared); miss: both miss; skip: reference clearance < %.2f m before the hit; "
+                "bad: status differs; wall: the reference hits the tile's side (entering below the surface) and the "
+                "library says CT_BELOW (accepted)\n",
+                kSkipClearM);
+    std::printf("  %-10s %5s %5s %5s | %-46s | %-46s\n", "family", "hits", "miss", "skip",
+                "exact mode (radius 0): median / RMS / max, bad, wall",
+                "old parabola (6371 km): median / RMS / max, bad, wall");
+    double worst = 0;
+    long bad = 0;
+    for (int f = 0; f < nf; ++f) {
+        std::printf("  %-10s %5ld %5ld %5ld | %8.4f %8.4f %9.4f m %4ld %4ld | %8.4f %8.4f %9.4f m %4ld %4ld  (mean range "
+                    "%.0f m)\n",
+                    families[f], exact[f].n, exact[f].miss_agree, exact[f].skipped, exact[f].median(), exact[f].rms(),
+                    exact[f].max, exact[f].mismatch, exact[f].wall_below, old[f].median(), old[f].rms(), old[f].max,
+                    old[f].mismatch, old[f].wall_below, (double)(rng_sum[f] / std::max<long>(1, ref_hits[f])));
+        if (exact[f].n) std::printf("  %-10s   worst (exact mode): %s\n", "", exact[f].worst);
+        worst = std::max(worst, exact[f].max);
+        bad += exact[f].mismatch;
+    }
+    TEST_ASSERT_MSG(bad == 0, "%ld rays with the library's status different from the reference's", bad);
+    TEST_ASSERT_MSG(worst <= kMaxErrM, "library exact mode off the reference by up to %.4f m (> %.4f m)", worst, kMaxErrM);
+}
+
+void test_exact_curvature() { compare(CT_EFFECT_CURVATURE); }
+void test_exact_curvature_refraction() { compare(CT_EFFECT_CURVATURE | CT_EFFECT_REFRACTION); }
+
+}  // namespace
+
+int main()
+{
+    TEST_BEGIN("test_earth");
+    RUN_TEST(test_reference_georef);
+    RUN_TEST(test_reference_convergence);
+    RUN_TEST(test_reference_nadir);
+    RUN_TEST(test_reference_flat);
+    RUN_TEST(test_exact_curvature);
+    RUN_TEST(test_exact_curvature_refraction);
+    return TEST_END();
+}
