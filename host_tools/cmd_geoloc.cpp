@@ -79,7 +79,8 @@ int cmd_geoloc(int argc, char **argv)
     if (!opt.count("--camera")) throw Error("geoloc needs --camera C.cameramodel");
     if (!opt.count("--pixels")) throw Error("geoloc needs --pixels pixels.csv");
     if (!opt.count("-o")) throw Error("geoloc needs -o out.csv");
-    ct_effects fx = {0u, CT_REFRACTION_K_STD_Q16, CT_EARTH_RADIUS_NM, 0};
+    // radius 0: the true Earth on UTM packages (the sphere of 6371 km on others)
+    ct_effects fx = {0u, CT_REFRACTION_K_STD_Q16, 0, 0};
     if (opt.count("--effects")) {
         std::string list = opt["--effects"], tok;
         std::stringstream ss(list);

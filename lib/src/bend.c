@@ -349,17 +349,10 @@ static uint64_t norm_div(ct_i128 n, int64_t d, int *s)
  * kf = floor(K 2^kshift) in [2^30, 2^32): K's relative error < 2^-29.    */
 ct_status ct_lower_setup(const ct_package *p, int64_t ox, int64_t oy, const ct_bend *bd, ct_lower *lw)
 {
-    int64_t post = ct_abs64(p->posting_e_nm), W = (int64_t)p->cells_x * ONE16, H = (int64_t)p->cells_y * ONE16;
-    int s1, s2, e, k;
+    int64_t post = ct_abs64(p->posting_e_nm);
+    int s1, s2, e;
     uint64_t q1, q2;
     if (bd->coeff_q16 <= 0 || post >= (INT64_C(1) << 40) || p->height_scale_nm <= 0) {
-        return CT_ERR_RANGE;
-    }
-    lw->obx = ox;
-    lw->oby = oy;
-    /* every corner within 2^31 on each axis: |o| <= 2^46, so no overflow */
-    if (lw->obx <= W - (INT64_C(1) << 31) || lw->obx >= (INT64_C(1) << 31) ||
-        lw->oby <= H - (INT64_C(1) << 31) || lw->oby >= (INT64_C(1) << 31)) {
         return CT_ERR_RANGE;
     }
     /* c posting^2 < 2^18 2^80; / R (< 2^55); / scale (< 2^63) */
@@ -371,8 +364,27 @@ ct_status ct_lower_setup(const ct_package *p, int64_t ox, int64_t oy, const ct_b
     if (e < 0 || e > 127) {
         return CT_ERR_RANGE;
     }
-    lw->kf = q2 >> 31;
-    lw->kshift = (uint32_t)e;
+    return ct_lower_setup_k(p, ox, oy, q2 >> 31, (uint32_t)e, (bd->flags & CT_BEND_NO_CULL) == 0u, lw);
+}
+
+ct_status ct_lower_setup_k(const ct_package *p, int64_t ox, int64_t oy, uint64_t kf, uint32_t kshift, int32_t cull,
+                           ct_lower *lw)
+{
+    int64_t W = (int64_t)p->cells_x * ONE16, H = (int64_t)p->cells_y * ONE16;
+    uint32_t e = kshift;
+    int k;
+    if (kf >= ((uint64_t)1 << 32) || kshift > 127u) {
+        return CT_ERR_RANGE;
+    }
+    lw->obx = ox;
+    lw->oby = oy;
+    /* every corner within 2^31 on each axis: |o| <= 2^46, so no overflow */
+    if (lw->obx <= W - (INT64_C(1) << 31) || lw->obx >= (INT64_C(1) << 31) ||
+        lw->oby <= H - (INT64_C(1) << 31) || lw->oby >= (INT64_C(1) << 31)) {
+        return CT_ERR_RANGE;
+    }
+    lw->kf = kf;
+    lw->kshift = e;
     /* kc = floor(kf 2^48 / 2^e), at most 2^33 (a smaller kc only weakens
      * the walks' lower bounds) */
     lw->kc = e >= 48 ? (int64_t)(lw->kf >> (e - 48)) : INT64_C(1) << 33;
@@ -391,7 +403,7 @@ ct_status ct_lower_setup(const ct_package *p, int64_t ox, int64_t oy, const ct_b
         }
         lw->dmax = ct_max64(lw->dmax, ct_lower_at(lw, (k & 1) ? W : 0, (k & 2) ? H : 0));
     }
-    lw->cull = (bd->flags & CT_BEND_NO_CULL) == 0u;
+    lw->cull = cull;
     return CT_OK;
 }
 

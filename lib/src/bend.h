@@ -70,6 +70,59 @@ int64_t ct_lower_at(const ct_lower *lw, int64_t x, int64_t y);
 ct_status ct_trace_lowered(const ct_package *pkg, const ct_ray *ray, const ct_lower *lw, ct_method method,
                            ct_hit *hit);
 
+/* A segment (origin to origin + direction) of a lowered ray: prepared as
+ * ct_ray_prepare_segment, traced against the lowered terrain (lw = NULL:
+ * the terrain itself).  A hit in the last cell beyond the segment's end
+ * (t beyond tend) belongs to the chord's extension: the caller discards it. */
+ct_status ct_prepare_lowered_segment(const ct_package *pkg, const ct_ray *ray, const ct_lower *lw,
+                                     ct_prepared *out);
+ct_status ct_trace_prepared_lowered(const ct_package *pkg, const ct_prepared *ray, const ct_lower *lw,
+                                    ct_method method, ct_hit *hit);
+
+/* ct_lower_setup for a given rise coefficient: D = floor(Q kf / 2^kshift)
+ * with kf < 2^32, kshift < 128; the same range checks.                     */
+ct_status ct_lower_setup_k(const ct_package *pkg, int64_t ox_q16, int64_t oy_q16, uint64_t kf, uint32_t kshift,
+                           int32_t cull, ct_lower *lw);
+
+/* The true Earth (earth.c): a line of sight straight in Earth-fixed space
+ * (WGS84; with refraction bent by k t^2 / 2R in its vertical plane) from a
+ * camera over a package on a UTM zone, traced in pieces whose map-frame
+ * image is a straight chord (sideways within the chord tolerance of the
+ * exact image at its middle) and, vertically, the quadratic through the
+ * exact images of its ends and middle -- each piece one lowered walk.     */
+typedef struct {
+    ct_utm zone;
+    int64_t c[3];          /* camera centre, ECEF nm                          */
+    int64_t ox, oy, oz;    /* the same, grid frame Q16 (the pose's point)     */
+    int32_t frame_q30[9];  /* ECEF of grid east, grid north, up at the camera:
+                              columns, Q30                                   */
+    int32_t refr_k_q16;    /* refraction coefficient (0: none), Q16           */
+    int64_t radius_nm;     /* radius for refraction's bending                 */
+    int64_t tol_q16;       /* chord tolerance, Q16 cells (>= 2)               */
+    int64_t tolz_q16;      /* the same in Q16 height units (>= 2)             */
+    int64_t tmax_nm;       /* no terrain beyond this range                    */
+    int32_t cull;
+} ct_earth;
+
+/* The camera's local frame from its map point (E, N) on a zone: lat, lon
+ * (Q61) and the ECEF columns of grid east, grid north and up (Q30); the
+ * grid axes are the true ones turned by the meridian convergence
+ * (geodesy.c).                                                             */
+ct_status ct_grid_frame_ecef(const ct_utm *zone, int64_t e_nm, int64_t n_nm, int64_t *lat_q61, int64_t *lon_q61,
+                             int32_t frame_q30[9]);
+
+/* Set-up for a pose over a UTM package: CT_ERR_CRS when the package is not
+ * on a UTM zone, CT_ERR_RANGE / CT_ERR_RAY for a camera outside the
+ * projection's or the tracer's domain.                                     */
+ct_status ct_earth_setup(const ct_package *pkg, const ct_pose *pose, int32_t refr_k_q16, int64_t radius_nm,
+                         int64_t chord_nm, uint32_t bend_flags, ct_earth *es);
+
+/* The first hit of the line of sight of a unit map-frame direction
+ * (grid east, grid north, up at the camera; Q39, without the pose's
+ * horizontal scale).  hit.steps / iters add up over the pieces.           */
+ct_status ct_trace_earth(const ct_package *pkg, const ct_earth *es, const int64_t dir_grid_q39[3], ct_method method,
+                         ct_hit *hit);
+
 /* ct_trace_prepared for a ray this library prepared itself (skips the
  * re-validation of the caller-visible struct). */
 ct_status ct_trace_prepared_own(const ct_package *pkg, const ct_prepared *ray, ct_method method, ct_hit *hit);

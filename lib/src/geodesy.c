@@ -23,6 +23,7 @@
 #include "conetrace.h"
 #include "fixed.h"
 #include "geodesy_tables.h"
+#include "bend.h"
 
 #define QB 59u
 #define ONE (INT64_C(1) << QB)
@@ -822,4 +823,49 @@ ct_status ct_package_geoid(const ct_package *pkg, int64_t e_nm, int64_t n_nm, in
         return st;
     }
     return ct_geoid_at(&pkg->geoid, lat, lon, n_geoid_nm);
+}
+
+/* ------------------------------------------------------------------------ */
+/* The camera's local frame for the true-Earth walk (bend.h, earth.c)        */
+
+ct_status ct_grid_frame_ecef(const ct_utm *z, int64_t e_nm, int64_t n_nm, int64_t *lat_q61, int64_t *lon_q61,
+                             int32_t f[9])
+{
+    int64_t lat, lon, e, n, g, k, sp, cp, sl, cl, sg, cg, east[3], north[3], up[3];
+    ct_status st;
+    int i;
+    if (z == NULL || lat_q61 == NULL || lon_q61 == NULL || f == NULL) {
+        return CT_ERR_ARG;
+    }
+    st = ct_utm_inverse(z, e_nm, n_nm, &lat, &lon);
+    if (st == CT_OK) {
+        st = forward(z, lat, lon, &e, &n, &g, &k);
+    }
+    if (st != CT_OK) {
+        return st;
+    }
+    qsincos(q61_to_59(lat), &sp, &cp);
+    qsincos(q61_to_59(lon), &sl, &cl);
+    qsincos(q61_to_59(g), &sg, &cg);
+    /* ENU in ECEF: east (-sin lon, cos lon, 0), north (-sin lat cos lon,
+     * -sin lat sin lon, cos lat), up (cos lat cos lon, cos lat sin lon,
+     * sin lat); grid east = cos g east - sin g north, grid north = sin g
+     * east + cos g north (pose_from_q's relation, inverted).  Q59 -> Q30 */
+    east[0] = -sl;
+    east[1] = cl;
+    east[2] = 0;
+    north[0] = -qmul(sp, cl);
+    north[1] = -qmul(sp, sl);
+    north[2] = cp;
+    up[0] = qmul(cp, cl);
+    up[1] = qmul(cp, sl);
+    up[2] = sp;
+    for (i = 0; i < 3; ++i) { /* bound: 3 ECEF axes */
+        f[3 * i] = (int32_t)q59_to_30(qmul(cg, east[i]) - qmul(sg, north[i]));
+        f[3 * i + 1] = (int32_t)q59_to_30(qmul(sg, east[i]) + qmul(cg, north[i]));
+        f[3 * i + 2] = (int32_t)q59_to_30(up[i]);
+    }
+    *lat_q61 = lat;
+    *lon_q61 = lon;
+    return CT_OK;
 }

@@ -1739,6 +1739,17 @@ ct_status ct_trace_prepared_own(const ct_package *p, const ct_prepared *r, ct_me
     return trace_impl(p, r, m, 1, NULL, h);
 }
 
+ct_status ct_prepare_lowered_segment(const ct_package *p, const ct_ray *ray, const ct_lower *lw, ct_prepared *out)
+{
+    return prepare_impl(p, ray, 1, lw, out);
+}
+
+ct_status ct_trace_prepared_lowered(const ct_package *p, const ct_prepared *r, const ct_lower *lw, ct_method m,
+                                    ct_hit *h)
+{
+    return trace_impl(p, r, m, 1, lw, h);
+}
+
 ct_status ct_trace_lowered(const ct_package *p, const ct_ray *ray, const ct_lower *lw, ct_method m, ct_hit *h)
 {
     ct_prepared r;

@@ -1,0 +1,582 @@
+/*
+ * earth.c -- the true Earth: a line of sight straight in Earth-fixed space
+ * (WGS84), or refracted, traced over a package on a UTM zone.
+ *
+ * The path: P(t) = C + t d - (k t^2 / 2R) w  (ECEF, nm; t >= 0 the range
+ * from the camera centre C, d the unit direction, w the unit vector normal
+ * to d in its vertical plane, upwards; the last term only with refraction,
+ * R the mean radius).  Its image in the package's frame (UTM E, N, the
+ * ellipsoidal height: ct_wgs84_from_ecef, ct_utm_forward, ct_map_to_grid)
+ * is neither a map-frame line nor a vertical parabola: it stretches along
+ * track (rho^2 tan(depression) / R), bends sideways (transverse Mercator:
+ * about E' rho^2 / (2 R^2) at E' from the central meridian) and rises with
+ * the ellipsoid's radius in its azimuth.  It is traced in pieces [ta, tb]:
+ *   - the exact images A, M, B of the ends and the middle (Q16 grid);
+ *   - horizontally the chord A -> B, accepted when M lies within the chord
+ *     tolerance of it (the image's sideways curvature is nearly constant
+ *     over a piece, so the middle is where it strays most); otherwise the
+ *     piece is shortened by sqrt(tol / deviation);
+ *   - vertically the quadratic z(s) = zA + b s + a s^2 in the range s along
+ *     the chord through A, M and B: the straight line from A to B lowered
+ *     by a s^2 at B, traced against the terrain lowered post by post by
+ *     a ((x - xA)^2 + (y - yA)^2) (the lowered walk of trace.c, ct_lower).
+ *     Over pieces of at most 8 km the image's height departs from that
+ *     quadratic by its cubic term only: < 0.05 mm (measured with PROJ in
+ *     tests/test_earth.cpp and docs/geolocation.md).  a < 0 (a path bending
+ *     down faster than the Earth: refraction k > 1) traces the chord itself,
+ *     the piece shortened until |a| l^2 / 4 is within the tolerance;
+ *   - a hit beyond the piece's end belongs to the next piece.
+ * Pieces off the tile (horizontally, or above the tallest post) are not
+ * traced and need no tolerance: they double in length up to 8 km.
+ *
+ * Formats: ECEF nm (|.| < 2^55), directions Q39 (unit = 2^39), t nm
+ * (< 2^48: 281 km), grid Q16 as everywhere.
+ */
+#include "bend.h"
+#include "camera.h"
+#include "fixed.h"
+
+#define ONE16 INT64_C(65536)
+#define KM_NM (INT64_C(1000) * 1000000000)
+#define PIECE_FIRST_NM (4 * KM_NM)
+#define PIECE_MAX_NM (30 * KM_NM)
+#define PIECE_MIN_NM (INT64_C(20) * 1000000000)
+#define TMAX_LIMIT_NM (INT64_C(1) << 48)
+#define EARTH_MAX_PIECES 8192u
+#define EARTH_MAX_RETRIES 8u
+
+typedef struct {
+    int64_t x, y, z;
+} gv;
+
+/* The image is interpolated between n exact images at the Chebyshev
+ * nodes of [0, tmax] (a polynomial of degree n - 1): n = 4 up to 25 km, 5
+ * up to 100 km, 6 beyond (to 281 km).  Against PROJ's exact image
+ * (measured, docs/geolocation.md) that stays within 0.005 mm: the image's
+ * k-th derivative scales as R^(1-k).  Lagrange form: w_j(tau) = K_j
+ * prod_{i != j} (tau - tau_i), tau = t / tmax in [0, 1]; the tau_i (Q60)
+ * and K_j = 1 / prod_{i != j} (tau_j - tau_i) (Q54, |K| < 165) generated
+ * with mpmath at 50 digits.  Each |tau - tau_i| <= 1, so the products stay
+ * in Q60, and w_j = (L_j K_j) >> 54 < 2^62 (the nodes' Lebesgue function
+ * is below 2.3 on [0, 1]).  Values are taken relative to the first node's
+ * image (|X| < 2^48 within 281 km): w X < 2^110.                        */
+#define NODES 6
+#define NODES_4_NM (25 * KM_NM)
+#define NODES_5_NM (100 * KM_NM)
+static const int64_t tau_q60[3][NODES] = {
+    {INT64_C(43880461954231926), INT64_C(355858772988187558), INT64_C(797062731618659418),
+     INT64_C(1109041042652615050), 0, 0},
+    {INT64_C(28213997436846120), INT64_C(237625623574046853), INT64_C(576460752303423488),
+     INT64_C(915295881032800123), INT64_C(1124707507170000856), 0},
+    {INT64_C(19642423811521231), INT64_C(168841445261774044), INT64_C(427261730853170675),
+     INT64_C(725659773753676301), INT64_C(984080059345072932), INT64_C(1133279080795325745)}};
+static const int64_t k_q54[3][NODES] = {
+    {-INT64_C(110300989657617965), INT64_C(266290145174595781), -INT64_C(266290145174595781),
+     INT64_C(110300989657617965), 0, 0},
+    {INT64_C(285017870483079962), -INT64_C(746186472325818753), INT64_C(922337203685477581),
+     -INT64_C(746186472325818753), INT64_C(285017870483079962), 0},
+    {-INT64_C(795728114401348337), INT64_C(2173969637555463702), -INT64_C(2969697751956812039),
+     INT64_C(2969697751956812039), -INT64_C(2173969637555463702), INT64_C(795728114401348337)}};
+
+typedef struct {
+    const ct_package *p;
+    const ct_earth *es;
+    ct_utm zone;
+    int64_t d[3];  /* direction, ECEF, Q39 */
+    int64_t w[3];  /* refraction's bending direction, Q30 (0: none) */
+    int refract;
+    int interp;    /* 1: the nodes below are set */
+    int nodes;     /* n: 4, 5 or 6 */
+    int64_t tmax;
+    gv base;       /* image of node 0 */
+    int64_t X[NODES][3]; /* images of the nodes less base */
+} path;
+
+/* round(a b / 2^s) (half up) in 128 bits; the result must fit (callers) */
+static int64_t mul_shr(int64_t a, int64_t b, unsigned s)
+{
+    return ct_mul_shr(a, b, s);
+}
+
+/* round(v / 2^60) of a 128-bit v whose result fits in int64 */
+static int64_t round_q60(ct_i128 v)
+{
+    ct_i128 r = ct_i128_sar(ct_i128_add(v, ct_i128_from64(INT64_C(1) << 59)), 60u);
+    return (int64_t)r.lo;
+}
+
+/* The exact image of P(t) in the grid frame. */
+static ct_status vertex_exact(const path *pa, int64_t t, gv *v)
+{
+    int64_t P[3], lat, lon, h, e, n, bend = 0;
+    int k;
+    ct_status st;
+    if (pa->refract) {
+        /* k t^2 / 2R: t < 2^48, t^2 < 2^96, |k| <= 2^17: < 2^113; / 2R
+         * (>= 2^41) leaves < 2^72 -- saturated at 2^62, then / 2^16 */
+        ct_i128 num = ct_i128_mul128_64(ct_umul64((uint64_t)t, (uint64_t)t), pa->es->refr_k_q16);
+        bend = ct_floor_div(ct_i128_floor_div_sat(num, 2 * pa->es->radius_nm), ONE16);
+    }
+    /* bound: 3 axes.  t d: < 2^48 2^40 = 2^88 (128-bit) / 2^39; bend w:
+     * < 2^46 2^31 / 2^30 */
+    for (k = 0; k < 3; ++k) {
+        P[k] = pa->es->c[k] + mul_shr(t, pa->d[k], 39u);
+        if (pa->refract) {
+            P[k] -= mul_shr(bend, pa->w[k], 30u);
+        }
+    }
+    st = ct_wgs84_from_ecef(P, &lat, &lon, &h);
+    if (st == CT_OK) {
+        st = ct_utm_forward(&pa->zone, lat, lon, &e, &n);
+    }
+    if (st == CT_OK) {
+        st = ct_map_to_grid(pa->p, e, n, h, &v->x, &v->y, &v->z);
+    }
+    return st;
+}
+
+/* The image of P(t), 0 <= t <= tmax: interpolated when the nodes are set. */
+static ct_status vertex(const path *pa, int64_t t, gv *v)
+{
+    const int64_t *tq = tau_q60[pa->nodes - 4], *kq = k_q54[pa->nodes - 4];
+    int64_t tau;
+    ct_i128 acc[3];
+    int i, j, k;
+    if (!pa->interp) {
+        return vertex_exact(pa, t, v);
+    }
+    /* tau = t 2^60 / tmax: t <= tmax < 2^48 */
+    tau = ct_i128_floor_div(ct_i128_shl(ct_i128_from64(t), 60u), pa->tmax);
+    for (k = 0; k < 3; ++k) { /* bound: 3 */
+        acc[k] = ct_i128_from64(0);
+    }
+    for (j = 0; j < pa->nodes; ++j) { /* bound: NODES */
+        int64_t lj = INT64_C(1) << 60, wj;
+        for (i = 0; i < pa->nodes; ++i) { /* bound: NODES */
+            if (i != j) {
+                lj = mul_shr(lj, tau - tq[i], 60u);
+            }
+        }
+        wj = mul_shr(lj, kq[j], 54u);
+        for (k = 0; k < 3; ++k) { /* bound: 3 */
+            acc[k] = ct_i128_add(acc[k], ct_i128_mul(wj, pa->X[j][k]));
+        }
+    }
+    v->x = pa->base.x + round_q60(acc[0]);
+    v->y = pa->base.y + round_q60(acc[1]);
+    v->z = pa->base.z + round_q60(acc[2]);
+    return CT_OK;
+}
+
+/* The nodes' exact images; pa->interp = 0 when one is outside the
+ * projection's domain (the vertices are then computed exactly). */
+static void set_nodes(path *pa, int64_t tmax)
+{
+    int j;
+    gv v;
+    pa->interp = 0;
+    pa->tmax = tmax;
+    pa->nodes = tmax <= NODES_4_NM ? 4 : (tmax <= NODES_5_NM ? 5 : 6);
+    for (j = 0; j < pa->nodes; ++j) { /* bound: NODES */
+        /* t_j = tmax tau_j: < 2^48 2^60 in 128 bits */
+        int64_t t = mul_shr(tmax, tau_q60[pa->nodes - 4][j], 60u);
+        if (vertex_exact(pa, t, &v) != CT_OK) {
+            return;
+        }
+        if (j == 0) {
+            pa->base = v;
+        }
+        pa->X[j][0] = v.x - pa->base.x;
+        pa->X[j][1] = v.y - pa->base.y;
+        pa->X[j][2] = v.z - pa->base.z;
+        if (ct_abs64(pa->X[j][0]) >= (INT64_C(1) << 48) || ct_abs64(pa->X[j][1]) >= (INT64_C(1) << 48) ||
+            ct_abs64(pa->X[j][2]) >= (INT64_C(1) << 48)) {
+            return;
+        }
+    }
+    pa->interp = 1;
+}
+
+/* The piece A -> B (middle M): chord length l, the middle's sideways
+ * deviation, its range along the chord, and the vertical quadratic's
+ * coefficient a = num / den (den > 0; den = 0: no quadratic). */
+typedef struct {
+    int64_t ux, uy, l, dev, sm;
+    ct_i128 num, den;
+    int64_t dip; /* |a| l^2 / 4, Q16 height units (saturated) */
+} fit;
+
+static void fit_piece(const gv *A, const gv *B, const gv *M, fit *f)
+{
+    int64_t mx = M->x - A->x, my = M->y - A->y;
+    ct_i128 cross, dot, l2;
+    f->ux = B->x - A->x;
+    f->uy = B->y - A->y;
+    /* pieces are at most 8 km: |u|, |m| < 2^43 Q16 even at 1 mm posting;
+     * squares and products in 128 bits */
+    l2 = ct_i128_add(ct_i128_mul(f->ux, f->ux), ct_i128_mul(f->uy, f->uy));
+    f->l = (int64_t)ct_i128_isqrt(l2);
+    cross = ct_i128_sub(ct_i128_mul(f->ux, my), ct_i128_mul(f->uy, mx));
+    dot = ct_i128_add(ct_i128_mul(f->ux, mx), ct_i128_mul(f->uy, my));
+    if (f->l == 0) {
+        f->dev = (int64_t)ct_i128_isqrt(ct_i128_add(ct_i128_mul(mx, mx), ct_i128_mul(my, my)));
+        f->sm = 0;
+    } else {
+        f->dev = ct_i128_floor_div(ct_i128_sign(cross) < 0 ? ct_i128_neg(cross) : cross, f->l);
+        f->sm = ct_i128_floor_div(dot, f->l);
+    }
+    f->den = ct_i128_from64(0);
+    f->num = ct_i128_from64(0);
+    f->dip = 0;
+    /* the quadratic through (0, 0), (sm, zm'), (l, zb'):
+     *   a = (zm' l - zb' sm) / (sm l (l - sm)),
+     * only for a chord of a cell or more with the middle well inside */
+    if (f->l >= (INT64_C(1) << 40) || ct_abs64(M->z - A->z) >= (INT64_C(1) << 48) ||
+        ct_abs64(B->z - A->z) >= (INT64_C(1) << 48)) {
+        f->dip = INT64_C(1) << 62; /* beyond the fit's range: shorten */
+    } else if (f->l >= ONE16 && f->sm > f->l / 4 && f->sm < f->l - f->l / 4) {
+        int64_t zm = M->z - A->z, zb = B->z - A->z, q1;
+        /* |z'| < 2^48, l < 2^40: products < 2^88, den < 2^120 */
+        f->num = ct_i128_sub(ct_i128_mul(zm, f->l), ct_i128_mul(zb, f->sm));
+        f->den = ct_i128_mul128_64(ct_i128_mul(f->sm, f->l), f->l - f->sm);
+        /* dip = |num| l / (4 sm (l - sm)): |num| l < 2^128 is not assured,
+         * so |num| / sm first (sm > l / 4: the quotient < 2^50), then l /
+         * (4 (l - sm)) < 1 */
+        q1 = ct_i128_floor_div_sat(ct_i128_sign(f->num) < 0 ? ct_i128_neg(f->num) : f->num, f->sm);
+        f->dip = ct_i128_floor_div_sat(ct_i128_mul(q1, f->l), 4 * (f->l - f->sm));
+    }
+}
+
+/* The model's distance from the exact image Q (a quarter point): its
+ * sideways distance from the chord (Q16 cells) and the height difference
+ * at its range along the chord (Q16 height units): the chord's height
+ * there plus the lowering (lw) or the straight chord (lw = NULL).       */
+static void model_error(const gv *A, const gv *B, const gv *Q, const fit *f, const ct_lower *lw, int64_t dB,
+                        int64_t *lat, int64_t *vert)
+{
+    int64_t qx = Q->x - A->x, qy = Q->y - A->y, sq, zl;
+    ct_i128 cross, dot;
+    if (f->l == 0) {
+        /* a vertical chord: the sideways distance only */
+        *lat = (int64_t)ct_i128_isqrt(ct_i128_add(ct_i128_mul(qx, qx), ct_i128_mul(qy, qy)));
+        *vert = 0;
+        return;
+    }
+    cross = ct_i128_sub(ct_i128_mul(f->ux, qy), ct_i128_mul(f->uy, qx));
+    dot = ct_i128_add(ct_i128_mul(f->ux, qx), ct_i128_mul(f->uy, qy));
+    *lat = ct_i128_floor_div(ct_i128_sign(cross) < 0 ? ct_i128_neg(cross) : cross, f->l);
+    sq = ct_i128_floor_div(dot, f->l);
+    /* the line's height at sq: (B.z - dB - A.z) sq / l, |.| < 2^48 2^44 */
+    zl = A->z + ct_i128_floor_div(ct_i128_mul(B->z - dB - A->z, sq), f->l);
+    if (lw != NULL) {
+        zl += ct_lower_at(lw, Q->x, Q->y);
+    }
+    *vert = ct_abs64(Q->z - zl);
+}
+
+/* kf, kshift with kf 2^-kshift = num / den (num, den > 0), kf in
+ * [2^30, 2^32); 0 when the quotient is beyond the lowered walk's range. */
+static int rise_coeff(ct_i128 num, ct_i128 den, uint64_t *kf, uint32_t *kshift)
+{
+    unsigned nb, db, r = 0u;
+    int e;
+    int64_t d64, q;
+    nb = num.hi != 0u ? 64u + ct_bitlen64(num.hi) : ct_bitlen64(num.lo);
+    db = den.hi != 0u ? 64u + ct_bitlen64(den.hi) : ct_bitlen64(den.lo);
+    if (db > 62u) {
+        r = db - 62u;
+        den = r >= 64u ? ct_i128_from64((int64_t)(den.hi >> (r - 64u)))
+                       : ct_i128_from64((int64_t)((den.lo >> r) | (den.hi << (64u - r))));
+        db = 62u;
+    }
+    d64 = (int64_t)den.lo;
+    /* num 2^e / d64 in [2^30, 2^32): e = 31 - (nb - db), and num 2^e <
+     * 2^(nb + e) = 2^(31 + db) <= 2^93 */
+    e = 31 - ((int)nb - (int)db);
+    if (e < 0 || d64 <= 0) {
+        return 0;
+    }
+    /* ct_i128_shl shifts by less than 64 */
+    num = e >= 64 ? ct_i128_shl(ct_i128_shl(num, 63u), (unsigned)e - 63u) : ct_i128_shl(num, (unsigned)e);
+    q = ct_i128_floor_div(num, d64);
+    /* bound: 2 halvings */
+    while (q >= (INT64_C(1) << 32)) {
+        q >>= 1;
+        e--;
+    }
+    if (e + (int)r > 127 || e < 0) {
+        return 0;
+    }
+    *kf = (uint64_t)q;
+    *kshift = (uint32_t)(e + (int)r);
+    return 1;
+}
+
+ct_status ct_earth_setup(const ct_package *p, const ct_pose *pose, int32_t refr_k_q16, int64_t radius_nm,
+                         int64_t chord_nm, uint32_t bend_flags, ct_earth *es)
+{
+    int64_t lat, lon, post, far2x, far2y, dz;
+    ct_status st;
+    if (p == NULL || pose == NULL || es == NULL) {
+        return CT_ERR_ARG;
+    }
+    if (p->epsg > 0x7fffffffu || ct_utm_zone_of_epsg((int32_t)p->epsg, &es->zone) != CT_OK) {
+        return CT_ERR_CRS;
+    }
+    st = ct_grid_frame_ecef(&es->zone, pose->e_nm, pose->n_nm, &lat, &lon, es->frame_q30);
+    if (st == CT_OK) {
+        st = ct_ecef_from_wgs84(lat, lon, pose->h_nm, es->c);
+    }
+    if (st != CT_OK) {
+        return st;
+    }
+    if (ct_map_to_grid(p, pose->e_nm, pose->n_nm, pose->h_nm, &es->ox, &es->oy, &es->oz) != CT_OK ||
+        ct_abs64(es->ox) > CT_MAX_ORIGIN_Q16 || ct_abs64(es->oy) > CT_MAX_ORIGIN_Q16 ||
+        ct_abs64(es->oz) > CT_MAX_ORIGIN_Q16) {
+        return CT_ERR_RAY;
+    }
+    es->refr_k_q16 = refr_k_q16;
+    es->radius_nm = radius_nm;
+    post = ct_abs64(p->posting_e_nm);
+    /* chord (<= 2^50) 2^16 < 2^66: 128-bit */
+    es->tol_q16 = ct_max64(2, ct_i128_floor_div_sat(ct_i128_shl(ct_i128_from64(chord_nm), 16), post));
+    es->tolz_q16 = ct_max64(2, ct_i128_floor_div_sat(ct_i128_shl(ct_i128_from64(chord_nm), 16), p->height_scale_nm));
+    es->cull = (bend_flags & CT_BEND_NO_CULL) == 0u;
+    /* no terrain beyond the farthest tile corner: the range to it (map
+     * metres are ground metres within 0.1 %) plus the height down to the
+     * lowest post, with 10 % and 1 km to spare */
+    far2x = ct_max64(ct_abs64(es->ox), ct_abs64(es->ox - (int64_t)p->cells_x * ONE16));
+    far2y = ct_max64(ct_abs64(es->oy), ct_abs64(es->oy - (int64_t)p->cells_y * ONE16));
+    dz = ct_abs64(es->oz - (int64_t)p->hmin * ONE16);
+    {
+        /* Q16 -> nm (saturated; each capped at 2^48: squares < 2^98) */
+        int64_t hx = ct_i128_floor_div_sat(ct_i128_mul(far2x, post), ONE16);
+        int64_t hy = ct_i128_floor_div_sat(ct_i128_mul(far2y, post), ONE16);
+        int64_t hz = ct_i128_floor_div_sat(ct_i128_mul(dz, p->height_scale_nm), ONE16);
+        hx = ct_min64(hx, TMAX_LIMIT_NM);
+        hy = ct_min64(hy, TMAX_LIMIT_NM);
+        hz = ct_min64(hz, TMAX_LIMIT_NM);
+        ct_i128 s2 = ct_i128_add(ct_i128_add(ct_i128_mul(hx, hx), ct_i128_mul(hy, hy)), ct_i128_mul(hz, hz));
+        int64_t dist = (int64_t)ct_i128_isqrt(s2);
+        if (dist > TMAX_LIMIT_NM) {
+            dist = TMAX_LIMIT_NM;
+        }
+        es->tmax_nm = ct_min64(TMAX_LIMIT_NM, dist + dist / 10 + KM_NM);
+    }
+    return CT_OK;
+}
+
+/* 1 when nothing of the piece can touch terrain: off the tile
+ * horizontally (the box of A, B, M widened by the deviation and 2 cells)
+ * or above the tallest post. */
+static int piece_off(const ct_package *p, const gv *A, const gv *B, const gv *M, const fit *f, int64_t tolz)
+{
+    int64_t m = f->dev + 2 * ONE16;
+    int64_t x0 = ct_min64(A->x, ct_min64(B->x, M->x)) - m, x1 = ct_max64(A->x, ct_max64(B->x, M->x)) + m;
+    int64_t y0 = ct_min64(A->y, ct_min64(B->y, M->y)) - m, y1 = ct_max64(A->y, ct_max64(B->y, M->y)) + m;
+    int64_t zlow = ct_min64(A->z, ct_min64(B->z, M->z)) - f->dip - tolz;
+    if (x1 < 0 || y1 < 0 || x0 > (int64_t)p->cells_x * ONE16 || y0 > (int64_t)p->cells_y * ONE16) {
+        return 1;
+    }
+    return zlow > ((int64_t)p->hmax + 1) * ONE16;
+}
+
+/* 1 when the path never comes back over the tile: beyond an edge and
+ * moving away on that axis faster than 1/1024 of its horizontal progress
+ * (its heading turns by far less over 281 km), or above the tallest post
+ * and rising on a convex piece. */
+static int gone(const ct_package *p, const gv *A, const gv *B, const gv *M, const fit *f)
+{
+    int64_t W = (int64_t)p->cells_x * ONE16, H = (int64_t)p->cells_y * ONE16, away = f->l / 1024 + 1;
+    if ((B->x < 0 && A->x - B->x > away) || (B->x > W && B->x - A->x > away) || (B->y < 0 && A->y - B->y > away) ||
+        (B->y > H && B->y - A->y > away)) {
+        return 1;
+    }
+    return ct_i128_sign(f->num) >= 0 && B->z > ((int64_t)p->hmax + 1) * ONE16 && B->z >= M->z && M->z >= A->z;
+}
+
+ct_status ct_trace_earth(const ct_package *p, const ct_earth *es, const int64_t dg[3], ct_method m, ct_hit *h)
+{
+    path pa;
+    gv A, B, M;
+    fit f;
+    int64_t ta = 0, L = PIECE_FIRST_NM;
+    uint32_t piece, steps = 0u, iters = 0u;
+    ct_status st;
+    int k;
+    if (p == NULL || es == NULL || dg == NULL || h == NULL) {
+        return CT_ERR_ARG;
+    }
+    if ((uint32_t)m >= (uint32_t)CT_METHOD_COUNT) {
+        return CT_ERR_METHOD;
+    }
+    pa.p = p;
+    pa.es = es;
+    pa.zone = es->zone;
+    /* d = frame dg: |frame| <= 2^30, |dg| <= 2^40: products < 2^70 */
+    for (k = 0; k < 3; ++k) { /* bound: 3 axes */
+        ct_i128 s = ct_i128_from64(0);
+        int j;
+        for (j = 0; j < 3; ++j) { /* bound: 3 terms */
+            s = ct_i128_add(s, ct_i128_mul(es->frame_q30[3 * k + j], dg[j]));
+        }
+        pa.d[k] = (int64_t)ct_i128_sar(ct_i128_add(s, ct_i128_from64(INT64_C(1) << 29)), 30u).lo;
+        pa.w[k] = 0;
+    }
+    pa.refract = 0;
+    if (es->refr_k_q16 != 0) {
+        /* w = up - (up . d) d, normalised (Q30); up is the frame's third
+         * column.  Near the vertical (|w| < 2^-10) refraction bends nothing
+         * worth a term. */
+        int64_t up[3], dq[3], dot = 0, n2, nn;
+        for (k = 0; k < 3; ++k) { /* bound: 3 */
+            up[k] = es->frame_q30[3 * k + 2];
+            dq[k] = ct_floor_div(pa.d[k] + (INT64_C(1) << 8), INT64_C(1) << 9); /* Q30 */
+            dot += up[k] * dq[k];                                              /* < 2^62 */
+        }
+        dot = ct_floor_div(dot + (INT64_C(1) << 29), INT64_C(1) << 30);
+        n2 = 0;
+        for (k = 0; k < 3; ++k) { /* bound: 3 */
+            pa.w[k] = up[k] - ct_floor_div(dot * dq[k] + (INT64_C(1) << 29), INT64_C(1) << 30);
+            n2 += pa.w[k] * pa.w[k];
+        }
+        nn = (int64_t)ct_isqrt64((uint64_t)n2);
+        if (nn >= (INT64_C(1) << 20)) {
+            for (k = 0; k < 3; ++k) { /* bound: 3 */
+                pa.w[k] = ct_floor_div(pa.w[k] * (INT64_C(1) << 30) + nn / 2, nn);
+            }
+            pa.refract = 1;
+        }
+    }
+    pa.interp = 0;
+    set_nodes(&pa, es->tmax_nm);
+    A.x = es->ox;
+    A.y = es->oy;
+    A.z = es->oz;
+    /* bound: EARTH_MAX_PIECES pieces, each with at most EARTH_MAX_RETRIES
+     * + 1 tries */
+    for (piece = 0u; piece < EARTH_MAX_PIECES && ta < es->tmax_nm; ++piece) {
+        int64_t tb = ta, Lc = L, elat = 0, evert = 0, dB = 0;
+        int off = 0;
+        uint32_t r;
+        ct_lower lw;
+        const ct_lower *lwp = NULL;
+        for (r = 0u; r <= EARTH_MAX_RETRIES; ++r) {
+            int ok;
+            Lc = ct_min64(L, es->tmax_nm - ta);
+            tb = ta + Lc;
+            st = vertex(&pa, tb, &B);
+            if (st == CT_OK) {
+                st = vertex(&pa, ta + Lc / 2, &M);
+            }
+            if (st != CT_OK) {
+                /* beyond the projection's domain: nothing of this tile */
+                h->steps = steps;
+                h->iters = iters;
+                return CT_MISS;
+            }
+            fit_piece(&A, &B, &M, &f);
+            off = piece_off(p, &A, &B, &M, &f, es->tolz_q16);
+            lwp = NULL;
+            elat = f.dev;
+            evert = 0;
+            ok = off || f.dev <= es->tol_q16;
+            if (ok && !off) {
+                uint64_t kf;
+                uint32_t ks;
+                gv Q1, Q3;
+                int64_t l1, v1, l3, v3;
+                if (ct_i128_sign(f.num) > 0 && ct_i128_sign(f.den) > 0 && rise_coeff(f.num, f.den, &kf, &ks) &&
+                    ct_lower_setup_k(p, A.x, A.y, kf, ks, es->cull, &lw) == CT_OK) {
+                    lwp = &lw;
+                }
+                dB = lwp != NULL ? ct_lower_at(lwp, B.x, B.y) : 0;
+                /* the model against the exact image at the quarter points */
+                if (vertex(&pa, ta + Lc / 4, &Q1) != CT_OK || vertex(&pa, ta + Lc - Lc / 4, &Q3) != CT_OK) {
+                    h->steps = steps;
+                    h->iters = iters;
+                    return CT_MISS;
+                }
+                model_error(&A, &B, &Q1, &f, lwp, dB, &l1, &v1);
+                model_error(&A, &B, &Q3, &f, lwp, dB, &l3, &v3);
+                elat = ct_max64(elat, ct_max64(l1, l3));
+                evert = ct_max64(v1, v3);
+                ok = elat <= es->tol_q16 && evert <= es->tolz_q16;
+            }
+            if (ok || Lc <= PIECE_MIN_NM) {
+                break;
+            }
+            {
+                /* shorten by sqrt(tol / excess) * 0.8 (at least 1/8):
+                 * excess >= tol, both < 2^62 */
+                int64_t ex = ct_max64(ct_min64(elat, INT64_C(1) << 40) * 1024 / ct_max64(es->tol_q16, 1),
+                                      ct_min64(evert, INT64_C(1) << 40) * 1024 / ct_max64(es->tolz_q16, 1));
+                int64_t fr = (int64_t)ct_isqrt64((uint64_t)((INT64_C(1) << 40) / ct_max64(ex, 1024))); /* Q15 */
+                L = ct_max64(PIECE_MIN_NM, ct_max64(Lc / 8, mul_shr(Lc, fr * 4 / 5, 15u)));
+            }
+        }
+        if (!off) {
+            ct_ray ray;
+            ct_prepared pr;
+            ct_hit sh;
+            ray.x_q16 = A.x;
+            ray.y_q16 = A.y;
+            ray.z_q16 = A.z;
+            ray.dx = f.ux;
+            ray.dy = f.uy;
+            ray.dz = B.z - dB - A.z;
+            if (ray.dx != 0 || ray.dy != 0 || ray.dz != 0) {
+                st = ct_prepare_lowered_segment(p, &ray, lwp, &pr);
+                if (st < 0) {
+                    return st;
+                }
+                if (st == CT_BELOW && ta == 0) {
+                    h->steps = steps;
+                    h->iters = iters;
+                    return CT_BELOW;
+                }
+                if (st != CT_MISS) {
+                    if (st == CT_BELOW) {
+                        /* the previous piece ended above the surface: the
+                         * path met it within the models' tolerance at A */
+                        pr.start = CT_HIT;
+                    }
+                    st = ct_trace_prepared_lowered(p, &pr, lwp, m, &sh);
+                    if (st < 0) {
+                        return st;
+                    }
+                    steps += sh.steps;
+                    iters += sh.iters;
+                    /* t_q26 < 2^35, tend_d <= 2^26: < 2^61; tend_n < 2^34 */
+                    if ((st == CT_HIT || st == CT_HIT_VOID) &&
+                        sh.t_q26 * pr.tend_d <= pr.tend_n * (INT64_C(1) << CT_T_FRAC_BITS)) {
+                        *h = sh;
+                        h->steps = steps;
+                        h->iters = iters;
+                        return st;
+                    }
+                }
+            }
+        }
+        steps++;
+        iters++;
+        if (gone(p, &A, &B, &M, &f)) {
+            break;
+        }
+        /* the next piece: longer where this one was well within the
+         * tolerance or off the tile */
+        if (off || (elat * 4 <= es->tol_q16 && evert * 4 <= es->tolz_q16)) {
+            L = ct_min64(PIECE_MAX_NM, 2 * Lc);
+        } else {
+            L = Lc;
+        }
+        A = B;
+        ta = tb;
+    }
+    h->steps = steps;
+    h->iters = iters;
+    h->x_q16 = h->y_q16 = h->z_q16 = 0;
+    h->e_nm = h->n_nm = h->h_nm = 0;
+    h->cell_x = h->cell_y = -1;
+    return CT_MISS;
+}
