@@ -605,8 +605,13 @@ typedef struct {
     uint32_t flags;            /* CT_EFFECT_* bits; 0 = a straight ray       */
     int32_t refraction_k_q16;  /* k in Q16, [-2, 2] (used with REFRACTION;
                                   0 is k = 0, not a default)                */
-    int64_t earth_radius_nm;   /* R; 0 = CT_EARTH_RADIUS_NM; else
-                                  [2^40, 2^54] nm (1.1 km .. 18,000 km)     */
+    int64_t earth_radius_nm;   /* 0: with CT_EFFECT_CURVATURE on a package
+                                  on a UTM zone, the true Earth (earth.c:
+                                  the line of sight straight in Earth-fixed
+                                  space, WGS84); else the sphere of
+                                  CT_EARTH_RADIUS_NM.  Non-zero: the sphere
+                                  of that radius, [2^40, 2^54] nm (1.1 km ..
+                                  18,000 km), as a map-frame parabola      */
     int64_t chord_nm;          /* polyline tolerance; 0 = CT_EFFECTS_CHORD_NM;
                                   else [2^10, 2^50] nm, and the polyline's
                                   segment sqrt(8 chord R / |c|) must be at

@@ -1,5 +1,7 @@
 /*
- * geodesy.c -- WGS84 geodetic <-> UTM (transverse Mercator) in integers.
+ * geodesy.c -- WGS84 geodetic <-> UTM (transverse Mercator) and <->
+ * Earth-fixed Cartesian (ECEF) in integers; geodetic poses; the geoid grid;
+ * the camera's local frame for the true-Earth walk (earth.c).
  *
  * Krueger's series to order n^6 as in Karney (2011), "Transverse Mercator
  * with an accuracy of a few nanometers": the conformal latitude from
