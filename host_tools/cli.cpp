@@ -35,25 +35,46 @@ using namespace ct_host;
 
 namespace {
 
-void print_usage(std::FILE *f)
+// One usage block per command: `conetrace --help` prints them all,
+// `conetrace CMD --help` its own (both on stdout, exit 0).
+struct UsageBlock {
+    const char *cmd, *text;
+};
+const UsageBlock kUsage[] = {
+    {"build",
+     "conetrace build DEM -o OUT.ctp [--sectors N] [--reduce r] [--slices K]\n"
+     "                [--height-scale M] [--posting M] [--threads T]\n"
+     "                [--builder slices|brute] [--window R] [--levels H1,H2,...]\n"
+     "                [--emit-c NAME] [--vdatum egm96|ellipsoid|unknown]\n"
+     "                [--utm ZONE{N|S}]   (geographic DEMs: resampled onto UTM at --posting M)\n"},
+    {"info", "conetrace info PKG\n"},
+    {"trace", "conetrace trace PKG --rays rays.csv [--method M] [--threads T] -o hits.csv\n"},
+    {"demo", "conetrace demo DEM [--sectors N] [--reduce r]\n"},
+    {"geoloc",
+     "conetrace geoloc PKG --camera C.cameramodel --pixels px.csv [--method M]\n"
+     "                 [--pose-wgs84 LAT,LON,H,YAW,PITCH,ROLL | --pose-map E,N,H,YAW,PITCH,ROLL]\n"
+     "                 [--effects curvature,refraction] [--refraction-k K]\n"
+     "                 [--earth-radius M] [--grid-step PX] [--threads T] -o g.csv\n"
+     "                 (curvature on a UTM package: the true Earth; --earth-radius: a sphere)\n"},
+    {"render",
+     "conetrace render DEM_or_PKG --what bitmap|dt|ddt|angles|apex -o OUT.png\n"
+     "                 [--slice H | --level k --slices K] [--reduce r] [--sectors N]\n"
+     "                 [--sector LIST] [--range LO,HI] [--hillshade] [--zoom Z]\n"
+     "                 [--columns C] [--no-legend] [--threads T]\n"},
+};
+
+// cmd == nullptr: every command
+void print_usage(std::FILE *f, const char *cmd = nullptr)
 {
-    std::fprintf(f,
-                 "usage: conetrace build DEM -o OUT.ctp [--sectors N] [--reduce r] [--slices K]\n"
-                 "                       [--height-scale M] [--posting M] [--threads T]\n"
-                 "                       [--builder slices|brute] [--window R] [--levels H1,H2,...]\n"
-                 "                       [--emit-c NAME] [--vdatum egm96|ellipsoid|unknown]\n"
-                 "                       [--utm ZONE{N|S}]   (geographic DEMs: resampled onto UTM at --posting M)\n"
-                 "       conetrace info PKG\n"
-                 "       conetrace trace PKG --rays rays.csv [--method M] [--threads T] -o hits.csv\n"
-                 "       conetrace demo DEM\n"
-                 "       conetrace geoloc PKG --camera C.cameramodel --pixels px.csv [--method M]\n"
-                 "                        [--effects curvature,refraction] [--refraction-k K]\n"
-                 "                        [--earth-radius M] [--grid-step PX] [--threads T] -o g.csv\n"
-                 "       conetrace render DEM_or_PKG --what bitmap|dt|ddt|angles|apex -o OUT.png\n"
-                 "                       [--slice H | --level k --slices K] [--reduce r] [--sectors N]\n"
-                 "                       [--sector LIST] [--range LO,HI] [--hillshade] [--zoom Z]\n"
-                 "                       [--columns C] [--no-legend] [--threads T]\n"
-                 "methods: incremental, hierarchical, cone, directional (default)\n");
+    bool first = true;
+    for (const UsageBlock &u : kUsage) {
+        if (cmd && std::strcmp(cmd, u.cmd) != 0) continue;
+        std::fprintf(f, "%s%s", first ? "usage: " : "       ", u.text);
+        first = false;
+    }
+    if (first) return print_usage(f);  // unknown command: all of them
+    std::fprintf(f, "methods: incremental, hierarchical, cone, directional (default)\n"
+                    "details: docs/cli.md\n");
 }
 
 [[noreturn]] void usage(const std::string &msg)
@@ -414,9 +435,15 @@ int main(int argc, char **argv)
     if (argc < 2) usage("missing command");
     std::string cmd = argv[1];
     // `conetrace --help` and `conetrace CMD --help`: the usage on stdout, exit 0
-    if (is_help(cmd) || (argc >= 3 && is_help(argv[2]) && std::string(argv[2]) != "help")) {
+    if (is_help(cmd)) {
         print_usage(stdout);
         return 0;
+    }
+    for (int k = 2; k < argc; ++k) {
+        if (std::strcmp(argv[k], "-h") == 0 || std::strcmp(argv[k], "--help") == 0) {
+            print_usage(stdout, cmd.c_str());
+            return 0;
+        }
     }
     try {
         if (cmd == "build") return cmd_build(argc, argv);

@@ -22,6 +22,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -273,8 +274,9 @@ static std::string fixture_package()
 // ---------------------------------------------------------------------------
 // 1. build + info on the real DEM
 
-// --help: the usage on stdout and exit 0 (for the program and for each
-// command); a missing or unknown command: the usage on stderr and exit 2.
+// --help: the usage on stdout and exit 0 (for the program: every command's;
+// `CMD --help`, anywhere on the line: that command's alone); a missing or
+// unknown command: the usage on stderr and exit 2.
 static void test_help(void)
 {
     std::string d = new_dir("help");
@@ -283,13 +285,29 @@ static void test_help(void)
     jobs.push_back(Job{d, {"--help"}});
     jobs.push_back(Job{d, {"-h"}});
     jobs.push_back(Job{d, {"help"}});
+    jobs.push_back(Job{d, {"geoloc", "pkg.ctp", "-h"}});
     std::vector<Run> runs = run_all(jobs);
-    for (const Run &r : runs) {
+    const char *cmds[] = {"build", "info", "trace", "demo", "geoloc", "render"};
+    for (size_t k = 0; k < runs.size(); ++k) {
+        const Run &r = runs[k];
         TEST_ASSERT_MSG(r.code == 0, "%s exited %d", r.cmd.c_str(), r.code);
-        TEST_ASSERT_MSG(starts_with(r.out, "usage: conetrace build") && contains(r.out, "conetrace geoloc PKG"),
-                        "%s: no usage on stdout", r.cmd.c_str());
         TEST_ASSERT_MSG(r.err.empty(), "%s wrote to stderr: %s", r.cmd.c_str(), r.err.c_str());
+        if (k < 6 || k == runs.size() - 1) {
+            // CMD --help: that command's usage alone
+            const char *c = k < 6 ? cmds[k] : "geoloc";
+            TEST_ASSERT_MSG(starts_with(r.out, std::string("usage: conetrace ") + c), "%s: no usage of %s on stdout",
+                            r.cmd.c_str(), c);
+            for (const char *o : cmds)
+                if (std::strcmp(o, c) != 0)
+                    TEST_ASSERT_MSG(!contains(r.out, std::string("conetrace ") + o + " "), "%s: also %s's usage",
+                                    r.cmd.c_str(), o);
+        } else {
+            TEST_ASSERT_MSG(starts_with(r.out, "usage: conetrace build") && contains(r.out, "conetrace geoloc PKG"),
+                            "%s: no usage on stdout", r.cmd.c_str());
+        }
     }
+    TEST_ASSERT(contains(runs[4].out, "--pose-wgs84") && contains(runs[0].out, "--vdatum") &&
+                contains(runs[0].out, "--utm"));
     Run bad = run_cli(d, {"frobnicate"});
     TEST_ASSERT(bad.code == 2 && bad.out.empty() && contains(bad.err, "unknown command 'frobnicate'") &&
                 contains(bad.err, "usage: conetrace build"));
