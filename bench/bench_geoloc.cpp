@@ -8,7 +8,11 @@
 // ground truth (tests/scene.hpp: mrcal + the reference tracer, --samples
 // points).  Also the directional trace without effects (straight rays),
 // to show what bending costs (last column: with effects / straight, the
-// median of per-round ratios; "incr. / dir." likewise).  The sides run in
+// median of per-round ratios; "incr. / dir." likewise), and, for scenes
+// with curvature on a UTM package, the true Earth (earth_radius_nm = 0:
+// the Earth-fixed line of sight, lib/src/earth.c) against the scene's
+// sphere parabola ("true Earth / sphere", the median of per-round ratios;
+// "-" otherwise).  The sides run in
 // alternating rounds, each the best of 5 after a warm-up.  Nothing here is
 // a pass/fail test; it only reports (and says so) if the two methods ever
 // disagree.
@@ -78,8 +82,8 @@ int main(int argc, char **argv)
                 stride == 1 ? "" : "4th (--quick) ");
     std::printf("| scene | effects | pixels hit | unproject ns | directional: trace ns / steps | incremental: trace ns / "
                 "steps | incr. / dir. time | straight dir.: trace ns / steps | error RMS / max (m), N points | with effects / "
-                "straight (dir.) |\n");
-    std::printf("|---|---|---|---|---|---|---|---|---|---|\n");
+                "straight (dir.) | true Earth dir.: trace ns / steps | true Earth / sphere |\n");
+    std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|\n");
     for (const char *name : names) {
         if (!only.empty() && only != name) continue;
         scene::World *w;
@@ -111,25 +115,36 @@ int main(int argc, char **argv)
             return (now_ns() - t0) / (double)n;
         };
         ct_effects fx = scene::lib_effects(w->s, w->s.effects);
-        std::vector<ct_geo> gd, gi, gs;
+        ct_effects fx_true = fx;
+        fx_true.earth_radius_nm = 0;
+        ct_utm zone;
+        const bool true_earth = (fx.flags & CT_EFFECT_CURVATURE) != 0u &&
+                                ct_utm_zone_of_epsg((int32_t)w->p.epsg, &zone) == CT_OK;
+        std::vector<ct_geo> gd, gi, gs, gt;
         // This machine's speed drifts by tens of percent within seconds: the
         // unprojection and the three traces in alternating rounds (one
         // warm-up round first); each trace is its batch less the same
         // round's unprojection; the table shows each side's best round and
         // the median over rounds of the per-round ratios.
         const int rounds = 5;
-        Run rd, ri, rs;
+        Run rd, ri, rs, rt;
         double un = 1e30;
-        std::vector<double> r_eff, r_inc;
+        std::vector<double> r_eff, r_inc, r_true;
         for (int round = 0; round <= rounds; ++round) {
             double u = unproject_ns();
             Run a = geolocate(*w, uv, CT_METHOD_DIRECTIONAL, &fx, &gd);
             Run b = geolocate(*w, uv, CT_METHOD_DIRECTIONAL, nullptr, &gs);
             Run c = geolocate(*w, uv, CT_METHOD_INCREMENTAL, &fx, &gi);
+            Run t = true_earth ? geolocate(*w, uv, CT_METHOD_DIRECTIONAL, &fx_true, &gt) : Run();
             if (round == 0) continue;
             a.ns -= u;
             b.ns -= u;
             c.ns -= u;
+            if (true_earth) {
+                t.ns -= u;
+                r_true.push_back(t.ns / std::max(1.0, a.ns));
+                if (round == 1 || t.ns < rt.ns) rt = t;
+            }
             r_eff.push_back(a.ns / std::max(1.0, b.ns));
             r_inc.push_back(c.ns / std::max(1.0, a.ns));
             if (round == 1 || a.ns < rd.ns) rd = a;
@@ -138,6 +153,10 @@ int main(int argc, char **argv)
             un = std::min(un, u);
         }
         std::sort(r_eff.begin(), r_eff.end());
+        std::sort(r_true.begin(), r_true.end());
+        char tcol[96] = "- | -";
+        if (true_earth)
+            std::snprintf(tcol, sizeof tcol, "%.0f / %.1f | %.2fx", rt.ns, rt.steps, r_true[r_true.size() / 2]);
         std::sort(r_inc.begin(), r_inc.end());
         long differ = 0;
         for (size_t k = 0; k < n; ++k)
@@ -165,10 +184,10 @@ int main(int argc, char **argv)
             ++cnt;
         }
         std::printf("| %s | %s | %.1f %% | %.0f | %.0f / %.1f | %.0f / %.1f | %.1fx | %.0f / %.1f | %.4f / %.4f, %ld | "
-                    "%.2fx |\n",
+                    "%.2fx | %s |\n",
                     name, scene::fx_names(w->s.effects).c_str(), 100.0 * (double)rd.hits / (double)n, un, rd.ns,
                     rd.steps, ri.ns, ri.steps, r_inc[r_inc.size() / 2], rs.ns, rs.steps, std::sqrt(s2 / std::max(1L, cnt)),
-                    mx, cnt, r_eff[r_eff.size() / 2]);
+                    mx, cnt, r_eff[r_eff.size() / 2], tcol);
         std::fflush(stdout);
         delete w;
     }
