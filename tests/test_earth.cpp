@@ -63,9 +63,10 @@ namespace {
 // Q16 rounding of its vertices (up to 2 units: 0.92 mm at 30 m posting).
 // So the library's hit lies within kMaxOffPathM of the reference path; its
 // distance from the reference hit is that times 1 / tan(incidence) along the
-// ray (2 cm at 3 deg), bounded here by kMaxErrM, and in RMS by kMaxRmsM.
+// ray (3.6 cm at 3 deg), bounded here by kMaxErrM, and in RMS by kMaxRmsM.
 const double kMaxOffPathM = 0.001 + 2 * 30.0 / 65536;
-const double kMaxErrM = 0.025;      // library exact mode vs reference, 3D distance (m)
+const double kMaxErrM = 0.04;       // library exact mode vs reference, 3D distance (m): the off-path
+                                    // bound over sin(3 deg), the shallowest incidence the poses make
 const double kMaxRmsM = 0.005;      // the same, RMS over every family
 const double kSkipClearM = 0.05;    // skip rays passing this close (m) over terrain before the hit
 const double kRefCheckM = 5e-5;     // reference vs closed form on a flat package (m)

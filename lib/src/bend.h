@@ -99,6 +99,7 @@ typedef struct {
     int32_t refr_k_q16;    /* refraction coefficient (0: none), Q16           */
     int64_t radius_nm;     /* radius for refraction's bending                 */
     int64_t tol_q16;       /* chord tolerance, Q16 cells (>= 2)               */
+    int64_t tol_q24;       /* the same in Q24 cells (the checks' units)       */
     int64_t tolz_q16;      /* the same in Q16 height units (>= 2)             */
     int64_t tmax_nm;       /* no terrain beyond this range                    */
     int32_t cull;

@@ -46,20 +46,21 @@
 #define EARTH_MAX_RETRIES 8u
 
 typedef struct {
-    int64_t x, y, z;
+    int64_t x, y, z;  /* Q16 grid (the walks' units)                       */
+    int64_t fx, fy;   /* x, y with 8 more bits (Q24): the checks' precision */
 } gv;
 
 /* The image is interpolated between n exact images at the Chebyshev
  * nodes of [0, tmax] (a polynomial of degree n - 1): n = 4 up to 25 km, 5
  * up to 100 km, 6 beyond (to 281 km).  Against PROJ's exact image
  * (measured, docs/geolocation.md) that stays within 0.005 mm: the image's
- * k-th derivative scales as R^(1-k).  Lagrange form: w_j(tau) = K_j
- * prod_{i != j} (tau - tau_i), tau = t / tmax in [0, 1]; the tau_i (Q60)
- * and K_j = 1 / prod_{i != j} (tau_j - tau_i) (Q54, |K| < 165) generated
- * with mpmath at 50 digits.  Each |tau - tau_i| <= 1, so the products stay
- * in Q60, and w_j = (L_j K_j) >> 54 < 2^62 (the nodes' Lebesgue function
- * is below 2.3 on [0, 1]).  Values are taken relative to the first node's
- * image (|X| < 2^48 within 281 km): w X < 2^110.                        */
+ * k-th derivative scales as R^(1-k).  The polynomial is kept per ray in
+ * powers of sigma = 2 t / tmax - 1 in [-1, 1]: c = V^-1 X, V the nodes'
+ * Vandermonde matrix (sigma_j = -cos((2j + 1) pi / 2n)), V^-1 in Q40
+ * (|entries| < 8, generated with mpmath at 60 digits); X the nodes' images
+ * less node 0's in Q24, required below 2^46 (else every vertex is computed
+ * exactly): c < 2^49, V^-1 X formed in 128 bits.  A vertex is then
+ * Horner's rule in sigma (Q60): n - 1 products < 2^110 per coordinate.   */
 #define NODES 6
 #define NODES_4_NM (25 * KM_NM)
 #define NODES_5_NM (100 * KM_NM)
@@ -70,13 +71,37 @@ static const int64_t tau_q60[3][NODES] = {
      INT64_C(915295881032800123), INT64_C(1124707507170000856), 0},
     {INT64_C(19642423811521231), INT64_C(168841445261774044), INT64_C(427261730853170675),
      INT64_C(725659773753676301), INT64_C(984080059345072932), INT64_C(1133279080795325745)}};
-static const int64_t k_q54[3][NODES] = {
-    {-INT64_C(110300989657617965), INT64_C(266290145174595781), -INT64_C(266290145174595781),
-     INT64_C(110300989657617965), 0, 0},
-    {INT64_C(285017870483079962), -INT64_C(746186472325818753), INT64_C(922337203685477581),
-     -INT64_C(746186472325818753), INT64_C(285017870483079962), 0},
-    {-INT64_C(795728114401348337), INT64_C(2173969637555463702), -INT64_C(2969697751956812039),
-     INT64_C(2969697751956812039), -INT64_C(2173969637555463702), INT64_C(795728114401348337)}};
+static const int64_t vinv4_q40[4][4] = {
+    {-INT64_C(113858157053), INT64_C(663613970941), INT64_C(663613970941), -INT64_C(113858157053)},
+    {INT64_C(123239181134), -INT64_C(1734106874812), INT64_C(1734106874812), -INT64_C(123239181134)},
+    {INT64_C(777472127994), -INT64_C(777472127994), -INT64_C(777472127994), INT64_C(777472127994)},
+    {-INT64_C(841529767285), INT64_C(2031632577321), -INT64_C(2031632577321), INT64_C(841529767285)}};
+static const int64_t vinv5_q40[5][5] = {
+    {INT64_C(0), INT64_C(0), INT64_C(1099511627776), INT64_C(0), INT64_C(0)},
+    {INT64_C(357252984102), -INT64_C(1513347925819), INT64_C(0), INT64_C(1513347925819), -INT64_C(357252984102)},
+    {-INT64_C(375638017279), INT64_C(2574661272831), -INT64_C(4398046511104), INT64_C(2574661272831),
+     -INT64_C(375638017279)},
+    {-INT64_C(1034042751249), INT64_C(1673116317342), INT64_C(0), -INT64_C(1673116317342), INT64_C(1034042751249)},
+    {INT64_C(1087256891186), -INT64_C(2846475495628), INT64_C(3518437208883), -INT64_C(2846475495628),
+     INT64_C(1087256891186)}};
+static const int64_t vinv6_q40[6][6] = {
+    {INT64_C(49102208789), -INT64_C(183251937963), INT64_C(683905543062), INT64_C(683905543062),
+     -INT64_C(183251937963), INT64_C(49102208789)},
+    {-INT64_C(50834347164), INT64_C(259157375998), -INT64_C(2642408107144), INT64_C(2642408107144),
+     -INT64_C(259157375998), INT64_C(50834347164)},
+    {-INT64_C(831212169428), INT64_C(2932031007403), -INT64_C(2100818837975), -INT64_C(2100818837975),
+     INT64_C(2932031007403), -INT64_C(831212169428)},
+    {INT64_C(860534159876), -INT64_C(4146518015967), INT64_C(8116940687818), -INT64_C(8116940687818),
+     INT64_C(4146518015967), -INT64_C(860534159876)},
+    {INT64_C(1466015503701), -INT64_C(2932031007403), INT64_C(1466015503701), INT64_C(1466015503701),
+     -INT64_C(2932031007403), INT64_C(1466015503701)},
+    {-INT64_C(1517730931094), INT64_C(4146518015967), -INT64_C(5664248947061), INT64_C(5664248947061),
+     -INT64_C(4146518015967), INT64_C(1517730931094)}};
+
+static int64_t vinv(int n, int k, int j)
+{
+    return n == 4 ? vinv4_q40[k][j] : (n == 5 ? vinv5_q40[k][j] : vinv6_q40[k][j]);
+}
 
 typedef struct {
     const ct_package *p;
@@ -88,21 +113,14 @@ typedef struct {
     int interp;    /* 1: the nodes below are set */
     int nodes;     /* n: 4, 5 or 6 */
     int64_t tmax;
-    gv base;       /* image of node 0 */
-    int64_t X[NODES][3]; /* images of the nodes less base */
+    int64_t base[3];      /* image of node 0, Q24 (x, y) and Q24 height   */
+    int64_t cf[NODES][3]; /* polynomial in sigma, Q24, lowest power first */
 } path;
 
 /* round(a b / 2^s) (half up) in 128 bits; the result must fit (callers) */
 static int64_t mul_shr(int64_t a, int64_t b, unsigned s)
 {
     return ct_mul_shr(a, b, s);
-}
-
-/* round(v / 2^60) of a 128-bit v whose result fits in int64 */
-static int64_t round_q60(ct_i128 v)
-{
-    ct_i128 r = ct_i128_sar(ct_i128_add(v, ct_i128_from64(INT64_C(1) << 59)), 60u);
-    return (int64_t)r.lo;
 }
 
 /* The exact image of P(t) in the grid frame. */
@@ -132,48 +150,51 @@ static ct_status vertex_exact(const path *pa, int64_t t, gv *v)
     if (st == CT_OK) {
         st = ct_map_to_grid(pa->p, e, n, h, &v->x, &v->y, &v->z);
     }
+    /* |x|, |y| < 2^55 (ct_map_to_grid's range) */
+    v->fx = v->x * 256;
+    v->fy = v->y * 256;
     return st;
+}
+
+/* round(v / 256) */
+static int64_t q24_to_16(int64_t v)
+{
+    return ct_floor_div(v + 128, 256);
 }
 
 /* The image of P(t), 0 <= t <= tmax: interpolated when the nodes are set. */
 static ct_status vertex(const path *pa, int64_t t, gv *v)
 {
-    const int64_t *tq = tau_q60[pa->nodes - 4], *kq = k_q54[pa->nodes - 4];
-    int64_t tau;
-    ct_i128 acc[3];
-    int i, j, k;
+    int64_t sig, r[3];
+    int j, k;
     if (!pa->interp) {
         return vertex_exact(pa, t, v);
     }
-    /* tau = t 2^60 / tmax: t <= tmax < 2^48 */
-    tau = ct_i128_floor_div(ct_i128_shl(ct_i128_from64(t), 60u), pa->tmax);
-    for (k = 0; k < 3; ++k) { /* bound: 3 */
-        acc[k] = ct_i128_from64(0);
-    }
-    for (j = 0; j < pa->nodes; ++j) { /* bound: NODES */
-        int64_t lj = INT64_C(1) << 60, wj;
-        for (i = 0; i < pa->nodes; ++i) { /* bound: NODES */
-            if (i != j) {
-                lj = mul_shr(lj, tau - tq[i], 60u);
-            }
+    /* sigma = (2t - tmax) 2^60 / tmax: |2t - tmax| <= tmax < 2^48 */
+    sig = ct_i128_floor_div(ct_i128_shl(ct_i128_from64(2 * t - pa->tmax), 60u), pa->tmax);
+    for (k = 0; k < 3; ++k) { /* bound: 3 coordinates */
+        int64_t acc = pa->cf[pa->nodes - 1][k];
+        for (j = pa->nodes - 2; j >= 0; --j) { /* bound: NODES - 1 */
+            acc = pa->cf[j][k] + mul_shr(sig, acc, 60u);
         }
-        wj = mul_shr(lj, kq[j], 54u);
-        for (k = 0; k < 3; ++k) { /* bound: 3 */
-            acc[k] = ct_i128_add(acc[k], ct_i128_mul(wj, pa->X[j][k]));
-        }
+        r[k] = pa->base[k] + acc;
     }
-    v->x = pa->base.x + round_q60(acc[0]);
-    v->y = pa->base.y + round_q60(acc[1]);
-    v->z = pa->base.z + round_q60(acc[2]);
+    v->fx = r[0];
+    v->fy = r[1];
+    v->x = q24_to_16(r[0]);
+    v->y = q24_to_16(r[1]);
+    v->z = q24_to_16(r[2]);
     return CT_OK;
 }
 
-/* The nodes' exact images; pa->interp = 0 when one is outside the
- * projection's domain (the vertices are then computed exactly). */
+/* The nodes' exact images and the polynomial through them; pa->interp = 0
+ * when one is outside the projection's domain (the vertices are then
+ * computed exactly). */
 static void set_nodes(path *pa, int64_t tmax)
 {
-    int j;
+    int j, k;
     gv v;
+    int64_t X[NODES][3];
     pa->interp = 0;
     pa->tmax = tmax;
     pa->nodes = tmax <= NODES_4_NM ? 4 : (tmax <= NODES_5_NM ? 5 : 6);
@@ -184,24 +205,59 @@ static void set_nodes(path *pa, int64_t tmax)
             return;
         }
         if (j == 0) {
-            pa->base = v;
+            pa->base[0] = v.x * 256;
+            pa->base[1] = v.y * 256;
+            pa->base[2] = v.z * 256;
         }
-        pa->X[j][0] = v.x - pa->base.x;
-        pa->X[j][1] = v.y - pa->base.y;
-        pa->X[j][2] = v.z - pa->base.z;
-        if (ct_abs64(pa->X[j][0]) >= (INT64_C(1) << 48) || ct_abs64(pa->X[j][1]) >= (INT64_C(1) << 48) ||
-            ct_abs64(pa->X[j][2]) >= (INT64_C(1) << 48)) {
+        X[j][0] = v.x * 256 - pa->base[0];
+        X[j][1] = v.y * 256 - pa->base[1];
+        X[j][2] = v.z * 256 - pa->base[2];
+        if (ct_abs64(X[j][0]) >= (INT64_C(1) << 46) || ct_abs64(X[j][1]) >= (INT64_C(1) << 46) ||
+            ct_abs64(X[j][2]) >= (INT64_C(1) << 46)) {
             return;
         }
     }
+    for (k = 0; k < pa->nodes; ++k) { /* bound: NODES */
+        for (j = 0; j < 3; ++j) { /* bound: 3 coordinates */
+            ct_i128 acc = ct_i128_from64(0);
+            int i;
+            for (i = 0; i < pa->nodes; ++i) { /* bound: NODES; < 2^43 2^46 each */
+                acc = ct_i128_add(acc, ct_i128_mul(vinv(pa->nodes, k, i), X[i][j]));
+            }
+            pa->cf[k][j] = (int64_t)ct_i128_sar(ct_i128_add(acc, ct_i128_from64(INT64_C(1) << 39)), 40u).lo;
+        }
+    }
     pa->interp = 1;
+}
+
+/* The chord's length in Q24 (|differences| < 2^44: squares in 128 bits). */
+static int64_t chord24(const gv *A, const gv *B)
+{
+    int64_t ux = B->fx - A->fx, uy = B->fy - A->fy;
+    return (int64_t)ct_i128_isqrt(ct_i128_add(ct_i128_mul(ux, ux), ct_i128_mul(uy, uy)));
+}
+
+/* The sideways distance (Q24) of Q from the chord A -> B of Q24 length l24
+ * (from A when the chord is vertical). */
+static int64_t lateral24(const gv *A, const gv *B, int64_t l24, const gv *Q)
+{
+    int64_t ux = B->fx - A->fx, uy = B->fy - A->fy, qx = Q->fx - A->fx, qy = Q->fy - A->fy;
+    ct_i128 cross;
+    if (l24 < 256) {
+        /* shorter than a Q16 unit: as good as vertical */
+        return (int64_t)ct_i128_isqrt(ct_i128_add(ct_i128_mul(qx, qx), ct_i128_mul(qy, qy)));
+    }
+    cross = ct_i128_sub(ct_i128_mul(ux, qy), ct_i128_mul(uy, qx));
+    return ct_i128_floor_div_sat(ct_i128_sign(cross) < 0 ? ct_i128_neg(cross) : cross, l24);
 }
 
 /* The piece A -> B (middle M): chord length l, the middle's sideways
  * deviation, its range along the chord, and the vertical quadratic's
  * coefficient a = num / den (den > 0; den = 0: no quadratic). */
 typedef struct {
-    int64_t ux, uy, l, dev, sm;
+    int64_t ux, uy, l, sm;
+    int64_t l24; /* the chord's length, Q24 */
+    int64_t dev; /* the middle's sideways deviation, Q24 */
     ct_i128 num, den;
     int64_t dip; /* |a| l^2 / 4, Q16 height units (saturated) */
 } fit;
@@ -209,27 +265,22 @@ typedef struct {
 static void fit_piece(const gv *A, const gv *B, const gv *M, fit *f)
 {
     int64_t mx = M->x - A->x, my = M->y - A->y;
-    ct_i128 cross, dot, l2;
+    ct_i128 dot, l2;
     f->ux = B->x - A->x;
     f->uy = B->y - A->y;
     /* pieces are at most 8 km: |u|, |m| < 2^43 Q16 even at 1 mm posting;
      * squares and products in 128 bits */
     l2 = ct_i128_add(ct_i128_mul(f->ux, f->ux), ct_i128_mul(f->uy, f->uy));
     f->l = (int64_t)ct_i128_isqrt(l2);
-    cross = ct_i128_sub(ct_i128_mul(f->ux, my), ct_i128_mul(f->uy, mx));
     dot = ct_i128_add(ct_i128_mul(f->ux, mx), ct_i128_mul(f->uy, my));
-    if (f->l == 0) {
-        f->dev = (int64_t)ct_i128_isqrt(ct_i128_add(ct_i128_mul(mx, mx), ct_i128_mul(my, my)));
-        f->sm = 0;
-    } else {
-        f->dev = ct_i128_floor_div(ct_i128_sign(cross) < 0 ? ct_i128_neg(cross) : cross, f->l);
-        f->sm = ct_i128_floor_div(dot, f->l);
-    }
+    f->sm = f->l == 0 ? 0 : ct_i128_floor_div_sat(dot, f->l);
+    f->l24 = chord24(A, B);
+    f->dev = lateral24(A, B, f->l24, M);
     f->den = ct_i128_from64(0);
     f->num = ct_i128_from64(0);
     f->dip = 0;
-    /* the quadratic through (0, 0), (sm, zm'), (l, zb'):
-     *   a = (zm' l - zb' sm) / (sm l (l - sm)),
+    /* the quadratic z = b s + a s^2 through (0, 0), (sm, zm'), (l, zb'):
+     *   a = (zb' sm - zm' l) / (sm l (l - sm)),
      * only for a chord of a cell or more with the middle well inside */
     if (f->l >= (INT64_C(1) << 40) || ct_abs64(M->z - A->z) >= (INT64_C(1) << 48) ||
         ct_abs64(B->z - A->z) >= (INT64_C(1) << 48)) {
@@ -237,7 +288,7 @@ static void fit_piece(const gv *A, const gv *B, const gv *M, fit *f)
     } else if (f->l >= ONE16 && f->sm > f->l / 4 && f->sm < f->l - f->l / 4) {
         int64_t zm = M->z - A->z, zb = B->z - A->z, q1;
         /* |z'| < 2^48, l < 2^40: products < 2^88, den < 2^120 */
-        f->num = ct_i128_sub(ct_i128_mul(zm, f->l), ct_i128_mul(zb, f->sm));
+        f->num = ct_i128_sub(ct_i128_mul(zb, f->sm), ct_i128_mul(zm, f->l));
         f->den = ct_i128_mul128_64(ct_i128_mul(f->sm, f->l), f->l - f->sm);
         /* dip = |num| l / (4 sm (l - sm)): |num| l < 2^128 is not assured,
          * so |num| / sm first (sm > l / 4: the quotient < 2^50), then l /
@@ -248,26 +299,25 @@ static void fit_piece(const gv *A, const gv *B, const gv *M, fit *f)
 }
 
 /* The model's distance from the exact image Q (a quarter point): its
- * sideways distance from the chord (Q16 cells) and the height difference
+ * sideways distance from the chord (Q24 cells) and the height difference
  * at its range along the chord (Q16 height units): the chord's height
  * there plus the lowering (lw) or the straight chord (lw = NULL).       */
 static void model_error(const gv *A, const gv *B, const gv *Q, const fit *f, const ct_lower *lw, int64_t dB,
                         int64_t *lat, int64_t *vert)
 {
     int64_t qx = Q->x - A->x, qy = Q->y - A->y, sq, zl;
-    ct_i128 cross, dot;
+    ct_i128 dot;
+    *lat = lateral24(A, B, f->l24, Q);
     if (f->l == 0) {
-        /* a vertical chord: the sideways distance only */
-        *lat = (int64_t)ct_i128_isqrt(ct_i128_add(ct_i128_mul(qx, qx), ct_i128_mul(qy, qy)));
-        *vert = 0;
+        *vert = 0; /* a vertical chord: the sideways distance only */
         return;
     }
-    cross = ct_i128_sub(ct_i128_mul(f->ux, qy), ct_i128_mul(f->uy, qx));
     dot = ct_i128_add(ct_i128_mul(f->ux, qx), ct_i128_mul(f->uy, qy));
-    *lat = ct_i128_floor_div(ct_i128_sign(cross) < 0 ? ct_i128_neg(cross) : cross, f->l);
-    sq = ct_i128_floor_div(dot, f->l);
+    /* sq: Q's range along the chord (within the piece: |sq| <= 2 l) */
+    sq = ct_i128_floor_div_sat(dot, f->l);
+    sq = ct_max64(-2 * f->l, ct_min64(2 * f->l, sq));
     /* the line's height at sq: (B.z - dB - A.z) sq / l, |.| < 2^48 2^44 */
-    zl = A->z + ct_i128_floor_div(ct_i128_mul(B->z - dB - A->z, sq), f->l);
+    zl = A->z + ct_i128_floor_div_sat(ct_i128_mul(B->z - dB - A->z, sq), f->l);
     if (lw != NULL) {
         zl += ct_lower_at(lw, Q->x, Q->y);
     }
@@ -340,6 +390,7 @@ ct_status ct_earth_setup(const ct_package *p, const ct_pose *pose, int32_t refr_
     post = ct_abs64(p->posting_e_nm);
     /* chord (<= 2^50) 2^16 < 2^66: 128-bit */
     es->tol_q16 = ct_max64(2, ct_i128_floor_div_sat(ct_i128_shl(ct_i128_from64(chord_nm), 16), post));
+    es->tol_q24 = ct_max64(2, ct_i128_floor_div_sat(ct_i128_shl(ct_i128_from64(chord_nm), 24), post));
     es->tolz_q16 = ct_max64(2, ct_i128_floor_div_sat(ct_i128_shl(ct_i128_from64(chord_nm), 16), p->height_scale_nm));
     es->cull = (bend_flags & CT_BEND_NO_CULL) == 0u;
     /* no terrain beyond the farthest tile corner: the range to it (map
@@ -371,7 +422,7 @@ ct_status ct_earth_setup(const ct_package *p, const ct_pose *pose, int32_t refr_
  * or above the tallest post. */
 static int piece_off(const ct_package *p, const gv *A, const gv *B, const gv *M, const fit *f, int64_t tolz)
 {
-    int64_t m = f->dev + 2 * ONE16;
+    int64_t m = f->dev / 256 + 2 * ONE16;
     int64_t x0 = ct_min64(A->x, ct_min64(B->x, M->x)) - m, x1 = ct_max64(A->x, ct_max64(B->x, M->x)) + m;
     int64_t y0 = ct_min64(A->y, ct_min64(B->y, M->y)) - m, y1 = ct_max64(A->y, ct_max64(B->y, M->y)) + m;
     int64_t zlow = ct_min64(A->z, ct_min64(B->z, M->z)) - f->dip - tolz;
@@ -453,6 +504,8 @@ ct_status ct_trace_earth(const ct_package *p, const ct_earth *es, const int64_t 
     A.x = es->ox;
     A.y = es->oy;
     A.z = es->oz;
+    A.fx = es->ox * 256; /* |ox| <= 2^46 */
+    A.fy = es->oy * 256;
     /* bound: EARTH_MAX_PIECES pieces, each with at most EARTH_MAX_RETRIES
      * + 1 tries */
     for (piece = 0u; piece < EARTH_MAX_PIECES && ta < es->tmax_nm; ++piece) {
@@ -480,7 +533,7 @@ ct_status ct_trace_earth(const ct_package *p, const ct_earth *es, const int64_t 
             lwp = NULL;
             elat = f.dev;
             evert = 0;
-            ok = off || f.dev <= es->tol_q16;
+            ok = off || f.dev <= es->tol_q24;
             if (ok && !off) {
                 uint64_t kf;
                 uint32_t ks;
@@ -501,7 +554,7 @@ ct_status ct_trace_earth(const ct_package *p, const ct_earth *es, const int64_t 
                 model_error(&A, &B, &Q3, &f, lwp, dB, &l3, &v3);
                 elat = ct_max64(elat, ct_max64(l1, l3));
                 evert = ct_max64(v1, v3);
-                ok = elat <= es->tol_q16 && evert <= es->tolz_q16;
+                ok = elat <= es->tol_q24 && evert <= es->tolz_q16;
             }
             if (ok || Lc <= PIECE_MIN_NM) {
                 break;
@@ -509,7 +562,7 @@ ct_status ct_trace_earth(const ct_package *p, const ct_earth *es, const int64_t 
             {
                 /* shorten by sqrt(tol / excess) * 0.8 (at least 1/8):
                  * excess >= tol, both < 2^62 */
-                int64_t ex = ct_max64(ct_min64(elat, INT64_C(1) << 40) * 1024 / ct_max64(es->tol_q16, 1),
+                int64_t ex = ct_max64(ct_min64(elat, INT64_C(1) << 40) * 1024 / ct_max64(es->tol_q24, 1),
                                       ct_min64(evert, INT64_C(1) << 40) * 1024 / ct_max64(es->tolz_q16, 1));
                 int64_t fr = (int64_t)ct_isqrt64((uint64_t)((INT64_C(1) << 40) / ct_max64(ex, 1024))); /* Q15 */
                 L = ct_max64(PIECE_MIN_NM, ct_max64(Lc / 8, mul_shr(Lc, fr * 4 / 5, 15u)));
@@ -565,10 +618,16 @@ ct_status ct_trace_earth(const ct_package *p, const ct_earth *es, const int64_t 
         }
         /* the next piece: longer where this one was well within the
          * tolerance or off the tile */
-        if (off || (elat * 4 <= es->tol_q16 && evert * 4 <= es->tolz_q16)) {
+        if (off) {
             L = ct_min64(PIECE_MAX_NM, 2 * Lc);
         } else {
-            L = Lc;
+            /* the errors grow as the square of the length: aim at 0.6 of
+             * the tolerance, by a factor in [1/2, 2] */
+            int64_t ex = ct_max64(ct_min64(elat, INT64_C(1) << 40) * 1024 / ct_max64(es->tol_q24, 1),
+                                  ct_min64(evert, INT64_C(1) << 40) * 1024 / ct_max64(es->tolz_q16, 1));
+            int64_t fr = (int64_t)ct_isqrt64((uint64_t)((INT64_C(1) << 40) / ct_max64(ex, 64))); /* Q15 */
+            fr = ct_min64(INT64_C(2) << 15, ct_max64(INT64_C(1) << 14, fr * 25 / 32));
+            L = ct_min64(PIECE_MAX_NM, ct_max64(PIECE_MIN_NM, mul_shr(Lc, fr, 15u)));
         }
         A = B;
         ta = tb;
