@@ -348,6 +348,122 @@ void test_geoloc_threads()
 // extrinsics ignored), bit for bit; lat,lon are ct_utm_inverse of E,N on a
 // UTM package (checked against the hit's forward projection); bad poses are
 // one-line errors.
+// --pose-map against the equivalent .cameramodel: rt_cam_ref written from
+// the very rotation ct_pose_from_map makes (its Q30 matrix, made orthonormal
+// in long double, as a rotation vector with 17 digits) and t = -R_cam_map C.
+// The CLI's model route then rebuilds the Q30 matrix and the centre: where
+// both routes round to the same Q30 matrix (always for multiples of 90 deg,
+// usually otherwise) the rows are identical, byte for byte; where a matrix
+// entry rounds the other way (a few Q30 units: the library's quaternion route
+// is not exactly orthonormal) the statuses agree and the hits within 1 mm.
+void test_geoloc_pose_map_vs_model()
+{
+    Setup *s = setup();
+    TEST_ASSERT(s != nullptr);
+    spit(g_dir + "/pxm.csv", kPixels);
+    auto q61 = [](double deg) { return (int64_t)std::llround((long double)deg * M_PIl / 180 * std::ldexp(1.0L, 61)); };
+    const double E0 = 500000 + 30 * 30 + 0.25, N0 = 4000000 - 26 * 30 - 0.5, H0 = 2750;
+    const double att[][3] = {{0, -90, 0}, {90, -90, 0}, {-90, 0, 0}, {-40, -75, 3}, {25, -60, -2}, {135, -45, 10}};
+    int identical = 0;
+    for (const auto &a : att) {
+        int32_t q[4];
+        ct_pose pose;
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_quat_from_ypr(q61(a[0]), q61(a[1]), q61(a[2]), q));
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_pose_from_map(&pose, std::llround(E0 * 1e9), std::llround(N0 * 1e9),
+                                                      std::llround(H0 * 1e9), q));
+        // R (map <- cam) from the pose, orthonormalised by one Newton step of
+        // the polar decomposition R <- (R + R^-T) / 2
+        long double R[9], Ri[9], det;
+        for (int k = 0; k < 9; ++k) R[k] = (long double)pose.R_map_cam_q30[k] / 1073741824.0L;
+        for (int it = 0; it < 3; ++it) {
+            det = R[0] * (R[4] * R[8] - R[5] * R[7]) - R[1] * (R[3] * R[8] - R[5] * R[6]) + R[2] * (R[3] * R[7] - R[4] * R[6]);
+            // inverse transpose = cofactor matrix / det
+            Ri[0] = (R[4] * R[8] - R[5] * R[7]) / det;
+            Ri[1] = -(R[3] * R[8] - R[5] * R[6]) / det;
+            Ri[2] = (R[3] * R[7] - R[4] * R[6]) / det;
+            Ri[3] = -(R[1] * R[8] - R[2] * R[7]) / det;
+            Ri[4] = (R[0] * R[8] - R[2] * R[6]) / det;
+            Ri[5] = -(R[0] * R[7] - R[1] * R[6]) / det;
+            Ri[6] = (R[1] * R[5] - R[2] * R[4]) / det;
+            Ri[7] = -(R[0] * R[5] - R[2] * R[3]) / det;
+            Ri[8] = (R[0] * R[4] - R[1] * R[3]) / det;
+            for (int k = 0; k < 9; ++k) R[k] = (R[k] + Ri[k]) / 2;
+        }
+        // R_cam_map = R^T; its rotation vector via the quaternion (robust at 180 deg)
+        long double C[9];
+        for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) C[3 * i + j] = R[3 * j + i];
+        long double qw, qx, qy, qz, tr = C[0] + C[4] + C[8];
+        if (tr > 0) {
+            long double t = std::sqrt(tr + 1) * 2;
+            qw = t / 4; qx = (C[7] - C[5]) / t; qy = (C[2] - C[6]) / t; qz = (C[3] - C[1]) / t;
+        } else if (C[0] >= C[4] && C[0] >= C[8]) {
+            long double t = std::sqrt(1 + C[0] - C[4] - C[8]) * 2;
+            qw = (C[7] - C[5]) / t; qx = t / 4; qy = (C[1] + C[3]) / t; qz = (C[2] + C[6]) / t;
+        } else if (C[4] >= C[8]) {
+            long double t = std::sqrt(1 + C[4] - C[0] - C[8]) * 2;
+            qw = (C[2] - C[6]) / t; qx = (C[1] + C[3]) / t; qy = t / 4; qz = (C[5] + C[7]) / t;
+        } else {
+            long double t = std::sqrt(1 + C[8] - C[0] - C[4]) * 2;
+            qw = (C[3] - C[1]) / t; qx = (C[2] + C[6]) / t; qy = (C[5] + C[7]) / t; qz = t / 4;
+        }
+        if (qw < 0) { qw = -qw; qx = -qx; qy = -qy; qz = -qz; }
+        const long double vn = std::sqrt(qx * qx + qy * qy + qz * qz), ang = 2 * std::atan2(vn, qw);
+        const long double rv[3] = {vn > 0 ? qx / vn * ang : 0, vn > 0 ? qy / vn * ang : 0, vn > 0 ? qz / vn * ang : 0};
+        const long double cen[3] = {(long double)pose.e_nm * 1e-9L, (long double)pose.n_nm * 1e-9L,
+                                    (long double)pose.h_nm * 1e-9L};
+        long double t3[3];
+        for (int i = 0; i < 3; ++i) t3[i] = -(C[3 * i] * cen[0] + C[3 * i + 1] * cen[1] + C[3 * i + 2] * cen[2]);
+        char model[1024];
+        std::snprintf(model, sizeof model,
+                      "{\n    'lensmodel':  'LENSMODEL_OPENCV4',\n"
+                      "    'intrinsics': [ 3000, 3001.5, 1023.5, 767.5, -0.28, 0.09, 0.0001, -0.0002 ],\n"
+                      "    'extrinsics': [ %.21Lg, %.21Lg, %.21Lg, %.21Lg, %.21Lg, %.21Lg ],\n"
+                      "    'imagersize': [ 2048, 1536 ],\n}\n",
+                      rv[0], rv[1], rv[2], t3[0], t3[1], t3[2]);
+        spit(g_dir + "/eq.cameramodel", model);
+        // the model route's pose, as the CLI builds it
+        ct_host::CameraModel cm = ct_host::read_cameramodel(g_dir + "/eq.cameramodel");
+        ct_host::LibCamera lc = ct_host::lib_camera(cm, "eq");
+        long dr = 0, dc = std::max(std::llabs(lc.pose.e_nm - pose.e_nm),
+                                   std::max(std::llabs(lc.pose.n_nm - pose.n_nm), std::llabs(lc.pose.h_nm - pose.h_nm)));
+        for (int k = 0; k < 9; ++k) dr = std::max(dr, (long)std::labs((long)lc.pose.R_map_cam_q30[k] - pose.R_map_cam_q30[k]));
+        std::printf("  yaw %g pitch %g roll %g: model route vs ct_pose_from_map: R within %ld Q30 units, centre within %ld nm\n",
+                    a[0], a[1], a[2], dr, dc);
+        TEST_ASSERT_MSG(dr <= 4 && dc <= 2, "yaw %g pitch %g roll %g: the model's pose is %ld Q30 / %ld nm off", a[0],
+                        a[1], a[2], dr, dc);
+        const bool same_pose = dr == 0 && dc == 0;
+        char arg[160];
+        std::snprintf(arg, sizeof arg, "%.9f,%.9f,%.9f,%g,%g,%g", E0, N0, H0, a[0], a[1], a[2]);
+        Run r1 = run({"geoloc", "t.ctp", "--camera", "cam.cameramodel", "--pixels", "pxm.csv", "--pose-map", arg, "-o",
+                      "gm1.csv"});
+        Run r2 = run({"geoloc", "t.ctp", "--camera", "eq.cameramodel", "--pixels", "pxm.csv", "-o", "gm2.csv"});
+        TEST_ASSERT_MSG(r1.code == 0 && r2.code == 0, "exit %d / %d: %s %s", r1.code, r2.code, r1.err.c_str(),
+                        r2.err.c_str());
+        const std::string g1 = slurp(g_dir + "/gm1.csv"), g2 = slurp(g_dir + "/gm2.csv");
+        if (same_pose) {
+            TEST_ASSERT_MSG(g1 == g2, "yaw %g pitch %g roll %g: --pose-map and the equivalent model differ", a[0],
+                            a[1], a[2]);
+            identical += g1 == g2 && lines_of(g1).size() > 2;
+        } else {
+            // a few Q30 units apart (the two routes round the same rotation):
+            // the same statuses, hits within 1 mm
+            std::vector<std::string> l1 = lines_of(g1), l2 = lines_of(g2);
+            TEST_ASSERT_EQUAL_INT(l1.size(), l2.size());
+            for (size_t k = 1; k < l1.size() && k < l2.size(); ++k) {
+                std::vector<std::string> f1 = split(l1[k]), f2 = split(l2[k]);
+                TEST_ASSERT(f1[2] == f2[2]);
+                if (f1[2] == "hit")
+                    for (int c = 3; c <= 5; ++c)
+                        TEST_ASSERT_MSG(std::fabs(std::stod(f1[c]) - std::stod(f2[c])) < 1e-3, "row %zu col %d: %s vs %s", k,
+                                        c, f1[c].c_str(), f2[c].c_str());
+            }
+        }
+    }
+    // the exact attitudes (multiples of 90 deg) and most general ones agree to the bit
+    TEST_ASSERT_MSG(identical >= 4, "only %d of the attitudes gave identical rows", identical);
+}
+
 void test_geoloc_poses()
 {
     Setup *s = setup();
@@ -675,6 +791,7 @@ int main()
     RUN_TEST(test_geoloc_end_to_end);
     RUN_TEST(test_geoloc_effects);
     RUN_TEST(test_geoloc_poses);
+    RUN_TEST(test_geoloc_pose_map_vs_model);
     RUN_TEST(test_geoloc_threads);
     RUN_TEST(test_geoloc_splined_grid);
     RUN_TEST(test_geoloc_bad_inputs);
