@@ -10,24 +10,29 @@
  * is neither a map-frame line nor a vertical parabola: it stretches along
  * track (rho^2 tan(depression) / R), bends sideways (transverse Mercator:
  * about E' rho^2 / (2 R^2) at E' from the central meridian) and rises with
- * the ellipsoid's radius in its azimuth.  It is traced in pieces [ta, tb]:
- *   - the exact images A, M, B of the ends and the middle (Q16 grid);
- *   - horizontally the chord A -> B, accepted when M lies within the chord
- *     tolerance of it (the image's sideways curvature is nearly constant
- *     over a piece, so the middle is where it strays most); otherwise the
- *     piece is shortened by sqrt(tol / deviation);
+ * the ellipsoid's radius in its azimuth.  The image is interpolated per
+ * ray through exact ones at Chebyshev nodes (below) and traced in pieces
+ * [ta, tb] of the range:
+ *   - the images A, M, B of the ends and the middle (Q16 grid, and x, y in
+ *     Q24 for the checks);
+ *   - horizontally the chord A -> B;
  *   - vertically the quadratic z(s) = zA + b s + a s^2 in the range s along
  *     the chord through A, M and B: the straight line from A to B lowered
  *     by a s^2 at B, traced against the terrain lowered post by post by
- *     a ((x - xA)^2 + (y - yA)^2) (the lowered walk of trace.c, ct_lower).
- *     Over pieces of at most 8 km the image's height departs from that
- *     quadratic by its cubic term only: < 0.05 mm (measured with PROJ in
- *     tests/test_earth.cpp and docs/geolocation.md).  a < 0 (a path bending
- *     down faster than the Earth: refraction k > 1) traces the chord itself,
- *     the piece shortened until |a| l^2 / 4 is within the tolerance;
+ *     a ((x - xA)^2 + (y - yA)^2) (the lowered walk of trace.c, ct_lower);
+ *     a < 0 (a path bending down faster than the Earth: refraction k > 1)
+ *     traces the chord itself;
+ *   - the model is checked against the images at the middle (sideways) and
+ *     the quarter points (sideways, and in height at their range along the
+ *     chord): within the chord tolerance the piece is traced, otherwise
+ *     shortened by 0.8 sqrt(tol / error) (errors grow as the length
+ *     squared) and checked again; the next piece aims at 0.6 of the
+ *     tolerance, at most twice as long, up to 30 km (the image's cubic term
+ *     the quarter points see is then well under the tolerance);
  *   - a hit beyond the piece's end belongs to the next piece.
  * Pieces off the tile (horizontally, or above the tallest post) are not
- * traced and need no tolerance: they double in length up to 8 km.
+ * traced and need no tolerance: they double in length.  The walk ends when
+ * the path has left the tile for good, at tmax, or after EARTH_MAX_PIECES.
  *
  * Formats: ECEF nm (|.| < 2^55), directions Q39 (unit = 2^39), t nm
  * (< 2^48: 281 km), grid Q16 as everywhere.
@@ -268,8 +273,8 @@ static void fit_piece(const gv *A, const gv *B, const gv *M, fit *f)
     ct_i128 dot, l2;
     f->ux = B->x - A->x;
     f->uy = B->y - A->y;
-    /* pieces are at most 8 km: |u|, |m| < 2^43 Q16 even at 1 mm posting;
-     * squares and products in 128 bits */
+    /* pieces are at most 30 km: |u|, |m| < 2^42 Q16 at 1 cm posting or
+     * more; squares and products in 128 bits */
     l2 = ct_i128_add(ct_i128_mul(f->ux, f->ux), ct_i128_mul(f->uy, f->uy));
     f->l = (int64_t)ct_i128_isqrt(l2);
     dot = ct_i128_add(ct_i128_mul(f->ux, mx), ct_i128_mul(f->uy, my));
