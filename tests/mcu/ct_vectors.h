@@ -133,6 +133,37 @@ typedef struct {
     int64_t lat2_q61, lon2_q61, h2_nm;    /* ct_wgs84_from_ecef(in_nm)        */
 } ct_vec_ecef;
 
+/* The vertical datum (lib/src/geodesy.c): ct_geoid_at at one point of one
+ * of the synthetic grids (ct_vec_set.geoid_grids). */
+typedef struct {
+    uint32_t grid;                        /* index into ct_vec_set.geoid_grids */
+    int64_t lat_q61, lon_q61;
+    ct_status status;
+    int64_t n_nm;                         /* ct_geoid_at, when CT_OK          */
+} ct_vec_geoid;
+
+/* ct_package_geoid at one map point of the datum package. */
+typedef struct {
+    int64_t e_nm, n_nm;
+    ct_status status;
+    int64_t n_geoid_nm;                   /* when CT_OK                       */
+} ct_vec_map_geoid;
+
+/* A package with a datum section (CT_PKG_FLAG_DATUM): what ct_package_open
+ * makes of it, and the geoid at map points. */
+typedef struct {
+    const char *name;
+    const uint8_t *bytes;                 /* 8-byte aligned package           */
+    uint32_t size;
+    ct_status open_status, verify_status;
+    uint32_t flags, epsg, vdatum, source_epsg;
+    uint32_t geoid_w, geoid_h;
+    int64_t geoid_lat0_q61, geoid_lon0_q61, geoid_step_q61;
+    uint32_t geoid_values_off;            /* pkg.geoid.values - bytes         */
+    const ct_vec_map_geoid *points;
+    uint32_t npoints;
+} ct_vec_datum_package;
+
 typedef struct {
     const ct_vec_package *packages;
     uint32_t npackages;
@@ -147,6 +178,12 @@ typedef struct {
     uint32_t ngeo;
     const ct_vec_ecef *ecef;
     uint32_t necef;
+    const ct_geoid_grid *geoid_grids;     /* some invalid (statuses)          */
+    uint32_t ngeoid_grids;
+    const ct_vec_geoid *geoid;
+    uint32_t ngeoid;
+    const ct_vec_datum_package *datum;
+    uint32_t ndatum;
 } ct_vec_set;
 
 extern const ct_vec_set ct_vectors;

@@ -8,7 +8,9 @@
 // -- package bytes, rays, prepared rays, every ct_hit field, map-frame
 // conversions, fixed-point results, and four cameras over the packages
 // (lenses, an unprojection grid, poses, straight and bent rays: every
-// ct_geolocate output, which the targets' batch must also reproduce) -- as a
+// ct_geolocate output, which the targets' batch must also reproduce), geoid
+// undulations (ct_geoid_at on synthetic grids; a package with a datum
+// section on UTM 17N and ct_package_geoid at map points) -- as a
 // C99 data file (ct_vectors.h).
 // The MCU program re-computes all of it with the Cortex-M build and requires
 // bit-identical results.
@@ -265,6 +267,239 @@ std::vector<uint8_t> build_with_builder(const Dem &d, int n, int r)
     return b;
 }
 #endif
+
+// ------------------------------------------------------------------ vertical datum
+// Geoid grids as a datum section stores them (conetrace.h): node (i, j) at
+// (lat0 - j step, lon0 + i step), Q61 radians, values in micrometres.
+struct GGrid {
+    uint32_t w = 0, h = 0;
+    int64_t lat0 = 0, lon0 = 0, step = 0;
+    std::vector<int32_t> um;              // w * h, row 0 north
+    bool null_values = false;             // an invalid grid: values NULL
+    std::vector<uint8_t> bytes;           // um, little-endian
+    void pack()
+    {
+        bytes.assign(4 * um.size(), 0);
+        for (size_t k = 0; k < um.size(); ++k) put32(bytes, 4 * k, (uint32_t)um[k]);
+    }
+    ct_geoid_grid view() const
+    {
+        ct_geoid_grid g{};
+        g.w = w;
+        g.h = h;
+        g.lat0_q61 = lat0;
+        g.lon0_q61 = lon0;
+        g.step_q61 = step;
+        g.values = null_values ? nullptr : bytes.data();
+        return g;
+    }
+};
+
+int64_t q61_deg(long double deg)
+{
+    return (int64_t)std::llround(deg * 3.14159265358979323846264338L / 180 * std::ldexp(1.0L, 61));
+}
+
+// The datum package: a tiny tile on UTM 17N (western North Carolina),
+// heights declared EGM96 (so ellipsoidal in the package), resampled from
+// EPSG:4326, with a 4 x 4 EGM96-like geoid at 15' around it.
+const int DATUM_EPSG = 32617, DATUM_SOURCE_EPSG = 4326, DW = 9, DH = 9;
+
+GGrid datum_geoid()
+{
+    GGrid g;
+    g.w = g.h = 4;
+    g.lat0 = q61_deg(36.0L);
+    g.lon0 = q61_deg(-82.0L);
+    g.step = q61_deg(0.25L);
+    g.um = {-31512345, -31204871, -30877210, -30561094, -31873026, -31590412, -31266583, -30938817,
+            -32215390, -31943177, -31631409, -31310266, -32547718, -32284935, -31988021, -31671532};
+    g.pack();
+    return g;
+}
+
+#ifdef CT_GEN_USE_BUILDER
+std::vector<uint8_t> build_datum_with_builder(const GGrid &gg, double oe, double on)
+{
+    ct_host::Terrain t;
+    t.width = DW;
+    t.height = DH;
+    t.codes.resize((size_t)DW * DH);
+    for (int j = 0; j < DH; ++j)
+        for (int i = 0; i < DW; ++i) {
+            double h = 420.0 + 25.0 * std::sin(i * 0.7) * std::cos(j * 0.5) + 3.0 * i;
+            t.codes[(size_t)j * DW + i] = (uint16_t)std::lround(h / SCALE_M);
+        }
+    t.geo.origin_e = oe;
+    t.geo.origin_n = on;
+    t.geo.posting_e = POSTING_M;
+    t.geo.posting_n = -POSTING_M;
+    t.geo.epsg = DATUM_EPSG;
+    t.geo.source_epsg = DATUM_SOURCE_EPSG;
+    t.height_offset_m = 0.0;
+    t.height_scale_m = SCALE_M;
+    t.vdatum = CT_VDATUM_EGM96;
+    t.geoid.w = (int)gg.w;
+    t.geoid.h = (int)gg.h;
+    t.geoid.lat0_q61 = gg.lat0;
+    t.geoid.lon0_q61 = gg.lon0;
+    t.geoid.step_q61 = gg.step;
+    t.geoid.um = gg.um;
+    ct_host::BuildOptions o;
+    o.sectors = 8;
+    o.reduce = 2;
+    o.threads = 1;
+    ct_host::BuildStats st;
+    std::vector<uint8_t> b = ct_host::build_package(t, o, &st);
+    std::fprintf(stderr, "gen_vectors: build_package datum package (EPSG:%d, EGM96): %zu bytes\n", DATUM_EPSG, b.size());
+    return b;
+}
+#endif
+
+// Without the builder: the degenerate package moved onto zone 17N with a
+// datum section appended (and the CRC redone).
+std::vector<uint8_t> degenerate_with_datum(const Dem &d, const GGrid &gg, double oe, double on)
+{
+    std::vector<uint8_t> b = write_degenerate_package(d, 8, 2);
+    const size_t off = (b.size() + 7u) & ~(size_t)7u;
+    size_t end = off + CT_DATUM_HEADER_SIZE + gg.bytes.size();
+    end = (end + 7u) & ~(size_t)7u;
+    b.resize(end, 0);
+    put64(b, 32, nm(oe));
+    put64(b, 40, nm(on));
+    put32(b, 80, DATUM_EPSG);
+    b[23] = (uint8_t)(b[23] | CT_PKG_FLAG_DATUM);
+    put32(b, CT_HDR_DATUM, (uint32_t)off);
+    put16(b, off, CT_VDATUM_EGM96);
+    put16(b, off + 2, gg.w);
+    put16(b, off + 4, gg.h);
+    put32(b, off + 8, DATUM_SOURCE_EPSG);
+    put64(b, off + 16, gg.lat0);
+    put64(b, off + 24, gg.lon0);
+    put64(b, off + 32, gg.step);
+    std::memcpy(b.data() + off + CT_DATUM_HEADER_SIZE, gg.bytes.data(), gg.bytes.size());
+    put32(b, 8, (uint32_t)end);
+    put32(b, 12, 0);
+    uint32_t crc = 0;
+    ct_crc32(0, b.data(), b.size(), &crc);
+    put32(b, 12, crc);
+    return b;
+}
+
+// The synthetic grids of the ct_geoid_at vectors: EGM96-like around
+// Munich, one across the antimeridian, one of extreme values and extreme
+// extent (north pole, the largest step, (w - 1) step = 2^62), one of the
+// smallest step at the equator, and three invalid ones.
+std::vector<GGrid> geoid_grids()
+{
+    std::vector<GGrid> v;
+    GGrid g;
+    g.w = g.h = 4;
+    g.lat0 = q61_deg(48.5L);
+    g.lon0 = q61_deg(11.0L);
+    g.step = q61_deg(0.25L);
+    g.um = {47912345, 48104562, 48296011, 48477236, 47621908, 47815530, 48003377, 48190245,
+            47322019, 47507664, 47698212, 47879011, 47015432, 47201188, 47388906, 47570013};
+    v.push_back(g);
+    g = GGrid();
+    g.w = g.h = 4;
+    g.lat0 = q61_deg(-16.0L);
+    g.lon0 = q61_deg(179.75L);
+    g.step = q61_deg(0.25L);
+    g.um = {57120334, 57388120, 57650712, 57901446, 56876204, 57140009, 57399512, 57648230,
+            56630871, 56890453, 57146287, 57392045, 56381652, 56638117, 56890946, 57133602};
+    v.push_back(g);
+    g = GGrid();
+    g.w = 17;
+    g.h = 3;
+    g.lat0 = CT_PI_Q61 / 2;
+    g.lon0 = -CT_PI_Q61;
+    g.step = CT_GEOID_MAX_STEP_Q61;
+    for (uint32_t k = 0; k < g.w * g.h; ++k)
+        g.um.push_back(k % 3 == 0 ? INT32_MIN : k % 3 == 1 ? INT32_MAX : (k % 2 ? -1 : 1));
+    v.push_back(g);
+    g = GGrid();
+    g.w = g.h = 4;
+    g.lat0 = q61_deg(0.001L);
+    g.lon0 = q61_deg(-0.001L);
+    g.step = CT_GEOID_MIN_STEP_Q61;
+    g.um = {17161234, 17161251, 17161270, 17161288, 17161199, 17161217, 17161236, 17161254,
+            17161165, 17161183, 17161202, 17161220, 17161131, 17161149, 17161168, 17161186};
+    v.push_back(g);
+    // invalid: one column; a step below the smallest; no values
+    g = v[0];
+    g.w = 1;
+    g.um.resize(4);
+    v.push_back(g);
+    g = v[0];
+    g.step = CT_GEOID_MIN_STEP_Q61 - 1;
+    v.push_back(g);
+    g = v[0];
+    g.null_values = true;
+    v.push_back(g);
+    for (GGrid &x : v) x.pack();
+    return v;
+}
+
+int64_t wrap_lon(int64_t lon)
+{
+    const uint64_t turn = 2u * (uint64_t)CT_PI_Q61;  // 2 pi > INT64_MAX in Q61
+    if (lon > CT_PI_Q61) return (int64_t)((uint64_t)lon - turn);
+    if (lon < -CT_PI_Q61) return (int64_t)((uint64_t)lon + turn);
+    return lon;
+}
+
+// Points of one grid: nodes, the last row and column, just outside each
+// side, inside, arbitrary int64.
+std::vector<ct_vec_geoid> geoid_points(Rng &g, const std::vector<GGrid> &grids)
+{
+    std::vector<ct_vec_geoid> out;
+    for (uint32_t gi = 0; gi < grids.size(); ++gi) {
+        const GGrid &G = grids[gi];
+        const uint64_t wid = (uint64_t)(G.w > 1 ? G.w - 1 : 1) * (uint64_t)G.step;
+        const uint64_t hei = (uint64_t)(G.h - 1) * (uint64_t)G.step;
+        const int64_t latS = G.lat0 - (int64_t)hei, lonE = G.lon0 + (int64_t)wid;
+        const bool valid = gi < 4;
+        const int n = valid ? 12 : 2;
+        for (int k = 0; k < n; ++k) {
+            ct_vec_geoid v{};
+            v.grid = gi;
+            int64_t lat = G.lat0 - (int64_t)(g.u64() % (hei + 1)), lon = G.lon0 + (int64_t)(g.u64() % (wid + 1));
+            switch (valid ? k : 8 + k) {
+            case 0: lat = G.lat0; lon = G.lon0; break;                                  // node (0, 0)
+            case 1: lat = latS; lon = lonE; break;                                      // the last corner
+            case 2: lat = latS; break;                                                  // the last row
+            case 3: lon = lonE; break;                                                  // the last column
+            case 4: lat = G.lat0 + 1; break;                                            // just north
+            case 5: lat = latS - 1; break;                                              // just south
+            case 6: lon = G.lon0 - 1; break;                                            // just west
+            case 7: lon = lonE + 1; break;                                              // just east
+            case 10:                                                                    // on a node column
+                lon = G.lon0 + (int64_t)(g.u64() % G.w) * G.step;
+                break;
+            case 11: lat = (int64_t)g.u64(); lon = (int64_t)g.u64(); break;             // anything
+            default: break;                                                             // inside
+            }
+            v.lat_q61 = lat;
+            v.lon_q61 = k == 11 ? lon : wrap_lon(lon);
+            const ct_geoid_grid view = G.view();
+            v.status = ct_geoid_at(&view, v.lat_q61, v.lon_q61, &v.n_nm);
+            out.push_back(v);
+        }
+        if (gi == 1) {  // the antimeridian itself, both ways
+            for (int s = 0; s < 2; ++s) {
+                ct_vec_geoid v{};
+                v.grid = gi;
+                v.lat_q61 = G.lat0 - (int64_t)(g.u64() % (hei + 1));
+                v.lon_q61 = s ? CT_PI_Q61 : -CT_PI_Q61;
+                const ct_geoid_grid view = G.view();
+                v.status = ct_geoid_at(&view, v.lat_q61, v.lon_q61, &v.n_nm);
+                out.push_back(v);
+            }
+        }
+    }
+    return out;
+}
 
 // ------------------------------------------------------------------ rays
 struct Pkg {
@@ -1069,10 +1304,144 @@ int main(int argc, char **argv)
                      i64(v.in_nm[2]).c_str(), (int)v.inv_status, i64(v.lat2_q61).c_str(), i64(v.lon2_q61).c_str(),
                      i64(v.h2_nm).c_str());
     std::fprintf(f, "};\n\n");
+    // the vertical datum: ct_geoid_at on the synthetic grids
+    const std::vector<GGrid> ggrids = geoid_grids();
+    std::vector<ct_vec_geoid> gpts;
+    {
+        Rng gg(5773u);
+        gpts = geoid_points(gg, ggrids);
+    }
+    for (size_t k = 0; k < ggrids.size(); ++k) {
+        const GGrid &G = ggrids[k];
+        if (G.null_values) continue;
+        std::fprintf(f, "static const uint8_t geoid_grid%zu_values[%zu] = {", k, G.bytes.size());
+        for (size_t i = 0; i < G.bytes.size(); ++i) std::fprintf(f, "%s0x%02x,", (i % 16) ? " " : "\n    ", G.bytes[i]);
+        std::fprintf(f, "\n};\n\n");
+    }
+    std::fprintf(f, "static const ct_geoid_grid geoid_grids[%zu] = {\n", ggrids.size());
+    for (size_t k = 0; k < ggrids.size(); ++k) {
+        const GGrid &G = ggrids[k];
+        char vals[64];
+        if (G.null_values)
+            std::snprintf(vals, sizeof vals, "(const uint8_t *)0");
+        else
+            std::snprintf(vals, sizeof vals, "geoid_grid%zu_values", k);
+        std::fprintf(f, "  {.w = %uu, .h = %uu, .lat0_q61 = %s, .lon0_q61 = %s, .step_q61 = %s, .values = %s},\n", G.w, G.h,
+                     i64(G.lat0).c_str(), i64(G.lon0).c_str(), i64(G.step).c_str(), vals);
+    }
+    std::fprintf(f, "};\n\nstatic const ct_vec_geoid geoid[%zu] = {\n", gpts.size());
+    for (const ct_vec_geoid &v : gpts)
+        std::fprintf(f, "  {%uu, %s, %s, %d, %s},\n", v.grid, i64(v.lat_q61).c_str(), i64(v.lon_q61).c_str(), (int)v.status,
+                     i64(v.n_nm).c_str());
+    std::fprintf(f, "};\n\n");
+    {
+        int counts[2] = {0, 0};
+        for (const ct_vec_geoid &v : gpts) counts[v.status == CT_OK ? 0 : 1]++;
+        std::fprintf(stderr, "gen_vectors: geoid: %zu grids, %zu points: %d inside, %d refused\n", ggrids.size(),
+                     gpts.size(), counts[0], counts[1]);
+    }
+    // the datum package: a tile on zone 17N with a datum section
+    {
+        const GGrid dg = datum_geoid();
+        ct_utm z17{};
+        int64_t ce = 0, cn = 0;
+        if (ct_utm_zone_of_epsg(DATUM_EPSG, &z17) != CT_OK ||
+            ct_utm_forward(&z17, q61_deg(35.6L), q61_deg(-81.6L), &ce, &cn) != CT_OK)
+            die("datum package: UTM 17N");
+        const double oe = std::floor((double)ce / 30e9) * 30.0, on = std::floor((double)cn / 30e9) * 30.0;
+        std::vector<uint8_t> bytes;
+        std::string dname = "datum_egm96_degenerate";
+        ct_package dp;
+        ct_vec_datum_package dv{};
+#ifdef CT_GEN_USE_BUILDER
+        dname = "datum_egm96_build_package";
+        try {
+            bytes = build_datum_with_builder(dg, oe, on);
+        } catch (const std::exception &e) {
+            std::fprintf(stderr, "gen_vectors: WARNING: build_package (datum package) threw: %s\n", e.what());
+        }
+        dv.open_status = bytes.empty() ? CT_ERR_ARG : ct_package_open(&dp, bytes.data(), bytes.size());
+        if (dv.open_status != CT_OK || (dp.flags & CT_PKG_FLAG_DATUM) == 0u) {
+            std::fprintf(stderr, "gen_vectors: WARNING: datum package rejected (%d)\n", (int)dv.open_status);
+            generator = "degenerate (FALLBACK: build_package failed)";
+            bytes.clear();
+        }
+#endif
+        if (bytes.empty()) {
+            dname = "datum_egm96_degenerate";
+            bytes = degenerate_with_datum(dem, dg, oe, on);
+        }
+        dv.open_status = ct_package_open(&dp, bytes.data(), bytes.size());
+        if (dv.open_status != CT_OK) die("host ct_package_open (datum package): " + std::to_string(dv.open_status));
+        dv.verify_status = ct_package_verify(&dp);
+        dv.flags = dp.flags;
+        dv.epsg = dp.epsg;
+        dv.vdatum = dp.vdatum;
+        dv.source_epsg = dp.source_epsg;
+        dv.geoid_w = dp.geoid.w;
+        dv.geoid_h = dp.geoid.h;
+        dv.geoid_lat0_q61 = dp.geoid.lat0_q61;
+        dv.geoid_lon0_q61 = dp.geoid.lon0_q61;
+        dv.geoid_step_q61 = dp.geoid.step_q61;
+        dv.geoid_values_off = (uint32_t)(dp.geoid.values - bytes.data());
+        if (dv.vdatum != CT_VDATUM_EGM96 || dv.geoid_w != dg.w || dv.source_epsg != (uint32_t)DATUM_SOURCE_EPSG)
+            die("datum package: datum section not as built");
+        // map points: in the tile (corners too), around it within the
+        // geoid, 100 km off (outside the geoid), off the zone, anything
+        std::vector<ct_vec_map_geoid> mp;
+        Rng gm(32617u);
+        const int64_t span = (int64_t)(DW - 1) * nm(POSTING_M);
+        for (int k = 0; k < 24; ++k) {
+            ct_vec_map_geoid v{};
+            v.e_nm = dp.origin_e_nm + gm.range(0, span);
+            v.n_nm = dp.origin_n_nm - gm.range(0, span);
+            if (k == 0) {
+                v.e_nm = dp.origin_e_nm;
+                v.n_nm = dp.origin_n_nm;
+            } else if (k == 1) {
+                v.e_nm = dp.origin_e_nm + span;
+                v.n_nm = dp.origin_n_nm - span;
+            } else if (k >= 12 && k < 18) {
+                v.e_nm += gm.range(-INT64_C(20000000000000), INT64_C(20000000000000));
+                v.n_nm += gm.range(-INT64_C(20000000000000), INT64_C(20000000000000));
+            } else if (k >= 18 && k < 21) {
+                v.e_nm += k == 20 ? -INT64_C(100000000000000) : 0;
+                v.n_nm += k == 18 ? INT64_C(100000000000000) : k == 19 ? -INT64_C(100000000000000) : 0;
+            } else if (k == 21) {
+                v.e_nm = INT64_C(5000000000000000);
+            } else if (k >= 22) {
+                v.e_nm = (int64_t)gm.u64();
+                v.n_nm = (int64_t)gm.u64();
+            }
+            v.status = ct_package_geoid(&dp, v.e_nm, v.n_nm, &v.n_geoid_nm);
+            mp.push_back(v);
+        }
+        int ok = 0;
+        for (const ct_vec_map_geoid &v : mp) ok += v.status == CT_OK;
+        std::fprintf(stderr, "gen_vectors: %s: %zu bytes, %zu map points: %d with a geoid, %zu refused\n", dname.c_str(),
+                     bytes.size(), mp.size(), ok, mp.size() - (size_t)ok);
+        std::fprintf(f, "static const union {\n    uint64_t align;\n    uint8_t b[%zu];\n} datum_pkg_bytes = {.b = {",
+                     bytes.size());
+        for (size_t i = 0; i < bytes.size(); ++i) std::fprintf(f, "%s0x%02x,", (i % 16) ? " " : "\n    ", bytes[i]);
+        std::fprintf(f, "\n}};\n\nstatic const ct_vec_map_geoid datum_points[%zu] = {\n", mp.size());
+        for (const ct_vec_map_geoid &v : mp)
+            std::fprintf(f, "  {%s, %s, %d, %s},\n", i64(v.e_nm).c_str(), i64(v.n_nm).c_str(), (int)v.status,
+                         i64(v.n_geoid_nm).c_str());
+        std::fprintf(f, "};\n\nstatic const ct_vec_datum_package datum[1] = {\n");
+        std::fprintf(f, "  {.name = \"%s\", .bytes = datum_pkg_bytes.b, .size = %zuu, .open_status = %d, .verify_status = %d,\n",
+                     dname.c_str(), bytes.size(), (int)dv.open_status, (int)dv.verify_status);
+        std::fprintf(f, "   .flags = %uu, .epsg = %uu, .vdatum = %uu, .source_epsg = %uu, .geoid_w = %uu, .geoid_h = %uu,\n",
+                     dv.flags, dv.epsg, dv.vdatum, dv.source_epsg, dv.geoid_w, dv.geoid_h);
+        std::fprintf(f, "   .geoid_lat0_q61 = %s, .geoid_lon0_q61 = %s, .geoid_step_q61 = %s, .geoid_values_off = %uu,\n",
+                     i64(dv.geoid_lat0_q61).c_str(), i64(dv.geoid_lon0_q61).c_str(), i64(dv.geoid_step_q61).c_str(),
+                     dv.geoid_values_off);
+        std::fprintf(f, "   .points = datum_points, .npoints = %zuu},\n};\n\n", mp.size());
+    }
     std::fprintf(f,
                  "const ct_vec_set ct_vectors = {packages, %zuu, fixed, %zuu, dirs, %zuu, \"%s\", cameras, %zuu, geo, "
-                 "%zuu, ecef, %zuu};\n",
-                 pkgs.size(), fx.size(), dirs.size(), generator.c_str(), cams.size(), geo.size(), ecef.size());
+                 "%zuu, ecef, %zuu,\n    geoid_grids, %zuu, geoid, %zuu, datum, 1u};\n",
+                 pkgs.size(), fx.size(), dirs.size(), generator.c_str(), cams.size(), geo.size(), ecef.size(),
+                 ggrids.size(), gpts.size());
     if (std::fclose(f) != 0) die("write error");
     return 0;
 }

@@ -7,9 +7,11 @@
  * ct_trace_prepared, map-frame conversions, surface heights, the
  * fixed-point core, and cameras: lens and grid set-up, unprojection,
  * projection, ct_geolocate with every method (straight and bent rays) and
- * ct_geolocate_batch.  Every field must be bit-identical.  Prints a summary
- * and stops with pass/fail through the platform layer (semihosting on
- * qemu).  C99, freestanding, no stdio, no float.
+ * ct_geolocate_batch, and the vertical datum (ct_geoid_at on synthetic
+ * grids, a package's datum section, ct_package_geoid).  Every field must be
+ * bit-identical.  Prints a summary and stops with pass/fail through the
+ * platform layer (semihosting on qemu).  C99, freestanding, no stdio, no
+ * float.
  */
 #include <stddef.h>
 #include <stdint.h>
@@ -542,6 +544,79 @@ static void check_fixed(const ct_vec_set *vs)
     }
 }
 
+/* The vertical datum: ct_geoid_at on the synthetic grids, and the datum
+ * package (open, its datum fields, ct_package_geoid at map points, a
+ * corrupted copy).  Returns the number of geoid values checked. */
+static uint32_t check_datum(const ct_vec_set *vs)
+{
+    uint32_t k, p, n = 0u;
+    int64_t v = 0;
+    g_where = "geoid";
+    g_method = 0u;
+    for (k = 0u; k < vs->ngeoid; ++k) {
+        const ct_vec_geoid *q = &vs->geoid[k];
+        g_idx = k;
+        if (q->grid >= vs->ngeoid_grids) {
+            eq_i64("geoid vector shape", 0, 1);
+            continue;
+        }
+        v = 0;
+        eq_i64("geoid status", q->status, ct_geoid_at(&vs->geoid_grids[q->grid], q->lat_q61, q->lon_q61, &v));
+        if (q->status == CT_OK) {
+            eq_i64("geoid N", q->n_nm, v);
+        }
+        n++;
+    }
+    g_idx = 0u;
+    eq_i64("geoid null grid", CT_ERR_ARG, ct_geoid_at(NULL, 0, 0, &v));
+    if (vs->ngeoid_grids > 0u) {
+        eq_i64("geoid null out", CT_ERR_ARG, ct_geoid_at(&vs->geoid_grids[0], 0, 0, NULL));
+    }
+    for (p = 0u; p < vs->ndatum; ++p) {
+        const ct_vec_datum_package *vd = &vs->datum[p];
+        ct_status st;
+        g_where = vd->name;
+        g_idx = 0u;
+        st = ct_package_open(&g_pkg, vd->bytes, vd->size);
+        eq_i64("datum open", vd->open_status, st);
+        if (st != CT_OK) {
+            continue;
+        }
+        eq_i64("datum verify", vd->verify_status, ct_package_verify(&g_pkg));
+        eq_u64("datum flags", vd->flags, g_pkg.flags);
+        eq_u64("datum epsg", vd->epsg, g_pkg.epsg);
+        eq_u64("vdatum", vd->vdatum, g_pkg.vdatum);
+        eq_u64("source_epsg", vd->source_epsg, g_pkg.source_epsg);
+        eq_u64("geoid w", vd->geoid_w, g_pkg.geoid.w);
+        eq_u64("geoid h", vd->geoid_h, g_pkg.geoid.h);
+        eq_i64("geoid lat0", vd->geoid_lat0_q61, g_pkg.geoid.lat0_q61);
+        eq_i64("geoid lon0", vd->geoid_lon0_q61, g_pkg.geoid.lon0_q61);
+        eq_i64("geoid step", vd->geoid_step_q61, g_pkg.geoid.step_q61);
+        eq_i64("geoid values", 1, g_pkg.geoid.values == vd->bytes + vd->geoid_values_off);
+        for (k = 0u; k < vd->npoints; ++k) {
+            const ct_vec_map_geoid *q = &vd->points[k];
+            g_idx = k;
+            v = 0;
+            eq_i64("package geoid status", q->status, ct_package_geoid(&g_pkg, q->e_nm, q->n_nm, &v));
+            if (q->status == CT_OK) {
+                eq_i64("package geoid N", q->n_geoid_nm, v);
+            }
+            n++;
+        }
+        g_idx = 0u;
+        eq_i64("package geoid null", CT_ERR_ARG, ct_package_geoid(NULL, 0, 0, &v));
+        /* one flipped byte in the geoid values: the CRC catches it */
+        if (vd->size <= sizeof g_copy.b && vd->geoid_values_off < vd->size) {
+            for (k = 0u; k < vd->size; ++k) {
+                g_copy.b[k] = vd->bytes[k];
+            }
+            g_copy.b[vd->geoid_values_off] ^= 0x01u;
+            eq_i64("datum corrupt", CT_ERR_CRC, ct_package_open(&g_pkg, g_copy.b, vd->size));
+        }
+    }
+    return n;
+}
+
 int main(void)
 {
     const ct_vec_set *vs = &ct_vectors;
@@ -559,6 +634,23 @@ int main(void)
         put_str(" points: forward, inverse, factors, geodetic poses), Earth-fixed (");
         put_u64(vs->necef);
         put_str(" points: forward, inverse): ");
+        put_u64(g_fail - before);
+        put_str(" mismatching fields");
+        flush_line();
+    }
+    {
+        uint32_t before = g_fail, n = check_datum(vs);
+        put_str("  vertical datum: ct_geoid_at (");
+        put_u64(vs->ngeoid_grids);
+        put_str(" grids, ");
+        put_u64(vs->ngeoid);
+        put_str(" points), ");
+        put_u64(vs->ndatum);
+        put_str(" datum package (open, fields, ");
+        put_u64(vs->ndatum > 0u ? vs->datum[0].npoints : 0u);
+        put_str(" map points): ");
+        put_u64(n);
+        put_str(" geoids, ");
         put_u64(g_fail - before);
         put_str(" mismatching fields");
         flush_line();
