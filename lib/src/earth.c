@@ -394,6 +394,9 @@ ct_status ct_earth_setup(const ct_package *p, const ct_pose *pose, int32_t refr_
     es->radius_nm = radius_nm;
     post = ct_abs64(p->posting_e_nm);
     /* chord (<= 2^50) 2^16 < 2^66: 128-bit */
+    /* the checks aim at 3/4 of the chord: they see the model at its middle
+     * and quarter points only, and the vertices are rounded to Q16 */
+    chord_nm -= chord_nm / 4;
     es->tol_q16 = ct_max64(2, ct_i128_floor_div_sat(ct_i128_shl(ct_i128_from64(chord_nm), 16), post));
     es->tol_q24 = ct_max64(2, ct_i128_floor_div_sat(ct_i128_shl(ct_i128_from64(chord_nm), 24), post));
     es->tolz_q16 = ct_max64(2, ct_i128_floor_div_sat(ct_i128_shl(ct_i128_from64(chord_nm), 16), p->height_scale_nm));
