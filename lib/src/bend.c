@@ -45,14 +45,6 @@ typedef struct {
     int64_t posting;       /* |posting|, nm */
 } bent;
 
-/* round(a / b), b > 0, 128-bit numerator, saturated to +-2^62 */
-static int64_t round_div128(ct_i128 a, int64_t b)
-{
-    ct_i128 twice = ct_i128_add(ct_i128_shl(a, 1), ct_i128_from64(b));
-    /* floor((2a + b) / 2b); b < 2^62 so 2b fits */
-    return ct_i128_floor_div_sat(twice, 2 * b);
-}
-
 /* round(s * u / L) for s >= 0, |u| <= 2^30, 1 <= L < 2^31: in 64 bits when
  * s < 2^31 (|s u| < 2^61, so 2 s u + L fits), else through 128 bits.  Both
  * give floor((2 s u + L) / 2L), the same value. */
@@ -61,7 +53,7 @@ static int64_t scale_round(int64_t s, int64_t u, int64_t L)
     if (s < (INT64_C(1) << 31)) {
         return ct_floor_div(2 * s * u + L, 2 * L);
     }
-    return round_div128(ct_i128_mul(s, u), L);
+    return ct_i128_round_div_sat(ct_i128_mul(s, u), L);
 }
 
 /* The vertex at range s (Q16 cells, s >= 0).  Returns CT_ERR_RANGE when
@@ -313,18 +305,12 @@ ct_status ct_bend_segment(const ct_package *p, const ct_bend *bd, int64_t *delta
     return CT_OK;
 }
 
-/* Bits of a non-negative 128-bit value. */
-static unsigned bitlen128(ct_i128 v)
-{
-    return v.hi != 0u ? 64u + ct_bitlen64(v.hi) : ct_bitlen64(v.lo);
-}
-
 /* q = floor(n 2^s / d) with s chosen so that q is in [2^61, 2^63): n > 0
  * (< 2^126), 0 < d < 2^63.  Returns q; *s may be negative (n shifted right
  * first, floored).  n 2^s < 2^(62 + bitlen(d)) <= 2^125. */
 static uint64_t norm_div(ct_i128 n, int64_t d, int *s)
 {
-    int e = 62 - ((int)bitlen128(n) - (int)ct_bitlen64((uint64_t)d));
+    int e = 62 - ((int)ct_i128_bits(n) - (int)ct_bitlen64((uint64_t)d));
     if (e >= 0) {
         /* e <= 62 + 63 - 1: in two shifts of < 64 */
         n = ct_i128_shl(n, (unsigned)(e > 63 ? 63 : e));
@@ -398,7 +384,7 @@ ct_status ct_lower_setup_k(const ct_package *p, int64_t ox, int64_t oy, uint64_t
         uint64_t ex = (uint64_t)ct_abs64(((k & 1) ? W : 0) - lw->obx);
         uint64_t ey = (uint64_t)ct_abs64(((k & 2) ? H : 0) - lw->oby);
         ct_i128 d = ct_umul64(ex * ex + ey * ey, lw->kf); /* < 2^63 * 2^32 */
-        if (bitlen128(d) > 32u + lw->kshift) {
+        if (ct_i128_bits(d) > 32u + lw->kshift) {
             return CT_ERR_RANGE; /* D >= 2^32 */
         }
         lw->dmax = ct_max64(lw->dmax, ct_lower_at(lw, (k & 1) ? W : 0, (k & 2) ? H : 0));

@@ -25,7 +25,8 @@
  * Every product is rounded half up (ct_mul_shr); the code is exact integer
  * arithmetic, bit-identical on every target.
  */
-#include "camera.h"
+#include "conetrace.h"
+#include "fixed.h"
 
 #define ONE32 (INT64_C(1) << 32)
 #define CAM_READY 0x314d4143u  /* "CAM1" */
@@ -108,13 +109,13 @@ static int radial(const ct_lens *l, int64_t r2, int64_t *R, int64_t *Rp)
         return 0;
     }
     /* R = N 2^32 / D: |N 2^32| < 2^92.2; D < 2^60.2 */
-    if (!ct_div_round(ct_i128_shl(ct_i128_from64(N), 32u), D, R_MAX, R) || *R < R_MIN) {
+    if (!ct_i128_round_div_lim(ct_i128_shl(ct_i128_from64(N), 32u), D, R_MAX, R) || *R < R_MIN) {
         return 0;
     }
     /* R' = (N' 2^32 - R D') / D (Q64 / Q32): |N' 2^32| < 2^87.7,
      * |R D'| < 2^40 2^55.7 = 2^95.7 */
     num = ct_i128_sub(ct_i128_shl(ct_i128_from64(Np), 32u), ct_i128_mul(*R, Dp));
-    return ct_div_round(num, D, RP_MAX, Rp);
+    return ct_i128_round_div_lim(num, D, RP_MAX, Rp);
 }
 
 /* distort(x, y) and its Jacobian.  0 outside the valid field. */
@@ -189,8 +190,8 @@ static int newton_step(const lens_eval *ev, int64_t ex, int64_t ey, int64_t *dx,
         ny = ct_i128_sar(ny, 1u);
     }
     /* step = n 2^32 / det: |n 2^32| <= 2^99 */
-    return ct_div_round(ct_i128_shl(nx, 32u), ds, STEP_MAX, dx) &&
-           ct_div_round(ct_i128_shl(ny, 32u), ds, STEP_MAX, dy);
+    return ct_i128_round_div_lim(ct_i128_shl(nx, 32u), ds, STEP_MAX, dx) &&
+           ct_i128_round_div_lim(ct_i128_shl(ny, 32u), ds, STEP_MAX, dy);
 }
 
 static int64_t max_abs2(int64_t a, int64_t b) { return ct_max64(ct_abs64(a), ct_abs64(b)); }
@@ -268,11 +269,11 @@ static void unit_ray(int64_t x, int64_t y, int32_t out[3])
     l2.hi += 1u;                                 /* + 1.0 in Q64       */
     L = (int64_t)ct_i128_isqrt(l2);              /* Q32, [2^32, 2^36)  */
     /* |x 2^30| < 2^65; quotients <= 2^30 */
-    (void)ct_div_round(ct_i128_shl(ct_i128_from64(x), 30u), L, INT64_C(1) << 30, &q);
+    (void)ct_i128_round_div_lim(ct_i128_shl(ct_i128_from64(x), 30u), L, INT64_C(1) << 30, &q);
     out[0] = (int32_t)q;
-    (void)ct_div_round(ct_i128_shl(ct_i128_from64(y), 30u), L, INT64_C(1) << 30, &q);
+    (void)ct_i128_round_div_lim(ct_i128_shl(ct_i128_from64(y), 30u), L, INT64_C(1) << 30, &q);
     out[1] = (int32_t)q;
-    (void)ct_div_round(ct_i128_shl(ct_i128_from64(1), 62u), L, INT64_C(1) << 30, &q);
+    (void)ct_i128_round_div_lim(ct_i128_shl(ct_i128_from64(1), 62u), L, INT64_C(1) << 30, &q);
     out[2] = (int32_t)q;
 }
 
@@ -374,8 +375,8 @@ ct_status ct_camera_unproject(const ct_camera *cam, int64_t u, int64_t v, int32_
     }
     /* x_d = (u 2^16 - cx) 2^32 / fx (all Q32): |u 2^16 - cx| <= 2^53, so
      * the numerator < 2^85; fx <= 2^52 */
-    if (!ct_div_round(ct_i128_shl(ct_i128_from64(u * 65536 - l->cx_q32), 32u), l->fx_q32, XD_MAX, &xt) ||
-        !ct_div_round(ct_i128_shl(ct_i128_from64(v * 65536 - l->cy_q32), 32u), l->fy_q32, XD_MAX, &yt)) {
+    if (!ct_i128_round_div_lim(ct_i128_shl(ct_i128_from64(u * 65536 - l->cx_q32), 32u), l->fx_q32, XD_MAX, &xt) ||
+        !ct_i128_round_div_lim(ct_i128_shl(ct_i128_from64(v * 65536 - l->cy_q32), 32u), l->fy_q32, XD_MAX, &yt)) {
         return CT_ERR_UNPROJECT;
     }
     if (!has_distortion(l)) {
@@ -415,21 +416,17 @@ ct_status ct_camera_project(const ct_camera *cam, const int32_t ray[3], int64_t 
         return CT_ERR_UNPROJECT; /* behind the camera (or at 90 deg) */
     }
     /* x = X 2^32 / Z, |x| <= 8: |X 2^32| < 2^63 */
-    if (!ct_div_round(ct_i128_shl(ct_i128_from64(ray[0]), 32u), ray[2], XY_MAX, &x) ||
-        !ct_div_round(ct_i128_shl(ct_i128_from64(ray[1]), 32u), ray[2], XY_MAX, &y) ||
+    if (!ct_i128_round_div_lim(ct_i128_shl(ct_i128_from64(ray[0]), 32u), ray[2], XY_MAX, &x) ||
+        !ct_i128_round_div_lim(ct_i128_shl(ct_i128_from64(ray[1]), 32u), ray[2], XY_MAX, &y) ||
         !lens_forward(cam, x, y, &ev)) {
         return CT_ERR_UNPROJECT;
     }
     /* u = (fx x_d + cx) in Q16: fx x_d < 2^52 2^50.1 = 2^102.1 (Q64),
      * cx 2^32 < 2^84 (Q64); the sum / 2^48 < 2^54.1 */
-    *u = ct_i128_to64(ct_i128_sar(ct_i128_add(ct_i128_add(ct_i128_mul(l->fx_q32, ev.xd),
-                                                          ct_i128_shl(ct_i128_from64(l->cx_q32), 32u)),
-                                              ct_i128_from64(INT64_C(1) << 47)),
-                                  48u));
-    *v = ct_i128_to64(ct_i128_sar(ct_i128_add(ct_i128_add(ct_i128_mul(l->fy_q32, ev.yd),
-                                                          ct_i128_shl(ct_i128_from64(l->cy_q32), 32u)),
-                                              ct_i128_from64(INT64_C(1) << 47)),
-                                  48u));
+    *u = ct_i128_round_shr(ct_i128_add(ct_i128_mul(l->fx_q32, ev.xd), ct_i128_shl(ct_i128_from64(l->cx_q32), 32u)),
+                           48u);
+    *v = ct_i128_round_shr(ct_i128_add(ct_i128_mul(l->fy_q32, ev.yd), ct_i128_shl(ct_i128_from64(l->cy_q32), 32u)),
+                           48u);
     return CT_OK;
 }
 
@@ -561,7 +558,7 @@ static ct_status grid_unproject(const ct_camera *c, int64_t u, int64_t v, int32_
     /* bound: 3 components; |V 2^30| < 2^81, quotient <= 2^30 */
     for (k = 0u; k < 3u; ++k) {
         int64_t q = 0;
-        (void)ct_div_round(ct_i128_shl(ct_i128_from64(V[k]), 30u), L, INT64_C(1) << 30, &q);
+        (void)ct_i128_round_div_lim(ct_i128_shl(ct_i128_from64(V[k]), 30u), L, INT64_C(1) << 30, &q);
         out[k] = (int32_t)q;
     }
     /* the result must lie within 60 deg of each of its 16 nodes (cos >=

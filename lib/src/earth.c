@@ -38,7 +38,6 @@
  * (< 2^48: 281 km), grid Q16 as everywhere.
  */
 #include "bend.h"
-#include "camera.h"
 #include "fixed.h"
 
 #define ONE16 INT64_C(65536)
@@ -122,12 +121,6 @@ typedef struct {
     int64_t cf[NODES][3]; /* polynomial in sigma, Q24, lowest power first */
 } path;
 
-/* round(a b / 2^s) (half up) in 128 bits; the result must fit (callers) */
-static int64_t mul_shr(int64_t a, int64_t b, unsigned s)
-{
-    return ct_mul_shr(a, b, s);
-}
-
 /* The exact image of P(t) in the grid frame. */
 static ct_status vertex_exact(const path *pa, int64_t t, gv *v)
 {
@@ -143,9 +136,9 @@ static ct_status vertex_exact(const path *pa, int64_t t, gv *v)
     /* bound: 3 axes.  t d: < 2^48 2^40 = 2^88 (128-bit) / 2^39; bend w:
      * < 2^46 2^31 / 2^30 */
     for (k = 0; k < 3; ++k) {
-        P[k] = pa->es->c[k] + mul_shr(t, pa->d[k], 39u);
+        P[k] = pa->es->c[k] + ct_mul_shr(t, pa->d[k], 39u);
         if (pa->refract) {
-            P[k] -= mul_shr(bend, pa->w[k], 30u);
+            P[k] -= ct_mul_shr(bend, pa->w[k], 30u);
         }
     }
     st = ct_wgs84_from_ecef(P, &lat, &lon, &h);
@@ -180,7 +173,7 @@ static ct_status vertex(const path *pa, int64_t t, gv *v)
     for (k = 0; k < 3; ++k) { /* bound: 3 coordinates */
         int64_t acc = pa->cf[pa->nodes - 1][k];
         for (j = pa->nodes - 2; j >= 0; --j) { /* bound: NODES - 1 */
-            acc = pa->cf[j][k] + mul_shr(sig, acc, 60u);
+            acc = pa->cf[j][k] + ct_mul_shr(sig, acc, 60u);
         }
         r[k] = pa->base[k] + acc;
     }
@@ -205,7 +198,7 @@ static void set_nodes(path *pa, int64_t tmax)
     pa->nodes = tmax <= NODES_4_NM ? 4 : (tmax <= NODES_5_NM ? 5 : 6);
     for (j = 0; j < pa->nodes; ++j) { /* bound: NODES */
         /* t_j = tmax tau_j: < 2^48 2^60 in 128 bits */
-        int64_t t = mul_shr(tmax, tau_q60[pa->nodes - 4][j], 60u);
+        int64_t t = ct_mul_shr(tmax, tau_q60[pa->nodes - 4][j], 60u);
         if (vertex_exact(pa, t, &v) != CT_OK) {
             return;
         }
@@ -229,7 +222,7 @@ static void set_nodes(path *pa, int64_t tmax)
             for (i = 0; i < pa->nodes; ++i) { /* bound: NODES; < 2^43 2^46 each */
                 acc = ct_i128_add(acc, ct_i128_mul(vinv(pa->nodes, k, i), X[i][j]));
             }
-            pa->cf[k][j] = (int64_t)ct_i128_sar(ct_i128_add(acc, ct_i128_from64(INT64_C(1) << 39)), 40u).lo;
+            pa->cf[k][j] = ct_i128_round_shr(acc, 40u);
         }
     }
     pa->interp = 1;
@@ -479,7 +472,7 @@ ct_status ct_trace_earth(const ct_package *p, const ct_earth *es, const int64_t 
         for (j = 0; j < 3; ++j) { /* bound: 3 terms */
             s = ct_i128_add(s, ct_i128_mul(es->frame_q30[3 * k + j], dg[j]));
         }
-        pa.d[k] = (int64_t)ct_i128_sar(ct_i128_add(s, ct_i128_from64(INT64_C(1) << 29)), 30u).lo;
+        pa.d[k] = ct_i128_round_shr(s, 30u);
         pa.w[k] = 0;
     }
     pa.refract = 0;
@@ -573,7 +566,7 @@ ct_status ct_trace_earth(const ct_package *p, const ct_earth *es, const int64_t 
                 int64_t ex = ct_max64(ct_min64(elat, INT64_C(1) << 40) * 1024 / ct_max64(es->tol_q24, 1),
                                       ct_min64(evert, INT64_C(1) << 40) * 1024 / ct_max64(es->tolz_q16, 1));
                 int64_t fr = (int64_t)ct_isqrt64((uint64_t)((INT64_C(1) << 40) / ct_max64(ex, 1024))); /* Q15 */
-                L = ct_max64(PIECE_MIN_NM, ct_max64(Lc / 8, mul_shr(Lc, fr * 4 / 5, 15u)));
+                L = ct_max64(PIECE_MIN_NM, ct_max64(Lc / 8, ct_mul_shr(Lc, fr * 4 / 5, 15u)));
             }
         }
         if (!off) {
@@ -635,7 +628,7 @@ ct_status ct_trace_earth(const ct_package *p, const ct_earth *es, const int64_t 
                                   ct_min64(evert, INT64_C(1) << 40) * 1024 / ct_max64(es->tolz_q16, 1));
             int64_t fr = (int64_t)ct_isqrt64((uint64_t)((INT64_C(1) << 40) / ct_max64(ex, 64))); /* Q15 */
             fr = ct_min64(INT64_C(2) << 15, ct_max64(INT64_C(1) << 14, fr * 25 / 32));
-            L = ct_min64(PIECE_MAX_NM, ct_max64(PIECE_MIN_NM, mul_shr(Lc, fr, 15u)));
+            L = ct_min64(PIECE_MAX_NM, ct_max64(PIECE_MIN_NM, ct_mul_shr(Lc, fr, 15u)));
         }
         A = B;
         ta = tb;

@@ -215,10 +215,86 @@ static inline ct_i128 ct_i128_mul128_64(ct_i128 a, int64_t b)
 }
 
 
+/* |a| for a > -2^127.                                                       */
+static inline ct_i128 ct_i128_abs(ct_i128 a) { return ct_i128_sign(a) < 0 ? ct_i128_neg(a) : a; }
+
+/* Number of significant bits of a non-negative 128-bit value (0 for 0).    */
+static inline unsigned ct_i128_bits(ct_i128 a)
+{
+    return a.hi != 0u ? ct_bitlen64(a.hi) + 64u : ct_bitlen64(a.lo);
+}
+
+/* floor(a / 2^n) of a 128-bit value, 1 <= n <= 63 (arithmetic shift
+ * written with unsigned operations only); never overflows.                 */
+static inline ct_i128 ct_i128_sar(ct_i128 a, unsigned n)
+{
+    ct_i128 r;
+    r.lo = (a.lo >> n) | (a.hi << (64u - n));
+    r.hi = (a.hi >> n) | (((a.hi >> 63) != 0u) ? ~(~(uint64_t)0 >> n) : 0u);
+    return r;
+}
+
+/* Rounded shifts and divisions of 128-bit values, all half up (ties toward
+ * +infinity): round(x) = floor(x + 1/2).  The one family every file uses.  */
+
+/* round(v / 2^n), 1 <= n <= 126: floor((v + 2^(n-1)) / 2^n) by an
+ * arithmetic shift of the two words.  Caller: v + 2^(n-1) does not wrap
+ * (|v| <= 2^126 ensures it) and the result fits in int64 (only its low 64
+ * bits are returned).                                                            */
+static inline int64_t ct_i128_round_shr(ct_i128 v, unsigned n)
+{
+    ct_i128 h = ct_i128_from64(1);
+    ct_i128 r;
+    uint64_t neg;
+    h = n - 1u >= 64u ? ct_i128_shl(ct_i128_shl(h, 63u), n - 64u) : ct_i128_shl(h, n - 1u);
+    r = ct_i128_add(v, h);
+    neg = (r.hi >> 63) != 0u ? ~(uint64_t)0 : 0u;
+    if (n >= 64u) {
+        /* (hi >> (n - 64)) with the sign's bits shifted in */
+        return (int64_t)(((r.hi ^ neg) >> (n - 64u)) ^ neg);
+    }
+    return (int64_t)((r.lo >> n) | (r.hi << (64u - n)));
+}
+
+/* round(a * b / 2^q), 1 <= q <= 63, through the 64 x 64 -> 128-bit
+ * product (|a * b| <= 2^126 for any int64 operands, so the sum cannot
+ * wrap); the result must fit in int64 (caller's bound at each use).        */
+static inline int64_t ct_mul_shr(int64_t a, int64_t b, unsigned q)
+{
+    return ct_i128_round_shr(ct_i128_mul(a, b), q);
+}
+
 /* floor(n / d) for d > 0 and |quotient| < 2^63.                             */
 int64_t ct_i128_floor_div(ct_i128 n, int64_t d);
 /* floor(n / d) for d > 0, saturated to [-2^62, 2^62].                      */
 int64_t ct_i128_floor_div_sat(ct_i128 n, int64_t d);
+
+/* round(n / d) = floor((2 n + d) / (2 d)) for 0 < d < 2^62 (2 d fits) and
+ * |n| < 2^125 (2 n + d fits); the quotient must satisfy |q| < 2^63 -- the
+ * caller checks it (ct_i128_round_div_lim, or its own test) or bounds it. */
+static inline int64_t ct_i128_round_div(ct_i128 n, int64_t d)
+{
+    return ct_i128_floor_div(ct_i128_add(ct_i128_shl(n, 1u), ct_i128_from64(d)), 2 * d);
+}
+
+/* round(n / d) as above, saturated to [-2^62, 2^62] (no bound on the
+ * quotient; 0 < d < 2^62, |n| < 2^125).                                     */
+static inline int64_t ct_i128_round_div_sat(ct_i128 n, int64_t d)
+{
+    return ct_i128_floor_div_sat(ct_i128_add(ct_i128_shl(n, 1u), ct_i128_from64(d)), 2 * d);
+}
+
+/* round(n / d) for d in (0, 2^61], checked: returns 0 (and leaves *q
+ * alone) when |n| > lim * d, lim in [0, 2^61], i.e. when |n / d| would
+ * exceed lim; otherwise |n| <= 2^122, the quotient fits, returns 1.       */
+static inline int ct_i128_round_div_lim(ct_i128 n, int64_t d, int64_t lim, int64_t *q)
+{
+    if (ct_i128_cmp(ct_i128_abs(n), ct_i128_mul(lim, d)) > 0) {
+        return 0;
+    }
+    *q = ct_i128_round_div(n, d);
+    return 1;
+}
 /* floor(sqrt(n)) for 0 <= n < 2^126.                                         */
 uint64_t ct_i128_isqrt(ct_i128 n);
 /* floor(sqrt(n)) for 64-bit n.                                               */

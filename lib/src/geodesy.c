@@ -31,27 +31,10 @@
 #define ONE (INT64_C(1) << QB)
 #define HALF_NM_Q8 INT64_C(128)
 
-/* round(v / 2^n), n in 1..126, for a 128-bit v whose result fits int64:
- * floor((v + 2^(n-1)) / 2^n) by an arithmetic shift of the two words */
-static int64_t round_shr128(ct_i128 v, unsigned n)
-{
-    ct_i128 h = ct_i128_from64(1);
-    ct_i128 r;
-    uint64_t neg;
-    h = n - 1u >= 64u ? ct_i128_shl(ct_i128_shl(h, 63u), n - 64u) : ct_i128_shl(h, n - 1u);
-    r = ct_i128_add(v, h);
-    neg = (r.hi >> 63) != 0u ? ~(uint64_t)0 : 0u;
-    if (n >= 64u) {
-        /* (hi >> (n - 64)) with the sign's bits shifted in */
-        return (int64_t)(((r.hi ^ neg) >> (n - 64u)) ^ neg);
-    }
-    return (int64_t)((r.lo >> n) | (r.hi << (64u - n)));
-}
-
 /* a * b in Q59, rounded: |a b| < 2^63 * 2^59 */
 static int64_t qmul(int64_t a, int64_t b)
 {
-    return round_shr128(ct_i128_mul(a, b), QB);
+    return ct_i128_round_shr(ct_i128_mul(a, b), QB);
 }
 
 /* a / b in Q59 (b != 0, |a / b| < 16), floored: a 2^59 < 2^126 */
@@ -381,8 +364,8 @@ static ct_status forward(const ct_utm *z, int64_t lat_q61, int64_t lon_q61, int6
     }
     clenshaw(tm_alpha, 1, xi, eta, s2, c2, sh2, ch2, &xi, &eta);
     /* k0 A (nm, Q8, < 2^61) times xi, eta (Q59, |.| < 2): Q67 -> nm */
-    *e_nm = INT64_C(500000000000000) + round_shr128(ct_i128_mul(TM_K0A_NM_Q8, eta), QB + 8u);
-    *n_nm = (z->south ? INT64_C(10000000000000000) : 0) + round_shr128(ct_i128_mul(TM_K0A_NM_Q8, xi), QB + 8u);
+    *e_nm = INT64_C(500000000000000) + ct_i128_round_shr(ct_i128_mul(TM_K0A_NM_Q8, eta), QB + 8u);
+    *n_nm = (z->south ? INT64_C(10000000000000000) : 0) + ct_i128_round_shr(ct_i128_mul(TM_K0A_NM_Q8, xi), QB + 8u);
     return CT_OK;
 }
 
@@ -496,11 +479,11 @@ ct_status ct_ecef_from_wgs84(int64_t lat_q61, int64_t lon_q61, int64_t h_nm, int
     /* N + h and N (1 - e^2) + h, nm * 2^8: h 2^8 in [-2^60, 2^62], N 2^8 <
      * 2^60.6, so both lie in (0, 2^62.5) (N >= a > 2^52 >= -h) */
     nh8 = n8 + h_nm * 256;
-    nz8 = round_shr128(ct_i128_mul(n8, TM_1ME2), QB) + h_nm * 256;
+    nz8 = ct_i128_round_shr(ct_i128_mul(n8, TM_1ME2), QB) + h_nm * 256;
     /* (< 2^62.5) times a Q59 factor (<= 1): < 2^122, rounded to nm (< 2^55) */
-    xyz_nm[0] = round_shr128(ct_i128_mul(nh8, qmul(cphi, clam)), QB + 8u);
-    xyz_nm[1] = round_shr128(ct_i128_mul(nh8, qmul(cphi, slam)), QB + 8u);
-    xyz_nm[2] = round_shr128(ct_i128_mul(nz8, sphi), QB + 8u);
+    xyz_nm[0] = ct_i128_round_shr(ct_i128_mul(nh8, qmul(cphi, clam)), QB + 8u);
+    xyz_nm[1] = ct_i128_round_shr(ct_i128_mul(nh8, qmul(cphi, slam)), QB + 8u);
+    xyz_nm[2] = ct_i128_round_shr(ct_i128_mul(nz8, sphi), QB + 8u);
     return CT_OK;
 }
 
@@ -575,7 +558,7 @@ ct_status ct_wgs84_from_ecef(const int64_t xyz_nm[3], int64_t *lat_q61, int64_t 
      * the sum < 2^123; rounded to nm */
     acc = ct_i128_add(ct_i128_mul(p, c), ct_i128_mul(az, s));
     acc = ct_i128_sub(acc, ct_i128_mul(ECEF_A_Q6, qsqrt_one_minus(qmul(TM_E2, qmul(s, s)))));
-    *h_nm = round_shr128(acc, QB + 6u);
+    *h_nm = ct_i128_round_shr(acc, QB + 6u);
     /* Q59 -> Q61; 4 pi (Q59) exceeds CT_PI_Q61 by 2 units: clamped */
     lat = ct_min64(4 * lat, CT_PI_Q61 / 2);
     *lat_q61 = xyz_nm[2] < 0 ? -lat : lat;
@@ -729,7 +712,7 @@ ct_status ct_pose_from_wgs84(ct_pose *pose, const ct_utm *zone, int64_t lat_q61,
     (void)cphi;
     n2 = ONE - qmul(TM_E2, qmul(sphi, sphi));
     {
-        int64_t rr = round_shr128(ct_i128_mul(INT64_C(6378137000000000), qdiv(qsqrt_one_minus(TM_E2), n2)), QB);
+        int64_t rr = ct_i128_round_shr(ct_i128_mul(INT64_C(6378137000000000), qdiv(qsqrt_one_minus(TM_E2), n2)), QB);
         int64_t ratio;
         if (ct_abs64(h_nm) > rr / 2) {
             pose->ready = 0u;

@@ -22,7 +22,7 @@
  * own 2^-25 direction quantisation).
  */
 #include "bend.h"
-#include "camera.h"
+#include "fixed.h"
 
 typedef struct {
     int64_t ox, oy, oz;   /* camera centre, grid frame, Q16 */

@@ -634,9 +634,6 @@ static void make_quad_low(const ctx *c, int32_t i, int32_t j, const lposts *L, w
     W->A = ct_i128_neg(ct_i128_shl(ct_i128_mul(cc, Dq), 16)); /* cc D_q < 2^61 */
 }
 
-/* |a| for a 128-bit a > -2^127. */
-static ct_i128 abs128(ct_i128 a) { return ct_i128_sign(a) < 0 ? ct_i128_neg(a) : a; }
-
 /* Unsigned 128 x 128 -> 256-bit product (a, b < 2^127), limbs low first. */
 static void umul128x128(ct_i128 a, ct_i128 b, uint64_t r[4])
 {
@@ -665,7 +662,7 @@ static int disc_nonneg_low(const wquad *W)
     if (ct_i128_sign(W->C) <= 0) {
         return 1;
     }
-    umul128x128(abs128(W->B), abs128(W->B), l);
+    umul128x128(ct_i128_abs(W->B), ct_i128_abs(W->B), l);
     umul128x128(ct_i128_shl(W->A, 2), W->C, r);
     for (k = 3; k >= 0; --k) { /* bound: 4 limbs */
         if (l[k] != r[k]) {
@@ -699,15 +696,6 @@ static int interior_hit_low(const ctx *c, const wquad *W, rt tin, rt tout)
     return disc_nonneg_low(W);
 }
 
-/* floor(a / 2^n) of a signed 128-bit a, 0 < n < 64 */
-static ct_i128 sar128(ct_i128 a, unsigned n)
-{
-    ct_i128 r;
-    r.lo = (a.lo >> n) | (a.hi << (64u - n));
-    r.hi = (uint64_t)(((a.hi >> 63) != 0u) ? ~(~a.hi >> n) : (a.hi >> n));
-    return r;
-}
-
 /* The hit's position only (the decision above is exact): the coefficients
  * scaled by one power of two into make_quad's ranges (|A|, |B|, |C| <
  * 2^59), which moves the root by far less than the reported position's
@@ -715,22 +703,22 @@ static ct_i128 sar128(ct_i128 a, unsigned n)
  * surface; root_t_q26 clamps it to [tin, tout] exactly either way. */
 static int64_t root_low(const ctx *c, wquad *W, rt tin, rt tout)
 {
-    ct_i128 m = abs128(W->A);
+    ct_i128 m = ct_i128_abs(W->A);
     uint64_t top;
     unsigned n;
-    if (ct_i128_cmp(abs128(W->B), m) > 0) {
-        m = abs128(W->B);
+    if (ct_i128_cmp(ct_i128_abs(W->B), m) > 0) {
+        m = ct_i128_abs(W->B);
     }
-    if (ct_i128_cmp(abs128(W->C), m) > 0) {
-        m = abs128(W->C);
+    if (ct_i128_cmp(ct_i128_abs(W->C), m) > 0) {
+        m = ct_i128_abs(W->C);
     }
     top = m.hi != 0u ? m.hi : 0u;
     n = top != 0u ? 64u + ct_bitlen64(top) : ct_bitlen64(m.lo);
     n = n > 59u ? n - 59u : 0u;
     if (n > 0u) {
-        W->A = sar128(W->A, n);
-        W->B = sar128(W->B, n);
-        W->C = sar128(W->C, n);
+        W->A = ct_i128_sar(W->A, n);
+        W->B = ct_i128_sar(W->B, n);
+        W->C = ct_i128_sar(W->C, n);
     }
     W->q.A = ct_i128_to64(W->A);
     W->q.B = ct_i128_to64(W->B);
@@ -1770,8 +1758,8 @@ static ct_status round_div(ct_i128 num, int64_t den, int64_t *q)
     if (ct_i128_cmp(num, lim) >= 0 || ct_i128_cmp(num, ct_i128_neg(lim)) <= 0) {
         return CT_ERR_RANGE;
     }
-    /* floor((2 num + den) / 2 den); den <= 2^51 so 2 den fits */
-    *q = ct_i128_floor_div(ct_i128_add(ct_i128_shl(num, 1), ct_i128_from64(den)), 2 * den);
+    /* den <= 2^51 and |num| < 2^113: ct_i128_round_div's ranges */
+    *q = ct_i128_round_div(num, den);
     return CT_OK;
 }
 
