@@ -187,7 +187,7 @@ void build_package_to(const Terrain &t, const BuildOptions &opt, PackageSink &si
 
     // slice levels (slice builder): L_k = ceil(hmin + k (hmax - hmin) / K),
     // duplicates removed, or the given ones plus the extremes
-    int slices_header = opt.slices;
+    int slices_header = opt.builder == PptBuilder::Degenerate ? 0 : opt.slices;
     std::vector<int> lv;
     if (opt.builder == PptBuilder::Slices) {
         const int K = opt.slices > 0 ? opt.slices : BuildOptions::DEFAULT_SLICES;
@@ -295,6 +295,8 @@ void build_package_to(const Terrain &t, const BuildOptions &opt, PackageSink &si
                 stats->full_dts = sst.full_dts;
                 stats->seconds_dt = sst.seconds_dt;
             }
+        } else if (opt.builder == PptBuilder::Degenerate) {
+            apex.swap(hcm);  // the angle codes stay 0
         } else {
             apex.swap(hcm);
             if (opt.slices > 0 && hmax > hmin) {

@@ -48,7 +48,10 @@ struct Terrain {
 // Slices: the paper's slice-by-slice directional-DT builder (the default;
 // builder_slices.cpp).  Brute: per-cell branch and bound over exact
 // geometry (builder_brute.cpp): tighter cones, slower; the test reference.
-enum class PptBuilder { Slices, Brute };
+// Degenerate: no cones -- exact apexes (the coarse cell's tallest post) and
+// every angle code 0 (always valid, no cone jumps); a package for tests
+// (the MCU vectors without a cone builder).
+enum class PptBuilder { Slices, Brute, Degenerate };
 
 struct BuildOptions {
     int sectors = 24;      // N, 1..64

@@ -15,11 +15,11 @@
 // The MCU program re-computes all of it with the Cortex-M build and requires
 // bit-identical results.
 //
-// Package source: with CT_GEN_USE_BUILDER the packages come from
-// ct_host::build_package (real cones, so cone jumps run on the MCU).
-// Without it, the generator writes the package itself from the library's
-// layout (ct_package_layout, ct_crc32): exact mipmap, apex = tallest corner
-// of each coarse cell, every angle code 0 (degenerate cone, always valid).
+// Package source: ct_host::build_package, with the slice builder when
+// CT_GEN_USE_BUILDER is defined (real cones, so cone jumps run on the MCU),
+// else (and as the fallback when that build fails) with
+// PptBuilder::Degenerate: exact mipmap, apex = tallest corner of each
+// coarse cell, every angle code 0 (degenerate cone, always valid).
 #include <cinttypes>
 #include <cmath>
 #include <cstdio>
@@ -34,10 +34,7 @@ extern "C" {
 #include "fixed.h"
 }
 #include "ct_vectors.h"
-
-#ifdef CT_GEN_USE_BUILDER
 #include "terrain.hpp"
-#endif
 
 namespace {
 
@@ -119,130 +116,20 @@ Dem make_dem()
     return d;
 }
 
-// ------------------------------------------------------------------ package writer (fallback)
-void put16(std::vector<uint8_t> &b, size_t o, uint32_t v)
-{
-    b[o] = (uint8_t)v;
-    b[o + 1] = (uint8_t)(v >> 8);
-}
+// ------------------------------------------------------------------ packages
 void put32(std::vector<uint8_t> &b, size_t o, uint32_t v)
 {
     for (int k = 0; k < 4; ++k) b[o + k] = (uint8_t)(v >> (8 * k));
 }
-void put64(std::vector<uint8_t> &b, size_t o, int64_t v)
-{
-    for (int k = 0; k < 8; ++k) b[o + k] = (uint8_t)((uint64_t)v >> (8 * k));
-}
 
 int64_t nm(double m) { return (int64_t)std::llround(m * 1e9); }
 
-std::vector<uint8_t> write_degenerate_package(const Dem &d, uint32_t n, uint32_t r)
+const char *builder_name(ct_host::PptBuilder b)
 {
-    uint32_t so[CT_SEC_COUNT], ss[CT_SEC_COUNT], levels = 0, total = 0;
-    bool voids = false;
-    for (uint8_t v : d.void_post) voids = voids || v;
-    if (ct_package_layout(W, H, r, n, voids ? 1u : 0u, so, ss, &levels, &total) != CT_OK) {
-        die("ct_package_layout failed");
-    }
-    std::vector<uint8_t> b(total, 0);
-    const uint32_t cx = W - 1, cy = H - 1;
-    uint32_t hmin = 0xffff, hmax = 0;
-    for (uint16_t c : d.codes) {
-        hmin = c < hmin ? c : hmin;
-        hmax = c > hmax ? c : hmax;
-    }
-    // heights
-    for (size_t k = 0; k < d.codes.size(); ++k) put16(b, so[CT_SEC_HEIGHTS] + 2 * k, d.codes[k]);
-    // fine cell maxima
-    std::vector<uint32_t> cm((size_t)cx * cy);
-    for (uint32_t j = 0; j < cy; ++j)
-        for (uint32_t i = 0; i < cx; ++i) {
-            uint32_t m = d.at((int)i, (int)j);
-            m = std::max<uint32_t>(m, d.at((int)i + 1, (int)j));
-            m = std::max<uint32_t>(m, d.at((int)i, (int)j + 1));
-            m = std::max<uint32_t>(m, d.at((int)i + 1, (int)j + 1));
-            cm[(size_t)j * cx + i] = m;
-        }
-    // mipmap levels 1..L: each level is the max of the 2x2 children
-    {
-        std::vector<uint32_t> prev = cm;
-        uint32_t pw = cx, ph = cy;
-        size_t off = so[CT_SEC_MIPMAP];
-        for (uint32_t l = 1; l <= levels; ++l) {
-            uint32_t mw = (pw + 1) / 2, mh = (ph + 1) / 2;
-            std::vector<uint32_t> cur((size_t)mw * mh, 0);
-            for (uint32_t j = 0; j < mh; ++j)
-                for (uint32_t i = 0; i < mw; ++i) {
-                    uint32_t m = 0;
-                    for (uint32_t dj = 0; dj < 2; ++dj)
-                        for (uint32_t di = 0; di < 2; ++di) {
-                            uint32_t ci = 2 * i + di, cj = 2 * j + dj;
-                            if (ci < pw && cj < ph) m = std::max(m, prev[(size_t)cj * pw + ci]);
-                        }
-                    cur[(size_t)j * mw + i] = m;
-                    put16(b, off, m);
-                    off += 2;
-                }
-            prev.swap(cur);
-            pw = mw;
-            ph = mh;
-        }
-        if (off != (size_t)so[CT_SEC_MIPMAP] + ss[CT_SEC_MIPMAP]) die("mipmap size mismatch");
-    }
-    // apex = tallest corner of each coarse cell; all angle codes 0
-    const uint32_t wc = (cx + r - 1) / r, hc = (cy + r - 1) / r;
-    for (uint32_t j = 0; j < hc; ++j)
-        for (uint32_t i = 0; i < wc; ++i) {
-            uint32_t m = 0;
-            for (uint32_t fj = j * r; fj < (j + 1) * r && fj < cy; ++fj)
-                for (uint32_t fi = i * r; fi < (i + 1) * r && fi < cx; ++fi) m = std::max(m, cm[(size_t)fj * cx + fi]);
-            put16(b, so[CT_SEC_APEX] + 2 * ((size_t)j * wc + i), m);
-        }
-    // voids: a fine cell is void if any of its posts is
-    if (voids) {
-        for (uint32_t j = 0; j < cy; ++j)
-            for (uint32_t i = 0; i < cx; ++i) {
-                size_t p = (size_t)j * W + i;
-                if (d.void_post[p] || d.void_post[p + 1] || d.void_post[p + W] || d.void_post[p + W + 1]) {
-                    size_t k = (size_t)j * cx + i;
-                    b[so[CT_SEC_VOIDS] + k / 8] |= (uint8_t)(1u << (k % 8));
-                }
-            }
-    }
-    // header
-    std::memcpy(b.data(), CT_PKG_MAGIC, 4);
-    put16(b, 4, CT_PKG_VERSION);
-    put16(b, 6, CT_PKG_HEADER_SIZE);
-    put32(b, 8, total);
-    put16(b, 16, W);
-    put16(b, 18, H);
-    b[20] = (uint8_t)r;
-    b[21] = (uint8_t)n;
-    b[22] = (uint8_t)levels;
-    b[23] = voids ? CT_PKG_FLAG_VOIDS : 0;
-    put16(b, 24, hmin);
-    put16(b, 26, hmax);
-    put32(b, 28, 0);
-    put64(b, 32, nm(ORIGIN_E_M));
-    put64(b, 40, nm(ORIGIN_N_M));
-    put64(b, 48, nm(POSTING_M));
-    put64(b, 56, nm(-POSTING_M));
-    put64(b, 64, nm(OFFSET_M));
-    put64(b, 72, nm(SCALE_M));
-    put32(b, 80, EPSG);
-    put32(b, 84, 0);
-    for (uint32_t k = 0; k < CT_SEC_COUNT; ++k) {
-        put32(b, CT_HDR_SECTION_TABLE + 8 * k, so[k]);
-        put32(b, CT_HDR_SECTION_TABLE + 8 * k + 4, ss[k]);
-    }
-    uint32_t crc = 0;
-    ct_crc32(0, b.data(), b.size(), &crc);  // CRC field is still zero
-    put32(b, 12, crc);
-    return b;
+    return b == ct_host::PptBuilder::Degenerate ? "degenerate" : "build_package";
 }
 
-#ifdef CT_GEN_USE_BUILDER
-std::vector<uint8_t> build_with_builder(const Dem &d, int n, int r)
+std::vector<uint8_t> build_with_builder(const Dem &d, int n, int r, ct_host::PptBuilder b)
 {
     ct_host::Terrain t;
     t.width = W;
@@ -260,13 +147,13 @@ std::vector<uint8_t> build_with_builder(const Dem &d, int n, int r)
     o.sectors = n;
     o.reduce = r;
     o.threads = 1;
+    o.builder = b;
     ct_host::BuildStats st;
-    std::vector<uint8_t> b = ct_host::build_package(t, o, &st);
-    std::fprintf(stderr, "gen_vectors: build_package N=%d r=%d: %zu bytes, %zu of %zu cones degenerate\n", n, r,
-                 b.size(), st.degenerate_cones, st.cones);
-    return b;
+    std::vector<uint8_t> bytes = ct_host::build_package(t, o, &st);
+    std::fprintf(stderr, "gen_vectors: build_package (%s) N=%d r=%d: %zu bytes, %zu of %zu cones degenerate\n",
+                 builder_name(b), n, r, bytes.size(), st.degenerate_cones, st.cones);
+    return bytes;
 }
-#endif
 
 // ------------------------------------------------------------------ vertical datum
 // Geoid grids as a datum section stores them (conetrace.h): node (i, j) at
@@ -318,8 +205,7 @@ GGrid datum_geoid()
     return g;
 }
 
-#ifdef CT_GEN_USE_BUILDER
-std::vector<uint8_t> build_datum_with_builder(const GGrid &gg, double oe, double on)
+std::vector<uint8_t> build_datum_with_builder(const GGrid &gg, double oe, double on, ct_host::PptBuilder b)
 {
     ct_host::Terrain t;
     t.width = DW;
@@ -349,41 +235,12 @@ std::vector<uint8_t> build_datum_with_builder(const GGrid &gg, double oe, double
     o.sectors = 8;
     o.reduce = 2;
     o.threads = 1;
+    o.builder = b;
     ct_host::BuildStats st;
-    std::vector<uint8_t> b = ct_host::build_package(t, o, &st);
-    std::fprintf(stderr, "gen_vectors: build_package datum package (EPSG:%d, EGM96): %zu bytes\n", DATUM_EPSG, b.size());
-    return b;
-}
-#endif
-
-// Without the builder: the degenerate package moved onto zone 17N with a
-// datum section appended (and the CRC redone).
-std::vector<uint8_t> degenerate_with_datum(const Dem &d, const GGrid &gg, double oe, double on)
-{
-    std::vector<uint8_t> b = write_degenerate_package(d, 8, 2);
-    const size_t off = (b.size() + 7u) & ~(size_t)7u;
-    size_t end = off + CT_DATUM_HEADER_SIZE + gg.bytes.size();
-    end = (end + 7u) & ~(size_t)7u;
-    b.resize(end, 0);
-    put64(b, 32, nm(oe));
-    put64(b, 40, nm(on));
-    put32(b, 80, DATUM_EPSG);
-    b[23] = (uint8_t)(b[23] | CT_PKG_FLAG_DATUM);
-    put32(b, CT_HDR_DATUM, (uint32_t)off);
-    put16(b, off, CT_VDATUM_EGM96);
-    put16(b, off + 2, gg.w);
-    put16(b, off + 4, gg.h);
-    put32(b, off + 8, DATUM_SOURCE_EPSG);
-    put64(b, off + 16, gg.lat0);
-    put64(b, off + 24, gg.lon0);
-    put64(b, off + 32, gg.step);
-    std::memcpy(b.data() + off + CT_DATUM_HEADER_SIZE, gg.bytes.data(), gg.bytes.size());
-    put32(b, 8, (uint32_t)end);
-    put32(b, 12, 0);
-    uint32_t crc = 0;
-    ct_crc32(0, b.data(), b.size(), &crc);
-    put32(b, 12, crc);
-    return b;
+    std::vector<uint8_t> bytes = ct_host::build_package(t, o, &st);
+    std::fprintf(stderr, "gen_vectors: build_package (%s) datum package (EPSG:%d, EGM96): %zu bytes\n",
+                 builder_name(b), DATUM_EPSG, bytes.size());
+    return bytes;
 }
 
 // The synthetic grids of the ct_geoid_at vectors: EGM96-like around
@@ -1060,7 +917,7 @@ int main(int argc, char **argv)
         // not break the whole build: fall back to the degenerate package and
         // say so in the vectors (mcu_vectors_host then fails, loudly).
         try {
-            P.bytes = build_with_builder(dem, (int)s.n, (int)s.r);
+            P.bytes = build_with_builder(dem, (int)s.n, (int)s.r, ct_host::PptBuilder::Slices);
             st = ct_package_open(&P.p, P.bytes.data(), P.bytes.size());
             if (st == CT_OK) st = ct_package_verify(&P.p);
             if (st != CT_OK) {
@@ -1079,7 +936,11 @@ int main(int argc, char **argv)
 #endif
         P.name = nm_;
         if (st != CT_OK) {
-            P.bytes = write_degenerate_package(dem, s.n, s.r);
+            try {
+                P.bytes = build_with_builder(dem, (int)s.n, (int)s.r, ct_host::PptBuilder::Degenerate);
+            } catch (const std::exception &e) {
+                die(std::string("build_package (degenerate) threw: ") + e.what());
+            }
             st = ct_package_open(&P.p, P.bytes.data(), P.bytes.size());
             if (st != CT_OK) die("host ct_package_open failed: " + std::to_string(st));
             st = ct_package_verify(&P.p);
@@ -1356,7 +1217,7 @@ int main(int argc, char **argv)
 #ifdef CT_GEN_USE_BUILDER
         dname = "datum_egm96_build_package";
         try {
-            bytes = build_datum_with_builder(dg, oe, on);
+            bytes = build_datum_with_builder(dg, oe, on, ct_host::PptBuilder::Slices);
         } catch (const std::exception &e) {
             std::fprintf(stderr, "gen_vectors: WARNING: build_package (datum package) threw: %s\n", e.what());
         }
@@ -1369,7 +1230,11 @@ int main(int argc, char **argv)
 #endif
         if (bytes.empty()) {
             dname = "datum_egm96_degenerate";
-            bytes = degenerate_with_datum(dem, dg, oe, on);
+            try {
+                bytes = build_datum_with_builder(dg, oe, on, ct_host::PptBuilder::Degenerate);
+            } catch (const std::exception &e) {
+                die(std::string("build_package (degenerate datum package) threw: ") + e.what());
+            }
         }
         dv.open_status = ct_package_open(&dp, bytes.data(), bytes.size());
         if (dv.open_status != CT_OK) die("host ct_package_open (datum package): " + std::to_string(dv.open_status));
