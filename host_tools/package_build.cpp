@@ -19,6 +19,7 @@
 #include "builder_slices.hpp"
 #include "conetrace.h"
 #include "host_io.hpp"
+#include "le.hpp"
 #include "terrain.hpp"
 
 namespace ct_host {
@@ -37,8 +38,10 @@ public:
     }
     void u16(uint32_t v)
     {
-        byte((uint8_t)v);
-        byte((uint8_t)(v >> 8));
+        uint8_t b[2];
+        put16(b, v);
+        byte(b[0]);
+        byte(b[1]);
     }
     void bytes(const uint8_t *p, size_t n)
     {
@@ -71,20 +74,6 @@ private:
     size_t pos_ = 0;
     uint32_t crc_ = 0;
 };
-
-void put16(std::vector<uint8_t> &b, size_t off, uint32_t v)
-{
-    b[off] = (uint8_t)v;
-    b[off + 1] = (uint8_t)(v >> 8);
-}
-void put32(std::vector<uint8_t> &b, size_t off, uint32_t v)
-{
-    for (int k = 0; k < 4; ++k) b[off + k] = (uint8_t)(v >> (8 * k));
-}
-void put64(std::vector<uint8_t> &b, size_t off, int64_t v)
-{
-    for (int k = 0; k < 8; ++k) b[off + k] = (uint8_t)((uint64_t)v >> (8 * k));
-}
 
 // The mipmap levels 1..levels of the fine cells' max pyramid (level l: 2x2
 // maxima of level l-1; level 0 = fine cells, not stored), one level in memory
@@ -361,15 +350,15 @@ void build_package_to(const Terrain &t, const BuildOptions &opt, PackageSink &si
         put64(d, 32, t.geoid.step_q61);
         w.bytes(d.data(), d.size());
         for (int32_t v : t.geoid.um) {
-            const uint32_t u = (uint32_t)v;
-            const uint8_t b[4] = {(uint8_t)u, (uint8_t)(u >> 8), (uint8_t)(u >> 16), (uint8_t)(u >> 24)};
+            uint8_t b[4];
+            put32(b, (uint32_t)v);
             w.bytes(b, 4);
         }
     }
     w.pad_to(total);
     w.flush();
     uint8_t crc[4];
-    for (int k = 0; k < 4; ++k) crc[k] = (uint8_t)(w.crc() >> (8 * k));
+    put32(crc, w.crc());
     sink.patch(12, crc, 4);
     if (stats) {
         stats->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

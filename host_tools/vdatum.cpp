@@ -8,6 +8,7 @@
 #include <proj.h>
 
 #include "conetrace.h"
+#include "le.hpp"
 
 namespace ct_host {
 
@@ -32,8 +33,7 @@ struct GridView {
     ct_geoid_grid g{};
     explicit GridView(const GeoidGrid &grid) : le(grid.um.size() * 4)
     {
-        for (size_t k = 0; k < grid.um.size(); ++k)
-            for (int b = 0; b < 4; ++b) le[4 * k + b] = (uint8_t)((uint32_t)grid.um[k] >> (8 * b));
+        for (size_t k = 0; k < grid.um.size(); ++k) put32(le, 4 * k, (uint32_t)grid.um[k]);
         g = ct_geoid_grid{(uint32_t)grid.w, (uint32_t)grid.h, grid.lat0_q61, grid.lon0_q61, grid.step_q61, le.data()};
     }
     // N in nm at a map point, or false

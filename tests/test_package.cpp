@@ -15,6 +15,7 @@
 #include "conetrace.h"
 #include "dem_cases.hpp"
 #include "harness.h"
+#include "le.hpp"
 #include "terrain.hpp"
 
 namespace {
@@ -29,23 +30,10 @@ std::vector<uint8_t> base_package(int sectors = 8, int reduce = 2)
     return ct_host::build_package(t, o);
 }
 
-void put16(std::vector<uint8_t> &b, size_t o, uint32_t v)
-{
-    b[o] = (uint8_t)v;
-    b[o + 1] = (uint8_t)(v >> 8);
-}
-void put32(std::vector<uint8_t> &b, size_t o, uint32_t v)
-{
-    for (int k = 0; k < 4; ++k) b[o + k] = (uint8_t)(v >> (8 * k));
-}
-void put64(std::vector<uint8_t> &b, size_t o, int64_t v)
-{
-    for (int k = 0; k < 8; ++k) b[o + k] = (uint8_t)((uint64_t)v >> (8 * k));
-}
-uint32_t get32(const std::vector<uint8_t> &b, size_t o)
-{
-    return (uint32_t)b[o] | ((uint32_t)b[o + 1] << 8) | ((uint32_t)b[o + 2] << 16) | ((uint32_t)b[o + 3] << 24);
-}
+using ct_host::get32;
+using ct_host::put16;
+using ct_host::put32;
+using ct_host::put64;
 
 // Recompute the CRC so a mutation reaches the check after the CRC.
 void fix_crc(std::vector<uint8_t> &b)

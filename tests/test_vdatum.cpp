@@ -18,6 +18,7 @@
 #include "conetrace.h"
 #include "dem_io.hpp"
 #include "harness.h"
+#include "le.hpp"
 #include "terrain.hpp"
 #include "vdatum.hpp"
 
@@ -80,17 +81,7 @@ void recrc(std::vector<uint8_t> &p)
     std::memset(&p[12], 0, 4);
     uint32_t c = 0;
     ct_crc32(0u, p.data(), p.size(), &c);
-    for (int k = 0; k < 4; ++k) p[12 + k] = (uint8_t)(c >> (8 * k));
-}
-
-uint32_t ld32(const std::vector<uint8_t> &p, size_t o)
-{
-    return (uint32_t)p[o] | (uint32_t)p[o + 1] << 8 | (uint32_t)p[o + 2] << 16 | (uint32_t)p[o + 3] << 24;
-}
-
-void st32(std::vector<uint8_t> &p, size_t o, uint32_t v)
-{
-    for (int k = 0; k < 4; ++k) p[o + k] = (uint8_t)(v >> (8 * k));
+    put32(p, 12, c);
 }
 
 // the geoid the package carries, at seeded points of the tile, against PROJ
@@ -230,8 +221,7 @@ void test_geoid_at_grid()
 {
     const int32_t um[6] = {1000, 3000, -5000, 2000, 4000, 2147483647};
     uint8_t le[24];
-    for (int k = 0; k < 6; ++k)
-        for (int b = 0; b < 4; ++b) le[4 * k + b] = (uint8_t)((uint32_t)um[k] >> (8 * b));
+    for (int k = 0; k < 6; ++k) put32(le + 4 * k, (uint32_t)um[k]);
     const int64_t s = INT64_C(1) << 53;  // about 0.22 deg
     const int64_t lat0 = INT64_C(1) << 60, lon0 = -(INT64_C(1) << 61);
     ct_geoid_grid g = {3u, 2u, lat0, lon0, s, le};
@@ -269,7 +259,7 @@ void test_geoid_at_grid()
 void test_datum_section_evil()
 {
     Built b = build(CT_VDATUM_EGM96);
-    const size_t off = ld32(b.pkg, CT_HDR_DATUM);
+    const size_t off = get32(b.pkg, CT_HDR_DATUM);
     TEST_ASSERT(off > 0 && off % 8 == 0);
     struct Case {
         const char *name;
@@ -277,11 +267,11 @@ void test_datum_section_evil()
         ct_status expect;
     };
     const Case cases[] = {
-        {"flag without offset", [](std::vector<uint8_t> &p, size_t) { st32(p, CT_HDR_DATUM, 0); }, CT_ERR_OFFSET},
+        {"flag without offset", [](std::vector<uint8_t> &p, size_t) { put32(p, CT_HDR_DATUM, 0); }, CT_ERR_OFFSET},
         {"offset without flag", [](std::vector<uint8_t> &p, size_t) { p[23] &= (uint8_t)~CT_PKG_FLAG_DATUM; }, CT_ERR_FLAGS},
-        {"offset misaligned", [](std::vector<uint8_t> &p, size_t o) { st32(p, CT_HDR_DATUM, (uint32_t)o + 4); }, CT_ERR_OFFSET},
-        {"offset inside the angles", [](std::vector<uint8_t> &p, size_t) { st32(p, CT_HDR_DATUM, ld32(p, CT_HDR_SECTION_TABLE + 8 * CT_SEC_ANGLES)); }, CT_ERR_OFFSET},
-        {"offset past the end", [](std::vector<uint8_t> &p, size_t) { st32(p, CT_HDR_DATUM, (ld32(p, 8) - 32) & ~7u); }, CT_ERR_OFFSET},
+        {"offset misaligned", [](std::vector<uint8_t> &p, size_t o) { put32(p, CT_HDR_DATUM, (uint32_t)o + 4); }, CT_ERR_OFFSET},
+        {"offset inside the angles", [](std::vector<uint8_t> &p, size_t) { put32(p, CT_HDR_DATUM, get32(p, CT_HDR_SECTION_TABLE + 8 * CT_SEC_ANGLES)); }, CT_ERR_OFFSET},
+        {"offset past the end", [](std::vector<uint8_t> &p, size_t) { put32(p, CT_HDR_DATUM, (get32(p, 8) - 32) & ~7u); }, CT_ERR_OFFSET},
         {"unknown datum code", [](std::vector<uint8_t> &p, size_t o) { p[o] = CT_VDATUM_COUNT; }, CT_ERR_RANGE},
         {"reserved word set", [](std::vector<uint8_t> &p, size_t o) { p[o + 12] = 1; }, CT_ERR_RANGE},
         {"one node per row", [](std::vector<uint8_t> &p, size_t o) { p[o + 2] = 1; p[o + 3] = 0; }, CT_ERR_DIMS},

@@ -34,6 +34,7 @@ extern "C" {
 #include "fixed.h"
 }
 #include "ct_vectors.h"
+#include "le.hpp"
 #include "terrain.hpp"
 
 namespace {
@@ -117,16 +118,13 @@ Dem make_dem()
 }
 
 // ------------------------------------------------------------------ packages
-void put32(std::vector<uint8_t> &b, size_t o, uint32_t v)
-{
-    for (int k = 0; k < 4; ++k) b[o + k] = (uint8_t)(v >> (8 * k));
-}
+using ct_host::put32;
 
 int64_t nm(double m) { return (int64_t)std::llround(m * 1e9); }
 
 const char *builder_name(ct_host::PptBuilder b)
 {
-    return b == ct_host::PptBuilder::Degenerate ? "degenerate" : "build_package";
+    return b == ct_host::PptBuilder::Degenerate ? "degenerate cones" : "slice builder";
 }
 
 std::vector<uint8_t> build_with_builder(const Dem &d, int n, int r, ct_host::PptBuilder b)
