@@ -6,13 +6,19 @@
  * Input: byte 0 selects the mode and byte 1 the base package (the two
  * packages of the MCU vectors, built by the project's builder: N = 8, r = 2
  * and N = 24, r = 1, with real cones).
- *   mode 0 (ray):     six int64 (x, y, z, dx, dy, dz), then a bend (c Q16,
+ *   mode 0 (ray, byte 0 = 0 mod 4):     six int64 (x, y, z, dx, dy, dz), then a bend (c Q16,
  *                     R and chord exponents) -- traced straight and bent
  *                     with all four methods on the intact package;
  *   mode 1 (package): edits (u16 offset, u8 value) applied to a copy of the
  *                     package, its CRC re-stamped (unless bit 7 of byte 1
  *                     is set), then ct_package_open / ct_package_verify and
  *                     a few rays from the bytes that follow the edits;
+ *   mode 2 (geolocation, byte 0 = 2 mod 4): a pinhole camera on an
+ *                     arbitrary map pose near the tile (yaw, pitch, roll),
+ *                     an arbitrary pixel and effects (curvature, refraction
+ *                     k, radius 0 = the true Earth on the UTM package,
+ *                     chord) through ct_geolocate with every method: a
+ *                     documented status, identical results, hits in the tile;
  *   mode 3 (geodesy, byte 0 = 3 mod 4): int64 lat, lon, e, n, yaw, pitch,
  *                     roll, h and a zone byte through ct_utm_forward,
  *                     ct_utm_inverse, ct_utm_factors, ct_quat_from_ypr and
@@ -309,6 +315,66 @@ static void ecef_mode(const int64_t *v)
     CHECK(ct_wgs84_from_ecef(xyz, NULL, &lo, &h) == CT_ERR_ARG);
 }
 
+static int geo_status_ok(ct_status s)
+{
+    return s == CT_HIT || s == CT_HIT_VOID || s == CT_MISS || s == CT_BELOW || s == CT_ERR_RAY ||
+           s == CT_ERR_RANGE || s == CT_ERR_UNPROJECT || s == CT_ERR_EFFECTS || s == CT_ERR_POSE ||
+           s == CT_ERR_ARG || s == CT_ERR_CRS;
+}
+
+/* Geolocation with arbitrary poses, pixels and effects on an intact
+ * package (the true Earth on the UTM one, the sphere elsewhere or with a
+ * radius): a documented status, the same status and hit from every method,
+ * a hit inside the tile. */
+static void geoloc_mode(const ct_vec_package *vp, const uint8_t *d, size_t n)
+{
+    static ct_package pkg;
+    ct_camera cam;
+    ct_lens lens;
+    ct_pose pose;
+    ct_effects fx;
+    ct_geo g0, g;
+    int32_t q[4];
+    size_t pos = 0u;
+    int64_t a = rd64(d, n, &pos), b = rd64(d, n, &pos), c = rd64(d, n, &pos), e = rd64(d, n, &pos);
+    int64_t pix = rd64(d, n, &pos);
+    const int64_t deg = INT64_C(40244552544872904); /* one degree, Q61 */
+    int m;
+    ct_status s0, s;
+    CHECK(ct_package_open(&pkg, vp->bytes, vp->size) == CT_OK);
+    memset(&lens, 0, sizeof lens);
+    lens.model = CT_LENS_PINHOLE;
+    lens.width = 1000u;
+    lens.height = 1000u;
+    lens.fx_q32 = lens.fy_q32 = (int64_t)1000 << 32;
+    lens.cx_q32 = lens.cy_q32 = (int64_t)500 << 32;
+    CHECK(ct_camera_init(&cam, &lens) == CT_OK);
+    /* the camera within ~35 km of the tile's corner, -1 .. 15 km up */
+    if (ct_quat_from_ypr((int64_t)(int16_t)(c >> 0) * (deg / 180), (int64_t)(int16_t)(c >> 16) * (deg / 360),
+                         (int64_t)(int16_t)(c >> 32) * (deg / 180), q) != CT_OK) {
+        return;
+    }
+    s = ct_pose_from_map(&pose, pkg.origin_e_nm + (int64_t)(int32_t)a * 16384, pkg.origin_n_nm + (int64_t)(int32_t)(a >> 32) * 16384,
+                         (int64_t)(b % INT64_C(16000000000000)) - INT64_C(1000000000000), q);
+    CHECK(s == CT_OK);
+    fx.flags = (uint32_t)(e & 3);
+    fx.refraction_k_q16 = (int32_t)((int16_t)(e >> 8)) * 4;
+    fx.earth_radius_nm = ((e >> 24) & 1) ? 0 : INT64_C(1) << (40 + ((e >> 25) & 0xf) % 15);
+    fx.chord_nm = ((e >> 29) & 1) ? 0 : INT64_C(1) << (10 + ((e >> 30) & 0x3f) % 41);
+    {
+        const int64_t u = (int64_t)(int32_t)pix % (INT64_C(1500) << 16), v = (int64_t)(int32_t)(pix >> 32) % (INT64_C(1500) << 16);
+        s0 = ct_geolocate(&pkg, &cam, &pose, CT_METHOD_INCREMENTAL, &fx, u, v, &g0);
+        CHECK(geo_status_ok(s0) && s0 == g0.status);
+        if (s0 == CT_HIT || s0 == CT_HIT_VOID) {
+            check_hit(&pkg, s0, &g0.hit, UINT32_MAX);
+        }
+        for (m = 1; m < CT_METHOD_COUNT; ++m) { /* bound: 4 methods */
+            s = ct_geolocate(&pkg, &cam, &pose, (ct_method)m, &fx, u, v, &g);
+            CHECK(s == s0 && same_hit(s0, &g0.hit, s, &g.hit));
+        }
+    }
+}
+
 static void geodesy_mode(const uint8_t *d, size_t n)
 {
     size_t pos = 0u;
@@ -386,6 +452,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *d, size_t n)
     }
     if ((d[0] & 3u) == 3u) {
         geodesy_mode(d + 2, n - 2u);
+    } else if ((d[0] & 3u) == 2u) {
+        geoloc_mode(vp, d + 2, n - 2u);
     } else if ((d[0] & 1u) == 0u) {
         ray_mode(vp, idx, d + 2, n - 2u);
     } else {
