@@ -161,7 +161,7 @@ static int64_t q24_to_16(int64_t v)
 }
 
 /* The image of P(t), 0 <= t <= tmax: interpolated when the nodes are set. */
-static ct_status vertex(const path *pa, int64_t t, gv *v)
+CT_NOINLINE static ct_status vertex(const path *pa, int64_t t, gv *v)
 {
     int64_t sig, r[3];
     int j, k;
@@ -188,7 +188,7 @@ static ct_status vertex(const path *pa, int64_t t, gv *v)
 /* The nodes' exact images and the polynomial through them; pa->interp = 0
  * when one is outside the projection's domain (the vertices are then
  * computed exactly). */
-static void set_nodes(path *pa, int64_t tmax)
+CT_NOINLINE static void set_nodes(path *pa, int64_t tmax)
 {
     int j, k;
     gv v;
@@ -260,7 +260,7 @@ typedef struct {
     int64_t dip; /* |a| l^2 / 4, Q16 height units (saturated) */
 } fit;
 
-static void fit_piece(const gv *A, const gv *B, const gv *M, fit *f)
+CT_NOINLINE static void fit_piece(const gv *A, const gv *B, const gv *M, fit *f)
 {
     int64_t mx = M->x - A->x, my = M->y - A->y;
     ct_i128 dot, l2;
@@ -324,7 +324,7 @@ static void model_error(const gv *A, const gv *B, const gv *Q, const fit *f, con
 
 /* kf, kshift with kf 2^-kshift = num / den (num, den > 0), kf in
  * [2^30, 2^32); 0 when the quotient is beyond the lowered walk's range. */
-static int rise_coeff(ct_i128 num, ct_i128 den, uint64_t *kf, uint32_t *kshift)
+CT_NOINLINE static int rise_coeff(ct_i128 num, ct_i128 den, uint64_t *kf, uint32_t *kshift)
 {
     unsigned nb, db, r = 0u;
     int e;
@@ -447,6 +447,80 @@ static int gone(const ct_package *p, const gv *A, const gv *B, const gv *M, cons
     return ct_i128_sign(f->num) >= 0 && B->z > ((int64_t)p->hmax + 1) * ONE16 && B->z >= M->z && M->z >= A->z;
 }
 
+/* The model's largest errors at the piece's quarter points (out of line:
+ * its vertices are not on the walk's stack). */
+CT_NOINLINE static ct_status quarter_errors(const path *pa, int64_t ta, int64_t Lc, const gv *A, const gv *B,
+                                            const fit *f, const ct_lower *lw, int64_t dB, int64_t *elat,
+                                            int64_t *evert)
+{
+    gv Q1, Q3;
+    int64_t l1, v1, l3, v3;
+    if (vertex(pa, ta + Lc / 4, &Q1) != CT_OK || vertex(pa, ta + Lc - Lc / 4, &Q3) != CT_OK) {
+        return CT_ERR_RANGE;
+    }
+    model_error(A, B, &Q1, f, lw, dB, &l1, &v1);
+    model_error(A, B, &Q3, f, lw, dB, &l3, &v3);
+    *elat = ct_max64(*elat, ct_max64(l1, l3));
+    *evert = ct_max64(v1, v3);
+    return CT_OK;
+}
+
+/* One piece traced: the line from A to B less the lowering at B, against
+ * the terrain lowered by lw (NULL: the chord against the terrain).  CT_MISS
+ * when the path goes on to the next piece; a hit (in *h, with the steps and
+ * iterations so far), CT_BELOW (the first piece starting below the
+ * surface) or an error otherwise.  Out of line: the prepared ray and the
+ * piece's hit are on the stack only while it runs. */
+CT_NOINLINE static ct_status trace_piece(const ct_package *p, const gv *A, const gv *B, const fit *f,
+                                         const ct_lower *lw, int64_t dB, int first, ct_method m, ct_hit *h,
+                                         uint32_t *steps, uint32_t *iters)
+{
+    ct_ray ray;
+    ct_prepared pr;
+    ct_hit sh;
+    ct_status st;
+    ray.x_q16 = A->x;
+    ray.y_q16 = A->y;
+    ray.z_q16 = A->z;
+    ray.dx = f->ux;
+    ray.dy = f->uy;
+    ray.dz = B->z - dB - A->z;
+    if (ray.dx == 0 && ray.dy == 0 && ray.dz == 0) {
+        return CT_MISS;
+    }
+    st = ct_prepare_lowered_segment(p, &ray, lw, &pr);
+    if (st < 0) {
+        return st;
+    }
+    if (st == CT_BELOW && first) {
+        h->steps = *steps;
+        h->iters = *iters;
+        return CT_BELOW;
+    }
+    if (st == CT_MISS) {
+        return CT_MISS;
+    }
+    if (st == CT_BELOW) {
+        /* the previous piece ended above the surface: the path met it
+         * within the models' tolerance at A */
+        pr.start = CT_HIT;
+    }
+    st = ct_trace_prepared_lowered(p, &pr, lw, m, &sh);
+    if (st < 0) {
+        return st;
+    }
+    *steps += sh.steps;
+    *iters += sh.iters;
+    /* t_q26 < 2^35, tend_d <= 2^26: < 2^61; tend_n < 2^34 */
+    if ((st == CT_HIT || st == CT_HIT_VOID) && sh.t_q26 * pr.tend_d <= pr.tend_n * (INT64_C(1) << CT_T_FRAC_BITS)) {
+        *h = sh;
+        h->steps = *steps;
+        h->iters = *iters;
+        return st;
+    }
+    return CT_MISS;
+}
+
 ct_status ct_trace_earth(const ct_package *p, const ct_earth *es, const int64_t dg[3], ct_method m, ct_hit *h)
 {
     path pa;
@@ -538,23 +612,17 @@ ct_status ct_trace_earth(const ct_package *p, const ct_earth *es, const int64_t 
             if (ok && !off) {
                 uint64_t kf;
                 uint32_t ks;
-                gv Q1, Q3;
-                int64_t l1, v1, l3, v3;
                 if (ct_i128_sign(f.num) > 0 && ct_i128_sign(f.den) > 0 && rise_coeff(f.num, f.den, &kf, &ks) &&
                     ct_lower_setup_k(p, A.x, A.y, kf, ks, es->cull, &lw) == CT_OK) {
                     lwp = &lw;
                 }
                 dB = lwp != NULL ? ct_lower_at(lwp, B.x, B.y) : 0;
                 /* the model against the exact image at the quarter points */
-                if (vertex(&pa, ta + Lc / 4, &Q1) != CT_OK || vertex(&pa, ta + Lc - Lc / 4, &Q3) != CT_OK) {
+                if (quarter_errors(&pa, ta, Lc, &A, &B, &f, lwp, dB, &elat, &evert) != CT_OK) {
                     h->steps = steps;
                     h->iters = iters;
                     return CT_MISS;
                 }
-                model_error(&A, &B, &Q1, &f, lwp, dB, &l1, &v1);
-                model_error(&A, &B, &Q3, &f, lwp, dB, &l3, &v3);
-                elat = ct_max64(elat, ct_max64(l1, l3));
-                evert = ct_max64(v1, v3);
                 ok = elat <= es->tol_q24 && evert <= es->tolz_q16;
             }
             if (ok || Lc <= PIECE_MIN_NM) {
@@ -570,46 +638,9 @@ ct_status ct_trace_earth(const ct_package *p, const ct_earth *es, const int64_t 
             }
         }
         if (!off) {
-            ct_ray ray;
-            ct_prepared pr;
-            ct_hit sh;
-            ray.x_q16 = A.x;
-            ray.y_q16 = A.y;
-            ray.z_q16 = A.z;
-            ray.dx = f.ux;
-            ray.dy = f.uy;
-            ray.dz = B.z - dB - A.z;
-            if (ray.dx != 0 || ray.dy != 0 || ray.dz != 0) {
-                st = ct_prepare_lowered_segment(p, &ray, lwp, &pr);
-                if (st < 0) {
-                    return st;
-                }
-                if (st == CT_BELOW && ta == 0) {
-                    h->steps = steps;
-                    h->iters = iters;
-                    return CT_BELOW;
-                }
-                if (st != CT_MISS) {
-                    if (st == CT_BELOW) {
-                        /* the previous piece ended above the surface: the
-                         * path met it within the models' tolerance at A */
-                        pr.start = CT_HIT;
-                    }
-                    st = ct_trace_prepared_lowered(p, &pr, lwp, m, &sh);
-                    if (st < 0) {
-                        return st;
-                    }
-                    steps += sh.steps;
-                    iters += sh.iters;
-                    /* t_q26 < 2^35, tend_d <= 2^26: < 2^61; tend_n < 2^34 */
-                    if ((st == CT_HIT || st == CT_HIT_VOID) &&
-                        sh.t_q26 * pr.tend_d <= pr.tend_n * (INT64_C(1) << CT_T_FRAC_BITS)) {
-                        *h = sh;
-                        h->steps = steps;
-                        h->iters = iters;
-                        return st;
-                    }
-                }
+            st = trace_piece(p, &A, &B, &f, lwp, dB, ta == 0, m, h, &steps, &iters);
+            if (st != CT_MISS) {
+                return st; /* a hit, the camera below the surface, or an error */
             }
         }
         steps++;
