@@ -1,8 +1,12 @@
 #!/bin/sh
 # bench_m4.sh -- instructions per ray on Cortex-M4, per method and ray family
 # (bench/m4/bench_m4.c under qemu mps2-an386 with -icount), over the fixture
-# package at N = 24, r = 3 and ct_bench's ray families (100 per family).
-# Each ray's status and steps must equal the host's.  Run by `make bench`.
+# package at N = 24, r = 3 and ct_bench's ray families (100 per family);
+# then instructions per pixel of ct_geolocate (directional) for 64 pixels of
+# an oblique camera over that package: straight, curvature + refraction on
+# the sphere, and on the true Earth (mean, min-max, per pixel in a batch,
+# and the per-call set-up).  Each ray's and pixel's status, steps (and hit)
+# must equal the host's, else exit status 1.  Run by `make bench`.
 #
 #   scripts/bench_m4.sh <build-dir> [rays-per-family]
 # Environment: CT_M4_OPT (default -Os, as the flight builds of make cross).

@@ -3,6 +3,8 @@
 #define CT_BENCH_M4_DATA_H
 #include <stdint.h>
 
+#include "conetrace.h"
+
 typedef struct {
     int64_t ray[6];      /* ct_ray: x, y, z (Q16), dx, dy, dz                */
     int32_t status[4];   /* the host's ct_trace status per method            */
@@ -17,10 +19,36 @@ typedef struct {
 #define M4_BEND_RADIUS_NM INT64_C(6371000000000000)
 #define M4_BEND_CHORD_NM INT64_C(1000000)
 
+/* Geolocation per pixel (ct_geolocate, directional) with the effects of
+ * M4_GEO_FX: 0 none (straight), 1 curvature + refraction (k = 0.13) on the
+ * sphere of CT_EARTH_RADIUS_NM (the map-frame parabola), 2 the same on the
+ * true Earth (earth_radius_nm = 0: the Earth-fixed line of sight, earth.c). */
+#define M4_GEO_FX 3
+static inline const ct_effects *m4_geo_effects(int k, ct_effects *fx)
+{
+    fx->flags = CT_EFFECT_ALL;
+    fx->refraction_k_q16 = CT_REFRACTION_K_STD_Q16;
+    fx->earth_radius_nm = k == 1 ? CT_EARTH_RADIUS_NM : 0;
+    fx->chord_nm = 0;
+    return k == 0 ? (const ct_effects *)0 : fx;
+}
+typedef struct {
+    int64_t uv[2];        /* pixel, Q16                                      */
+    int32_t status[M4_GEO_FX];  /* the host's ct_geolocate status per effects */
+    uint32_t steps[M4_GEO_FX];
+    int64_t enh[M4_GEO_FX][3];  /* the host's hit (E, N, h nm; 0 if no hit)  */
+} m4_pixel;
+
 extern const uint32_t m4_pkg_size;
 extern const uint8_t m4_pkg[];
 extern const uint32_t m4_family_count;
 extern const char *const m4_family_name[];
 extern const uint32_t m4_family_start[];
 extern const m4_ray m4_rays[];
+extern const char m4_geo_desc[];   /* the scene, for the report           */
+extern const ct_lens m4_geo_lens;
+extern const int64_t m4_geo_centre_nm[3]; /* camera centre E, N, h          */
+extern const int32_t m4_geo_q30[4];       /* ct_pose_from_map's quaternion  */
+extern const uint32_t m4_geo_count;
+extern const m4_pixel m4_geo_px[];
 #endif
