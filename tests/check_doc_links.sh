@@ -7,7 +7,7 @@
 # links when there are any.
 set -eu
 ROOT=${1:-$(cd "$(dirname "$0")/.." && pwd)}
-exec python3 - "$ROOT" <<'EOF'
+exec /usr/bin/python3 - "$ROOT" <<'EOF'
 import os, re, sys
 
 root = sys.argv[1]
