@@ -55,9 +55,9 @@ typedef struct {
 } gv;
 
 /* The image is interpolated between n exact images at the Chebyshev
- * nodes of [0, tmax] (a polynomial of degree n - 1): n = 4 up to 25 km, 5
- * up to 100 km, 6 beyond (to 281 km).  Against PROJ's exact image
- * (measured, docs/geolocation.md) that stays within 0.005 mm: the image's
+ * nodes of [0, tmax] (a polynomial of degree n - 1): n = 4 up to 35 km, 5
+ * up to 150 km, 6 beyond (to 281 km).  Against PROJ's exact image
+ * (measured, docs/geolocation.md) that stays within 0.02 mm: the image's
  * k-th derivative scales as R^(1-k).  The polynomial is kept per ray in
  * powers of sigma = 2 t / tmax - 1 in [-1, 1]: c = V^-1 X, V the nodes'
  * Vandermonde matrix (sigma_j = -cos((2j + 1) pi / 2n)), V^-1 in Q40
@@ -66,8 +66,8 @@ typedef struct {
  * exactly): c < 2^49, V^-1 X formed in 128 bits.  A vertex is then
  * Horner's rule in sigma (Q60): n - 1 products < 2^110 per coordinate.   */
 #define NODES 6
-#define NODES_4_NM (25 * KM_NM)
-#define NODES_5_NM (100 * KM_NM)
+#define NODES_4_NM (35 * KM_NM)
+#define NODES_5_NM (150 * KM_NM)
 static const int64_t tau_q60[3][NODES] = {
     {INT64_C(43880461954231926), INT64_C(355858772988187558), INT64_C(797062731618659418),
      INT64_C(1109041042652615050), 0, 0},
