@@ -147,23 +147,17 @@ std::vector<MapRay> read_rays_csv(const std::string &path)
 
 ct_status map_ray_to_grid(const ct_package &p, const MapRay &r, ct_ray *out)
 {
-    double pe = p.posting_e_nm * 1e-9, pn = p.posting_n_nm * 1e-9;
-    double sc = p.height_scale_nm * 1e-9, off = p.height_offset_nm * 1e-9;
-    double e0 = p.origin_e_nm * 1e-9, n0 = p.origin_n_nm * 1e-9;
-    double x = (r.e - e0) / pe - 0.5, y = (r.n - n0) / pn - 0.5, z = (r.h - off) / sc;
-    double lim = (double)CT_MAX_ORIGIN_Q16 / 65536.0;
-    if (!(std::fabs(x) < lim && std::fabs(y) < lim && std::fabs(z) < lim)) return CT_ERR_RAY;
-    out->x_q16 = std::llround(x * 65536.0);
-    out->y_q16 = std::llround(y * 65536.0);
-    out->z_q16 = std::llround(z * 65536.0);
-    double d[3] = {r.de / pe, r.dn / pn, r.dh / sc};
-    double m = std::max(std::fabs(d[0]), std::max(std::fabs(d[1]), std::fabs(d[2])));
+    // the flight library's conversion (ct_ray_from_map): origin in nm, the
+    // direction scaled so its largest component is 2^40 (its range)
+    const double lim = 2305843009213693952.0; /* 2^61 nm, ct_map_to_grid's range */
+    const double o[3] = {r.e * 1e9, r.n * 1e9, r.h * 1e9};
+    for (double v : o)
+        if (!(std::fabs(v) <= lim)) return CT_ERR_RAY;
+    double m = std::max(std::fabs(r.de), std::max(std::fabs(r.dn), std::fabs(r.dh)));
     if (!(m > 0) || !std::isfinite(m)) return CT_ERR_RAY;
-    double s = 4503599627370496.0 / m; /* 2^52 */
-    out->dx = std::llround(d[0] * s);
-    out->dy = std::llround(d[1] * s);
-    out->dz = std::llround(d[2] * s);
-    return CT_OK;
+    auto q40 = [m](double v) { return std::llround(v / m * 1099511627776.0); }; /* 2^40 */
+    return ct_ray_from_map(&p, std::llround(o[0]), std::llround(o[1]), std::llround(o[2]), q40(r.de), q40(r.dn),
+                           q40(r.dh), out);
 }
 
 Progress::Progress(std::string what) : what_(std::move(what)), t0_(std::chrono::steady_clock::now()) {}

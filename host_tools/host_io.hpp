@@ -62,8 +62,9 @@ struct MapRay {
 // "<path>:<line>: <reason>" on bad input.
 std::vector<MapRay> read_rays_csv(const std::string &path);
 
-// Map-frame ray (double metres) to a grid ray for the package: origin to
-// Q16 (rounded), direction scaled to |max| = 2^52.  CT_ERR_RAY if degenerate.
+// Map-frame ray (double metres) to a grid ray for the package with the
+// flight library's ct_ray_from_map: origin rounded to nm, direction scaled to
+// |max| = 2^40.  CT_ERR_RAY if degenerate or out of range.
 ct_status map_ray_to_grid(const ct_package &p, const MapRay &r, ct_ray *out);
 
 // A progress bar on stderr, shown only once the work has taken > 1 s.
