@@ -362,24 +362,17 @@ struct Panel {
 void draw_wedge_glyph(Image &im, int cx, int cy, int rad, int n, int s)
 {
     // ring, then the sector filled (s == n: whole disc, the omni plane)
-    int32_t b0x = 1, b0y = 0, b1x = 0, b1y = 1;
-    if (s < n) {
-        ct_sector_boundary((uint32_t)n, (uint32_t)s, &b0x, &b0y);
-        ct_sector_boundary((uint32_t)n, (uint32_t)s + 1, &b1x, &b1y);
-    }
+    int32_t bx[CT_MAX_SECTORS + 1], by[CT_MAX_SECTORS + 1];
+    for (int k = 0; s < n && k <= n; ++k) ct_sector_boundary((uint32_t)n, (uint32_t)k, &bx[k], &by[k]);
     for (int dy = -rad; dy <= rad; ++dy)
         for (int dx = -rad; dx <= rad; ++dx) {
             int d2 = dx * dx + dy * dy;
             if (d2 > rad * rad) continue;
             bool ring = d2 >= (rad - 1) * (rad - 1);
-            bool in = s >= n || n == 1;
-            if (!in) {
-                // the closed-wedge test with the flight library's convention:
-                // image x = grid x (east), image y = grid y (south)
-                int64_t c0 = (int64_t)b0x * dy - (int64_t)b0y * dx, c1 = (int64_t)dx * b1y - (int64_t)dy * b1x;
-                in = c0 >= 0 && c1 >= 0;
-                // N == 2, 3: wedges wider than 180 deg are not sectors here (N >= 2 has <= 180)
-            }
+            uint32_t in = 1;
+            // the flight library's closed-wedge test (image x = grid x, east;
+            // image y = grid y, south)
+            if (s < n) ct_in_wedge(bx, by, (uint32_t)n, (uint32_t)s, dx, dy, &in);
             if (ring || in) im.set(cx + dx, cy + dy, ring ? kInk : Rgb{230, 120, 30});
         }
 }

@@ -630,11 +630,6 @@ Wedge sector_wedge(uint32_t sectors, uint32_t s)
     return w;
 }
 
-bool in_wedge(const Wedge &w, int64_t dx, int64_t dy)
-{
-    return cross(w.b1x, w.b1y, dx, dy) >= 0 && cross(dx, dy, w.b2x, w.b2y) >= 0;
-}
-
 Prepared::Prepared(int width, int height, const uint8_t *bits) : w_(width), h_(height)
 {
     if (width < 1 || height < 1 || width > kMaxSide || height > kMaxSide ||

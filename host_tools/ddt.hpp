@@ -256,8 +256,6 @@ struct Wedge {
 // Sector s (0 <= s < N, 1 <= N <= CT_MAX_SECTORS) with boundaries from
 // ct_sector_boundary(N, s) and (N, s + 1).  Throws ct_host::Error.
 Wedge sector_wedge(uint32_t sectors, uint32_t s);
-// The exact closed-wedge test (the flight library's ct_in_wedge for N >= 2).
-bool in_wedge(const Wedge &w, int64_t dx, int64_t dy);
 
 // ------------------------------------------------------------------ options
 struct Options {

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "builder_common.hpp"
 #include "conetrace.h"
 #include "dem_cases.hpp"
 #include "harness.h"
@@ -327,6 +328,51 @@ void test_streamed_file_same_bytes()
 
 }  // namespace
 
+// The builders' inline closed-wedge test (bld::in_closed) is the flight
+// library's ct_in_wedge: every sector count, every sector, seeded vectors
+// (random up to 2^30, small, axis, the boundary rays and one unit beside them).
+static void test_builder_wedge_is_ct_in_wedge(void)
+{
+    ct_rng r;
+    ct_rng_seed(&r, ct_test_seed() + 20);
+    long checked = 0, inside = 0;
+    for (int n = 1; n <= (int)CT_MAX_SECTORS; ++n) {
+        const ct_host::bld::Wedge w = ct_host::bld::make_wedge(n);
+        for (int s = 0; s < n; ++s) {
+            std::vector<int64_t> v;
+            for (int k = 0; k < 300; ++k) {
+                const int64_t lim = k % 3 == 0 ? (INT64_C(1) << 30) : k % 3 == 1 ? (INT64_C(1) << 20) : 4;
+                v.push_back(ct_rng_range(&r, -lim, lim));
+                v.push_back(ct_rng_range(&r, -lim, lim));
+            }
+            for (int64_t a : {INT64_C(0), INT64_C(1), INT64_C(-1), INT64_C(1) << 30, -(INT64_C(1) << 30)})
+                for (int64_t b : {INT64_C(0), INT64_C(1), INT64_C(-1), INT64_C(1) << 30, -(INT64_C(1) << 30)}) {
+                    v.push_back(a);
+                    v.push_back(b);
+                }
+            for (int k = s; k <= s + 1; ++k)
+                for (int64_t ex = -1; ex <= 1; ++ex)
+                    for (int64_t ey = -1; ey <= 1; ++ey) {
+                        // the boundary itself (|b| <= 2^30) and one unit beside it
+                        v.push_back(std::max<int64_t>(-(INT64_C(1) << 30), std::min<int64_t>(INT64_C(1) << 30, w.bx[k] + ex)));
+                        v.push_back(std::max<int64_t>(-(INT64_C(1) << 30), std::min<int64_t>(INT64_C(1) << 30, w.by[k] + ey)));
+                        v.push_back(w.bx[k] / 1024 + ex);
+                        v.push_back(w.by[k] / 1024 + ey);
+                    }
+            for (size_t k = 0; k + 1 < v.size(); k += 2) {
+                uint32_t in = 2;
+                TEST_ASSERT_EQUAL_INT(CT_OK, ct_in_wedge(w.bx.data(), w.by.data(), (uint32_t)n, (uint32_t)s, v[k], v[k + 1], &in));
+                const bool host = ct_host::bld::in_closed(w, s, v[k], v[k + 1]);
+                TEST_ASSERT_MSG(host == (in != 0), "N=%d s=%d (%lld, %lld): builder %d, ct_in_wedge %u", n, s,
+                                (long long)v[k], (long long)v[k + 1], (int)host, in);
+                ++checked;
+                inside += host;
+            }
+        }
+    }
+    std::printf("  wedge test: %ld vectors, %ld inside, builder == ct_in_wedge\n", checked, inside);
+}
+
 int main()
 {
     TEST_BEGIN("test_package");
@@ -336,5 +382,6 @@ int main()
     RUN_TEST(test_random_corruption);
     RUN_TEST(test_prepared_ray_tampering);
     RUN_TEST(test_streamed_file_same_bytes);
+    RUN_TEST(test_builder_wedge_is_ct_in_wedge);
     return TEST_END();
 }
