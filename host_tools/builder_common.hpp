@@ -14,6 +14,7 @@
 #include <limits>
 #include <vector>
 
+#include "cells.hpp"
 #include "conetrace.h"
 #include "terrain.hpp"
 
@@ -162,13 +163,6 @@ inline double dist_max(const Wedge &w, int s, const Rect &r)
     return best * (1.0 + 1e-12) + 1e-12;
 }
 
-// A fine cell's height: the tallest of its four posts.
-inline uint16_t fine_max(const Terrain &t, int i, int j)
-{
-    const size_t k = (size_t)j * (size_t)t.width + (size_t)i, w = (size_t)t.width;
-    return std::max(std::max(t.codes[k], t.codes[k + 1]), std::max(t.codes[k + w], t.codes[k + w + 1]));
-}
-
 // Max pyramid of fine-cell maxima: level 0 = fine cells.
 // Max pyramid: level 0 is the fine-cell maxima themselves (not copied: the
 // pyramid must not outlive `fm`), levels 1.. are 2x2 maxima.
@@ -188,13 +182,8 @@ inline Pyramid make_pyramid(const std::vector<uint16_t> &fm, int cx, int cy)
     p.h.push_back(cy);
     while (p.w.back() > 1 || p.h.back() > 1) {
         int pw = p.w.back(), ph = p.h.back(), nw = (pw + 1) / 2, nh = (ph + 1) / 2;
-        std::vector<uint16_t> nx((size_t)nw * nh, 0);
         const auto &pr = p.lv.size() == 1 ? fm : p.lv.back();
-        for (int j = 0; j < ph; ++j)
-            for (int i = 0; i < pw; ++i) {
-                uint16_t &d = nx[(size_t)(j / 2) * nw + i / 2];
-                d = std::max(d, pr[(size_t)j * pw + i]);
-            }
+        std::vector<uint16_t> nx = max_pyramid_step(pw, ph, [&](int i, int j) { return pr[(size_t)j * pw + i]; });
         p.lv.push_back(std::move(nx));
         p.w.push_back(nw);
         p.h.push_back(nh);

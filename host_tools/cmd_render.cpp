@@ -53,6 +53,7 @@
 #include <OpenImageIO/imageio.h>
 
 #include "conetrace.h"
+#include "cells.hpp"
 #include "ddt.hpp"
 #include "dem_io.hpp"
 #include "host_io.hpp"
@@ -225,23 +226,6 @@ Input load_input(const std::string &path)
         }
     }
     return in;
-}
-
-// Coarse cell tops (height codes): max of the corners of the r x r fine
-// cells (the builder's cell heights and reduction).
-std::vector<uint16_t> cell_tops(const Terrain &t, int r, int &wc, int &hc)
-{
-    const int cx = t.width - 1, cy = t.height - 1;
-    wc = (cx + r - 1) / r;
-    hc = (cy + r - 1) / r;
-    std::vector<uint16_t> top((size_t)wc * hc, 0);
-    for (int j = 0; j < cy; ++j)
-        for (int i = 0; i < cx; ++i) {
-            uint16_t m = std::max(std::max(t.at(i, j), t.at(i + 1, j)), std::max(t.at(i, j + 1), t.at(i + 1, j + 1)));
-            uint16_t &d = top[(size_t)(j / r) * wc + i / r];
-            d = std::max(d, m);
-        }
-    return top;
 }
 
 // Hillshade in [0, 1] per coarse cell (mean over its fine cells), light from
@@ -433,7 +417,7 @@ int cmd_render(int argc, char **argv)
             long k = get_int(o, "--slices", kdef, 1, 65535);
             if (k == 0) fail("--level needs --slices K (the number of evenly spaced levels)");
             long l = get_int(o, "--level", 0, 0, k);
-            level = hmin + (double)l * (hmax - hmin) / (double)k;
+            level = slice_level(hmin, hmax, (int)k, (int)l);  // the builder's level, rounded up
         } else {
             fail("--what " + what + " needs a level: --slice H (metres) or --level k --slices K");
         }

@@ -17,6 +17,7 @@
 
 #include "builder_common.hpp"
 #include "builder_slices.hpp"
+#include "cells.hpp"
 #include "conetrace.h"
 #include "host_io.hpp"
 #include "le.hpp"
@@ -83,18 +84,14 @@ void write_mipmap(Writer &w, const Terrain &t, int cx, int cy, uint32_t levels)
     std::vector<uint16_t> prev, cur;
     int pw = cx, ph = cy;
     for (uint32_t l = 1; l <= levels; ++l) {
-        const int nw = (pw + 1) / 2, nh = (ph + 1) / 2;
-        cur.assign((size_t)nw * nh, 0);
-        for (int j = 0; j < ph; ++j)
-            for (int i = 0; i < pw; ++i) {
-                const uint16_t v = l == 1 ? fine_max(t, i, j) : prev[(size_t)j * pw + i];
-                uint16_t &d = cur[(size_t)(j / 2) * nw + i / 2];
-                d = std::max(d, v);
-            }
+        if (l == 1)
+            cur = max_pyramid_step(pw, ph, [&](int i, int j) { return fine_max(t, i, j); });
+        else
+            cur = max_pyramid_step(pw, ph, [&](int i, int j) { return prev[(size_t)j * pw + i]; });
         for (uint16_t v : cur) w.u16(v);
         prev.swap(cur);
-        pw = nw;
-        ph = nh;
+        pw = (pw + 1) / 2;
+        ph = (ph + 1) / 2;
     }
 }
 
@@ -196,9 +193,7 @@ void build_package_to(const Terrain &t, const BuildOptions &opt, PackageSink &si
             slices_header = (int)lv.size() - 1;
         } else {
             for (int k = 0; k <= K; ++k) {
-                int l = (int)std::ceil(hmin + (double)k * (hmax - hmin) / K - 1e-9);
-                l = std::clamp<int>(l, hmin, hmax);
-                if (k == K) l = hmax;
+                const int l = slice_level(hmin, hmax, K, k);
                 if (lv.empty() || l > lv.back()) lv.push_back(l);
             }
         }
@@ -250,12 +245,8 @@ void build_package_to(const Terrain &t, const BuildOptions &opt, PackageSink &si
     std::vector<uint16_t> apex;  // per coarse cell: apex height code
     {
         // coarse heights: the tallest post of the coarse cell's fine cells
-        std::vector<uint16_t> hcm(plane, 0);
-        for (int j = 0; j < c.cy; ++j)
-            for (int i = 0; i < c.cx; ++i) {
-                uint16_t &d = hcm[(size_t)(j / c.r) * wc + i / c.r];
-                d = std::max(d, fine_max(t, i, j));
-            }
+        int wct, hct;
+        std::vector<uint16_t> hcm = cell_tops(t, c.r, wct, hct);
         if (opt.builder == PptBuilder::Slices) {
             std::vector<uint16_t> k0(plane);  // apex levels, < lv.size() <= 65536
             // the paper's apex: the lowest level not below the cell's top
@@ -294,7 +285,7 @@ void build_package_to(const Terrain &t, const BuildOptions &opt, PackageSink &si
                     // smallest level hmin + k*(hmax-hmin)/K >= m, as an integer code
                     double step = (double)(hmax - hmin) / opt.slices;
                     int k = (int)std::ceil((m - hmin) / step - 1e-12);
-                    int lvl = (int)std::ceil(hmin + k * step - 1e-9);
+                    int lvl = slice_level(hmin, hmax, opt.slices, k);
                     am = (uint16_t)std::min<int>(hmax, std::max(m, lvl));
                 }
             }
