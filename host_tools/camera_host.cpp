@@ -13,7 +13,7 @@ extern "C" {
 #include <mrcal/mrcal.h>
 }
 
-#include "host_io.hpp"  // status_name
+#include "host_io.hpp"  // status_name, read_number_csv
 #include "terrain.hpp"  // ct_host::Error
 
 namespace ct_host {
@@ -255,50 +255,10 @@ LibCamera lib_camera(const CameraModel &m, const std::string &path, double grid_
 
 std::vector<PixelRow> read_pixels_csv(const std::string &path)
 {
-    std::ifstream in(path);
-    if (!in) throw Error(path + ": " + std::strerror(errno));
-    auto split = [](const std::string &s) {
-        std::vector<std::string> v;
-        std::string cur;
-        for (char ch : s) {
-            if (ch == ',') {
-                v.push_back(cur);
-                cur.clear();
-            } else if (ch != '\r' && ch != ' ' && ch != '\t') {
-                cur += ch;
-            }
-        }
-        v.push_back(cur);
-        return v;
-    };
-    std::string line;
-    if (!std::getline(in, line)) throw Error(path + ": empty file (expected a header u,v)");
-    std::vector<std::string> hdr = split(line);
-    const char *names[2] = {"u", "v"};
-    int col[2];
-    for (int k = 0; k < 2; ++k) {
-        col[k] = -1;
-        for (size_t c = 0; c < hdr.size(); ++c)
-            if (hdr[c] == names[k]) col[k] = (int)c;
-        if (col[k] < 0) throw Error(path + ":1: header lacks column '" + names[k] + "' (need u,v)");
-    }
     std::vector<PixelRow> rows;
-    int lineno = 1;
-    while (std::getline(in, line)) {
-        ++lineno;
-        if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
-        std::vector<std::string> f = split(line);
-        double v[2];
-        for (int k = 0; k < 2; ++k) {
-            if ((size_t)col[k] >= f.size()) throw Error(path + ":" + std::to_string(lineno) + ": too few columns");
-            char *end = nullptr;
-            v[k] = std::strtod(f[col[k]].c_str(), &end);
-            if (f[col[k]].empty() || !end || *end || !std::isfinite(v[k]))
-                throw Error(path + ":" + std::to_string(lineno) + ": bad number '" + f[col[k]] + "' in column " +
-                            names[k]);
-        }
-        rows.push_back(PixelRow{v[0], v[1], f[col[0]], f[col[1]]});
-    }
+    read_number_csv(path, {"u", "v"}, [&](const double *v, const std::vector<std::string> &text) {
+        rows.push_back(PixelRow{v[0], v[1], text[0], text[1]});
+    });
     return rows;
 }
 

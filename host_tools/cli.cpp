@@ -86,27 +86,13 @@ void print_usage(std::FILE *f, const char *cmd = nullptr)
 
 bool is_help(const std::string &s) { return s == "-h" || s == "--help" || s == "help"; }
 
-struct Args {
-    std::vector<std::string> pos;
-    std::map<std::string, std::string> opt;
-};
+using Args = CmdLine;
 
 Args parse(int argc, char **argv, int first, const std::vector<std::string> &valued)
 {
     Args a;
-    for (int k = first; k < argc; ++k) {
-        std::string s = argv[k];
-        if (s.size() > 1 && s[0] == '-') {
-            bool known = false;
-            for (const auto &v : valued)
-                if (v == s) known = true;
-            if (!known) usage("unknown option " + s);
-            if (k + 1 >= argc) usage("option " + s + " needs a value");
-            a.opt[s] = argv[++k];
-        } else {
-            a.pos.push_back(s);
-        }
-    }
+    const std::string err = parse_cmdline(argc, argv, first, valued, {}, false, &a);
+    if (!err.empty()) usage(err);
     return a;
 }
 

@@ -59,22 +59,15 @@ using namespace ct_host;
 
 int cmd_geoloc(int argc, char **argv)
 {
-    std::vector<std::string> pos;
-    std::map<std::string, std::string> opt;
-    const char *valued[] = {"--camera",       "--pixels",  "--method",     "--effects",  "--grid-step",
-                            "--refraction-k", "--earth-radius", "--threads", "--pose-wgs84", "--pose-map", "-o"};
-    for (int k = 2; k < argc; ++k) {
-        std::string s = argv[k];
-        if (s.size() > 1 && s[0] == '-') {
-            bool known = false;
-            for (const char *v : valued) known = known || s == v;
-            if (!known) throw Error("geoloc: unknown option " + s);
-            if (k + 1 >= argc) throw Error("geoloc: option " + s + " needs a value");
-            opt[s] = argv[++k];
-        } else {
-            pos.push_back(s);
-        }
-    }
+    CmdLine args;
+    const std::string err = parse_cmdline(argc, argv, 2,
+                                          {"--camera", "--pixels", "--method", "--effects", "--grid-step",
+                                           "--refraction-k", "--earth-radius", "--threads", "--pose-wgs84",
+                                           "--pose-map", "-o"},
+                                          {}, false, &args);
+    if (!err.empty()) throw Error("geoloc: " + err);
+    const std::vector<std::string> &pos = args.pos;
+    std::map<std::string, std::string> &opt = args.opt;
     if (pos.size() != 1) throw Error("geoloc needs exactly one package file");
     if (!opt.count("--camera")) throw Error("geoloc needs --camera C.cameramodel");
     if (!opt.count("--pixels")) throw Error("geoloc needs --pixels pixels.csv");

@@ -263,26 +263,17 @@ struct Opts {
 
 Opts parse_opts(int argc, char **argv)
 {
-    static const char *valued[] = {"-o",      "--what",  "--slice",   "--level", "--slices",  "--reduce", "--sectors",
-                                   "--sector", "--range", "--zoom",    "--columns", "--threads"};
+    CmdLine c;
+    const std::string err = parse_cmdline(argc, argv, 2,
+                                          {"-o", "--what", "--slice", "--level", "--slices", "--reduce", "--sectors",
+                                           "--sector", "--range", "--zoom", "--columns", "--threads"},
+                                          {"--hillshade", "--no-legend"}, true, &c);
+    if (!err.empty()) fail(err);
     Opts o;
-    for (int k = 2; k < argc; ++k) {
-        std::string s = argv[k];
-        if (s == "--hillshade") {
-            o.hillshade = true;
-        } else if (s == "--no-legend") {
-            o.legend = false;
-        } else if (s.size() > 1 && s[0] == '-') {
-            bool known = false;
-            for (const char *v : valued) known = known || s == v;
-            if (!known) fail("unknown option " + s);
-            if (k + 1 >= argc) fail("option " + s + " needs a value");
-            if (o.val.count(s)) fail("option " + s + " given twice");
-            o.val[s] = argv[++k];
-        } else {
-            o.pos.push_back(s);
-        }
-    }
+    o.pos = std::move(c.pos);
+    o.val = std::move(c.opt);
+    o.hillshade = c.flag.count("--hillshade") > 0;
+    o.legend = c.flag.count("--no-legend") == 0;
     return o;
 }
 

@@ -97,12 +97,39 @@ std::string status_name(ct_status s)
     return n;
 }
 
-std::vector<MapRay> read_rays_csv(const std::string &path)
+std::string parse_cmdline(int argc, char **argv, int first, const std::vector<std::string> &valued,
+                          const std::vector<std::string> &flags, bool once, CmdLine *out)
 {
+    auto in = [](const std::vector<std::string> &v, const std::string &s) {
+        for (const std::string &x : v)
+            if (x == s) return true;
+        return false;
+    };
+    for (int k = first; k < argc; ++k) {
+        std::string s = argv[k];
+        if (in(flags, s)) {
+            out->flag.insert(s);
+        } else if (s.size() > 1 && s[0] == '-') {
+            if (!in(valued, s)) return "unknown option " + s;
+            if (k + 1 >= argc) return "option " + s + " needs a value";
+            if (once && out->opt.count(s)) return "option " + s + " given twice";
+            out->opt[s] = argv[++k];
+        } else {
+            out->pos.push_back(s);
+        }
+    }
+    return "";
+}
+
+void read_number_csv(const std::string &path, const std::vector<std::string> &names,
+                     const std::function<void(const double *v, const std::vector<std::string> &text)> &row)
+{
+    std::string need;
+    for (const std::string &n : names) need += (need.empty() ? "" : ",") + n;
     std::ifstream in(path);
     if (!in) throw Error(path + ": " + std::strerror(errno));
     std::string line;
-    if (!std::getline(in, line)) throw Error(path + ": empty file (expected a header E,N,h,dE,dN,dh)");
+    if (!std::getline(in, line)) throw Error(path + ": empty file (expected a header " + need + ")");
     auto split = [](const std::string &s) {
         std::vector<std::string> v;
         std::string cur;
@@ -117,31 +144,41 @@ std::vector<MapRay> read_rays_csv(const std::string &path)
         v.push_back(cur);
         return v;
     };
+    const size_t n = names.size();
     std::vector<std::string> hdr = split(line);
-    const char *names[6] = {"E", "N", "h", "dE", "dN", "dh"};
-    int col[6];
-    for (int k = 0; k < 6; ++k) {
+    std::vector<int> col(n);
+    for (size_t k = 0; k < n; ++k) {
         col[k] = -1;
         for (size_t c = 0; c < hdr.size(); ++c)
             if (hdr[c] == names[k]) col[k] = (int)c;
-        if (col[k] < 0) throw Error(path + ":1: header lacks column '" + names[k] + "' (need E,N,h,dE,dN,dh)");
+        if (col[k] < 0) throw Error(path + ":1: header lacks column '" + names[k] + "' (need " + need + ")");
     }
-    std::vector<MapRay> rays;
+    std::vector<double> v(n);
+    std::vector<std::string> text(n);
     int lineno = 1;
     while (std::getline(in, line)) {
         ++lineno;
         if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
         std::vector<std::string> f = split(line);
-        double v[6];
-        for (int k = 0; k < 6; ++k) {
+        for (size_t k = 0; k < n; ++k) {
             if ((size_t)col[k] >= f.size()) throw Error(path + ":" + std::to_string(lineno) + ": too few columns");
             char *end = nullptr;
             v[k] = std::strtod(f[col[k]].c_str(), &end);
             if (f[col[k]].empty() || !end || *end || !std::isfinite(v[k]))
-                throw Error(path + ":" + std::to_string(lineno) + ": bad number '" + f[col[k]] + "' in column " + names[k]);
+                throw Error(path + ":" + std::to_string(lineno) + ": bad number '" + f[col[k]] + "' in column " +
+                            names[k]);
+            text[k] = std::move(f[col[k]]);
         }
-        rays.push_back(MapRay{v[0], v[1], v[2], v[3], v[4], v[5]});
+        row(v.data(), text);
     }
+}
+
+std::vector<MapRay> read_rays_csv(const std::string &path)
+{
+    std::vector<MapRay> rays;
+    read_number_csv(path, {"E", "N", "h", "dE", "dN", "dh"}, [&](const double *v, const std::vector<std::string> &) {
+        rays.push_back(MapRay{v[0], v[1], v[2], v[3], v[4], v[5]});
+    });
     return rays;
 }
 

@@ -1,10 +1,13 @@
-// host_io.hpp -- files, CSV rays, progress, map <-> grid conversion (host).
+// host_io.hpp -- files, command lines, CSVs of numbers (rays, pixels), progress,
+// map <-> grid conversion (host).
 #pragma once
 
 #include <chrono>
 #include <cstdint>
 #include <cstdio>
 #include <functional>
+#include <map>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -53,6 +56,28 @@ void parallel_chunks(size_t n, int threads, size_t chunk, const std::function<vo
 
 // --threads T: a number of threads in [0, 256] (0 = all cores).
 int threads_option(const std::string &text, const std::string &cmd);
+
+// A command's arguments from argv[first]: "NAME VALUE" for the names in
+// `valued`, bare switches in `flags`, the rest positional (an argument
+// starting with '-' and longer than one character is an option).  Returns
+// "" or the error: "unknown option X", "option X needs a value" and, with
+// once, "option X given twice" (else the last value wins).
+struct CmdLine {
+    std::vector<std::string> pos;
+    std::map<std::string, std::string> opt;
+    std::set<std::string> flag;
+};
+std::string parse_cmdline(int argc, char **argv, int first, const std::vector<std::string> &valued,
+                          const std::vector<std::string> &flags, bool once, CmdLine *out);
+
+// A CSV of numbers whose header names the columns (any order, others
+// ignored; blanks and CR dropped from every field; blank lines skipped):
+// row(v, text) for each data row, v[k] and text[k] the value and field of
+// column names[k].  Throws Error "<path>: empty file (expected a header
+// A,B,..)", "<path>:1: header lacks column 'A' (need A,B,..)",
+// "<path>:<line>: too few columns" / ": bad number 'x' in column A".
+void read_number_csv(const std::string &path, const std::vector<std::string> &names,
+                     const std::function<void(const double *v, const std::vector<std::string> &text)> &row);
 
 // A ray in the map frame (metres): origin (e, n, h), direction (de, dn, dh).
 struct MapRay {
