@@ -54,15 +54,6 @@ int parse_vdatum(const std::string &s)
     throw Error("unknown vertical datum '" + s + "' (expected egm96, ellipsoid or unknown)");
 }
 
-const char *vdatum_name(int v)
-{
-    switch (v) {
-    case CT_VDATUM_WGS84: return "ellipsoid";
-    case CT_VDATUM_EGM96: return "egm96";
-    default: return "unknown";
-    }
-}
-
 Egm96::Egm96()
 {
     PJ_CONTEXT *ctx = proj_context_create();

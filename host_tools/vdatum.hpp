@@ -15,8 +15,6 @@ namespace ct_host {
 
 // "unknown", "ellipsoid" (or "wgs84"), "egm96"; throws Error otherwise.
 int parse_vdatum(const std::string &s);
-// The name parse_vdatum reads, for messages.
-const char *vdatum_name(int vdatum);
 
 // EGM96 undulation N (metres, h_ellipsoid = h_geoid + N) through PROJ at
 // a geodetic point.  Throws Error when PROJ or its grid is missing.

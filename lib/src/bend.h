@@ -98,12 +98,23 @@ typedef struct {
                               columns, Q30                                   */
     int32_t refr_k_q16;    /* refraction coefficient (0: none), Q16           */
     int64_t radius_nm;     /* radius for refraction's bending                 */
-    int64_t tol_q16;       /* chord tolerance, Q16 cells (>= 2)               */
-    int64_t tol_q24;       /* the same in Q24 cells (the checks' units)       */
+    int64_t tol_q24;       /* chord tolerance, Q24 cells (>= 2)               */
     int64_t tolz_q16;      /* the same in Q16 height units (>= 2)             */
     int64_t tmax_nm;       /* no terrain beyond this range                    */
     int32_t cull;
 } ct_earth;
+
+/* Library-internal helpers shared between files.                          */
+
+/* R_map_cam ray (Q30 x Q30 -> Q39) without the pose's horizontal scale:
+ * the local grid frame (camera.c; ct_pose_rotate applies hscale to it).
+ * The pose and the ray are the caller's, checked.                          */
+void ct_pose_rotate_grid(const ct_pose *pose, const int32_t ray_q30[3], int64_t out_q39[3]);
+
+/* A geoid grid's ranges (conetrace.h, the datum section): CT_OK,
+ * CT_ERR_DIMS (nodes) or CT_ERR_GEOREF (step, extent, corner); the values
+ * pointer is not looked at (geodesy.c).                                     */
+ct_status ct_geoid_grid_check(const ct_geoid_grid *grid);
 
 /* The camera's local frame from its map point (E, N) on a zone: lat, lon
  * (Q61) and the ECEF columns of grid east, grid north and up (Q30); the

@@ -25,7 +25,7 @@
  * Every product is rounded half up (ct_mul_shr); the code is exact integer
  * arithmetic, bit-identical on every target.
  */
-#include "conetrace.h"
+#include "bend.h"
 #include "fixed.h"
 
 #define ONE32 (INT64_C(1) << 32)
@@ -629,13 +629,9 @@ ct_status ct_pose_init(ct_pose *pose, const int32_t R[9], int64_t e, int64_t n, 
     return CT_OK;
 }
 
-ct_status ct_pose_rotate(const ct_pose *pose, const int32_t ray[3], int64_t out[3])
+void ct_pose_rotate_grid(const ct_pose *pose, const int32_t ray[3], int64_t out[3])
 {
     uint32_t i;
-    CT_ASSERT(pose != NULL && ray != NULL && out != NULL);
-    if (pose == NULL || ray == NULL || out == NULL || pose->ready != POSE_READY) {
-        return CT_ERR_ARG;
-    }
     /* bound: 3 rows.  |R| <= 2^30 + 2^12 (ct_pose_init), |ray| < 2^31:
      * each product < 2^61.1, the sum of three < 2^62.7; Q60 -> Q39 */
     for (i = 0u; i < 3u; ++i) {
@@ -643,6 +639,16 @@ ct_status ct_pose_rotate(const ct_pose *pose, const int32_t ray[3], int64_t out[
         int64_t s = (int64_t)row[0] * ray[0] + (int64_t)row[1] * ray[1] + (int64_t)row[2] * ray[2];
         out[i] = ct_floor_div(s + (INT64_C(1) << 20), INT64_C(1) << 21);
     }
+}
+
+ct_status ct_pose_rotate(const ct_pose *pose, const int32_t ray[3], int64_t out[3])
+{
+    uint32_t i;
+    CT_ASSERT(pose != NULL && ray != NULL && out != NULL);
+    if (pose == NULL || ray == NULL || out == NULL || pose->ready != POSE_READY) {
+        return CT_ERR_ARG;
+    }
+    ct_pose_rotate_grid(pose, ray, out);
     if (pose->hscale_q30 != ((int32_t)1 << 30)) {
         /* a geodetic pose: horizontal map metres per ground metre (|out| <=
          * 2^39.1, hscale in [2^29, 2^31): products < 2^70.1, 128-bit; the

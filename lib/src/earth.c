@@ -390,7 +390,6 @@ ct_status ct_earth_setup(const ct_package *p, const ct_pose *pose, int32_t refr_
     /* the checks aim at 3/4 of the chord: they see the model at its middle
      * and quarter points only, and the vertices are rounded to Q16 */
     chord_nm -= chord_nm / 4;
-    es->tol_q16 = ct_max64(2, ct_i128_floor_div_sat(ct_i128_shl(ct_i128_from64(chord_nm), 16), post));
     es->tol_q24 = ct_max64(2, ct_i128_floor_div_sat(ct_i128_shl(ct_i128_from64(chord_nm), 24), post));
     es->tolz_q16 = ct_max64(2, ct_i128_floor_div_sat(ct_i128_shl(ct_i128_from64(chord_nm), 16), p->height_scale_nm));
     es->cull = (bend_flags & CT_BEND_NO_CULL) == 0u;

@@ -756,20 +756,30 @@ static int64_t geoid_node_nm(const ct_geoid_grid *g, uint32_t i, uint32_t j)
     return (int64_t)(int32_t)u * 1000;
 }
 
+ct_status ct_geoid_grid_check(const ct_geoid_grid *g)
+{
+    uint32_t most = g->w > g->h ? g->w : g->h;
+    if (g->w < 2u || g->h < 2u || most > CT_GEOID_MAX_NODES) {
+        return CT_ERR_DIMS;
+    }
+    if (g->step_q61 < CT_GEOID_MIN_STEP_Q61 || g->step_q61 > CT_GEOID_MAX_STEP_Q61 ||
+        (uint64_t)(most - 1u) > ((uint64_t)1 << 62) / (uint64_t)g->step_q61 ||
+        ct_abs64(g->lat0_q61) > CT_PI_Q61 / 2 || ct_abs64(g->lon0_q61) > CT_PI_Q61) {
+        return CT_ERR_GEOREF;
+    }
+    return CT_OK;
+}
+
 ct_status ct_geoid_at(const ct_geoid_grid *g, int64_t lat_q61, int64_t lon_q61, int64_t *n_geoid_nm)
 {
     const int64_t one = INT64_C(1) << GEOID_FRAC_BITS, half = one / 2;
-    uint32_t i, j, most;
+    uint32_t i, j;
     int64_t fx, fy, a, c;
     uint64_t dlon;
     if (g == NULL || n_geoid_nm == NULL) {
         return CT_ERR_ARG;
     }
-    most = g->w > g->h ? g->w : g->h;
-    if (g->w < 2u || g->h < 2u || most > CT_GEOID_MAX_NODES || g->values == NULL ||
-        g->step_q61 < CT_GEOID_MIN_STEP_Q61 || g->step_q61 > CT_GEOID_MAX_STEP_Q61 ||
-        (uint64_t)(most - 1u) > ((uint64_t)1 << 62) / (uint64_t)g->step_q61 ||
-        ct_abs64(g->lat0_q61) > CT_PI_Q61 / 2 || ct_abs64(g->lon0_q61) > CT_PI_Q61) {
+    if (g->values == NULL || ct_geoid_grid_check(g) != CT_OK) {
         return CT_ERR_RANGE;
     }
     if (ct_abs64(lat_q61) > CT_PI_Q61 / 2 || ct_abs64(lon_q61) > CT_PI_Q61 || g->lat0_q61 < lat_q61) {

@@ -111,18 +111,17 @@ static ct_status setup(const ct_package *p, const ct_camera *cam, const ct_pose 
     s->shift = b + 40u > 62u ? b + 40u - 62u : 0u;
     s->earth = 0;
     if (effects != NULL && (effects->flags & CT_EFFECT_CURVATURE) != 0u && effects->earth_radius_nm == 0) {
-        /* the true Earth on a package on a UTM zone; others keep the
-         * sphere of CT_EARTH_RADIUS_NM */
-        ct_utm z;
-        if (p->epsg <= 0x7fffffffu && ct_utm_zone_of_epsg((int32_t)p->epsg, &z) == CT_OK) {
-            ct_status st = ct_earth_setup(p, pose,
-                                          (effects->flags & CT_EFFECT_REFRACTION) != 0u ? effects->refraction_k_q16 : 0,
-                                          CT_EARTH_RADIUS_NM, s->bend.chord_nm, s->bend.flags, &s->es);
-            if (st != CT_OK) {
-                return st == CT_ERR_RAY ? CT_ERR_RAY : CT_ERR_POSE;
-            }
+        /* the true Earth on a package on a UTM zone (CT_ERR_CRS: another
+         * CRS, which keeps the sphere of CT_EARTH_RADIUS_NM) */
+        ct_status st = ct_earth_setup(p, pose,
+                                      (effects->flags & CT_EFFECT_REFRACTION) != 0u ? effects->refraction_k_q16 : 0,
+                                      CT_EARTH_RADIUS_NM, s->bend.chord_nm, s->bend.flags, &s->es);
+        if (st == CT_OK) {
             s->earth = 1;
             return CT_OK;
+        }
+        if (st != CT_ERR_CRS) {
+            return st == CT_ERR_RAY ? CT_ERR_RAY : CT_ERR_POSE;
         }
     }
     if (s->bend.coeff_q16 != 0 && ct_bent_prepare(p, &s->bend, s->ox, s->oy, &s->bent) != CT_OK) {
@@ -158,15 +157,9 @@ static ct_status one_pixel(const ct_package *p, const ct_camera *cam, const ct_p
         st = ct_pose_rotate(pose, out->ray_cam_q30, out->dir_map_q39);
     }
     if (st == CT_OK && s->earth) {
-        /* the map-frame direction without the pose's horizontal scale:
-         * R ray, Q60 -> Q39 (as ct_pose_rotate) */
+        /* the map-frame direction without the pose's horizontal scale */
         int64_t dg[3];
-        for (k = 0u; k < 3u; ++k) { /* bound: 3 rows */
-            const int32_t *row = pose->R_map_cam_q30 + 3u * k;
-            int64_t sum = (int64_t)row[0] * out->ray_cam_q30[0] + (int64_t)row[1] * out->ray_cam_q30[1] +
-                          (int64_t)row[2] * out->ray_cam_q30[2];
-            dg[k] = ct_floor_div(sum + (INT64_C(1) << 20), INT64_C(1) << 21);
-        }
+        ct_pose_rotate_grid(pose, out->ray_cam_q30, dg);
         st = ct_trace_earth(p, &s->es, dg, m, &out->hit);
     } else if (st == CT_OK) {
         ray.x_q16 = s->ox;

@@ -3,7 +3,7 @@
  * tables (sector boundaries, cot per angle code).  The layout is defined
  * once here (ct_package_layout) and used by the reader and the writer.
  */
-#include "conetrace.h"
+#include "bend.h"
 #include "fixed.h"
 
 /* Sizes are computed in uint64: W, H <= 2^15 so W*H*2 < 2^31 and every
@@ -281,26 +281,23 @@ static ct_status open_datum(ct_package *pkg, const uint8_t *b, uint32_t total,
         return CT_ERR_RANGE;
     }
     if (gw != 0u || gh != 0u) {
-        int64_t step = ct_ld64s(d + 32), lat0 = ct_ld64s(d + 16), lon0 = ct_ld64s(d + 24);
-        uint32_t most = gw > gh ? gw : gh;
-        if (gw < 2u || gh < 2u || gw > CT_GEOID_MAX_NODES || gh > CT_GEOID_MAX_NODES) {
-            return CT_ERR_DIMS;
-        }
-        if (step < CT_GEOID_MIN_STEP_Q61 || step > CT_GEOID_MAX_STEP_Q61 ||
-            (uint64_t)(most - 1u) > ((uint64_t)1 << 62) / (uint64_t)step ||
-            ct_abs64(lat0) > CT_PI_Q61 / 2 || ct_abs64(lon0) > CT_PI_Q61) {
-            return CT_ERR_GEOREF;
+        ct_geoid_grid g;
+        ct_status st;
+        g.w = gw;
+        g.h = gh;
+        g.lat0_q61 = ct_ld64s(d + 16);
+        g.lon0_q61 = ct_ld64s(d + 24);
+        g.step_q61 = ct_ld64s(d + 32);
+        g.values = d + CT_DATUM_HEADER_SIZE;
+        st = ct_geoid_grid_check(&g);
+        if (st != CT_OK) {
+            return st;
         }
         /* 4 gw gh <= 2^26: no overflow in 64 bits */
         if ((uint64_t)off + CT_DATUM_HEADER_SIZE + 4u * (uint64_t)gw * gh > (uint64_t)total) {
             return CT_ERR_SIZE;
         }
-        pkg->geoid.w = gw;
-        pkg->geoid.h = gh;
-        pkg->geoid.lat0_q61 = lat0;
-        pkg->geoid.lon0_q61 = lon0;
-        pkg->geoid.step_q61 = step;
-        pkg->geoid.values = d + CT_DATUM_HEADER_SIZE;
+        pkg->geoid = g;
     }
     pkg->vdatum = vd;
     pkg->source_epsg = ct_ld32(d + 8);
