@@ -61,6 +61,7 @@
 #include <vector>
 
 #include "conetrace.h"
+#include "proj_pair.hpp"
 
 namespace earth_ref {
 
@@ -84,14 +85,7 @@ struct Proj {
     int epsg = 0;
     long calls = 0;
 
-    static PJ *make(PJ_CONTEXT *c, const char *a, const char *b)
-    {
-        PJ *p = proj_create_crs_to_crs(c, a, b, nullptr);
-        if (!p) return nullptr;
-        PJ *n = proj_normalize_for_visualization(c, p);
-        proj_destroy(p);
-        return n;
-    }
+    static PJ *make(PJ_CONTEXT *c, const char *a, const char *b) { return proj_normalized(c, a, b); }
     explicit Proj(int epsg_code) : epsg(epsg_code)
     {
         if (!((epsg >= 32601 && epsg <= 32660) || (epsg >= 32701 && epsg <= 32760)))
@@ -214,6 +208,17 @@ struct Surface {
         ld u = x - i, v = y - j;
         ld h00 = at(i, j), h10 = at(i + 1, j), h01 = at(i, j + 1), h11 = at(i + 1, j + 1);
         return h00 + (h10 - h00) * u + (h01 - h00) * v + (h11 - h10 - h01 + h00) * u * v;
+    }
+    // the surface under a map point, or the mean height off the tile (where
+    // test poses put a camera a given height above the ground)
+    ld ground_under(ld E, ld N) const
+    {
+        ld x, y;
+        grid(E, N, &x, &y);
+        if (inside(x, y)) return height(x, y);
+        ld s = 0;
+        for (ld v : z) s += v;
+        return s / z.size();
     }
 };
 
@@ -534,6 +539,17 @@ inline Result trace(Proj &pj, const Surface &sf, const Los &L)
         }
     }
     const Sample cam = prev;
+    // the result for a hit at range t on the path
+    auto hit_at = [&](ld t) {
+        Sample hs = detail::sample(pj, sf, L, t);
+        res.status = HIT;
+        res.e = hs.E;
+        res.n = hs.N;
+        res.h = hs.h;
+        res.t = t;
+        res.range = std::hypot(hs.E - cam.E, hs.N - cam.N);
+        return res;
+    };
     ld hit_t = -1;
     int fine_left = 0;
     while (prev.t < t_max) {
@@ -565,15 +581,8 @@ inline Result trace(Proj &pj, const Surface &sf, const Los &L)
                     // the path enters the tile's box at or below the surface:
                     // that entry point (on the box's side) is the path's first
                     // point at or below the terrain -- a hit on the wall
-                    Sample hs = detail::sample(pj, sf, L, hit_t);
-                    res.status = HIT;
                     res.wall = true;
-                    res.e = hs.E;
-                    res.n = hs.N;
-                    res.h = hs.h;
-                    res.t = hit_t;
-                    res.range = std::hypot(hs.E - cam.E, hs.N - cam.N);
-                    return res;
+                    return hit_at(hit_t);
                 }
                 break;
             }
@@ -627,14 +636,7 @@ inline Result trace(Proj &pj, const Surface &sf, const Los &L)
         }
         hit_t = b;
     }
-    Sample hs = detail::sample(pj, sf, L, hit_t);
-    res.status = HIT;
-    res.e = hs.E;
-    res.n = hs.N;
-    res.h = hs.h;
-    res.t = hit_t;
-    res.range = std::hypot(hs.E - cam.E, hs.N - cam.N);
-    return res;
+    return hit_at(hit_t);
 }
 
 // Where a map point (E, N, h) -- e.g. another tracer's hit -- lies relative

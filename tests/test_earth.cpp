@@ -168,16 +168,6 @@ struct Pose {
     ct_pose pose;
 };
 
-ld ground_under(const earth_ref::Surface &sf, ld e, ld n)
-{
-    ld x, y;
-    sf.grid(e, n, &x, &y);
-    if (sf.inside(x, y)) return sf.height(x, y);
-    ld s = 0;
-    for (ld v : sf.z) s += v;
-    return s / sf.z.size();
-}
-
 bool make_pose(const earth_ref::Surface &sf, const PoseDef &d, Pose *out)
 {
     earth_ref::Proj &pj = proj();
@@ -185,7 +175,7 @@ bool make_pose(const earth_ref::Surface &sf, const PoseDef &d, Pose *out)
     pj.utm_inverse(d.e, d.n, &lat, &lon);
     out->def = d;
     const int64_t la = q61(lat), lo = q61(lon);
-    const int64_t h_nm = std::llround((ground_under(sf, d.e, d.n) + d.above) * 1e9L);
+    const int64_t h_nm = std::llround((sf.ground_under(d.e, d.n) + d.above) * 1e9L);
     out->lat = deg_of_q61(la);
     out->lon = deg_of_q61(lo);
     out->h = (ld)h_nm * 1e-9L;

@@ -77,6 +77,7 @@ extern "C" {
 #include "dem_io.hpp"
 #include "earth_reference.hpp"
 #include "harness.h"
+#include "proj_pair.hpp"
 #include "terrain.hpp"
 #include "vdatum.hpp"
 #include "warp.hpp"
@@ -222,22 +223,8 @@ bool cell_valid(const World &w, ld x, ld y)
 }
 
 // ---- PROJ: orthometric (EGM96) height of a WGS84 3D point -------------------
-struct ProjEgm96 {
-    PJ_CONTEXT *ctx = proj_context_create();
-    PJ *pj = nullptr;
-    ProjEgm96()
-    {
-        PJ *p = proj_create_crs_to_crs(ctx, "EPSG:4979", "EPSG:4326+5773", nullptr);
-        if (p) {
-            pj = proj_normalize_for_visualization(ctx, p);
-            proj_destroy(p);
-        }
-    }
-    ~ProjEgm96()
-    {
-        if (pj) proj_destroy(pj);
-        proj_context_destroy(ctx);
-    }
+struct ProjEgm96 : ProjPair {
+    ProjEgm96() : ProjPair("EPSG:4979", "EPSG:4326+5773") {}
     ld height(ld lat_deg, ld lon_deg, ld h_ell) const
     {
         PJ_COORD c = proj_trans(pj, PJ_FWD, proj_coord((double)lon_deg, (double)lat_deg, (double)h_ell, 0));
@@ -297,23 +284,13 @@ struct Pose {
     ld C[3];             // camera centre, ECEF (PROJ)
 };
 
-ld ground_under(const earth_ref::Surface &sf, ld e, ld n)
-{
-    ld x, y;
-    sf.grid(e, n, &x, &y);
-    if (sf.inside(x, y)) return sf.height(x, y);
-    ld s = 0;
-    for (ld v : sf.z) s += v;
-    return s / sf.z.size();
-}
-
 bool make_pose(World &w, const PoseDef &d, Pose *out)
 {
     ld lat, lon;
     w.pj->utm_inverse(d.e, d.n, &lat, &lon);
     out->def = d;
     const int64_t la = q61(lat), lo = q61(lon);
-    const int64_t h_nm = std::llround((ground_under(w.sf, d.e, d.n) + d.above) * 1e9L);
+    const int64_t h_nm = std::llround((w.sf.ground_under(d.e, d.n) + d.above) * 1e9L);
     out->lat = deg_of_q61(la);
     out->lon = deg_of_q61(lo);
     out->h = (ld)h_nm * 1e-9L;

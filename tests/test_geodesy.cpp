@@ -13,6 +13,7 @@
 
 #include "conetrace.h"
 #include "harness.h"
+#include "proj_pair.hpp"
 
 namespace {
 
@@ -21,25 +22,9 @@ typedef long double ld;
 int64_t q61(ld deg) { return (int64_t)std::llround(deg * M_PIl / 180 * std::ldexp(1.0L, 61)); }
 ld deg_of(int64_t q) { return (ld)q / std::ldexp(1.0L, 61) * 180 / M_PIl; }
 
-struct Proj {
-    PJ_CONTEXT *ctx = nullptr;
-    PJ *pj = nullptr;
-    Proj(int epsg)
-    {
-        ctx = proj_context_create();
-        char dst[32];
-        std::snprintf(dst, sizeof dst, "EPSG:%d", epsg);
-        PJ *p = proj_create_crs_to_crs(ctx, "EPSG:4326", dst, nullptr);
-        if (p) {
-            pj = proj_normalize_for_visualization(ctx, p);  // lon, lat order
-            proj_destroy(p);
-        }
-    }
-    ~Proj()
-    {
-        if (pj) proj_destroy(pj);
-        proj_context_destroy(ctx);
-    }
+// EPSG:4326 (lon, lat) -> EPSG:epsg
+struct Proj : ProjPair {
+    explicit Proj(int epsg) : ProjPair("EPSG:4326", ("EPSG:" + std::to_string(epsg)).c_str()) {}
 };
 
 struct Stats {
@@ -345,23 +330,9 @@ void geo_ref(ld x, ld y, ld z, ld *lat, ld *lon, ld *h)
 
 ld rad_of(int64_t q) { return (ld)q / std::ldexp(1.0L, 61); }
 
-struct Proj3 {
-    PJ_CONTEXT *ctx = nullptr;
-    PJ *pj = nullptr;  // EPSG:4979 (lon, lat deg, h m) <-> EPSG:4978 (m)
-    Proj3()
-    {
-        ctx = proj_context_create();
-        PJ *p = proj_create_crs_to_crs(ctx, "EPSG:4979", "EPSG:4978", nullptr);
-        if (p) {
-            pj = proj_normalize_for_visualization(ctx, p);
-            proj_destroy(p);
-        }
-    }
-    ~Proj3()
-    {
-        if (pj) proj_destroy(pj);
-        proj_context_destroy(ctx);
-    }
+// EPSG:4979 (lon, lat deg, h m) <-> EPSG:4978 (m)
+struct Proj3 : ProjPair {
+    Proj3() : ProjPair("EPSG:4979", "EPSG:4978") {}
 };
 
 // a seeded geodetic point: every latitude (poles and the equator exactly

@@ -18,6 +18,7 @@
 #include "conetrace.h"
 #include "dem_io.hpp"
 #include "harness.h"
+#include "proj_pair.hpp"
 #include "le.hpp"
 #include "terrain.hpp"
 #include "vdatum.hpp"
@@ -29,24 +30,8 @@ namespace {
 const std::string kDem = std::string(CT_FIXTURES_DIR) + "/jacksboro_fault_dem.tif";
 
 // N (metres) at UTM (E, N) by PROJ: (E, N, 0 m above EGM96) -> WGS84 3D
-struct ProjGeoid {
-    PJ_CONTEXT *ctx = proj_context_create();
-    PJ *pj = nullptr;
-    explicit ProjGeoid(int epsg)
-    {
-        char src[48];
-        std::snprintf(src, sizeof src, "EPSG:%d+5773", epsg);
-        PJ *p = proj_create_crs_to_crs(ctx, src, "EPSG:4979", nullptr);
-        if (p) {
-            pj = proj_normalize_for_visualization(ctx, p);
-            proj_destroy(p);
-        }
-    }
-    ~ProjGeoid()
-    {
-        if (pj) proj_destroy(pj);
-        proj_context_destroy(ctx);
-    }
+struct ProjGeoid : ProjPair {
+    explicit ProjGeoid(int epsg) : ProjPair(("EPSG:" + std::to_string(epsg) + "+5773").c_str(), "EPSG:4979") {}
     double at(double e, double n) const
     {
         PJ_COORD c = proj_trans(pj, PJ_FWD, proj_coord(e, n, 0.0, 0.0));
