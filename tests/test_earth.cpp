@@ -513,15 +513,18 @@ void compare(unsigned flags)
     const std::vector<PoseDef> defs = pose_defs();
     const char *families[] = {"nadir", "oblique30", "oblique20", "grazing5", "grazing3", "long"};
     const int nf = 6;
-    Stat exact[nf], old[nf];
+    Stat exact[nf], old[nf], fitted[nf];
     ld rng_sum[nf] = {0};
     long ref_hits[nf] = {0};
     ct_rng rng;
     ct_rng_seed(&rng, ct_test_seed() * 1009 + flags);
     const int npix = std::max(1, (int)std::lround(kPixelsPerPose * ct_test_scale()));
     const ct_effects fx = {flags, CT_REFRACTION_K_STD_Q16, 0, 0};
-    ct_effects fx_old = fx;
+    ct_effects fx_old = fx, fx_fit = fx;
     fx_old.earth_radius_nm = CT_EARTH_RADIUS_NM;
+    fx_fit.flags |= CT_EFFECT_EARTH_FIT;
+    double fit_vs_exact = 0;
+    long fit_status_diff = 0;
     long first_reports = 0;
     auto t0 = std::chrono::steady_clock::now();
     for (const PoseDef &d : defs) {
@@ -529,9 +532,25 @@ void compare(unsigned flags)
         while (std::strcmp(families[f], d.family) != 0) f++;
         Pose p;
         TEST_ASSERT_MSG(make_pose(w->sf, d, &p), "pose %s", d.family);
+        std::vector<int64_t> uv(2 * (size_t)npix);
         for (int k = 0; k < npix; ++k) {
-            const int64_t u = ct_rng_range(&rng, 0, (int64_t)(cam.w - 1) << 16);
-            const int64_t v = ct_rng_range(&rng, 0, (int64_t)(cam.h - 1) << 16);
+            uv[2 * k] = ct_rng_range(&rng, 0, (int64_t)(cam.w - 1) << 16);
+            uv[2 * k + 1] = ct_rng_range(&rng, 0, (int64_t)(cam.h - 1) << 16);
+        }
+        // the fitted map: the whole pose in one batch, its first pixel also
+        // alone (the batch's results are ct_geolocate's, bit for bit)
+        std::vector<ct_geo> gf((size_t)npix);
+        TEST_ASSERT(ct_geolocate_batch(&w->p, &cam.cam, &p.pose, CT_METHOD_DIRECTIONAL, &fx_fit, uv.data(),
+                                       (size_t)npix, gf.data(), gf.size()) == CT_OK);
+        {
+            ct_geo g1;
+            const ct_status s1 =
+                ct_geolocate(&w->p, &cam.cam, &p.pose, CT_METHOD_DIRECTIONAL, &fx_fit, uv[0], uv[1], &g1);
+            TEST_ASSERT(s1 == gf[0].status && g1.hit.e_nm == gf[0].hit.e_nm && g1.hit.n_nm == gf[0].hit.n_nm &&
+                        g1.hit.h_nm == gf[0].hit.h_nm && g1.hit.steps == gf[0].hit.steps);
+        }
+        for (int k = 0; k < npix; ++k) {
+            const int64_t u = uv[2 * k], v = uv[2 * k + 1];
             ld ray[3];
             earth_ref::pinhole_ray(cam.fx, cam.fy, cam.cx, cam.cy, (ld)u / 65536, (ld)v / 65536, ray);
             const earth_ref::Los L = earth_ref::los_from_pose(pj, p.pose, ray, &fx);
@@ -543,6 +562,7 @@ void compare(unsigned flags)
             if (r.min_clear < kSkipClearM) {
                 exact[f].skipped++;
                 old[f].skipped++;
+                fitted[f].skipped++;
                 continue;
             }
             if (r.status == CT_HIT) {
@@ -583,6 +603,15 @@ void compare(unsigned flags)
             };
             judge(exact[f], ls, g, true);
             judge(old[f], los, go, false);
+            const int lfs = gf[k].status == CT_HIT_VOID ? CT_HIT : gf[k].status;
+            judge(fitted[f], lfs, gf[k], true);
+            if (lfs != ls) {
+                fit_status_diff++;
+            } else if (ls == CT_HIT) {
+                fit_vs_exact = std::max(fit_vs_exact, (double)dist3(gf[k].hit.e_nm * 1e-9L, gf[k].hit.n_nm * 1e-9L,
+                                                                    gf[k].hit.h_nm * 1e-9L, g.hit.e_nm * 1e-9L,
+                                                                    g.hit.n_nm * 1e-9L, g.hit.h_nm * 1e-9L));
+            }
         }
     }
     const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -611,6 +640,29 @@ void compare(unsigned flags)
         n += exact[f].n;
         bad += exact[f].mismatch;
     }
+    double fworst = 0, fworst_off = 0, fsum2 = 0;
+    long fbad = 0, fn = 0;
+    for (int f = 0; f < nf; ++f) {
+        std::printf("  %-10s fitted map (CT_EFFECT_EARTH_FIT): %5ld hits, median / RMS / max %8.4f %8.4f %9.4f m, "
+                    "bad %ld, wall %ld\n",
+                    families[f], fitted[f].n, fitted[f].median(), fitted[f].rms(), fitted[f].max, fitted[f].mismatch,
+                    fitted[f].wall_below);
+        if (fitted[f].n) std::printf("  %-10s   worst (fitted map): %s\n", "", fitted[f].worst);
+        fworst = std::max(fworst, fitted[f].max);
+        fworst_off = std::max(fworst_off, fitted[f].max_off);
+        fsum2 += fitted[f].sum2;
+        fn += fitted[f].n;
+        fbad += fitted[f].mismatch;
+    }
+    const double frms = fn ? std::sqrt(fsum2 / (double)fn) : 0;
+    std::printf("  fitted map: hits within %.4f m of the reference path, RMS %.4f m, max %.4f m from the reference "
+                "hit; vs the exact map's hits: up to %.4f m apart, %ld statuses differ\n",
+                fworst_off, frms, fworst, fit_vs_exact, fit_status_diff);
+    TEST_ASSERT_MSG(fworst_off <= kMaxOffPathM, "fitted map: a hit %.4f m off the reference path (> %.4f m)",
+                    fworst_off, kMaxOffPathM);
+    TEST_ASSERT_MSG(frms <= kMaxRmsM, "fitted map: RMS %.4f m (> %.4f m)", frms, kMaxRmsM);
+    TEST_ASSERT_MSG(fbad == 0, "fitted map: %ld rays with a status different from the reference's", fbad);
+    TEST_ASSERT_MSG(fworst <= kMaxErrM, "fitted map off the reference by up to %.4f m (> %.4f m)", fworst, kMaxErrM);
     const double rms = n ? std::sqrt(sum2 / (double)n) : 0;
     std::printf("  exact mode: hits within %.4f m of the reference path (bound %.4f m), RMS %.4f m, max %.4f m from "
                 "the reference hit\n", worst_off, kMaxOffPathM, rms, worst);

@@ -84,6 +84,9 @@ ct_status ct_trace_prepared_lowered(const ct_package *pkg, const ct_prepared *ra
 ct_status ct_lower_setup_k(const ct_package *pkg, int64_t ox_q16, int64_t oy_q16, uint64_t kf, uint32_t kshift,
                            int32_t cull, ct_lower *lw);
 
+#define CT_EARTH_FIT_DEG 6
+#define CT_EARTH_FIT_TERMS 84 /* (deg + 1)(deg + 2)(deg + 3) / 6 for deg 6 */
+
 /* The true Earth (earth.c): a line of sight straight in Earth-fixed space
  * (WGS84; with refraction bent by k t^2 / 2R in its vertical plane) from a
  * camera over a package on a UTM zone, traced in pieces whose map-frame
@@ -102,6 +105,15 @@ typedef struct {
     int64_t tolz_q16;      /* the same in Q16 height units (>= 2)             */
     int64_t tmax_nm;       /* no terrain beyond this range                    */
     int32_t cull;
+    /* The fitted map (CT_EFFECT_EARTH_FIT; earth.c): the image of ECEF
+     * points P in the cube |P - c| <= 2^qrho nm as a sum of Chebyshev
+     * products T_a(s_x) T_b(s_y) T_c(s_z), s = (P - c) / 2^qrho, a + b + c
+     * <= deg, interpolated through the exact images at the tensor grid of
+     * (deg + 1)^3 Chebyshev points.  deg = 0: no fit.                    */
+    int32_t fit_deg;       /* 0, or 4..CT_EARTH_FIT_DEG                       */
+    uint32_t fit_qrho;     /* the cube's half-width is 2^fit_qrho nm, 44..47  */
+    int64_t fit_base[3];   /* image of c: grid x, y, z, Q24                   */
+    int64_t fit_cf[CT_EARTH_FIT_TERMS][3]; /* coefficients, Q24, |.| < 2^50   */
 } ct_earth;
 
 /* Library-internal helpers shared between files.                          */
@@ -125,9 +137,10 @@ ct_status ct_grid_frame_ecef(const ct_utm *zone, int64_t e_nm, int64_t n_nm, int
 
 /* Set-up for a pose over a UTM package: CT_ERR_CRS when the package is not
  * on a UTM zone, CT_ERR_RANGE / CT_ERR_RAY for a camera outside the
- * projection's or the tracer's domain.                                     */
+ * projection's or the tracer's domain.  fitted != 0: fit the map (above)
+ * when the cube needed is at most 2^47 nm (else the exact map is kept).  */
 ct_status ct_earth_setup(const ct_package *pkg, const ct_pose *pose, int32_t refr_k_q16, int64_t radius_nm,
-                         int64_t chord_nm, uint32_t bend_flags, ct_earth *es);
+                         int64_t chord_nm, uint32_t bend_flags, int fitted, ct_earth *es);
 
 /* The first hit of the line of sight of a unit map-frame direction
  * (grid east, grid north, up at the camera; Q39, without the pose's

@@ -50,8 +50,9 @@
 #define EARTH_MAX_RETRIES 8u
 
 typedef struct {
-    int64_t x, y, z;  /* Q16 grid (the walks' units)                       */
-    int64_t fx, fy;   /* x, y with 8 more bits (Q24): the checks' precision */
+    int64_t x, y, z;    /* Q16 grid (the walks' units)                       */
+    int64_t fx, fy, fz; /* x, y, z with 8 more bits (Q24): the checks' and
+                           the node polynomial's precision                  */
 } gv;
 
 /* The image is interpolated between n exact images at the Chebyshev
@@ -121,11 +122,219 @@ typedef struct {
     int64_t cf[NODES][3]; /* polynomial in sigma, Q24, lowest power first */
 } path;
 
-/* The exact image of P(t) in the grid frame. */
+/* round(v / 256) */
+static int64_t q24_to_16(int64_t v)
+{
+    return ct_floor_div(v + 128, 256);
+}
+
+/* ---- the fitted map (CT_EFFECT_EARTH_FIT) ------------------------------
+ * T_a(x_i) = cos(a (2i + 1) pi / 2m) in Q62 for m = deg + 1 points per
+ * axis (generated with mpmath at 60 digits); row 1 holds the points x_i. */
+static const int64_t cheb5_q62[5][5] = {
+    {INT64_C(4611686018427387904), INT64_C(4611686018427387904), INT64_C(4611686018427387904),
+     INT64_C(4611686018427387904), INT64_C(4611686018427387904)},
+    {INT64_C(4385974038932618941), INT64_C(2710681029835013083), INT64_C(0), -INT64_C(2710681029835013083),
+     -INT64_C(4385974038932618941)},
+    {INT64_C(3730932361629093763), -INT64_C(1425089352415399811), -INT64_C(4611686018427387904),
+     -INT64_C(1425089352415399811), INT64_C(3730932361629093763)},
+    {INT64_C(2710681029835013083), -INT64_C(4385974038932618941), INT64_C(0), INT64_C(4385974038932618941),
+     -INT64_C(2710681029835013083)},
+    {INT64_C(1425089352415399811), -INT64_C(3730932361629093763), INT64_C(4611686018427387904),
+     -INT64_C(3730932361629093763), INT64_C(1425089352415399811)}};
+static const int64_t cheb6_q62[6][6] = {
+    {INT64_C(4611686018427387904), INT64_C(4611686018427387904), INT64_C(4611686018427387904),
+     INT64_C(4611686018427387904), INT64_C(4611686018427387904), INT64_C(4611686018427387904)},
+    {INT64_C(4454546627935218059), INT64_C(3260954456333195553), INT64_C(1193592171602022505),
+     -INT64_C(1193592171602022505), -INT64_C(3260954456333195553), -INT64_C(4454546627935218059)},
+    {INT64_C(3993837246235628775), INT64_C(0), -INT64_C(3993837246235628775), -INT64_C(3993837246235628775),
+     INT64_C(0), INT64_C(3993837246235628775)},
+    {INT64_C(3260954456333195553), -INT64_C(3260954456333195553), -INT64_C(3260954456333195553),
+     INT64_C(3260954456333195553), INT64_C(3260954456333195553), -INT64_C(3260954456333195553)},
+    {INT64_C(2305843009213693952), -INT64_C(4611686018427387904), INT64_C(2305843009213693952),
+     INT64_C(2305843009213693952), -INT64_C(4611686018427387904), INT64_C(2305843009213693952)},
+    {INT64_C(1193592171602022505), -INT64_C(3260954456333195553), INT64_C(4454546627935218059),
+     -INT64_C(4454546627935218059), INT64_C(3260954456333195553), -INT64_C(1193592171602022505)}};
+static const int64_t cheb7_q62[7][7] = {
+    {INT64_C(4611686018427387904), INT64_C(4611686018427387904), INT64_C(4611686018427387904),
+     INT64_C(4611686018427387904), INT64_C(4611686018427387904), INT64_C(4611686018427387904),
+     INT64_C(4611686018427387904)},
+    {INT64_C(4496061421583520199), INT64_C(3605561316464170519), INT64_C(2000935573311439104), INT64_C(0),
+     -INT64_C(2000935573311439104), -INT64_C(3605561316464170519), -INT64_C(4496061421583520199)},
+    {INT64_C(4154985531143938469), INT64_C(1026196679933739317), -INT64_C(2875339201863983833),
+     -INT64_C(4611686018427387904), -INT64_C(2875339201863983833), INT64_C(1026196679933739317),
+     INT64_C(4154985531143938469)},
+    {INT64_C(3605561316464170519), -INT64_C(2000935573311439104), -INT64_C(4496061421583520199), INT64_C(0),
+     INT64_C(4496061421583520199), INT64_C(2000935573311439104), -INT64_C(3605561316464170519)},
+    {INT64_C(2875339201863983833), -INT64_C(4154985531143938469), -INT64_C(1026196679933739317),
+     INT64_C(4611686018427387904), -INT64_C(1026196679933739317), -INT64_C(4154985531143938469),
+     INT64_C(2875339201863983833)},
+    {INT64_C(2000935573311439104), -INT64_C(4496061421583520199), INT64_C(3605561316464170519), INT64_C(0),
+     -INT64_C(3605561316464170519), INT64_C(4496061421583520199), -INT64_C(2000935573311439104)},
+    {INT64_C(1026196679933739317), -INT64_C(2875339201863983833), INT64_C(4154985531143938469),
+     -INT64_C(4611686018427387904), INT64_C(4154985531143938469), -INT64_C(2875339201863983833),
+     INT64_C(1026196679933739317)}};
+#define T_ONE_Q62 (INT64_C(1) << 62)
+
+static int64_t cheb_at_node(int deg, int a, int i)
+{
+    return deg == 4 ? cheb5_q62[a][i] : (deg == 5 ? cheb6_q62[a][i] : cheb7_q62[a][i]);
+}
+
+/* x = round(v 2^24 / |s|) - off (the sign of s folded into v), 0 < |s| <=
+ * 2^50, |v| < 2^62: |v 2^24| < 2^86; CT_ERR_RANGE when the quotient passes
+ * 2^61. */
+static ct_status grid24(int64_t v, int64_t s, int64_t off, int64_t *x)
+{
+    if (s < 0) {
+        v = -v;
+        s = -s;
+    }
+    if (!ct_i128_round_div_lim(ct_i128_shl(ct_i128_from64(v), 24u), s, INT64_C(1) << 61, x)) {
+        return CT_ERR_RANGE;
+    }
+    *x -= off;
+    return CT_OK;
+}
+
+/* The exact image of the ECEF point P (nm) in the grid frame, Q24 (as
+ * ct_map_to_grid with 8 more bits). */
+static ct_status image24(const ct_package *p, const ct_utm *zone, const int64_t P[3], int64_t g[3])
+{
+    int64_t lat, lon, h, e, n;
+    ct_status st = ct_wgs84_from_ecef(P, &lat, &lon, &h);
+    if (st == CT_OK) {
+        st = ct_utm_forward(zone, lat, lon, &e, &n);
+    }
+    if (st != CT_OK) {
+        return st;
+    }
+    if (ct_abs64(e) > (INT64_C(1) << 60) || ct_abs64(n) > (INT64_C(1) << 60) || ct_abs64(h) > (INT64_C(1) << 60)) {
+        return CT_ERR_RANGE;
+    }
+    /* the origin and offset are the package's (|.| <= 2^61, checked at
+     * open), so the differences stay below 2^62 */
+    st = grid24(e - p->origin_e_nm, p->posting_e_nm, INT64_C(1) << 23, &g[0]);
+    if (st == CT_OK) {
+        st = grid24(n - p->origin_n_nm, p->posting_n_nm, INT64_C(1) << 23, &g[1]);
+    }
+    if (st == CT_OK) {
+        st = grid24(h - p->height_offset_nm, p->height_scale_nm, 0, &g[2]);
+    }
+    return st;
+}
+
+/* The fitted image of c + D (|D| <= 2^qrho per axis, checked by the
+ * caller), Q24: sum of cf T_a(s_x) T_b(s_y) T_c(s_z), s = D 2^(62 - qrho)
+ * in Q62.  T by the recurrence T_(n+1) = 2 s T_n - T_(n-1) (|T| <= 1: each
+ * product < 2^125); a product of three T's in Q62, times cf (< 2^50):
+ * < 2^112, at most 84 of them summed in 128 bits. */
+static void fit_eval(const ct_earth *es, const int64_t D[3], int64_t g[3])
+{
+    int64_t T[3][CT_EARTH_FIT_DEG + 1];
+    ct_i128 acc[3];
+    int a, b, c, k, t = 0, deg = es->fit_deg;
+    for (k = 0; k < 3; ++k) { /* bound: 3 axes */
+        int n;
+        T[k][0] = T_ONE_Q62;
+        T[k][1] = D[k] * (INT64_C(1) << (62u - es->fit_qrho)); /* |D| <= 2^qrho */
+        for (n = 1; n < deg; ++n) { /* bound: CT_EARTH_FIT_DEG - 1 */
+            T[k][n + 1] = ct_mul_shr(T[k][1], T[k][n], 61u) - T[k][n - 1];
+        }
+        acc[k] = ct_i128_from64(0);
+    }
+    for (a = 0; a <= deg; ++a) {             /* bound: CT_EARTH_FIT_DEG + 1 */
+        for (b = 0; a + b <= deg; ++b) {     /* bound: CT_EARTH_FIT_DEG + 1 */
+            int64_t tt = ct_mul_shr(T[0][a], T[1][b], 62u);
+            for (c = 0; a + b + c <= deg; ++c) { /* bound: CT_EARTH_FIT_DEG + 1 */
+                int64_t ttt = ct_mul_shr(tt, T[2][c], 62u);
+                for (k = 0; k < 3; ++k) { /* bound: 3 coordinates */
+                    acc[k] = ct_i128_add(acc[k], ct_i128_mul(es->fit_cf[t][k], ttt));
+                }
+                t++;
+            }
+        }
+    }
+    for (k = 0; k < 3; ++k) { /* bound: 3 coordinates */
+        g[k] = es->fit_base[k] + ct_i128_round_shr(acc[k], 62u);
+    }
+}
+
+/* The fit through the exact images at the (deg + 1)^3 Chebyshev points of
+ * the cube: c_abc = (2/m)^3 g_a g_b g_c sum_ijk f_ijk T_a(x_i) T_b(x_j)
+ * T_c(x_k), m = deg + 1, g_0 = 1/2 and 1 otherwise, f the images less the
+ * camera's.  |f| < 2^47 is required (else no fit); each term f T T T /
+ * 2^56 (Q30) < 2^53, the sum over <= 343 points < 2^61.5, kept in the
+ * coefficient array itself; then / (m^3 2^(3 + zeros)) to Q24: |c| <= 8
+ * max|f| < 2^50.  Leaves fit_deg = 0 when a point is outside the
+ * projection's domain or too far. */
+static void fit_map(const ct_package *p, ct_earth *es, uint32_t qrho)
+{
+    int deg = qrho <= 44u ? 4 : (qrho == 45u ? 5 : 6);
+    int m = deg + 1, i, j, k, a, b, c, t, o;
+    es->fit_deg = 0;
+    es->fit_qrho = qrho;
+    es->fit_base[0] = es->ox * 256; /* |ox| <= 2^46 */
+    es->fit_base[1] = es->oy * 256;
+    es->fit_base[2] = es->oz * 256;
+    for (t = 0; t < CT_EARTH_FIT_TERMS; ++t) { /* bound: CT_EARTH_FIT_TERMS */
+        es->fit_cf[t][0] = es->fit_cf[t][1] = es->fit_cf[t][2] = 0;
+    }
+    for (i = 0; i < m; ++i) {             /* bound: CT_EARTH_FIT_DEG + 1 */
+        for (j = 0; j < m; ++j) {         /* bound: CT_EARTH_FIT_DEG + 1 */
+            for (k = 0; k < m; ++k) {     /* bound: CT_EARTH_FIT_DEG + 1 */
+                int64_t P[3], f[3];
+                /* the point: c + 2^qrho x (|x| <= 2^62 in Q62) */
+                P[0] = es->c[0] + ct_mul_shr(cheb_at_node(deg, 1, i), INT64_C(1) << qrho, 62u);
+                P[1] = es->c[1] + ct_mul_shr(cheb_at_node(deg, 1, j), INT64_C(1) << qrho, 62u);
+                P[2] = es->c[2] + ct_mul_shr(cheb_at_node(deg, 1, k), INT64_C(1) << qrho, 62u);
+                if (image24(p, &es->zone, P, f) != CT_OK) {
+                    return;
+                }
+                for (o = 0; o < 3; ++o) { /* bound: 3 coordinates */
+                    f[o] -= es->fit_base[o];
+                    if (ct_abs64(f[o]) >= (INT64_C(1) << 47)) {
+                        return;
+                    }
+                }
+                t = 0;
+                for (a = 0; a <= deg; ++a) {             /* bound: CT_EARTH_FIT_DEG + 1 */
+                    for (b = 0; a + b <= deg; ++b) {     /* bound: CT_EARTH_FIT_DEG + 1 */
+                        int64_t tt = ct_mul_shr(cheb_at_node(deg, a, i), cheb_at_node(deg, b, j), 62u);
+                        for (c = 0; a + b + c <= deg; ++c) { /* bound: CT_EARTH_FIT_DEG + 1 */
+                            int64_t ttt = ct_mul_shr(tt, cheb_at_node(deg, c, k), 62u);
+                            for (o = 0; o < 3; ++o) { /* bound: 3 coordinates */
+                                es->fit_cf[t][o] += ct_mul_shr(f[o], ttt, 56u);
+                            }
+                            t++;
+                        }
+                    }
+                }
+            }
+        }
+    }
+    t = 0;
+    for (a = 0; a <= deg; ++a) {             /* bound: CT_EARTH_FIT_DEG + 1 */
+        for (b = 0; a + b <= deg; ++b) {     /* bound: CT_EARTH_FIT_DEG + 1 */
+            for (c = 0; a + b + c <= deg; ++c) { /* bound: CT_EARTH_FIT_DEG + 1 */
+                /* D = m^3 2^(3 + zeros) <= 343 * 64; 2 |sum| + D < 2^63 */
+                int64_t D = (int64_t)(m * m * m) << (3 + (a == 0) + (b == 0) + (c == 0));
+                for (o = 0; o < 3; ++o) { /* bound: 3 coordinates */
+                    es->fit_cf[t][o] = ct_floor_div(2 * es->fit_cf[t][o] + D, 2 * D);
+                }
+                t++;
+            }
+        }
+    }
+    es->fit_deg = deg;
+}
+
+/* The image of P(t) in the grid frame: exact, or by the fitted map when
+ * there is one and P is in its cube. */
 static ct_status vertex_exact(const path *pa, int64_t t, gv *v)
 {
-    int64_t P[3], lat, lon, h, e, n, bend = 0;
-    int k;
+    int64_t D[3], g[3], bend = 0;
+    int k, in = pa->es->fit_deg > 0;
     ct_status st;
     if (pa->refract) {
         /* k t^2 / 2R: t < 2^48, t^2 < 2^96, |k| <= 2^17: < 2^113; / 2R
@@ -136,28 +345,40 @@ static ct_status vertex_exact(const path *pa, int64_t t, gv *v)
     /* bound: 3 axes.  t d: < 2^48 2^40 = 2^88 (128-bit) / 2^39; bend w:
      * < 2^46 2^31 / 2^30 */
     for (k = 0; k < 3; ++k) {
-        P[k] = pa->es->c[k] + ct_mul_shr(t, pa->d[k], 39u);
+        D[k] = ct_mul_shr(t, pa->d[k], 39u);
         if (pa->refract) {
-            P[k] -= ct_mul_shr(bend, pa->w[k], 30u);
+            D[k] -= ct_mul_shr(bend, pa->w[k], 30u);
         }
+        in = in && ct_abs64(D[k]) <= (INT64_C(1) << pa->es->fit_qrho);
     }
-    st = ct_wgs84_from_ecef(P, &lat, &lon, &h);
-    if (st == CT_OK) {
-        st = ct_utm_forward(&pa->zone, lat, lon, &e, &n);
+    if (in) {
+        fit_eval(pa->es, D, g);
+        v->fx = g[0];
+        v->fy = g[1];
+        v->fz = g[2];
+        v->x = q24_to_16(g[0]);
+        v->y = q24_to_16(g[1]);
+        v->z = q24_to_16(g[2]);
+        return CT_OK;
     }
-    if (st == CT_OK) {
-        st = ct_map_to_grid(pa->p, e, n, h, &v->x, &v->y, &v->z);
+    {
+        int64_t P[3], lat, lon, h, e, n;
+        for (k = 0; k < 3; ++k) { /* bound: 3 axes */
+            P[k] = pa->es->c[k] + D[k];
+        }
+        st = ct_wgs84_from_ecef(P, &lat, &lon, &h);
+        if (st == CT_OK) {
+            st = ct_utm_forward(&pa->zone, lat, lon, &e, &n);
+        }
+        if (st == CT_OK) {
+            st = ct_map_to_grid(pa->p, e, n, h, &v->x, &v->y, &v->z);
+        }
     }
     /* |x|, |y| < 2^55 (ct_map_to_grid's range) */
     v->fx = v->x * 256;
     v->fy = v->y * 256;
+    v->fz = v->z * 256;
     return st;
-}
-
-/* round(v / 256) */
-static int64_t q24_to_16(int64_t v)
-{
-    return ct_floor_div(v + 128, 256);
 }
 
 /* The image of P(t), 0 <= t <= tmax: interpolated when the nodes are set. */
@@ -179,6 +400,7 @@ CT_NOINLINE static ct_status vertex(const path *pa, int64_t t, gv *v)
     }
     v->fx = r[0];
     v->fy = r[1];
+    v->fz = r[2];
     v->x = q24_to_16(r[0]);
     v->y = q24_to_16(r[1]);
     v->z = q24_to_16(r[2]);
@@ -203,13 +425,13 @@ CT_NOINLINE static void set_nodes(path *pa, int64_t tmax)
             return;
         }
         if (j == 0) {
-            pa->base[0] = v.x * 256;
-            pa->base[1] = v.y * 256;
-            pa->base[2] = v.z * 256;
+            pa->base[0] = v.fx;
+            pa->base[1] = v.fy;
+            pa->base[2] = v.fz;
         }
-        X[j][0] = v.x * 256 - pa->base[0];
-        X[j][1] = v.y * 256 - pa->base[1];
-        X[j][2] = v.z * 256 - pa->base[2];
+        X[j][0] = v.fx - pa->base[0];
+        X[j][1] = v.fy - pa->base[1];
+        X[j][2] = v.fz - pa->base[2];
         if (ct_abs64(X[j][0]) >= (INT64_C(1) << 46) || ct_abs64(X[j][1]) >= (INT64_C(1) << 46) ||
             ct_abs64(X[j][2]) >= (INT64_C(1) << 46)) {
             return;
@@ -361,7 +583,7 @@ CT_NOINLINE static int rise_coeff(ct_i128 num, ct_i128 den, uint64_t *kf, uint32
 }
 
 ct_status ct_earth_setup(const ct_package *p, const ct_pose *pose, int32_t refr_k_q16, int64_t radius_nm,
-                         int64_t chord_nm, uint32_t bend_flags, ct_earth *es)
+                         int64_t chord_nm, uint32_t bend_flags, int fitted, ct_earth *es)
 {
     int64_t lat, lon, post, far2x, far2y, dz;
     ct_status st;
@@ -413,6 +635,26 @@ ct_status ct_earth_setup(const ct_package *p, const ct_pose *pose, int32_t refr_
             dist = TMAX_LIMIT_NM;
         }
         es->tmax_nm = ct_min64(TMAX_LIMIT_NM, dist + dist / 10 + KM_NM);
+    }
+    es->fit_deg = 0;
+    es->fit_qrho = 0u;
+    if (fitted) {
+        /* the cube holds every node C + t d - bend w, t <= tmax: its
+         * half-width 2^q >= tmax + the bend at tmax (as vertex_exact: |k|
+         * tmax^2 / 2R, < 2^62 saturated) + 1 km */
+        int64_t need, bend;
+        uint32_t q = 44u;
+        ct_i128 num = ct_i128_mul128_64(ct_umul64((uint64_t)es->tmax_nm, (uint64_t)es->tmax_nm),
+                                        refr_k_q16 < 0 ? -(int64_t)refr_k_q16 : (int64_t)refr_k_q16);
+        bend = ct_floor_div(ct_i128_floor_div_sat(num, 2 * radius_nm), ONE16);
+        need = es->tmax_nm + bend + KM_NM; /* < 2^48 + 2^46 + 2^40 */
+        /* bound: 4 sizes */
+        while (q < 48u && (INT64_C(1) << q) < need) {
+            q++;
+        }
+        if (q <= 47u) {
+            fit_map(p, es, q);
+        }
     }
     return CT_OK;
 }
@@ -580,6 +822,7 @@ ct_status ct_trace_earth(const ct_package *p, const ct_earth *es, const int64_t 
     A.z = es->oz;
     A.fx = es->ox * 256; /* |ox| <= 2^46 */
     A.fy = es->oy * 256;
+    A.fz = es->oz * 256;
     /* bound: EARTH_MAX_PIECES pieces, each with at most EARTH_MAX_RETRIES
      * + 1 tries */
     for (piece = 0u; piece < EARTH_MAX_PIECES && ta < es->tmax_nm; ++piece) {
