@@ -46,6 +46,7 @@
 #include <string>
 #include <vector>
 
+#include "bend.h"
 #include "conetrace.h"
 #include "dem_io.hpp"
 #include "earth_reference.hpp"
@@ -68,6 +69,8 @@ const double kMaxOffPathM = 0.001 + 2 * 30.0 / 65536;
 const double kMaxErrM = 0.04;       // library exact mode vs reference, 3D distance (m): the off-path
                                     // bound over sin(3 deg), the shallowest incidence the poses make
 const double kMaxRmsM = 0.005;      // the same, RMS over every family
+const double kFitMaxM = 2e-5;       // fitted map vs the reference ECEF -> UTM over its cube (m):
+                                    // measured 1.4e-5 at 2^47 nm, degree 6; <= 1.7e-6 below
 const double kSkipClearM = 0.05;    // skip rays passing this close (m) over terrain before the hit
 const double kRefCheckM = 5e-5;     // reference vs closed form on a flat package (m)
 const double kNadirM = 1e-3;        // nadir hit vs the point below the camera (m)
@@ -673,6 +676,80 @@ void compare(unsigned flags)
     TEST_ASSERT_MSG(worst <= kMaxErrM, "library exact mode off the reference by up to %.4f m (> %.4f m)", worst, kMaxErrM);
 }
 
+// The fitted map (CT_EFFECT_EARTH_FIT) against PROJ's ECEF -> UTM over its
+// whole cube, for cameras ever farther west of the tile (cubes of 2^44 ..
+// 2^47 nm, degrees 4 .. 6): the fit is interpolation, so the error is
+// largest between its points and near the cube's corners -- sampled at
+// random points, at the corners and on the faces' middles.
+void test_fitted_map()
+{
+    earth_ref::Proj &pj = proj();
+    World *w = jacksboro();
+    const ct_package &pk = w->p;
+    ct_rng rng;
+    ct_rng_seed(&rng, ct_test_seed() * 31 + 7);
+    const int nrand = std::max(200, (int)std::lround(3000 * ct_test_scale()));
+    uint32_t seen = 0;
+    double worst = 0;
+    for (ld back_km : {0.0L, 12.0L, 40.0L, 100.0L}) {
+        Pose p;
+        TEST_ASSERT(make_pose(w->sf, {"far", 201045 + back_km * 1000, 4065840, 3000, 270, -10}, &p));
+        ct_earth es;
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_earth_setup(&pk, &p.pose, CT_REFRACTION_K_STD_Q16, CT_EARTH_RADIUS_NM,
+                                                    CT_EFFECTS_CHORD_NM, 0u, 1, &es));
+        TEST_ASSERT_MSG(es.fit_deg >= 4 && es.fit_deg <= CT_EARTH_FIT_DEG, "no fit %d km back (range %.1f km)",
+                        (int)back_km, es.tmax_nm * 1e-12);
+        seen |= 1u << es.fit_qrho % 32u;
+        const int64_t half = INT64_C(1) << es.fit_qrho;
+        double err[3] = {0, 0, 0};
+        auto check = [&](const int64_t D[3]) {
+            int64_t g[3];
+            TEST_ASSERT_EQUAL_INT(CT_OK, ct_earth_image24(&pk, &es, D, 1, g));
+            // the reference: long-double geodetic coordinates (PROJ's own
+            // ECEF -> geodetic is one Bowring step, off by tens of um 70 km
+            // from the ellipsoid), PROJ's transverse Mercator
+            ld X[3], E, N, h, lat, lon;
+            for (int k = 0; k < 3; ++k) X[k] = (ld)(es.c[k] + D[k]) * 1e-9L;
+            earth_ref::geodetic_ld(X, &lat, &lon, &h);
+            pj.utm(lat * 180 / kPi, lon * 180 / kPi, &E, &N);
+            const ld fe = pk.origin_e_nm * 1e-9L + (ld)(g[0] + (INT64_C(1) << 23)) * (ld)pk.posting_e_nm * 1e-9L / 16777216.0L;
+            const ld fn = pk.origin_n_nm * 1e-9L + (ld)(g[1] + (INT64_C(1) << 23)) * (ld)pk.posting_n_nm * 1e-9L / 16777216.0L;
+            const ld fh = pk.height_offset_nm * 1e-9L + (ld)g[2] * (ld)pk.height_scale_nm * 1e-9L / 16777216.0L;
+            err[0] = std::max(err[0], (double)std::fabs(fe - E));
+            err[1] = std::max(err[1], (double)std::fabs(fn - N));
+            err[2] = std::max(err[2], (double)std::fabs(fh - h));
+        };
+        for (int c = 0; c < 27; ++c) {  // corners, edge and face middles, centre
+            const int64_t D[3] = {(c % 3 - 1) * half, (c / 3 % 3 - 1) * half, (c / 9 - 1) * half};
+            check(D);
+        }
+        for (int k = 0; k < nrand; ++k) {
+            const int64_t D[3] = {ct_rng_range(&rng, -half, half), ct_rng_range(&rng, -half, half),
+                                  ct_rng_range(&rng, -half, half)};
+            check(D);
+        }
+        // just outside the cube: no fitted image
+        const int64_t Dout[3] = {half + 1, 0, 0};
+        int64_t gout[3];
+        TEST_ASSERT_EQUAL_INT(CT_ERR_RANGE, ct_earth_image24(&pk, &es, Dout, 1, gout));
+        const double e = std::max(err[0], std::max(err[1], err[2]));
+        std::printf("  camera %3.0Lf km east of the tile: range %.1f km, cube half-width 2^%u nm (%.1f km), degree %d "
+                    "(%d exact images): fit vs the reference max |dE| %.2g, |dN| %.2g, |dh| %.2g m\n",
+                    back_km, es.tmax_nm * 1e-12, es.fit_qrho, (double)half * 1e-12, es.fit_deg,
+                    (es.fit_deg + 1) * (es.fit_deg + 1) * (es.fit_deg + 1), err[0], err[1], err[2]);
+        worst = std::max(worst, e);
+    }
+    TEST_ASSERT_MSG(seen == (1u << 44 % 32) + (1u << 45 % 32) + (1u << 46 % 32) + (1u << 47 % 32),
+                    "the poses did not make every cube size (mask %x)", seen);
+    TEST_ASSERT_MSG(worst <= kFitMaxM, "fitted map off PROJ by %.3g m (> %.3g m)", worst, kFitMaxM);
+    // a camera too far for a fit keeps the exact map
+    Pose far;
+    TEST_ASSERT(make_pose(w->sf, {"far", 201045 + 130000, 4065840, 3000, 270, -10}, &far));
+    ct_earth es;
+    const ct_status st = ct_earth_setup(&pk, &far.pose, 0, CT_EARTH_RADIUS_NM, CT_EFFECTS_CHORD_NM, 0u, 1, &es);
+    TEST_ASSERT(st != CT_OK || es.fit_deg == 0);
+}
+
 void test_exact_curvature() { compare(CT_EFFECT_CURVATURE); }
 void test_exact_curvature_refraction() { compare(CT_EFFECT_CURVATURE | CT_EFFECT_REFRACTION); }
 
@@ -685,6 +762,7 @@ int main()
     RUN_TEST(test_reference_convergence);
     RUN_TEST(test_reference_nadir);
     RUN_TEST(test_reference_flat);
+    RUN_TEST(test_fitted_map);
     RUN_TEST(test_exact_curvature);
     RUN_TEST(test_exact_curvature_refraction);
     return TEST_END();

@@ -607,7 +607,7 @@ typedef struct {
  * every point the pixel's path is converted at, d = 4, 5 or 6 by its size
  * (125-343 exact conversions at set-up); beyond 141 km (a camera more than
  * ~120 km from the tile's far corner) the exact map is kept.  Fitted and
- * exact images differ by under 0.03 mm (docs/geolocation.md); the hit is
+ * exact images differ by under 0.02 mm (docs/geolocation.md); the hit is
  * within the same error bound.  For batches: a single-pixel call pays the
  * whole set-up.  Ignored without the true Earth.                          */
 #define CT_EFFECT_EARTH_FIT 4u

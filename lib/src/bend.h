@@ -112,8 +112,10 @@ typedef struct {
      * (deg + 1)^3 Chebyshev points.  deg = 0: no fit.                    */
     int32_t fit_deg;       /* 0, or 4..CT_EARTH_FIT_DEG                       */
     uint32_t fit_qrho;     /* the cube's half-width is 2^fit_qrho nm, 44..47  */
+    uint32_t fit_fb[3];    /* fraction bits of the samples per axis, 26..32   */
     int64_t fit_base[3];   /* image of c: grid x, y, z, Q24                   */
-    int64_t fit_cf[CT_EARTH_FIT_TERMS][3]; /* coefficients, Q24, |.| < 2^50   */
+    int64_t fit_cf[CT_EARTH_FIT_TERMS][3]; /* coefficients, Q(fit_fb - 2),
+                                              |.| < 2^56                    */
 } ct_earth;
 
 /* Library-internal helpers shared between files.                          */
@@ -141,6 +143,11 @@ ct_status ct_grid_frame_ecef(const ct_utm *zone, int64_t e_nm, int64_t n_nm, int
  * when the cube needed is at most 2^47 nm (else the exact map is kept).  */
 ct_status ct_earth_setup(const ct_package *pkg, const ct_pose *pose, int32_t refr_k_q16, int64_t radius_nm,
                          int64_t chord_nm, uint32_t bend_flags, int fitted, ct_earth *es);
+
+/* The image of the ECEF point c + D (|D| <= 2^50 nm per axis) in the grid
+ * frame, Q24: fitted (CT_ERR_RANGE when there is no fit or D is outside
+ * its cube) or exact (for tests of the fit).                              */
+ct_status ct_earth_image24(const ct_package *pkg, const ct_earth *es, const int64_t D[3], int fitted, int64_t g[3]);
 
 /* The first hit of the line of sight of a unit map-frame direction
  * (grid east, grid north, up at the camera; Q39, without the pose's

@@ -181,30 +181,30 @@ static int64_t cheb_at_node(int deg, int a, int i)
     return deg == 4 ? cheb5_q62[a][i] : (deg == 5 ? cheb6_q62[a][i] : cheb7_q62[a][i]);
 }
 
-/* x = round(v 2^24 / |s|) - off (the sign of s folded into v), 0 < |s| <=
- * 2^50, |v| < 2^62: |v 2^24| < 2^86; CT_ERR_RANGE when the quotient passes
- * 2^61. */
-static ct_status grid24(int64_t v, int64_t s, int64_t off, int64_t *x)
+/* f = round((v 2^fb - c) / |s|) with the sign of s folded into v and c,
+ * 0 < |s| <= 2^50, |v| < 2^62, fb <= 32, |c| < 2^113: |v 2^fb| < 2^94; 0
+ * when the quotient passes 2^55. */
+static int rel_q(int64_t v, ct_i128 c, int64_t s, uint32_t fb, int64_t *f)
 {
+    ct_i128 num = ct_i128_sub(ct_i128_shl(ct_i128_from64(v), fb), c);
     if (s < 0) {
-        v = -v;
+        num = ct_i128_neg(num);
         s = -s;
     }
-    if (!ct_i128_round_div_lim(ct_i128_shl(ct_i128_from64(v), 24u), s, INT64_C(1) << 61, x)) {
-        return CT_ERR_RANGE;
-    }
-    *x -= off;
-    return CT_OK;
+    return ct_i128_round_div_lim(num, s, INT64_C(1) << 55, f);
 }
 
-/* The exact image of the ECEF point P (nm) in the grid frame, Q24 (as
- * ct_map_to_grid with 8 more bits). */
-static ct_status image24(const ct_package *p, const ct_utm *zone, const int64_t P[3], int64_t g[3])
+/* The exact image of the ECEF point P (nm) in the grid frame less the
+ * camera's grid point (ox, oy, oz), with fb[k] fraction bits per axis (26
+ * .. 32): f = (e - e0) 2^fb / pe - (ox 2^(fb - 16) + 2^(fb - 1)) (as
+ * ct_map_to_grid with fb - 16 more bits), likewise n, and (h - h0) 2^fb /
+ * hs - oz 2^(fb - 16).  CT_ERR_RANGE when |f| > 2^55. */
+static ct_status image_rel(const ct_package *p, const ct_earth *es, const int64_t P[3], int64_t f[3])
 {
     int64_t lat, lon, h, e, n;
     ct_status st = ct_wgs84_from_ecef(P, &lat, &lon, &h);
     if (st == CT_OK) {
-        st = ct_utm_forward(zone, lat, lon, &e, &n);
+        st = ct_utm_forward(&es->zone, lat, lon, &e, &n);
     }
     if (st != CT_OK) {
         return st;
@@ -213,22 +213,29 @@ static ct_status image24(const ct_package *p, const ct_utm *zone, const int64_t 
         return CT_ERR_RANGE;
     }
     /* the origin and offset are the package's (|.| <= 2^61, checked at
-     * open), so the differences stay below 2^62 */
-    st = grid24(e - p->origin_e_nm, p->posting_e_nm, INT64_C(1) << 23, &g[0]);
-    if (st == CT_OK) {
-        st = grid24(n - p->origin_n_nm, p->posting_n_nm, INT64_C(1) << 23, &g[1]);
+     * open), so the differences stay below 2^62; |ox| <= 2^46 (set-up):
+     * (ox 2^(fb - 16) + 2^(fb - 1)) |pe| < 2^63 2^50 */
+    if (!rel_q(e - p->origin_e_nm,
+               ct_i128_mul(es->ox * (INT64_C(1) << (es->fit_fb[0] - 16u)) + (INT64_C(1) << (es->fit_fb[0] - 1u)),
+                           p->posting_e_nm),
+               p->posting_e_nm, es->fit_fb[0], &f[0]) ||
+        !rel_q(n - p->origin_n_nm,
+               ct_i128_mul(es->oy * (INT64_C(1) << (es->fit_fb[1] - 16u)) + (INT64_C(1) << (es->fit_fb[1] - 1u)),
+                           p->posting_n_nm),
+               p->posting_n_nm, es->fit_fb[1], &f[1]) ||
+        !rel_q(h - p->height_offset_nm, ct_i128_mul(es->oz * (INT64_C(1) << (es->fit_fb[2] - 16u)), p->height_scale_nm),
+               p->height_scale_nm, es->fit_fb[2], &f[2])) {
+        return CT_ERR_RANGE;
     }
-    if (st == CT_OK) {
-        st = grid24(h - p->height_offset_nm, p->height_scale_nm, 0, &g[2]);
-    }
-    return st;
+    return CT_OK;
 }
 
 /* The fitted image of c + D (|D| <= 2^qrho per axis, checked by the
- * caller), Q24: sum of cf T_a(s_x) T_b(s_y) T_c(s_z), s = D 2^(62 - qrho)
- * in Q62.  T by the recurrence T_(n+1) = 2 s T_n - T_(n-1) (|T| <= 1: each
- * product < 2^125); a product of three T's in Q62, times cf (< 2^50):
- * < 2^112, at most 84 of them summed in 128 bits. */
+ * caller), Q24: the base plus the sum of cf T_a(s_x) T_b(s_y) T_c(s_z), s
+ * = D 2^(62 - qrho) in Q62.  T by the recurrence T_(n+1) = 2 s T_n -
+ * T_(n-1) (|T| <= 1: each product < 2^125); a product of three T's in Q62
+ * times cf (Q(fb - 2), < 2^56): < 2^118, at most 84 of them summed in 128
+ * bits (< 2^125), rounded once to Q24. */
 static void fit_eval(const ct_earth *es, const int64_t D[3], int64_t g[3])
 {
     int64_t T[3][CT_EARTH_FIT_DEG + 1];
@@ -256,17 +263,20 @@ static void fit_eval(const ct_earth *es, const int64_t D[3], int64_t g[3])
         }
     }
     for (k = 0; k < 3; ++k) { /* bound: 3 coordinates */
-        g[k] = es->fit_base[k] + ct_i128_round_shr(acc[k], 62u);
+        g[k] = es->fit_base[k] + ct_i128_round_shr(acc[k], 36u + es->fit_fb[k]);
     }
 }
 
 /* The fit through the exact images at the (deg + 1)^3 Chebyshev points of
  * the cube: c_abc = (2/m)^3 g_a g_b g_c sum_ijk f_ijk T_a(x_i) T_b(x_j)
  * T_c(x_k), m = deg + 1, g_0 = 1/2 and 1 otherwise, f the images less the
- * camera's.  |f| < 2^47 is required (else no fit); each term f T T T /
- * 2^56 (Q30) < 2^53, the sum over <= 343 points < 2^61.5, kept in the
- * coefficient array itself; then / (m^3 2^(3 + zeros)) to Q24: |c| <= 8
- * max|f| < 2^50.  Leaves fit_deg = 0 when a point is outside the
+ * camera's grid point with fb fraction bits (|f| <= 2^55, else no fit:
+ * image_rel).  Each term f T T T / 2^64 (Q(fb - 2)) < 2^53, the sum over
+ * <= 343 points < 2^61.5, kept in the coefficient array itself; then times
+ * 8 g_a g_b g_c / m^3 (in 128 bits): |c| <= 8 max|f| / 4 < 2^56.  The
+ * samples' rounding (2^-33 of a cell or height unit) reaches the fit
+ * amplified by the interpolation's Lebesgue constant (< 12 for degree 6):
+ * far below a micrometre.  Leaves fit_deg = 0 when a point is outside the
  * projection's domain or too far. */
 static void fit_map(const ct_package *p, ct_earth *es, uint32_t qrho)
 {
@@ -274,9 +284,18 @@ static void fit_map(const ct_package *p, ct_earth *es, uint32_t qrho)
     int m = deg + 1, i, j, k, a, b, c, t, o;
     es->fit_deg = 0;
     es->fit_qrho = qrho;
-    es->fit_base[0] = es->ox * 256; /* |ox| <= 2^46 */
-    es->fit_base[1] = es->oy * 256;
-    es->fit_base[2] = es->oz * 256;
+    /* fraction bits: the images lie within 2^(qrho + 1) nm of the camera's
+     * (the cube's half-diagonal sqrt(3) 2^qrho, stretched by at most 1 %
+     * by the projection), so |f| <= 2^(qrho + 1 + fb) / scale <= 2^55 for
+     * fb = 54 - qrho + floor(log2 scale), at most 32; below 26 no fit */
+    for (o = 0; o < 3; ++o) { /* bound: 3 axes */
+        int64_t sc = ct_abs64(o == 0 ? p->posting_e_nm : (o == 1 ? p->posting_n_nm : p->height_scale_nm));
+        int fb = 54 - (int)qrho + (int)ct_bitlen64((uint64_t)sc) - 1;
+        if (fb < 26) {
+            return;
+        }
+        es->fit_fb[o] = fb > 32 ? 32u : (uint32_t)fb;
+    }
     for (t = 0; t < CT_EARTH_FIT_TERMS; ++t) { /* bound: CT_EARTH_FIT_TERMS */
         es->fit_cf[t][0] = es->fit_cf[t][1] = es->fit_cf[t][2] = 0;
     }
@@ -288,14 +307,8 @@ static void fit_map(const ct_package *p, ct_earth *es, uint32_t qrho)
                 P[0] = es->c[0] + ct_mul_shr(cheb_at_node(deg, 1, i), INT64_C(1) << qrho, 62u);
                 P[1] = es->c[1] + ct_mul_shr(cheb_at_node(deg, 1, j), INT64_C(1) << qrho, 62u);
                 P[2] = es->c[2] + ct_mul_shr(cheb_at_node(deg, 1, k), INT64_C(1) << qrho, 62u);
-                if (image24(p, &es->zone, P, f) != CT_OK) {
+                if (image_rel(p, es, P, f) != CT_OK) {
                     return;
-                }
-                for (o = 0; o < 3; ++o) { /* bound: 3 coordinates */
-                    f[o] -= es->fit_base[o];
-                    if (ct_abs64(f[o]) >= (INT64_C(1) << 47)) {
-                        return;
-                    }
                 }
                 t = 0;
                 for (a = 0; a <= deg; ++a) {             /* bound: CT_EARTH_FIT_DEG + 1 */
@@ -304,7 +317,7 @@ static void fit_map(const ct_package *p, ct_earth *es, uint32_t qrho)
                         for (c = 0; a + b + c <= deg; ++c) { /* bound: CT_EARTH_FIT_DEG + 1 */
                             int64_t ttt = ct_mul_shr(tt, cheb_at_node(deg, c, k), 62u);
                             for (o = 0; o < 3; ++o) { /* bound: 3 coordinates */
-                                es->fit_cf[t][o] += ct_mul_shr(f[o], ttt, 56u);
+                                es->fit_cf[t][o] += ct_i128_round_shr(ct_i128_mul(f[o], ttt), 64u);
                             }
                             t++;
                         }
@@ -317,16 +330,43 @@ static void fit_map(const ct_package *p, ct_earth *es, uint32_t qrho)
     for (a = 0; a <= deg; ++a) {             /* bound: CT_EARTH_FIT_DEG + 1 */
         for (b = 0; a + b <= deg; ++b) {     /* bound: CT_EARTH_FIT_DEG + 1 */
             for (c = 0; a + b + c <= deg; ++c) { /* bound: CT_EARTH_FIT_DEG + 1 */
-                /* D = m^3 2^(3 + zeros) <= 343 * 64; 2 |sum| + D < 2^63 */
-                int64_t D = (int64_t)(m * m * m) << (3 + (a == 0) + (b == 0) + (c == 0));
+                /* 8 g_a g_b g_c = 2^(3 - zeros) */
+                unsigned sh = 3u - (unsigned)((a == 0) + (b == 0) + (c == 0));
                 for (o = 0; o < 3; ++o) { /* bound: 3 coordinates */
-                    es->fit_cf[t][o] = ct_floor_div(2 * es->fit_cf[t][o] + D, 2 * D);
+                    es->fit_cf[t][o] =
+                        ct_i128_round_div(ct_i128_shl(ct_i128_from64(es->fit_cf[t][o]), sh), (int64_t)(m * m * m));
                 }
                 t++;
             }
         }
     }
     es->fit_deg = deg;
+}
+
+ct_status ct_earth_image24(const ct_package *p, const ct_earth *es, const int64_t D[3], int fitted, int64_t g[3])
+{
+    int64_t P[3], f[3];
+    int k, in = fitted && es->fit_deg > 0;
+    ct_status st;
+    for (k = 0; k < 3; ++k) { /* bound: 3 axes */
+        if (ct_abs64(D[k]) > (INT64_C(1) << 50)) {
+            return CT_ERR_RANGE;
+        }
+        in = in && ct_abs64(D[k]) <= (INT64_C(1) << es->fit_qrho);
+        P[k] = es->c[k] + D[k];
+    }
+    if (in) {
+        fit_eval(es, D, g);
+        return CT_OK;
+    }
+    if (fitted) {
+        return CT_ERR_RANGE;
+    }
+    st = image_rel(p, es, P, f);
+    for (k = 0; k < 3 && st == CT_OK; ++k) { /* bound: 3 axes */
+        g[k] = es->fit_base[k] + ct_i128_round_shr(ct_i128_from64(f[k]), es->fit_fb[k] - 24u);
+    }
+    return st;
 }
 
 /* The image of P(t) in the grid frame: exact, or by the fitted map when
@@ -638,6 +678,10 @@ ct_status ct_earth_setup(const ct_package *p, const ct_pose *pose, int32_t refr_
     }
     es->fit_deg = 0;
     es->fit_qrho = 0u;
+    es->fit_base[0] = es->ox * 256; /* |ox| <= 2^46 */
+    es->fit_base[1] = es->oy * 256;
+    es->fit_base[2] = es->oz * 256;
+    es->fit_fb[0] = es->fit_fb[1] = es->fit_fb[2] = 32u;
     if (fitted) {
         /* the cube holds every node C + t d - bend w, t <= tmax: its
          * half-width 2^q >= tmax + the bend at tmax (as vertex_exact: |k|
