@@ -54,8 +54,10 @@ const UsageBlock kUsage[] = {
      "conetrace geoloc PKG --camera C.cameramodel --pixels px.csv [--method M]\n"
      "                 [--pose-wgs84 LAT,LON,H,YAW,PITCH,ROLL | --pose-map E,N,H,YAW,PITCH,ROLL]\n"
      "                 [--effects curvature,refraction] [--refraction-k K]\n"
-     "                 [--earth-radius M] [--grid-step PX] [--threads T] -o g.csv\n"
-     "                 (curvature on a UTM package: the true Earth; --earth-radius: a sphere)\n"},
+     "                 [--earth-radius M] [--earth-map auto|fitted|exact] [--grid-step PX]\n"
+     "                 [--threads T] -o g.csv\n"
+     "                 (curvature on a UTM package: the true Earth, its map fitted once per\n"
+     "                 chunk of pixels when there are 256 or more (auto); --earth-radius: a sphere)\n"},
     {"render",
      "conetrace render DEM_or_PKG --what bitmap|dt|ddt|angles|apex -o OUT.png\n"
      "                 [--slice H | --level k --slices K] [--reduce r] [--sectors N]\n"

@@ -4,7 +4,8 @@
 # package at N = 24, r = 3 and ct_bench's ray families (100 per family);
 # then instructions per pixel of ct_geolocate (directional) for 64 pixels of
 # an oblique camera over that package: straight, curvature + refraction on
-# the sphere, and on the true Earth (mean, min-max, per pixel in a batch,
+# the sphere, and on the true Earth, exact and with its map fitted per call
+# (mean, min-max, per pixel in a batch,
 # and the per-call set-up).  Each ray's and pixel's status, steps (and hit)
 # must equal the host's, else exit status 1.  Run by `make bench`.
 #

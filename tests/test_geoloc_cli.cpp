@@ -570,6 +570,106 @@ void test_geoloc_poses()
     fs::remove(g_dir + "/tu.ctp");
 }
 
+// --earth-map on a UTM package with curvature (the true Earth): auto picks
+// the fitted map for 256 pixels or more (byte-identical to --earth-map
+// fitted), the rows are the library's with CT_EFFECT_EARTH_FIT for any
+// --threads; the exact map (per-pixel conversions) finds the same statuses
+// and hits within a few millimetres (the two paths' images differ by
+// micrometres; a grazing ray turns that into millimetres along itself).
+void test_geoloc_earth_map()
+{
+    Setup *s = setup();
+    TEST_ASSERT(s != nullptr);
+    ct_host::Terrain t = s->c.t;
+    t.geo.epsg = 32617;
+    auto cu = dem_cases::make_case("cli-utm", t, 8, 1);
+    spit(g_dir + "/tm.ctp", std::string(cu.pkg.begin(), cu.pkg.end()));
+    ct_package pu;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_package_open(&pu, cu.pkg.data(), cu.pkg.size()));
+    std::string px = "u,v\n";
+    ct_rng rng;
+    ct_rng_seed(&rng, 91);
+    std::vector<std::pair<double, double>> uv;
+    for (int k = 0; k < 1500; ++k) {
+        double u = -50 + 2100 * ct_rng_unit(&rng), v = -50 + 1600 * ct_rng_unit(&rng);
+        uv.push_back({u, v});
+        char line[64];
+        std::snprintf(line, sizeof line, "%.17g,%.17g\n", u, v);
+        px += line;
+    }
+    spit(g_dir + "/pxe.csv", px);
+    auto q61 = [](double deg) { return (int64_t)std::llround((long double)deg * M_PIl / 180 * std::ldexp(1.0L, 61)); };
+    // 40 deg below the horizon, towards the north-west, from 1.5 km above
+    // the tile's south-east corner (lat, lon from the library's inverse)
+    const double E0 = 500000 + 60 * 30, N0 = 4000000 - 60 * 30, H0 = 1500;
+    ct_utm z = {17, 0};
+    int64_t la, lo;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_utm_inverse(&z, std::llround(E0 * 1e9), std::llround(N0 * 1e9), &la, &lo));
+    const long double lat = (long double)la / std::ldexp(1.0L, 61) * 180 / M_PIl;
+    const long double lon = (long double)lo / std::ldexp(1.0L, 61) * 180 / M_PIl;
+    char arg[160];
+    std::snprintf(arg, sizeof arg, "%.12Lf,%.12Lf,%.9f,-45,-40,0", lat, lon, H0);
+    int32_t q[4];
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_quat_from_ypr(q61(-45), q61(-40), 0, q));
+    ct_host::CameraModel cm = ct_host::read_cameramodel(g_dir + "/cam.cameramodel");
+    ct_host::LibCamera lc = ct_host::lib_camera(cm, "cam");
+    ct_pose pose;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_pose_from_wgs84(&pose, &z, q61((double)lat), q61((double)lon),
+                                                   std::llround(H0 * 1e9), q));
+    auto geoloc = [&](const char *map, const char *threads) -> std::string {
+        std::vector<std::string> args = {"geoloc", "tm.ctp", "--camera", "cam.cameramodel", "--pixels", "pxe.csv",
+                                         "--pose-wgs84", arg, "--effects", "curvature,refraction", "-o", "ge.csv"};
+        if (*map) {
+            args.push_back("--earth-map");
+            args.push_back(map);
+        }
+        if (*threads) {
+            args.push_back("--threads");
+            args.push_back(threads);
+        }
+        Run r = run(args);
+        if (r.code != 0) return "failed: --earth-map " + std::string(map) + ": " + r.err;
+        return slurp(g_dir + "/ge.csv");
+    };
+    const std::string fitted = geoloc("fitted", "1");
+    TEST_ASSERT_MSG(fitted.compare(0, 7, "failed:") != 0, "%s", fitted.c_str());
+    TEST_ASSERT_MSG(geoloc("", "") == fitted, "auto differs from fitted");
+    TEST_ASSERT_MSG(geoloc("fitted", "2") == fitted, "fitted: two threads differ from one");
+    const std::string exact = geoloc("exact", "");
+    TEST_ASSERT_MSG(exact.compare(0, 7, "failed:") != 0, "%s", exact.c_str());
+    std::vector<std::string> rf = lines_of(fitted), rx = lines_of(exact);
+    TEST_ASSERT_EQUAL_INT(uv.size() + 1, rf.size());
+    TEST_ASSERT_EQUAL_INT(uv.size() + 1, rx.size());
+    ct_effects fx = {CT_EFFECT_CURVATURE | CT_EFFECT_REFRACTION | CT_EFFECT_EARTH_FIT, CT_REFRACTION_K_STD_Q16, 0, 0};
+    int hits = 0, both = 0;
+    double apart = 0;
+    for (size_t k = 0; k < uv.size(); ++k) {
+        std::vector<std::string> f = split(rf[k + 1]), x = split(rx[k + 1]);
+        TEST_ASSERT_MSG(f[2] == x[2], "row %zu: fitted %s, exact %s", k + 1, f[2].c_str(), x[2].c_str());
+        if (f[2] == "hit") {
+            both++;
+            double d2 = 0;
+            for (int c = 3; c <= 5; ++c) d2 += std::pow(std::stod(f[c]) - std::stod(x[c]), 2);
+            apart = std::max(apart, std::sqrt(d2));
+        }
+        if (k % 37 == 0) {
+            int64_t uq, vq;
+            TEST_ASSERT(ct_host::pixel_to_q16(uv[k].first, uv[k].second, &uq, &vq));
+            ct_geo g;
+            ct_status want = ct_geolocate(&pu, &lc.cam, &pose, CT_METHOD_DIRECTIONAL, &fx, uq, vq, &g);
+            check_row(f, "fitted ", k + 1, want, g, &hits, &pu);
+        }
+    }
+    std::printf("  --earth-map: %d rows hit; fitted vs exact hits up to %.2g m apart\n", both, apart);
+    TEST_ASSERT_MSG(hits >= 10 && both >= 300, "only %d / %d hits", hits, both);
+    TEST_ASSERT_MSG(apart <= 0.01, "fitted and exact hits %.3g m apart", apart);
+    Run bad = run({"geoloc", "tm.ctp", "--camera", "cam.cameramodel", "--pixels", "pxe.csv", "--pose-wgs84", arg,
+                   "--effects", "curvature", "--earth-map", "sometimes", "-o", "ge.csv"});
+    TEST_ASSERT(bad.code != 0 && bad.err.find("--earth-map needs auto, fitted or exact") != std::string::npos);
+    fs::remove(g_dir + "/ge.csv");
+    fs::remove(g_dir + "/pxe.csv");
+}
+
 // --effects curvature,refraction with --refraction-k and --earth-radius:
 // the rows are the library's ct_geolocate with the same ct_effects, bit for
 // bit, and (with an exaggerated 30 km earth) differ from the straight rays.
@@ -793,6 +893,7 @@ int main()
     RUN_TEST(test_geoloc_poses);
     RUN_TEST(test_geoloc_pose_map_vs_model);
     RUN_TEST(test_geoloc_threads);
+    RUN_TEST(test_geoloc_earth_map);
     RUN_TEST(test_geoloc_splined_grid);
     RUN_TEST(test_geoloc_bad_inputs);
     int rc = TEST_END();

@@ -107,7 +107,8 @@ static ct_geo g_geo[64];
  * host or a set-up failure. */
 static int geo_bench(const ct_package *p, uint32_t empty, uint64_t ipt_q16)
 {
-    static const char *const fxname[M4_GEO_FX] = {"straight", "sphere c+r", "true Earth c+r"};
+    static const char *const fxname[M4_GEO_FX] = {"straight", "sphere c+r", "true Earth c+r",
+                                                            "true Earth c+r, fitted"};
     static int64_t uv[2 * 64];
     ct_camera cam;
     ct_pose pose;

@@ -22,11 +22,12 @@ typedef struct {
 /* Geolocation per pixel (ct_geolocate, directional) with the effects of
  * M4_GEO_FX: 0 none (straight), 1 curvature + refraction (k = 0.13) on the
  * sphere of CT_EARTH_RADIUS_NM (the map-frame parabola), 2 the same on the
- * true Earth (earth_radius_nm = 0: the Earth-fixed line of sight, earth.c). */
-#define M4_GEO_FX 3
+ * true Earth (earth_radius_nm = 0: the Earth-fixed line of sight, earth.c),
+ * 3 the true Earth with its map fitted once per call (CT_EFFECT_EARTH_FIT). */
+#define M4_GEO_FX 4
 static inline const ct_effects *m4_geo_effects(int k, ct_effects *fx)
 {
-    fx->flags = CT_EFFECT_ALL;
+    fx->flags = k == 3 ? CT_EFFECT_ALL | CT_EFFECT_EARTH_FIT : CT_EFFECT_ALL;
     fx->refraction_k_q16 = CT_REFRACTION_K_STD_Q16;
     fx->earth_radius_nm = k == 1 ? CT_EARTH_RADIUS_NM : 0;
     fx->chord_nm = 0;

@@ -115,7 +115,9 @@ typedef struct {
     uint32_t fit_fb[3];    /* fraction bits of the samples per axis, 26..32   */
     int64_t fit_base[3];   /* image of c: grid x, y, z, Q24                   */
     int64_t fit_cf[CT_EARTH_FIT_TERMS][3]; /* coefficients, Q(fit_fb - 2),
-                                              |.| < 2^56                    */
+                                              |.| < 2^56; of degree >= 3
+                                              divided by 2^fit_sh: < 2^28   */
+    uint32_t fit_sh[CT_EARTH_FIT_DEG + 1][3]; /* per degree and coordinate  */
 } ct_earth;
 
 /* Library-internal helpers shared between files.                          */

@@ -230,40 +230,70 @@ static ct_status image_rel(const ct_package *p, const ct_earth *es, const int64_
     return CT_OK;
 }
 
+/* round(v / 2^n), 1 <= n <= 62, for |v| < 2^62 */
+static int64_t rshr64(int64_t v, unsigned n)
+{
+    return ct_floor_div(v + (INT64_C(1) << (n - 1u)), INT64_C(1) << n);
+}
+
 /* The fitted image of c + D (|D| <= 2^qrho per axis, checked by the
  * caller), Q24: the base plus the sum of cf T_a(s_x) T_b(s_y) T_c(s_z), s
- * = D 2^(62 - qrho) in Q62.  T by the recurrence T_(n+1) = 2 s T_n -
- * T_(n-1) (|T| <= 1: each product < 2^125); a product of three T's in Q62
- * times cf (Q(fb - 2), < 2^56): < 2^118, at most 84 of them summed in 128
- * bits (< 2^125), rounded once to Q24. */
+ * = D / 2^qrho.
+ *   - Terms of total degree <= 2 (the large ones: up to 2^56 for the
+ *     linear, rho^2 / R for the quadratic): T in Q62 (T_2 = 2 s^2 - 1), a
+ *     product of three < 2^62, times cf (< 2^56): < 2^118, in 128 bits.
+ *   - Degree k >= 3 (at most rho^3 / R^2, 69 m at 141 km): cf stored as
+ *     cf' = round(cf / 2^sh[k]) with |cf'| <= 2^27 (fit_map), T in Q30 by
+ *     the recurrence T_(n+1) = 2 s T_n - T_(n-1) (|T| <= 1 + 2^-26), each
+ *     term cf' T T T < 2^57.1 in 64 bits; a degree's <= 28 terms sum below
+ *     2^62, then times 2^(32 + sh[k]) (sh <= 29: < 2^123) into the 128-bit
+ *     sum.
+ *   The sum (Q(fb + 60), < 2^125) is rounded once to Q24.  The rounding of
+ *   cf' (2^(sh - 1) per term) costs under 2 um at 141 km (fit_map). */
 static void fit_eval(const ct_earth *es, const int64_t D[3], int64_t g[3])
 {
-    int64_t T[3][CT_EARTH_FIT_DEG + 1];
+    int64_t T[3][3], U[3][CT_EARTH_FIT_DEG + 1], gs[CT_EARTH_FIT_DEG + 1][3];
     ct_i128 acc[3];
-    int a, b, c, k, t = 0, deg = es->fit_deg;
+    int a, b, c, k, o, t = 0, deg = es->fit_deg;
+    unsigned q = es->fit_qrho;
     for (k = 0; k < 3; ++k) { /* bound: 3 axes */
         int n;
         T[k][0] = T_ONE_Q62;
-        T[k][1] = D[k] * (INT64_C(1) << (62u - es->fit_qrho)); /* |D| <= 2^qrho */
-        for (n = 1; n < deg; ++n) { /* bound: CT_EARTH_FIT_DEG - 1 */
-            T[k][n + 1] = ct_mul_shr(T[k][1], T[k][n], 61u) - T[k][n - 1];
+        T[k][1] = D[k] * (INT64_C(1) << (62u - q)); /* |D| <= 2^qrho */
+        T[k][2] = ct_mul_shr(T[k][1], T[k][1], 61u) - T_ONE_Q62;
+        U[k][0] = INT64_C(1) << 30;
+        U[k][1] = rshr64(D[k], q - 30u); /* |.| <= 2^30 */
+        for (n = 1; n < deg; ++n) { /* bound: CT_EARTH_FIT_DEG - 1; |2 U_1 U_n| < 2^62 */
+            U[k][n + 1] = rshr64(2 * U[k][1] * U[k][n], 30u) - U[k][n - 1];
         }
         acc[k] = ct_i128_from64(0);
     }
+    for (k = 0; k <= deg; ++k) { /* bound: CT_EARTH_FIT_DEG + 1 */
+        gs[k][0] = gs[k][1] = gs[k][2] = 0;
+    }
     for (a = 0; a <= deg; ++a) {             /* bound: CT_EARTH_FIT_DEG + 1 */
         for (b = 0; a + b <= deg; ++b) {     /* bound: CT_EARTH_FIT_DEG + 1 */
-            int64_t tt = ct_mul_shr(T[0][a], T[1][b], 62u);
             for (c = 0; a + b + c <= deg; ++c) { /* bound: CT_EARTH_FIT_DEG + 1 */
-                int64_t ttt = ct_mul_shr(tt, T[2][c], 62u);
-                for (k = 0; k < 3; ++k) { /* bound: 3 coordinates */
-                    acc[k] = ct_i128_add(acc[k], ct_i128_mul(es->fit_cf[t][k], ttt));
+                if (a + b + c <= 2) {
+                    int64_t ttt = ct_mul_shr(ct_mul_shr(T[0][a], T[1][b], 62u), T[2][c], 62u);
+                    for (o = 0; o < 3; ++o) { /* bound: 3 coordinates */
+                        acc[o] = ct_i128_add(acc[o], ct_i128_mul(es->fit_cf[t][o], ttt));
+                    }
+                } else {
+                    int64_t ttt = rshr64(rshr64(U[0][a] * U[1][b], 30u) * U[2][c], 30u);
+                    for (o = 0; o < 3; ++o) { /* bound: 3 coordinates */
+                        gs[a + b + c][o] += es->fit_cf[t][o] * ttt;
+                    }
                 }
                 t++;
             }
         }
     }
-    for (k = 0; k < 3; ++k) { /* bound: 3 coordinates */
-        g[k] = es->fit_base[k] + ct_i128_round_shr(acc[k], 36u + es->fit_fb[k]);
+    for (o = 0; o < 3; ++o) { /* bound: 3 coordinates */
+        for (k = 3; k <= deg; ++k) { /* bound: CT_EARTH_FIT_DEG - 2 */
+            acc[o] = ct_i128_add(acc[o], ct_i128_shl(ct_i128_from64(gs[k][o]), 32u + es->fit_sh[k][o]));
+        }
+        g[o] = es->fit_base[o] + ct_i128_round_shr(acc[o], 36u + es->fit_fb[o]);
     }
 }
 
@@ -337,6 +367,41 @@ static void fit_map(const ct_package *p, ct_earth *es, uint32_t qrho)
                         ct_i128_round_div(ct_i128_shl(ct_i128_from64(es->fit_cf[t][o]), sh), (int64_t)(m * m * m));
                 }
                 t++;
+            }
+        }
+    }
+    /* degrees >= 3: cf' = round(cf / 2^sh) with sh the least making every
+     * |cf'| < 2^27 (per degree and coordinate; sh <= 29 as |cf| < 2^56) */
+    for (k = 3; k <= deg; ++k) { /* bound: CT_EARTH_FIT_DEG - 2 */
+        for (o = 0; o < 3; ++o) { /* bound: 3 coordinates */
+            int64_t mx = 0;
+            unsigned sh = 0u;
+            t = 0;
+            for (a = 0; a <= deg; ++a) {             /* bound: CT_EARTH_FIT_DEG + 1 */
+                for (b = 0; a + b <= deg; ++b) {     /* bound: CT_EARTH_FIT_DEG + 1 */
+                    for (c = 0; a + b + c <= deg; ++c) { /* bound: CT_EARTH_FIT_DEG + 1 */
+                        if (a + b + c == k) {
+                            mx = ct_max64(mx, ct_abs64(es->fit_cf[t][o]));
+                        }
+                        t++;
+                    }
+                }
+            }
+            /* bound: 30 halvings */
+            while ((mx >> sh) >= (INT64_C(1) << 27)) {
+                sh++;
+            }
+            es->fit_sh[k][o] = sh;
+            t = 0;
+            for (a = 0; a <= deg; ++a) {             /* bound: CT_EARTH_FIT_DEG + 1 */
+                for (b = 0; a + b <= deg; ++b) {     /* bound: CT_EARTH_FIT_DEG + 1 */
+                    for (c = 0; a + b + c <= deg; ++c) { /* bound: CT_EARTH_FIT_DEG + 1 */
+                        if (a + b + c == k && sh > 0u) {
+                            es->fit_cf[t][o] = rshr64(es->fit_cf[t][o], sh);
+                        }
+                        t++;
+                    }
+                }
             }
         }
     }
