@@ -425,7 +425,7 @@ void test_statuses_and_errors()
     {
         const ct_effects good = {CT_EFFECT_ALL, CT_REFRACTION_K_STD_Q16, 0, 0};
         std::vector<ct_effects> bad(7, good);
-        bad[0].flags = 4u;
+        bad[0].flags = 8u;  // the first unknown flag (4 is CT_EFFECT_EARTH_FIT)
         bad[1].flags = 0x80000000u | CT_EFFECT_CURVATURE;
         bad[2].refraction_k_q16 = 2 * 65536 + 1;
         bad[3].earth_radius_nm = 1000;                     // below 2^40 nm
@@ -433,6 +433,20 @@ void test_statuses_and_errors()
         bad[5].chord_nm = 1;                               // below 2^10 nm
         bad[6].chord_nm = 1 << 12;                         // segment < 1/64 cell at R = 6371 km
         bad[6].earth_radius_nm = INT64_C(1) << 40;
+        {
+            // CT_EFFECT_EARTH_FIT without the true Earth is ignored: the
+            // straight ray, and the sphere parabola with a radius
+            ct_effects fit = {CT_EFFECT_EARTH_FIT, 0, 0, 0}, fit_sphere = good, sphere = good;
+            fit_sphere.flags |= CT_EFFECT_EARTH_FIT;
+            fit_sphere.earth_radius_nm = sphere.earth_radius_nm = CT_EARTH_RADIUS_NM;
+            ct_geo a, b;
+            TEST_ASSERT_EQUAL_INT(ct_geolocate(&wd->p, &obl.lib.cam, &obl.lib.pose, CT_METHOD_DIRECTIONAL, nullptr, cu, cv, &a),
+                                  ct_geolocate(&wd->p, &obl.lib.cam, &obl.lib.pose, CT_METHOD_DIRECTIONAL, &fit, cu, cv, &b));
+            TEST_ASSERT(a.hit.e_nm == b.hit.e_nm && a.hit.n_nm == b.hit.n_nm && a.hit.h_nm == b.hit.h_nm);
+            TEST_ASSERT_EQUAL_INT(ct_geolocate(&wd->p, &obl.lib.cam, &obl.lib.pose, CT_METHOD_DIRECTIONAL, &sphere, cu, cv, &a),
+                                  ct_geolocate(&wd->p, &obl.lib.cam, &obl.lib.pose, CT_METHOD_DIRECTIONAL, &fit_sphere, cu, cv, &b));
+            TEST_ASSERT(a.hit.e_nm == b.hit.e_nm && a.hit.n_nm == b.hit.n_nm && a.hit.h_nm == b.hit.h_nm);
+        }
         for (const ct_effects &fx : bad) {
             TEST_ASSERT_EQUAL_INT(CT_ERR_EFFECTS, ct_geolocate(&wd->p, &obl.lib.cam, &obl.lib.pose, CT_METHOD_DIRECTIONAL, &fx, cu, cv, &o));
             TEST_ASSERT_EQUAL_INT(CT_ERR_EFFECTS, o.status);

@@ -118,6 +118,8 @@ typedef struct {
     int interp;    /* 1: the nodes below are set */
     int nodes;     /* n: 4, 5 or 6 */
     int64_t tmax;
+    int64_t tinv;  /* floor(2^(60 + tsh) / tmax), in (2^60, 2^61]    */
+    unsigned tsh;  /* bit length of tmax                              */
     int64_t base[3];      /* image of node 0, Q24 (x, y) and Q24 height   */
     int64_t cf[NODES][3]; /* polynomial in sigma, Q24, lowest power first */
 } path;
@@ -230,10 +232,28 @@ static ct_status image_rel(const ct_package *p, const ct_earth *es, const int64_
     return CT_OK;
 }
 
-/* round(v / 2^n), 1 <= n <= 62, for |v| < 2^62 */
+/* round(v / 2^n) = floor((v + 2^(n-1)) / 2^n), 1 <= n <= 62, |v| < 2^62
+ * (the sum cannot wrap): by unsigned shifts of the sum and of its
+ * complement when negative (floor(x / m) = -floor((-x - 1) / m) - 1), as
+ * ct_i128_round_shr -- no division, no shift of a negative value. */
 static int64_t rshr64(int64_t v, unsigned n)
 {
-    return ct_floor_div(v + (INT64_C(1) << (n - 1u)), INT64_C(1) << n);
+    uint64_t u = (uint64_t)v + ((uint64_t)1 << (n - 1u));
+    uint64_t neg = (u >> 63) != 0u ? ~(uint64_t)0 : 0u;
+    return (int64_t)(((u ^ neg) >> n) ^ neg);
+}
+
+/* round(x y / 2^62) and round(x y / 2^30) for |x|, |y| <= 2^62 + 2^8
+ * (resp. 2^30 + 2^8), skipping the product when a factor is exactly one
+ * (T_0, or T_n(s) = 1): the same value, no multiplication. */
+static int64_t mul62(int64_t x, int64_t y)
+{
+    return x == T_ONE_Q62 ? y : (y == T_ONE_Q62 ? x : ct_mul_shr(x, y, 62u));
+}
+
+static int64_t mul30(int64_t x, int64_t y)
+{
+    return x == (INT64_C(1) << 30) ? y : (y == (INT64_C(1) << 30) ? x : rshr64(x * y, 30u));
 }
 
 /* The fitted image of c + D (|D| <= 2^qrho per axis, checked by the
@@ -275,12 +295,12 @@ static void fit_eval(const ct_earth *es, const int64_t D[3], int64_t g[3])
         for (b = 0; a + b <= deg; ++b) {     /* bound: CT_EARTH_FIT_DEG + 1 */
             for (c = 0; a + b + c <= deg; ++c) { /* bound: CT_EARTH_FIT_DEG + 1 */
                 if (a + b + c <= 2) {
-                    int64_t ttt = ct_mul_shr(ct_mul_shr(T[0][a], T[1][b], 62u), T[2][c], 62u);
+                    int64_t ttt = mul62(mul62(T[0][a], T[1][b]), T[2][c]);
                     for (o = 0; o < 3; ++o) { /* bound: 3 coordinates */
                         acc[o] = ct_i128_add(acc[o], ct_i128_mul(es->fit_cf[t][o], ttt));
                     }
                 } else {
-                    int64_t ttt = rshr64(rshr64(U[0][a] * U[1][b], 30u) * U[2][c], 30u);
+                    int64_t ttt = mul30(mul30(U[0][a], U[1][b]), U[2][c]);
                     for (o = 0; o < 3; ++o) { /* bound: 3 coordinates */
                         gs[a + b + c][o] += es->fit_cf[t][o] * ttt;
                     }
@@ -494,8 +514,9 @@ CT_NOINLINE static ct_status vertex(const path *pa, int64_t t, gv *v)
     if (!pa->interp) {
         return vertex_exact(pa, t, v);
     }
-    /* sigma = (2t - tmax) 2^60 / tmax: |2t - tmax| <= tmax < 2^48 */
-    sig = ct_i128_floor_div(ct_i128_shl(ct_i128_from64(2 * t - pa->tmax), 60u), pa->tmax);
+    /* sigma = (2t - tmax) 2^60 / tmax (within 2 units): |2t - tmax| <=
+     * tmax < 2^49, times tinv <= 2^61: < 2^110 */
+    sig = ct_i128_to64(ct_i128_sar(ct_i128_mul(2 * t - pa->tmax, pa->tinv), pa->tsh));
     for (k = 0; k < 3; ++k) { /* bound: 3 coordinates */
         int64_t acc = pa->cf[pa->nodes - 1][k];
         for (j = pa->nodes - 2; j >= 0; --j) { /* bound: NODES - 1 */
@@ -522,6 +543,9 @@ CT_NOINLINE static void set_nodes(path *pa, int64_t tmax)
     int64_t X[NODES][3];
     pa->interp = 0;
     pa->tmax = tmax;
+    /* tmax >= 1 km (set-up): tsh in [40, 49], 60 + tsh < 128 */
+    pa->tsh = ct_bitlen64((uint64_t)tmax);
+    pa->tinv = ct_i128_floor_div(ct_i128_shl(ct_i128_shl(ct_i128_from64(1), 60u), pa->tsh), tmax);
     pa->nodes = tmax <= NODES_4_NM ? 4 : (tmax <= NODES_5_NM ? 5 : 6);
     for (j = 0; j < pa->nodes; ++j) { /* bound: NODES */
         /* t_j = tmax tau_j: < 2^48 2^60 in 128 bits */

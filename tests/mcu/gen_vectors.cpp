@@ -790,7 +790,8 @@ std::vector<Cam> make_cameras(Rng &g, const std::vector<const ct_package *> &pk)
         c.effects.chord_nm = INT64_C(1) << 20;
         c.batch_method = CT_METHOD_DIRECTIONAL;
     }
-    {  // unprojection grid baked from the first lens, curvature only
+    {  // unprojection grid baked from the first lens, curvature only (the
+       // true Earth, its map fitted per call)
         Cam &c = cams[3];
         c.name = "grid_from_opencv8";
         c.package = 1;
@@ -819,7 +820,7 @@ std::vector<Cam> make_cameras(Rng &g, const std::vector<const ct_package *> &pk)
         c.e_nm = nm(E0 + 300);
         c.n_nm = nm(N0 - 1300);
         c.h_nm = nm(800);
-        c.effects.flags = CT_EFFECT_CURVATURE;
+        c.effects.flags = CT_EFFECT_CURVATURE | CT_EFFECT_EARTH_FIT;
         c.batch_method = CT_METHOD_HIERARCHICAL;
     }
     for (Cam &c : cams) run_camera(g, c, *pk[c.package]);
