@@ -16,7 +16,10 @@ deps:
 test: all
 	cd $(BUILD) && ctest --output-on-failure -j$(JOBS)
 
-demo: all
+# the demo builds only the CLI (not the tests and benchmarks)
+demo: deps
+	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release
+	cmake --build $(BUILD) -j$(JOBS) --target conetrace_cli
 	scripts/demo.sh $(BUILD)
 
 bench: all

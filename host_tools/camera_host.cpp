@@ -6,6 +6,8 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <sstream>
+#include <string>
 
 #include <unistd.h>
 
@@ -292,6 +294,22 @@ std::string nm_to_decimal(int64_t nm)
     std::string s;
     append_nm_decimal(s, nm);
     return s;
+}
+
+uint32_t effects_from_list(const std::string &list)
+{
+    uint32_t flags = 0u;
+    std::stringstream ss(list);
+    std::string tok;
+    while (std::getline(ss, tok, ',')) {
+        tok.erase(0, tok.find_first_not_of(' '));
+        tok.erase(tok.find_last_not_of(' ') + 1);
+        if (tok.empty()) continue;
+        if (tok == "curvature") flags |= CT_EFFECT_CURVATURE;
+        else if (tok == "refraction") flags |= CT_EFFECT_REFRACTION;
+        else throw Error("--effects '" + list + "': unknown effect '" + tok + "' (curvature, refraction)");
+    }
+    return flags;
 }
 
 }  // namespace ct_host

@@ -99,4 +99,9 @@ bool pixel_to_q16(double u, double v, int64_t *u_q16, int64_t *v_q16);
 std::string nm_to_decimal(int64_t nm);
 void append_nm_decimal(std::string &out, int64_t nm);  // the same, appended
 
+// --effects LIST: comma-separated curvature, refraction (spaces around the
+// names allowed; empty: none) to CT_EFFECT_* flags.  Throws Error naming
+// the unknown effect.
+uint32_t effects_from_list(const std::string &list);
+
 }  // namespace ct_host

@@ -33,6 +33,11 @@
 
 using namespace ct_host;
 
+namespace ct_host {
+// cmd_demo.cpp: geolocation, the picture and the table of the demo
+int demo_main_job(const std::vector<uint8_t> &pkg, const Terrain &t, const std::map<std::string, std::string> &opt);
+}  // namespace ct_host
+
 namespace {
 
 // One usage block per command: `conetrace --help` prints them all,
@@ -49,7 +54,11 @@ const UsageBlock kUsage[] = {
      "                [--utm ZONE{N|S}]   (geographic DEMs: resampled onto UTM at --posting M)\n"},
     {"info", "conetrace info PKG\n"},
     {"trace", "conetrace trace PKG --rays rays.csv [--method M] [--threads T] -o hits.csv\n"},
-    {"demo", "conetrace demo DEM [--sectors N] [--reduce r]\n"},
+    {"demo",
+     "conetrace demo DEM --camera C.cameramodel [--effects curvature,refraction] [--step PX]\n"
+     "               [--sectors N] [--reduce r] [-o DIR]\n"
+     "               (the main job: package the DEM, geolocate a grid of the camera's pixels,\n"
+     "               draw DIR/footprint.png and list DIR/pixels.csv; DIR defaults to demo)\n"},
     {"geoloc",
      "conetrace geoloc PKG --camera C.cameramodel --pixels px.csv [--method M]\n"
      "                 [--pose-wgs84 LAT,LON,H,YAW,PITCH,ROLL | --pose-map E,N,H,YAW,PITCH,ROLL]\n"
@@ -342,75 +351,23 @@ int cmd_trace(int argc, char **argv)
 
 int cmd_demo(int argc, char **argv)
 {
-    Args a = parse(argc, argv, 2, {"--sectors", "--reduce"});
+    Args a = parse(argc, argv, 2, {"--camera", "--effects", "--step", "--sectors", "--reduce", "-o"});
     if (a.pos.size() != 1) usage("demo needs a DEM file");
+    if (!a.opt.count("--camera")) usage("demo needs --camera C.cameramodel");
     Terrain t = load_terrain(a.pos[0], 0, 0);
     BuildOptions o;
     o.sectors = to_int(a, "--sectors", 24);
-    o.reduce = to_int(a, "--reduce", 1);
+    o.reduce = to_int(a, "--reduce", 3);
     Progress bar("building cones");
     o.progress = [&](size_t d, size_t n) { bar.update(d, n); };
     BuildStats bs;
     std::vector<uint8_t> pkg = build_package(t, o, &bs);
     bar.finish();
-    ct_package p;
-    if (ct_package_open(&p, pkg.data(), pkg.size()) != CT_OK) throw Error("demo: package did not open");
-    std::printf("DEM %s: %dx%d posts, %.0f m posting; package %zu bytes (%.2fx DEM), %d sectors, r=%d, "
-                "built in %.2f s\n\n",
-                a.pos[0].c_str(), t.width, t.height, std::fabs(t.geo.posting_e), pkg.size(),
+    std::printf("DEM %s: %dx%d posts, %.0f m posting, EPSG:%d; package %zu bytes (%.2fx the DEM), %d sectors, r=%d, "
+                "built in %.2f s\n",
+                a.pos[0].c_str(), t.width, t.height, std::fabs(t.geo.posting_e), t.geo.epsg, pkg.size(),
                 pkg.size() / (2.0 * t.width * t.height), o.sectors, o.reduce, bs.seconds);
-    // a handful of rays across the tile, in the map frame
-    double w = (t.width - 1) * std::fabs(t.geo.posting_e), hgt = (t.height - 1) * std::fabs(t.geo.posting_n);
-    double e0 = t.geo.origin_e + 0.5 * t.geo.posting_e, n0 = t.geo.origin_n + 0.5 * t.geo.posting_n;
-    double top = t.height_offset_m + 65535 * t.height_scale_m;
-    struct Demo { const char *name; MapRay r; };
-    std::vector<Demo> demos = {
-        {"nadir", {e0 + 0.41 * w, n0 - 0.37 * hgt, top + 500, 0, 0, -1}},
-        {"oblique 30 deg", {e0 + 0.05 * w, n0 - 0.5 * hgt, top, 0.866, -0.05, -0.5}},
-        {"grazing 2 deg", {e0 + 0.02 * w, n0 - 0.3 * hgt, t.height_offset_m + 0.6 * 65535 * t.height_scale_m, 0.9994, -0.3, -0.0349}},
-        {"horizontal", {e0, n0 - 0.5 * hgt, 0, 1, 0.02, 0}},
-        {"rising 5 deg", {e0 + 0.5 * w, n0 - 0.5 * hgt, t.height_offset_m + 1.0, 0.7, 0.7, 0.087}},
-    };
-    // heights relative to the terrain: the horizontal and rising rays start
-    // a few metres above the ground below them
-    {
-        uint16_t lo = 65535, hi = 0;
-        for (uint16_t c : t.codes) {
-            lo = std::min(lo, c);
-            hi = std::max(hi, c);
-        }
-        auto ground = [&](double fx, double fy) {
-            int i = (int)std::lround(fx * (t.width - 1)), j = (int)std::lround(fy * (t.height - 1));
-            return t.height_offset_m + t.at(i, j) * t.height_scale_m;
-        };
-        demos[1].r.h = t.height_offset_m + hi * t.height_scale_m + 300;
-        demos[2].r.h = t.height_offset_m + (lo + 0.8 * (hi - lo)) * t.height_scale_m;
-        demos[3].r.h = std::max(t.height_offset_m + (lo + 0.75 * (hi - lo)) * t.height_scale_m, ground(0.0, 0.5) + 5.0);
-        demos[4].r.h = ground(0.5, 0.5) + 5.0;
-    }
-    const char *mnames[4] = {"incremental", "hierarchical", "cone", "directional"};
-    std::printf("%-16s %-7s %14s %14s %10s | %11s %12s %5s %11s\n", "ray", "status", "E (m)", "N (m)", "h (m)",
-                mnames[0], mnames[1], mnames[2], mnames[3]);
-    for (const Demo &d : demos) {
-        ct_ray gr;
-        ct_hit h[4];
-        ct_status s[4];
-        ct_status ps = map_ray_to_grid(p, d.r, &gr);
-        for (int k = 0; k < 4; ++k) s[k] = ps == CT_OK ? ct_trace(&p, &gr, (ct_method)k, &h[k]) : ps;
-        bool same = true;
-        for (int k = 1; k < 4; ++k)
-            same = same && s[k] == s[0] && h[k].x_q16 == h[0].x_q16 && h[k].y_q16 == h[0].y_q16 && h[k].z_q16 == h[0].z_q16;
-        if (s[0] == CT_HIT || s[0] == CT_HIT_VOID)
-            std::printf("%-16s %-7s %14.3f %14.3f %10.3f | %11u %12u %5u %11u%s\n", d.name, status_name(s[0]).c_str(),
-                        h[0].e_nm * 1e-9, h[0].n_nm * 1e-9, h[0].h_nm * 1e-9, h[0].steps, h[1].steps, h[2].steps,
-                        h[3].steps, same ? "" : "  (METHODS DISAGREE)");
-        else
-            std::printf("%-16s %-7s %14s %14s %10s | %11u %12u %5u %11u%s\n", d.name, status_name(s[0]).c_str(), "-",
-                        "-", "-", h[0].steps, h[1].steps, h[2].steps, h[3].steps, same ? "" : "  (METHODS DISAGREE)");
-    }
-    std::printf("\nsteps: cells visited (incremental), blocks+cells (hierarchical), cone jumps+cells (cone, "
-                "directional).\nAll four methods return the identical hit; see `make bench` for statistics.\n");
-    return 0;
+    return demo_main_job(pkg, t, a.opt);
 }
 
 }  // namespace

@@ -80,18 +80,7 @@ int cmd_geoloc(int argc, char **argv)
     if (!opt.count("-o")) throw Error("geoloc needs -o out.csv");
     // radius 0: the true Earth on UTM packages (the sphere of 6371 km on others)
     ct_effects fx = {0u, CT_REFRACTION_K_STD_Q16, 0, 0};
-    if (opt.count("--effects")) {
-        std::string list = opt["--effects"], tok;
-        std::stringstream ss(list);
-        while (std::getline(ss, tok, ',')) {
-            tok.erase(0, tok.find_first_not_of(' '));
-            tok.erase(tok.find_last_not_of(' ') + 1);
-            if (tok.empty()) continue;
-            if (tok == "curvature") fx.flags |= CT_EFFECT_CURVATURE;
-            else if (tok == "refraction") fx.flags |= CT_EFFECT_REFRACTION;
-            else throw Error("--effects '" + list + "': unknown effect '" + tok + "' (curvature, refraction)");
-        }
-    }
+    if (opt.count("--effects")) fx.flags = effects_from_list(opt["--effects"]);
     auto number = [&](const char *name, double lo, double hi, const char *what) {
         const std::string &g = opt[name];
         char *end = nullptr;

@@ -56,6 +56,7 @@
 #include "cells.hpp"
 #include "ddt.hpp"
 #include "dem_io.hpp"
+#include "picture.hpp"
 #include "host_io.hpp"
 #include "terrain.hpp"
 
@@ -67,26 +68,9 @@ constexpr int GAP = 8;      // pixels between panels
 constexpr int STRIP = 28;   // header above each sector panel
 constexpr int LEGEND = 26;  // colour bar below the panels (incl. its gap)
 
-struct Rgb {
-    uint8_t r, g, b;
-};
-constexpr Rgb kWhite{255, 255, 255};
 constexpr Rgb kFeature{38, 38, 46};    // bitmap: terrain at/above the level
 constexpr Rgb kNone{200, 200, 200};    // infinity, no cone (not in viridis)
-constexpr Rgb kInk{20, 20, 20};
 
-// Viridis (matplotlib's), 11 anchors at t = 0, 0.1, ..., 1, linear between.
-Rgb viridis(double t)
-{
-    static const uint8_t a[11][3] = {{68, 1, 84},    {72, 36, 117},  {65, 68, 135},  {53, 95, 141},
-                                     {42, 120, 142}, {33, 145, 140}, {34, 168, 132}, {68, 191, 112},
-                                     {122, 209, 81}, {189, 223, 38}, {253, 231, 37}};
-    t = std::min(1.0, std::max(0.0, t)) * 10.0;
-    int k = std::min(9, (int)t);
-    double f = t - k;
-    auto mix = [&](int c) { return (uint8_t)std::lround(a[k][c] + f * (a[k + 1][c] - a[k][c])); };
-    return Rgb{mix(0), mix(1), mix(2)};
-}
 // 256-entry palette: index = round(255 * t).
 Rgb palette(bool grey, int idx)
 {
@@ -96,51 +80,6 @@ Rgb palette(bool grey, int idx)
 
 [[noreturn]] void fail(const std::string &msg) { throw Error("render: " + msg); }
 
-// ------------------------------------------------------------------ image
-struct Image {
-    int w = 0, h = 0;
-    std::vector<uint8_t> px;  // RGB
-    Image(int w_, int h_) : w(w_), h(h_), px((size_t)w_ * h_ * 3, 255) {}
-    void set(int x, int y, Rgb c)
-    {
-        if (x < 0 || y < 0 || x >= w || y >= h) return;
-        uint8_t *p = &px[((size_t)y * w + x) * 3];
-        p[0] = c.r, p[1] = c.g, p[2] = c.b;
-    }
-};
-
-// 3 x 5 digits and a few signs, bit 14 = top-left.
-void draw_text(Image &im, int x, int y, const std::string &s, int scale)
-{
-    auto glyph = [](char ch) -> unsigned {
-        switch (ch) {
-        case '0': return 075557;
-        case '1': return 026227;
-        case '2': return 071747;
-        case '3': return 071717;
-        case '4': return 055711;
-        case '5': return 074717;
-        case '6': return 074757;
-        case '7': return 071111;
-        case '8': return 075757;
-        case '9': return 075717;
-        case '.': return 000002;
-        case '-': return 000700;
-        case 'o': return 000757;  // "omni"
-        default: return 0;
-        }
-    };
-    for (char ch : s) {
-        unsigned g = glyph(ch);
-        for (int r = 0; r < 5; ++r)
-            for (int c = 0; c < 3; ++c)
-                if (g & (1u << (14 - (r * 3 + c))))
-                    for (int a = 0; a < scale; ++a)
-                        for (int b = 0; b < scale; ++b) im.set(x + c * scale + b, y + r * scale + a, kInk);
-        x += 4 * scale;
-    }
-}
-
 std::string fmt_num(double v)
 {
     char b[32];
@@ -149,33 +88,6 @@ std::string fmt_num(double v)
     else
         std::snprintf(b, sizeof b, "%.1f", v);
     return b;
-}
-
-void write_png_atomic(const std::string &path, const Image &im, const std::string &desc)
-{
-    const std::string tmp = path + ".tmp." + std::to_string((long)getpid()) + ".png";
-    auto out = OIIO::ImageOutput::create("png");
-    if (!out) throw Error(path + ": cannot write PNG (" + OIIO::geterror() + ")");
-    OIIO::ImageSpec spec(im.w, im.h, 3, OIIO::TypeDesc::UINT8);
-    spec.attribute("ImageDescription", desc);
-    spec.attribute("Software", "conetrace render");
-    errno = 0;
-    bool opened = out->open(tmp, spec);
-    const int open_errno = errno;
-    bool ok = opened && out->write_image(OIIO::TypeDesc::UINT8, im.px.data());
-    std::string err = ok ? "" : out->geterror();
-    if (!opened && open_errno != 0) err = std::strerror(open_errno);  // OIIO's text names the temporary
-    ok = out->close() && ok;
-    if (ok && std::rename(tmp.c_str(), path.c_str()) != 0) {
-        ok = false;
-        err = std::strerror(errno);
-    }
-    if (!ok) {
-        std::remove(tmp.c_str());
-        if (err.empty()) err = out->geterror();
-        // OIIO's messages often repeat the (temporary) file name; keep the reason
-        throw Error(path + ": cannot write (" + (err.empty() ? "unknown error" : err) + ")");
-    }
 }
 
 // ------------------------------------------------------------------ input
@@ -226,32 +138,6 @@ Input load_input(const std::string &path)
         }
     }
     return in;
-}
-
-// Hillshade in [0, 1] per coarse cell (mean over its fine cells), light from
-// azimuth 315 deg (NW), 45 deg up; gradients from the cell's four posts.
-std::vector<double> hillshade(const Terrain &t, int r, int wc, int hc)
-{
-    const int cx = t.width - 1, cy = t.height - 1;
-    const double post = std::fabs(t.geo.posting_e) > 0 ? std::fabs(t.geo.posting_e) : 1.0;
-    const double alt = M_PI / 4, az = 7 * M_PI / 4;  // from north, clockwise
-    // light vector in (east, south, up)
-    const double lx = std::cos(alt) * std::sin(az), ly = -std::cos(alt) * std::cos(az), lz = std::sin(alt);
-    std::vector<double> sum((size_t)wc * hc, 0.0);
-    std::vector<int> cnt((size_t)wc * hc, 0);
-    for (int j = 0; j < cy; ++j)
-        for (int i = 0; i < cx; ++i) {
-            double z00 = t.at(i, j), z10 = t.at(i + 1, j), z01 = t.at(i, j + 1), z11 = t.at(i + 1, j + 1);
-            double s = t.height_scale_m / post;
-            double gx = 0.5 * ((z10 + z11) - (z00 + z01)) * s, gy = 0.5 * ((z01 + z11) - (z00 + z10)) * s;
-            double nrm = std::sqrt(gx * gx + gy * gy + 1.0);
-            double sh = std::max(0.0, (-gx * lx - gy * ly + lz) / nrm);
-            size_t k = (size_t)(j / r) * wc + i / r;
-            sum[k] += sh;
-            cnt[k] += 1;
-        }
-    for (size_t k = 0; k < sum.size(); ++k) sum[k] = cnt[k] ? sum[k] / cnt[k] : 1.0;
-    return sum;
 }
 
 // ------------------------------------------------------------------ options
@@ -569,7 +455,7 @@ int cmd_render(int argc, char **argv)
         }
     }
     if (what != "bitmap") desc << "; scale " << lo << ".." << hi << " " << unit;
-    write_png_atomic(out, im, desc.str());
+    write_png_atomic(out, im, desc.str(), "conetrace render");
     std::printf("%s: %dx%d px, %d panel%s of %dx%d cells; %s\n", out.c_str(), im.w, im.h, n, n == 1 ? "" : "s", wc, hc,
                 desc.str().c_str());
     return 0;

@@ -1,7 +1,12 @@
 #!/bin/sh
-# make demo: package the bundled real DEM (fixtures/jacksboro_fault_dem.tif)
-# and trace a handful of rays with every method.
+# make demo: the main job on the bundled real DEM (fixtures/jacksboro_fault_dem.tif,
+# fixtures/README.md): package it, geolocate a grid of a wide-angle camera's
+# pixels (fixtures/scenes/wide_opencv8: OPENCV8 lens, 1.8 km up, 45 deg down
+# towards the south-east) with curvature and refraction -- the true Earth --
+# and draw what it sees: $OUT/footprint.png, the pixels in $OUT/pixels.csv.
 set -eu
 BUILD=${1:-build}
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
-exec "$BUILD/host_tools/conetrace" demo "$ROOT/fixtures/jacksboro_fault_dem.tif" --sectors 24 --reduce 1
+OUT=${CT_DEMO_DIR:-$BUILD/demo}
+exec "$BUILD/host_tools/conetrace" demo "$ROOT/fixtures/jacksboro_fault_dem.tif" \
+    --camera "$ROOT/fixtures/scenes/wide_opencv8.cameramodel" --effects curvature,refraction -o "$OUT"

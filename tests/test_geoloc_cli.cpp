@@ -26,7 +26,10 @@
 #include <string>
 #include <vector>
 
+#include <OpenImageIO/imageio.h>
+
 #include "camera_host.hpp"
+#include "picture.hpp"
 #include "conetrace.h"
 #include "dem_cases.hpp"
 #include "harness.h"
@@ -670,6 +673,105 @@ void test_geoloc_earth_map()
     fs::remove(g_dir + "/pxe.csv");
 }
 
+// `conetrace demo` (make demo's main job) on the bundled DEM and the
+// oblique30 scene's camera: every geolocated pixel of pixels.csv is the
+// library's (the same package built by `conetrace build --reduce 3`, the same
+// effects), its dot lies where its map point falls in the picture (the
+// test's own georeference arithmetic from the crop and zoom the PNG states),
+// and the picture there has the dot's range colour (not a golden image).
+void test_demo()
+{
+    const std::string dem = std::string(CT_FIXTURES_DIR) + "/jacksboro_fault_dem.tif";
+    const std::string model = std::string(CT_FIXTURES_DIR) + "/scenes/oblique30.cameramodel";
+    Run r = run({"demo", dem, "--camera", model, "--step", "64", "-o", "demo_out"});
+    TEST_ASSERT_MSG(r.code == 0, "demo: exit %d: %s", r.code, r.err.c_str());
+    TEST_ASSERT(r.out.find("picture: demo_out/footprint.png") != std::string::npos);
+    TEST_ASSERT(r.out.find("(the same hits, bit for bit)") != std::string::npos);
+    Run b = run({"build", dem, "--reduce", "3", "-o", "demo_pkg.ctp"});
+    TEST_ASSERT_MSG(b.code == 0, "build: %s", b.err.c_str());
+    const std::string bytes = slurp(g_dir + "/demo_pkg.ctp");
+    ct_package pk;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_package_open(&pk, (const uint8_t *)bytes.data(), bytes.size()));
+    ct_host::LibCamera lc = ct_host::lib_camera(ct_host::read_cameramodel(model), model);
+    // the picture and what it says of itself
+    auto in = OIIO::ImageInput::open(g_dir + "/demo_out/footprint.png");
+    TEST_ASSERT(in != nullptr);
+    const OIIO::ImageSpec spec = in->spec();
+    TEST_ASSERT_EQUAL_INT(3, spec.nchannels);
+    std::vector<uint8_t> px((size_t)spec.width * spec.height * 3);
+    TEST_ASSERT(in->read_image(0, 0, 0, 3, OIIO::TypeDesc::UINT8, px.data()));
+    in->close();
+    const std::string desc = spec.get_string_attribute("ImageDescription");
+    int i0, i1, j0, j1, zoom;
+    const size_t at = desc.find("posts ");
+    TEST_ASSERT_MSG(at != std::string::npos && std::sscanf(desc.c_str() + at, "posts %d..%d x %d..%d of the DEM, %d",
+                                                           &i0, &i1, &j0, &j1, &zoom) == 5,
+                    "description '%s'", desc.c_str());
+    TEST_ASSERT_EQUAL_INT(std::max(300, (i1 - i0 + 1) * zoom), spec.width);
+    TEST_ASSERT_EQUAL_INT((j1 - j0 + 1) * zoom + 40, spec.height);
+    // the rows
+    std::vector<std::string> rows = lines_of(slurp(g_dir + "/demo_out/pixels.csv"));
+    TEST_ASSERT(rows.size() > 1 && rows[0] == "u,v,status,E,N,h,range,steps,px,py");
+    TEST_ASSERT_EQUAL_INT(16 * 12 + 1, rows.size());  // every 64th pixel of 1024 x 768
+    ct_effects fx = {CT_EFFECT_CURVATURE | CT_EFFECT_REFRACTION | CT_EFFECT_EARTH_FIT, CT_REFRACTION_K_STD_Q16, 0, 0};
+    struct Dot {
+        int x, y;
+        double range;
+    };
+    std::vector<Dot> dots;
+    double rmin = 1e300, rmax = 0;
+    const double pe = pk.posting_e_nm * 1e-9, pn = pk.posting_n_nm * 1e-9;
+    for (size_t k = 1; k < rows.size(); ++k) {
+        std::vector<std::string> f = split(rows[k]);
+        TEST_ASSERT_EQUAL_INT(10, f.size());
+        int64_t uq, vq;
+        TEST_ASSERT(ct_host::pixel_to_q16(std::stod(f[0]), std::stod(f[1]), &uq, &vq));
+        ct_geo g;
+        const ct_status want = ct_geolocate(&pk, &lc.cam, &lc.pose, CT_METHOD_DIRECTIONAL, &fx, uq, vq, &g);
+        TEST_ASSERT_MSG(f[2] == ct_host::status_name(want), "row %zu: %s, library %s", k, f[2].c_str(),
+                        ct_host::status_name(want).c_str());
+        if (want != CT_HIT && want != CT_HIT_VOID) continue;
+        TEST_ASSERT_MSG(f[3] == ct_host::nm_to_decimal(g.hit.e_nm) && f[4] == ct_host::nm_to_decimal(g.hit.n_nm) &&
+                            f[5] == ct_host::nm_to_decimal(g.hit.h_nm),
+                        "row %zu: the hit is not the library's", k);
+        const double x = ((g.hit.e_nm - pk.origin_e_nm) * 1e-9 / pe - i0) * zoom;
+        const double y = ((g.hit.n_nm - pk.origin_n_nm) * 1e-9 / pn - j0) * zoom;
+        TEST_ASSERT_MSG(std::stoi(f[8]) == (int)std::floor(x) && std::stoi(f[9]) == (int)std::floor(y),
+                        "row %zu: dot at (%s, %s), the georeference puts it at (%.2f, %.2f)", k, f[8].c_str(),
+                        f[9].c_str(), x, y);
+        TEST_ASSERT(x >= 0 && y >= 0 && x < (i1 - i0 + 1) * zoom && y < (j1 - j0 + 1) * zoom);
+        const double rg = std::stod(f[6]);
+        dots.push_back({(int)std::floor(x), (int)std::floor(y), rg});
+        rmin = std::min(rmin, rg);
+        rmax = std::max(rmax, rg);
+    }
+    TEST_ASSERT_MSG(dots.size() >= 150, "only %zu hits", dots.size());
+    // each dot's centre has its colour, or a neighbour's whose dot (radius
+    // 2) covers it; the camera's mark (radius 7, heading 60 px) is drawn last
+    const double cx = ((lc.pose.e_nm - pk.origin_e_nm) * 1e-9 / pe - i0) * zoom;
+    const double cy = ((lc.pose.n_nm - pk.origin_n_nm) * 1e-9 / pn - j0) * zoom;
+    int checked = 0;
+    for (const Dot &d : dots) {
+        if (std::hypot(d.x - cx, d.y - cy) < 70) continue;
+        const uint8_t *c = &px[((size_t)d.y * spec.width + d.x) * 3];
+        bool ok = false;
+        for (const Dot &e : dots) {
+            if (std::abs(e.x - d.x) > 2 || std::abs(e.y - d.y) > 2) continue;
+            const ct_host::Rgb v = ct_host::viridis((e.range - rmin) / std::max(1.0, rmax - rmin));
+            ok = ok || (c[0] == v.r && c[1] == v.g && c[2] == v.b);
+        }
+        TEST_ASSERT_MSG(ok, "the picture at (%d, %d) is (%d, %d, %d), no dot's colour", d.x, d.y, c[0], c[1], c[2]);
+        checked++;
+    }
+    std::printf("  demo: %zu hits of %zu pixels, %d dots checked in the %dx%d picture (posts %d..%d x %d..%d, zoom %d)\n",
+                dots.size(), rows.size() - 1, checked, spec.width, spec.height, i0, i1, j0, j1, zoom);
+    TEST_ASSERT(checked >= 100);
+    Run bad = run({"demo", dem, "-o", "demo_out"});
+    TEST_ASSERT(bad.code != 0 && bad.err.find("demo needs --camera") != std::string::npos);
+    fs::remove_all(g_dir + "/demo_out");
+    fs::remove(g_dir + "/demo_pkg.ctp");
+}
+
 // --effects curvature,refraction with --refraction-k and --earth-radius:
 // the rows are the library's ct_geolocate with the same ct_effects, bit for
 // bit, and (with an exaggerated 30 km earth) differ from the straight rays.
@@ -894,6 +996,7 @@ int main()
     RUN_TEST(test_geoloc_pose_map_vs_model);
     RUN_TEST(test_geoloc_threads);
     RUN_TEST(test_geoloc_earth_map);
+    RUN_TEST(test_demo);
     RUN_TEST(test_geoloc_splined_grid);
     RUN_TEST(test_geoloc_bad_inputs);
     int rc = TEST_END();

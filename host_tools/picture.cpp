@@ -1,0 +1,145 @@
+// picture.cpp -- see picture.hpp.
+#include "picture.hpp"
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+
+#include <unistd.h>
+
+#include <OpenImageIO/imageio.h>
+
+#include "host_io.hpp"
+
+namespace ct_host {
+
+// Viridis (matplotlib's), 11 anchors at t = 0, 0.1, ..., 1, linear between.
+Rgb viridis(double t)
+{
+    static const uint8_t a[11][3] = {{68, 1, 84},    {72, 36, 117},  {65, 68, 135},  {53, 95, 141},
+                                     {42, 120, 142}, {33, 145, 140}, {34, 168, 132}, {68, 191, 112},
+                                     {122, 209, 81}, {189, 223, 38}, {253, 231, 37}};
+    t = std::min(1.0, std::max(0.0, t)) * 10.0;
+    int k = std::min(9, (int)t);
+    double f = t - k;
+    auto mix = [&](int c) { return (uint8_t)std::lround(a[k][c] + f * (a[k + 1][c] - a[k][c])); };
+    return Rgb{mix(0), mix(1), mix(2)};
+}
+
+void Image::line(int x0, int y0, int x1, int y1, Rgb c)
+{
+    const int dx = std::abs(x1 - x0), dy = -std::abs(y1 - y0), sx = x0 < x1 ? 1 : -1, sy = y0 < y1 ? 1 : -1;
+    int err = dx + dy;
+    for (;;) {  // at most dx - dy + 1 points
+        set(x0, y0, c);
+        if (x0 == x1 && y0 == y1) break;
+        const int e2 = 2 * err;
+        if (e2 >= dy) {
+            err += dy;
+            x0 += sx;
+        }
+        if (e2 <= dx) {
+            err += dx;
+            y0 += sy;
+        }
+    }
+}
+
+void Image::disc(int cx, int cy, int r, Rgb c)
+{
+    for (int y = -r; y <= r; ++y)
+        for (int x = -r; x <= r; ++x)
+            if (x * x + y * y <= r * r + r) set(cx + x, cy + y, c);
+}
+
+// 3 x 5 digits and a few signs, bit 14 = top-left.
+void draw_text(Image &im, int x, int y, const std::string &s, int scale)
+{
+    auto glyph = [](char ch) -> unsigned {
+        switch (ch) {
+        case '0': return 075557;
+        case '1': return 026227;
+        case '2': return 071747;
+        case '3': return 071717;
+        case '4': return 055711;
+        case '5': return 074717;
+        case '6': return 074757;
+        case '7': return 071111;
+        case '8': return 075757;
+        case '9': return 075717;
+        case '.': return 000002;
+        case '-': return 000700;
+        case 'o': return 000757;  // "omni"
+        default: return 0;
+        }
+    };
+    for (char ch : s) {
+        unsigned g = glyph(ch);
+        for (int r = 0; r < 5; ++r)
+            for (int c = 0; c < 3; ++c)
+                if (g & (1u << (14 - (r * 3 + c))))
+                    for (int a = 0; a < scale; ++a)
+                        for (int b = 0; b < scale; ++b) im.set(x + c * scale + b, y + r * scale + a, kInk);
+        x += 4 * scale;
+    }
+}
+
+// Hillshade in [0, 1] per coarse cell (mean over its fine cells), light from
+// azimuth 315 deg (NW), 45 deg up; gradients from the cell's four posts.
+std::vector<double> hillshade(const Terrain &t, int r, int wc, int hc)
+{
+    const int cx = t.width - 1, cy = t.height - 1;
+    const double post = std::fabs(t.geo.posting_e) > 0 ? std::fabs(t.geo.posting_e) : 1.0;
+    const double alt = M_PI / 4, az = 7 * M_PI / 4;  // from north, clockwise
+    // light vector in (east, south, up)
+    const double lx = std::cos(alt) * std::sin(az), ly = -std::cos(alt) * std::cos(az), lz = std::sin(alt);
+    std::vector<double> sum((size_t)wc * hc, 0.0);
+    std::vector<int> cnt((size_t)wc * hc, 0);
+    for (int j = 0; j < cy; ++j)
+        for (int i = 0; i < cx; ++i) {
+            double z00 = t.at(i, j), z10 = t.at(i + 1, j), z01 = t.at(i, j + 1), z11 = t.at(i + 1, j + 1);
+            double s = t.height_scale_m / post;
+            double gx = 0.5 * ((z10 + z11) - (z00 + z01)) * s, gy = 0.5 * ((z01 + z11) - (z00 + z10)) * s;
+            double nrm = std::sqrt(gx * gx + gy * gy + 1.0);
+            double sh = std::max(0.0, (-gx * lx - gy * ly + lz) / nrm);
+            size_t k = (size_t)(j / r) * wc + i / r;
+            sum[k] += sh;
+            cnt[k] += 1;
+        }
+    for (size_t k = 0; k < sum.size(); ++k) sum[k] = cnt[k] ? sum[k] / cnt[k] : 1.0;
+    return sum;
+}
+
+void write_png_atomic(const std::string &path, const Image &im, const std::string &desc,
+                      const std::string &software)
+{
+    const std::string tmp = path + ".tmp." + std::to_string((long)getpid()) + ".png";
+    auto out = OIIO::ImageOutput::create("png");
+    if (!out) throw Error(path + ": cannot write PNG (" + OIIO::geterror() + ")");
+    OIIO::ImageSpec spec(im.w, im.h, 3, OIIO::TypeDesc::UINT8);
+    spec.attribute("ImageDescription", desc);
+    spec.attribute("Software", software);
+    errno = 0;
+    bool opened = out->open(tmp, spec);
+    const int open_errno = errno;
+    bool ok = opened && out->write_image(OIIO::TypeDesc::UINT8, im.px.data());
+    std::string err = ok ? "" : out->geterror();
+    if (!opened && open_errno != 0) err = std::strerror(open_errno);  // OIIO's text names the temporary
+    ok = out->close() && ok;
+    if (ok && std::rename(tmp.c_str(), path.c_str()) != 0) {
+        ok = false;
+        err = std::strerror(errno);
+    }
+    if (!ok) {
+        std::remove(tmp.c_str());
+        if (err.empty()) err = out->geterror();
+        // OIIO's messages often repeat the (temporary) file name; keep the reason
+        throw Error(path + ": cannot write (" + (err.empty() ? "unknown error" : err) + ")");
+    }
+}
+
+
+}  // namespace ct_host

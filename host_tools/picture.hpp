@@ -1,0 +1,58 @@
+// picture.hpp -- small RGB pictures for `conetrace render` and `conetrace
+// demo`: an image buffer with points, lines and 3x5-pixel digits, the
+// viridis colour map, a hillshade of a terrain, and an atomic PNG writer
+// (OpenImageIO).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "terrain.hpp"
+
+namespace ct_host {
+
+struct Rgb {
+    uint8_t r, g, b;
+};
+constexpr Rgb kWhite{255, 255, 255};
+constexpr Rgb kInk{20, 20, 20};
+
+// Viridis (matplotlib's), 11 anchors at t = 0, 0.1, ..., 1, linear between;
+// t is clamped to [0, 1].
+Rgb viridis(double t);
+
+struct Image {
+    int w = 0, h = 0;
+    std::vector<uint8_t> px;  // RGB, rows top to bottom
+    Image(int w_, int h_) : w(w_), h(h_), px((size_t)w_ * h_ * 3, 255) {}
+    void set(int x, int y, Rgb c)  // ignored outside the image
+    {
+        if (x < 0 || y < 0 || x >= w || y >= h) return;
+        uint8_t *p = &px[((size_t)y * w + x) * 3];
+        p[0] = c.r, p[1] = c.g, p[2] = c.b;
+    }
+    Rgb get(int x, int y) const
+    {
+        const uint8_t *p = &px[((size_t)y * w + x) * 3];
+        return Rgb{p[0], p[1], p[2]};
+    }
+    // a segment (Bresenham), a filled disc and a ring of radius r
+    void line(int x0, int y0, int x1, int y1, Rgb c);
+    void disc(int cx, int cy, int r, Rgb c);
+};
+
+// Digits, '.', '-', 'o' (3 x 5 glyphs, each pixel scale x scale) in ink.
+void draw_text(Image &im, int x, int y, const std::string &s, int scale);
+
+// Hillshade in [0, 1] per coarse cell of r x r cells (mean over its fine
+// cells; wc x hc coarse cells), light from the NW, 45 deg up.
+std::vector<double> hillshade(const Terrain &t, int r, int wc, int hc);
+
+// Write a PNG (description and software in its text chunks) through a
+// temporary file renamed into place: never a partial file.  Throws Error
+// naming the path and the reason.
+void write_png_atomic(const std::string &path, const Image &im, const std::string &desc,
+                      const std::string &software);
+
+}  // namespace ct_host
