@@ -78,7 +78,7 @@ int demo_main_job(const std::vector<uint8_t> &bytes, const Terrain &t, const std
     const unsigned W = cm.width, H = cm.height;
     if (W == 0 || H == 0) throw Error(cpath + ": no image size");
     ct_effects fx = {effects_from_list(opt.count("--effects") ? opt.at("--effects") : "curvature,refraction"),
-                     CT_REFRACTION_K_STD_Q16, 0, 0};
+                     CT_REFRACTION_K_STD_Q16, 0, 0, nullptr};
     fx.flags |= CT_EFFECT_EARTH_FIT;  // batches only; ignored without the true Earth
     ct_utm zone;
     const bool utm = ct_utm_zone_of_epsg((int32_t)p.epsg, &zone) == CT_OK;

@@ -79,7 +79,7 @@ int cmd_geoloc(int argc, char **argv)
     if (!opt.count("--pixels")) throw Error("geoloc needs --pixels pixels.csv");
     if (!opt.count("-o")) throw Error("geoloc needs -o out.csv");
     // radius 0: the true Earth on UTM packages (the sphere of 6371 km on others)
-    ct_effects fx = {0u, CT_REFRACTION_K_STD_Q16, 0, 0};
+    ct_effects fx = {0u, CT_REFRACTION_K_STD_Q16, 0, 0, nullptr};
     if (opt.count("--effects")) fx.flags = effects_from_list(opt["--effects"]);
     auto number = [&](const char *name, double lo, double hi, const char *what) {
         const std::string &g = opt[name];

@@ -258,7 +258,7 @@ inline World *load_world(const std::string &scene_path)
 
 inline ct_effects lib_effects(const Scene &s, unsigned fx)
 {
-    ct_effects e = {0u, (int32_t)std::lround(s.k * 65536), (int64_t)std::llround(s.radius_m * 1e9), 0};
+    ct_effects e = {0u, (int32_t)std::lround(s.k * 65536), (int64_t)std::llround(s.radius_m * 1e9), 0, nullptr};
     if (fx & FX_CURVATURE) e.flags |= CT_EFFECT_CURVATURE;
     if (fx & FX_REFRACTION) e.flags |= CT_EFFECT_REFRACTION;
     return e;

@@ -306,7 +306,7 @@ void test_reference_nadir()
         for (int refr = 0; refr < 2; ++refr) {
             Pose p;
             TEST_ASSERT(make_pose(w->sf, {"nadir", pl[0], pl[1], 3000, 30, -90}, &p));
-            ct_effects fx = {CT_EFFECT_CURVATURE | (refr ? CT_EFFECT_REFRACTION : 0u), CT_REFRACTION_K_STD_Q16, 0, 0};
+            ct_effects fx = {CT_EFFECT_CURVATURE | (refr ? CT_EFFECT_REFRACTION : 0u), CT_REFRACTION_K_STD_Q16, 0, 0, nullptr};
             // the camera's optical axis is the local down (pitch -90 in NED): ray (0, 0, 1)
             const ld ray[3] = {0, 0, 1};
             ld qd[4];
@@ -335,7 +335,7 @@ void test_reference_nadir()
         Pose p;
         TEST_ASSERT(make_pose(w->sf, {"under", 201045, 4065840, -5, 0, -30}, &p));
         const ld ray[3] = {0, 0, 1};
-        ct_effects fx = {CT_EFFECT_CURVATURE, 0, 0, 0};
+        ct_effects fx = {CT_EFFECT_CURVATURE, 0, 0, 0, nullptr};
         TEST_ASSERT_EQUAL_INT(CT_BELOW, earth_ref::geolocate(pj, w->sf, p.pose, ray, &fx).status);
     }
     std::printf("  nadir: hit vs the surface point below the camera within %.3g m\n", worst);
@@ -390,7 +390,7 @@ void test_reference_flat()
         for (int refr = 0; refr < 2; ++refr) {
             Pose p;
             TEST_ASSERT(make_pose(w->sf, {"flat", c.e, c.n, c.above, c.yaw, c.pitch}, &p));
-            ct_effects fx = {CT_EFFECT_CURVATURE | (refr ? CT_EFFECT_REFRACTION : 0u), CT_REFRACTION_K_STD_Q16, 0, 0};
+            ct_effects fx = {CT_EFFECT_CURVATURE | (refr ? CT_EFFECT_REFRACTION : 0u), CT_REFRACTION_K_STD_Q16, 0, 0, nullptr};
             const ld ray[3] = {0, 0, 1};
             earth_ref::Los L = earth_ref::los_from_pose(pj, p.pose, ray, &fx);
             earth_ref::Result r = earth_ref::trace(pj, w->sf, L);
@@ -516,16 +516,22 @@ void compare(unsigned flags)
     const std::vector<PoseDef> defs = pose_defs();
     const char *families[] = {"nadir", "oblique30", "oblique20", "grazing5", "grazing3", "long"};
     const int nf = 6;
-    Stat exact[nf], old[nf], fitted[nf];
+    Stat exact[nf], old[nf], fitted[nf], kmap[nf];
     ld rng_sum[nf] = {0};
     long ref_hits[nf] = {0};
     ct_rng rng;
     ct_rng_seed(&rng, ct_test_seed() * 1009 + flags);
     const int npix = std::max(1, (int)std::lround(kPixelsPerPose * ct_test_scale()));
-    const ct_effects fx = {flags, CT_REFRACTION_K_STD_Q16, 0, 0};
-    ct_effects fx_old = fx, fx_fit = fx;
+    const ct_effects fx = {flags, CT_REFRACTION_K_STD_Q16, 0, 0, nullptr};
+    ct_effects fx_old = fx, fx_fit = fx, fx_kept = fx;
     fx_old.earth_radius_nm = CT_EARTH_RADIUS_NM;
     fx_fit.flags |= CT_EFFECT_EARTH_FIT;
+    // one map for every pose, kept across calls: the tile's centre at 500 m,
+    // a cube of 70 km (every pose's range from there, with 10 km to spare)
+    static ct_earth_map kept;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_earth_map_init(&w->p, INT64_C(201045) * 1000000000, INT64_C(4065840) * 1000000000,
+                                                   INT64_C(500) * 1000000000, INT64_C(60000) * 1000000000, &kept));
+    fx_kept.earth_map = &kept;
     double fit_vs_exact = 0;
     long fit_status_diff = 0;
     long first_reports = 0;
@@ -542,9 +548,11 @@ void compare(unsigned flags)
         }
         // the fitted map: the whole pose in one batch, its first pixel also
         // alone (the batch's results are ct_geolocate's, bit for bit)
-        std::vector<ct_geo> gf((size_t)npix);
+        std::vector<ct_geo> gf((size_t)npix), gk((size_t)npix);
         TEST_ASSERT(ct_geolocate_batch(&w->p, &cam.cam, &p.pose, CT_METHOD_DIRECTIONAL, &fx_fit, uv.data(),
                                        (size_t)npix, gf.data(), gf.size()) == CT_OK);
+        TEST_ASSERT(ct_geolocate_batch(&w->p, &cam.cam, &p.pose, CT_METHOD_DIRECTIONAL, &fx_kept, uv.data(),
+                                       (size_t)npix, gk.data(), gk.size()) == CT_OK);
         {
             ct_geo g1;
             const ct_status s1 =
@@ -566,6 +574,7 @@ void compare(unsigned flags)
                 exact[f].skipped++;
                 old[f].skipped++;
                 fitted[f].skipped++;
+                kmap[f].skipped++;
                 continue;
             }
             if (r.status == CT_HIT) {
@@ -608,6 +617,7 @@ void compare(unsigned flags)
             judge(old[f], los, go, false);
             const int lfs = gf[k].status == CT_HIT_VOID ? CT_HIT : gf[k].status;
             judge(fitted[f], lfs, gf[k], true);
+            judge(kmap[f], gk[k].status == CT_HIT_VOID ? CT_HIT : gk[k].status, gk[k], true);
             if (lfs != ls) {
                 fit_status_diff++;
             } else if (ls == CT_HIT) {
@@ -657,6 +667,21 @@ void compare(unsigned flags)
         fn += fitted[f].n;
         fbad += fitted[f].mismatch;
     }
+    double kworst = 0, kworst_off = 0, ksum2 = 0;
+    long kbad = 0, kn = 0;
+    for (int f = 0; f < nf; ++f) {
+        kworst = std::max(kworst, kmap[f].max);
+        kworst_off = std::max(kworst_off, kmap[f].max_off);
+        ksum2 += kmap[f].sum2;
+        kn += kmap[f].n;
+        kbad += kmap[f].mismatch;
+    }
+    const double krms = kn ? std::sqrt(ksum2 / (double)kn) : 0;
+    std::printf("  kept map (ct_earth_map_init, one for all poses): %ld hits within %.4f m of the reference path, RMS "
+                "%.4f m, max %.4f m from the reference hit, %ld statuses differ\n",
+                kn, kworst_off, krms, kworst, kbad);
+    TEST_ASSERT_MSG(kworst_off <= kMaxOffPathM && krms <= kMaxRmsM && kbad == 0 && kworst <= kMaxErrM,
+                    "kept map: off path %.4f, RMS %.4f, %ld bad, max %.4f m", kworst_off, krms, kbad, kworst);
     const double frms = fn ? std::sqrt(fsum2 / (double)fn) : 0;
     std::printf("  fitted map: hits within %.4f m of the reference path, RMS %.4f m, max %.4f m from the reference "
                 "hit; vs the exact map's hits: up to %.4f m apart, %ld statuses differ\n",
@@ -696,11 +721,11 @@ void test_fitted_map()
         TEST_ASSERT(make_pose(w->sf, {"far", 201045 + back_km * 1000, 4065840, 3000, 270, -10}, &p));
         ct_earth es;
         TEST_ASSERT_EQUAL_INT(CT_OK, ct_earth_setup(&pk, &p.pose, CT_REFRACTION_K_STD_Q16, CT_EARTH_RADIUS_NM,
-                                                    CT_EFFECTS_CHORD_NM, 0u, 1, &es));
-        TEST_ASSERT_MSG(es.fit_deg >= 4 && es.fit_deg <= CT_EARTH_FIT_DEG, "no fit %d km back (range %.1f km)",
-                        (int)back_km, es.tmax_nm * 1e-12);
-        seen |= 1u << es.fit_qrho % 32u;
-        const int64_t half = INT64_C(1) << es.fit_qrho;
+                                                    CT_EFFECTS_CHORD_NM, 0u, 1, nullptr, &es));
+        TEST_ASSERT_MSG(es.map == &es.fit && es.fit.deg >= 4 && es.fit.deg <= CT_EARTH_MAP_DEG,
+                        "no fit %d km back (range %.1f km)", (int)back_km, es.tmax_nm * 1e-12);
+        seen |= 1u << es.fit.qrho % 32u;
+        const int64_t half = INT64_C(1) << es.fit.qrho;
         double err[3] = {0, 0, 0};
         auto check = [&](const int64_t D[3]) {
             int64_t g[3];
@@ -735,9 +760,66 @@ void test_fitted_map()
         const double e = std::max(err[0], std::max(err[1], err[2]));
         std::printf("  camera %3.0Lf km east of the tile: range %.1f km, cube half-width 2^%u nm (%.1f km), degree %d "
                     "(%d exact images): fit vs the reference max |dE| %.2g, |dN| %.2g, |dh| %.2g m\n",
-                    back_km, es.tmax_nm * 1e-12, es.fit_qrho, (double)half * 1e-12, es.fit_deg,
-                    (es.fit_deg + 1) * (es.fit_deg + 1) * (es.fit_deg + 1), err[0], err[1], err[2]);
+                    back_km, es.tmax_nm * 1e-12, es.fit.qrho, (double)half * 1e-12, es.fit.deg,
+                    (es.fit.deg + 1) * (es.fit.deg + 1) * (es.fit.deg + 1), err[0], err[1], err[2]);
         worst = std::max(worst, e);
+    }
+    // a map kept across calls (ct_earth_map_init): centred on the tile at
+    // 500 m, 70 km cube; checked through a camera 3 km up at the centre
+    {
+        static ct_earth_map km;
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_earth_map_init(&pk, INT64_C(201045) * 1000000000, INT64_C(4065840) * 1000000000,
+                                                       INT64_C(500) * 1000000000, INT64_C(60000) * 1000000000, &km));
+        TEST_ASSERT_EQUAL_INT(46, (int)km.qrho);
+        TEST_ASSERT_EQUAL_INT(6, km.deg);
+        Pose p;
+        TEST_ASSERT(make_pose(w->sf, {"kept", 201045, 4065840, 3000, 0, -30}, &p));
+        ct_earth es;
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_earth_setup(&pk, &p.pose, 0, CT_EARTH_RADIUS_NM, CT_EFFECTS_CHORD_NM, 0u, 0,
+                                                    &km, &es));
+        TEST_ASSERT(es.map == &km);
+        const int64_t half = INT64_C(1) << km.qrho;
+        double err[3] = {0, 0, 0};
+        for (int k = 0; k < nrand; ++k) {
+            int64_t D[3], g[3];
+            for (int a = 0; a < 3; ++a) D[a] = ct_rng_range(&rng, -half, half) - es.moff[a];
+            TEST_ASSERT_EQUAL_INT(CT_OK, ct_earth_image24(&pk, &es, D, 1, g));
+            ld X[3], E, N, h, lat, lon;
+            for (int a = 0; a < 3; ++a) X[a] = (ld)(es.c[a] + D[a]) * 1e-9L;
+            earth_ref::geodetic_ld(X, &lat, &lon, &h);
+            pj.utm(lat * 180 / kPi, lon * 180 / kPi, &E, &N);
+            err[0] = std::max(err[0], (double)std::fabs(pk.origin_e_nm * 1e-9L +
+                                                        (ld)(g[0] + (INT64_C(1) << 23)) * (ld)pk.posting_e_nm * 1e-9L / 16777216.0L - E));
+            err[1] = std::max(err[1], (double)std::fabs(pk.origin_n_nm * 1e-9L +
+                                                        (ld)(g[1] + (INT64_C(1) << 23)) * (ld)pk.posting_n_nm * 1e-9L / 16777216.0L - N));
+            err[2] = std::max(err[2], (double)std::fabs(pk.height_offset_nm * 1e-9L +
+                                                        (ld)g[2] * (ld)pk.height_scale_nm * 1e-9L / 16777216.0L - h));
+        }
+        std::printf("  kept map (ct_earth_map_init, centre of the tile, 2^%u nm, degree %d): fit vs the reference max "
+                    "|dE| %.2g, |dN| %.2g, |dh| %.2g m\n", km.qrho, km.deg, err[0], err[1], err[2]);
+        worst = std::max(worst, std::max(err[0], std::max(err[1], err[2])));
+        // refused: another package's map, a map never fitted, bad arguments
+        ct_effects fx = {CT_EFFECT_CURVATURE, 0, 0, 0, &km};
+        ct_geo g;
+        Cam cam = make_camera();
+        TEST_ASSERT(ct_geolocate(&pk, &cam.cam, &p.pose, CT_METHOD_DIRECTIONAL, &fx, 100 << 16, 100 << 16, &g) >= 0);
+        ct_package other = pk;
+        other.origin_e_nm += 1;
+        TEST_ASSERT_EQUAL_INT(CT_ERR_EFFECTS,
+                              ct_geolocate(&other, &cam.cam, &p.pose, CT_METHOD_DIRECTIONAL, &fx, 100 << 16, 100 << 16, &g));
+        static ct_earth_map blank;
+        fx.earth_map = &blank;
+        TEST_ASSERT_EQUAL_INT(CT_ERR_EFFECTS,
+                              ct_geolocate(&pk, &cam.cam, &p.pose, CT_METHOD_DIRECTIONAL, &fx, 100 << 16, 100 << 16, &g));
+        TEST_ASSERT_EQUAL_INT(CT_ERR_RANGE, ct_earth_map_init(&pk, 201045000000000, 4065840000000000, 0, 0, &blank));
+        TEST_ASSERT_EQUAL_INT(CT_ERR_RANGE, ct_earth_map_init(&pk, 201045000000000, 4065840000000000, 0,
+                                                              (INT64_C(1) << 47) + 1, &blank));
+        TEST_ASSERT_EQUAL_INT(CT_ERR_ARG, ct_earth_map_init(&pk, 0, 0, 0, 1, nullptr));
+        other = pk;
+        other.epsg = 0;
+        TEST_ASSERT_EQUAL_INT(CT_ERR_CRS, ct_earth_map_init(&other, 201045000000000, 4065840000000000, 0,
+                                                            INT64_C(1) << 44, &blank));
+        TEST_ASSERT(blank.ready != CT_EARTH_MAP_READY);
     }
     TEST_ASSERT_MSG(seen == (1u << 44 % 32) + (1u << 45 % 32) + (1u << 46 % 32) + (1u << 47 % 32),
                     "the poses did not make every cube size (mask %x)", seen);
@@ -746,8 +828,8 @@ void test_fitted_map()
     Pose far;
     TEST_ASSERT(make_pose(w->sf, {"far", 201045 + 130000, 4065840, 3000, 270, -10}, &far));
     ct_earth es;
-    const ct_status st = ct_earth_setup(&pk, &far.pose, 0, CT_EARTH_RADIUS_NM, CT_EFFECTS_CHORD_NM, 0u, 1, &es);
-    TEST_ASSERT(st != CT_OK || es.fit_deg == 0);
+    const ct_status st = ct_earth_setup(&pk, &far.pose, 0, CT_EARTH_RADIUS_NM, CT_EFFECTS_CHORD_NM, 0u, 1, nullptr, &es);
+    TEST_ASSERT(st != CT_OK || es.map == nullptr);
 }
 
 void test_exact_curvature() { compare(CT_EFFECT_CURVATURE); }

@@ -423,7 +423,7 @@ void test_statuses_and_errors()
     }
     // effects: parameters out of range are CT_ERR_EFFECTS for the call
     {
-        const ct_effects good = {CT_EFFECT_ALL, CT_REFRACTION_K_STD_Q16, 0, 0};
+        const ct_effects good = {CT_EFFECT_ALL, CT_REFRACTION_K_STD_Q16, 0, 0, nullptr};
         std::vector<ct_effects> bad(7, good);
         bad[0].flags = 8u;  // the first unknown flag (4 is CT_EFFECT_EARTH_FIT)
         bad[1].flags = 0x80000000u | CT_EFFECT_CURVATURE;
@@ -436,7 +436,7 @@ void test_statuses_and_errors()
         {
             // CT_EFFECT_EARTH_FIT without the true Earth is ignored: the
             // straight ray, and the sphere parabola with a radius
-            ct_effects fit = {CT_EFFECT_EARTH_FIT, 0, 0, 0}, fit_sphere = good, sphere = good;
+            ct_effects fit = {CT_EFFECT_EARTH_FIT, 0, 0, 0, nullptr}, fit_sphere = good, sphere = good;
             fit_sphere.flags |= CT_EFFECT_EARTH_FIT;
             fit_sphere.earth_radius_nm = sphere.earth_radius_nm = CT_EARTH_RADIUS_NM;
             ct_geo a, b;

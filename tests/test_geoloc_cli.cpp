@@ -331,7 +331,7 @@ void test_geoloc_threads()
     TEST_ASSERT_EQUAL_INT(5001, rows.size());
     ct_host::CameraModel cm = ct_host::read_cameramodel(g_dir + "/cam.cameramodel");
     ct_host::LibCamera lc = ct_host::lib_camera(cm, "cam");
-    ct_effects fx = {CT_EFFECT_CURVATURE | CT_EFFECT_REFRACTION, CT_REFRACTION_K_STD_Q16, 0, 0};
+    ct_effects fx = {CT_EFFECT_CURVATURE | CT_EFFECT_REFRACTION, CT_REFRACTION_K_STD_Q16, 0, 0, nullptr};
     int hits = 0;
     for (size_t k = 0; k < uv.size(); k += 97) {
         std::vector<std::string> f = split(rows[k + 1]);
@@ -643,7 +643,7 @@ void test_geoloc_earth_map()
     std::vector<std::string> rf = lines_of(fitted), rx = lines_of(exact);
     TEST_ASSERT_EQUAL_INT(uv.size() + 1, rf.size());
     TEST_ASSERT_EQUAL_INT(uv.size() + 1, rx.size());
-    ct_effects fx = {CT_EFFECT_CURVATURE | CT_EFFECT_REFRACTION | CT_EFFECT_EARTH_FIT, CT_REFRACTION_K_STD_Q16, 0, 0};
+    ct_effects fx = {CT_EFFECT_CURVATURE | CT_EFFECT_REFRACTION | CT_EFFECT_EARTH_FIT, CT_REFRACTION_K_STD_Q16, 0, 0, nullptr};
     int hits = 0, both = 0;
     double apart = 0;
     for (size_t k = 0; k < uv.size(); ++k) {
@@ -713,7 +713,7 @@ void test_demo()
     std::vector<std::string> rows = lines_of(slurp(g_dir + "/demo_out/pixels.csv"));
     TEST_ASSERT(rows.size() > 1 && rows[0] == "u,v,status,E,N,h,range,steps,px,py");
     TEST_ASSERT_EQUAL_INT(16 * 12 + 1, rows.size());  // every 64th pixel of 1024 x 768
-    ct_effects fx = {CT_EFFECT_CURVATURE | CT_EFFECT_REFRACTION | CT_EFFECT_EARTH_FIT, CT_REFRACTION_K_STD_Q16, 0, 0};
+    ct_effects fx = {CT_EFFECT_CURVATURE | CT_EFFECT_REFRACTION | CT_EFFECT_EARTH_FIT, CT_REFRACTION_K_STD_Q16, 0, 0, nullptr};
     struct Dot {
         int x, y;
         double range;
@@ -788,10 +788,10 @@ void test_geoloc_effects()
     };
     const Opt opts[] = {
         {{"--effects", "curvature, refraction", "--refraction-k", "0.25", "--earth-radius", "30000"},
-         {CT_EFFECT_CURVATURE | CT_EFFECT_REFRACTION, 16384, INT64_C(30000000000000), 0}},
+         {CT_EFFECT_CURVATURE | CT_EFFECT_REFRACTION, 16384, INT64_C(30000000000000), 0, nullptr}},
         {{"--effects", "refraction", "--earth-radius", "20000"},
-         {CT_EFFECT_REFRACTION, CT_REFRACTION_K_STD_Q16, INT64_C(20000000000000), 0}},
-        {{"--effects", "curvature"}, {CT_EFFECT_CURVATURE, 0, CT_EARTH_RADIUS_NM, 0}},
+         {CT_EFFECT_REFRACTION, CT_REFRACTION_K_STD_Q16, INT64_C(20000000000000), 0, nullptr}},
+        {{"--effects", "curvature"}, {CT_EFFECT_CURVATURE, 0, CT_EARTH_RADIUS_NM, 0, nullptr}},
     };
     std::vector<std::string> rows0 = lines_of(slurp(g_dir + "/g0.csv"));
     ct_host::LibCamera lc = ct_host::lib_camera(ct_host::read_cameramodel(g_dir + "/cam.cameramodel"), "cam");

@@ -23,15 +23,26 @@ typedef struct {
  * M4_GEO_FX: 0 none (straight), 1 curvature + refraction (k = 0.13) on the
  * sphere of CT_EARTH_RADIUS_NM (the map-frame parabola), 2 the same on the
  * true Earth (earth_radius_nm = 0: the Earth-fixed line of sight, earth.c),
- * 3 the true Earth with its map fitted once per call (CT_EFFECT_EARTH_FIT). */
-#define M4_GEO_FX 4
-static inline const ct_effects *m4_geo_effects(int k, ct_effects *fx)
+ * 3 the true Earth with its map fitted once per call (CT_EFFECT_EARTH_FIT),
+ * 4 the true Earth through a map kept across calls (m4_geo_map_init).     */
+#define M4_GEO_FX 5
+static inline const ct_effects *m4_geo_effects(int k, ct_effects *fx, const ct_earth_map *map)
 {
     fx->flags = k == 3 ? CT_EFFECT_ALL | CT_EFFECT_EARTH_FIT : CT_EFFECT_ALL;
     fx->refraction_k_q16 = CT_REFRACTION_K_STD_Q16;
     fx->earth_radius_nm = k == 1 ? CT_EARTH_RADIUS_NM : 0;
     fx->chord_nm = 0;
+    fx->earth_map = k == 4 ? map : (const ct_earth_map *)0;
     return k == 0 ? (const ct_effects *)0 : fx;
+}
+/* The kept map of effect 4: around the tile's centre at its lowest post's
+ * height, a 35 km cube (the camera 4.5 km back and its 16 km range).      */
+static inline ct_status m4_geo_map_init(const ct_package *p, ct_earth_map *map)
+{
+    int64_t e = p->origin_e_nm + (int64_t)(p->width / 2u) * p->posting_e_nm;
+    int64_t n = p->origin_n_nm + (int64_t)(p->height / 2u) * p->posting_n_nm;
+    int64_t h = p->height_offset_nm + (int64_t)p->hmin * p->height_scale_nm;
+    return ct_earth_map_init(p, e, n, h, INT64_C(1) << 45, map);
 }
 typedef struct {
     int64_t uv[2];        /* pixel, Q16                                      */

@@ -71,9 +71,14 @@ bool geo_data(FILE *f, const ct_package &p)
         }
     const size_t n = uv.size() / 2;
     std::vector<ct_geo> g[M4_GEO_FX];
+    static ct_earth_map map;
+    if (m4_geo_map_init(&p, &map) != CT_OK) {
+        std::fprintf(stderr, "ct_gen_m4_data: the kept Earth map fails\n");
+        return false;
+    }
     for (int e = 0; e < M4_GEO_FX; ++e) {
         ct_effects fx;
-        const ct_effects *pf = m4_geo_effects(e, &fx);
+        const ct_effects *pf = m4_geo_effects(e, &fx, &map);
         g[e].resize(n);
         std::vector<ct_geo> b(n);
         if (ct_geolocate_batch(&p, &cam, &pose, CT_METHOD_DIRECTIONAL, pf, uv.data(), n, b.data(), n) != CT_OK) {

@@ -68,7 +68,7 @@ int main(void)
     const int32_t R[9] = {1073741824, 0, 0, 0, -s45, s45, 0, -s45, -s45};
     ct_lens lens = {CT_LENS_PINHOLE, 640u, 480u, (int64_t)800 << 32, (int64_t)800 << 32,
                     ((int64_t)639 << 31), ((int64_t)479 << 31), {0, 0, 0, 0, 0, 0, 0, 0}};
-    ct_effects fx = {CT_EFFECT_CURVATURE | CT_EFFECT_REFRACTION, CT_REFRACTION_K_STD_Q16, 0, 0};
+    ct_effects fx = {CT_EFFECT_CURVATURE | CT_EFFECT_REFRACTION, CT_REFRACTION_K_STD_Q16, 0, 0, NULL};
     ct_camera cam;
     ct_pose pose;
     int64_t e, n, h;

@@ -614,6 +614,30 @@ typedef struct {
 #define CT_EARTH_RADIUS_NM INT64_C(6371000000000000) /* 6371 km (mean)     */
 #define CT_REFRACTION_K_STD_Q16 8520  /* k = 0.13 (standard atmosphere), Q16 */
 #define CT_EFFECTS_CHORD_NM INT64_C(1000000)         /* 1 mm               */
+/* A fitted map from Earth-fixed space into a UTM package's grid (the true
+ * Earth, earth.c), kept in caller memory across calls: ct_earth_map_init
+ * fits it once over a cube around a point (e.g. the tile's centre, large
+ * enough for every camera position and its range), then every ct_geolocate
+ * / ct_geolocate_batch whose ct_effects.earth_map points to it maps the
+ * lines of sight through it where they lie in its cube (exactly
+ * elsewhere), with no set-up per call beyond the camera's own.  As
+ * CT_EFFECT_EARTH_FIT's per-call map: within 0.02 mm of the exact map.
+ * The fields are the library's; about 2.3 KB.                             */
+#define CT_EARTH_MAP_DEG 6
+#define CT_EARTH_MAP_TERMS 84   /* terms of total degree <= 6 in 3 variables */
+typedef struct {
+    uint32_t ready;            /* CT_EARTH_MAP_READY once fitted            */
+    int32_t deg;               /* 4..CT_EARTH_MAP_DEG; 0: none              */
+    uint32_t qrho;             /* the cube's half-width is 2^qrho nm        */
+    uint32_t fb[3];            /* the samples' fraction bits per axis       */
+    uint32_t sh[CT_EARTH_MAP_DEG + 1][3]; /* per degree: coefficient shift */
+    int64_t c[3];              /* the cube's centre, ECEF nm                */
+    int64_t g16[3];            /* its grid point, Q16                       */
+    int64_t georef[7];         /* the package's georeference it fits        */
+    int64_t cf[CT_EARTH_MAP_TERMS][3]; /* Chebyshev coefficients            */
+} ct_earth_map;
+#define CT_EARTH_MAP_READY 0x4d524145u /* "EARM" */
+
 typedef struct {
     uint32_t flags;            /* CT_EFFECT_* bits; 0 = a straight ray       */
     int32_t refraction_k_q16;  /* k in Q16, [-2, 2] (used with REFRACTION;
@@ -629,7 +653,20 @@ typedef struct {
                                   else [2^10, 2^50] nm, and the polyline's
                                   segment sqrt(8 chord R / |c|) must be at
                                   least 1/64 of a cell (else CT_ERR_EFFECTS) */
+    const ct_earth_map *earth_map; /* NULL, or a map fitted for this package
+                                  (ct_earth_map_init; else CT_ERR_EFFECTS),
+                                  used with the true Earth (else ignored)   */
 } ct_effects;
+
+/* Fit a ct_earth_map for `pkg` (on a UTM zone) over the cube of half-width
+ * 2^q nm >= radius_nm (q = 44..47: 17.6 .. 141 km) around the map point
+ * (e, n, h): (d + 1)^3 exact conversions, d = 4, 5, 6 for q = 44, 45, >= 46
+ * (125 .. 343; 9.4M instructions at q = 44 on Cortex-M4).  CT_OK;
+ * CT_ERR_ARG (NULL), CT_ERR_CRS (not UTM), CT_ERR_RANGE (radius beyond
+ * 2^47 nm or not positive, the point off the zone or the grid's range, or
+ * a cube point the projection cannot take).                              */
+ct_status ct_earth_map_init(const ct_package *pkg, int64_t e_nm, int64_t n_nm, int64_t h_nm, int64_t radius_nm,
+                            ct_earth_map *map);
 
 /* Result of geolocating one pixel.                                         */
 typedef struct {

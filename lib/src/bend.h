@@ -84,9 +84,6 @@ ct_status ct_trace_prepared_lowered(const ct_package *pkg, const ct_prepared *ra
 ct_status ct_lower_setup_k(const ct_package *pkg, int64_t ox_q16, int64_t oy_q16, uint64_t kf, uint32_t kshift,
                            int32_t cull, ct_lower *lw);
 
-#define CT_EARTH_FIT_DEG 6
-#define CT_EARTH_FIT_TERMS 84 /* (deg + 1)(deg + 2)(deg + 3) / 6 for deg 6 */
-
 /* The true Earth (earth.c): a line of sight straight in Earth-fixed space
  * (WGS84; with refraction bent by k t^2 / 2R in its vertical plane) from a
  * camera over a package on a UTM zone, traced in pieces whose map-frame
@@ -105,19 +102,15 @@ typedef struct {
     int64_t tolz_q16;      /* the same in Q16 height units (>= 2)             */
     int64_t tmax_nm;       /* no terrain beyond this range                    */
     int32_t cull;
-    /* The fitted map (CT_EFFECT_EARTH_FIT; earth.c): the image of ECEF
-     * points P in the cube |P - c| <= 2^qrho nm as a sum of Chebyshev
-     * products T_a(s_x) T_b(s_y) T_c(s_z), s = (P - c) / 2^qrho, a + b + c
-     * <= deg, interpolated through the exact images at the tensor grid of
-     * (deg + 1)^3 Chebyshev points.  deg = 0: no fit.                    */
-    int32_t fit_deg;       /* 0, or 4..CT_EARTH_FIT_DEG                       */
-    uint32_t fit_qrho;     /* the cube's half-width is 2^fit_qrho nm, 44..47  */
-    uint32_t fit_fb[3];    /* fraction bits of the samples per axis, 26..32   */
-    int64_t fit_base[3];   /* image of c: grid x, y, z, Q24                   */
-    int64_t fit_cf[CT_EARTH_FIT_TERMS][3]; /* coefficients, Q(fit_fb - 2),
-                                              |.| < 2^56; of degree >= 3
-                                              divided by 2^fit_sh: < 2^28   */
-    uint32_t fit_sh[CT_EARTH_FIT_DEG + 1][3]; /* per degree and coordinate  */
+    /* The fitted map (earth.c): the image of ECEF points P in the cube |P
+     * - map->c| <= 2^qrho nm as a sum of Chebyshev products T_a(s_x)
+     * T_b(s_y) T_c(s_z), s = (P - map->c) / 2^qrho, a + b + c <= deg,
+     * interpolated through the exact images at the tensor grid of (deg +
+     * 1)^3 Chebyshev points.  map: NULL (exact), &fit (CT_EFFECT_EARTH_FIT:
+     * fitted per call around the camera) or the caller's.                 */
+    const ct_earth_map *map;
+    int64_t moff[3];       /* c - map->c, ECEF nm                            */
+    ct_earth_map fit;
 } ct_earth;
 
 /* Library-internal helpers shared between files.                          */
@@ -142,9 +135,13 @@ ct_status ct_grid_frame_ecef(const ct_utm *zone, int64_t e_nm, int64_t n_nm, int
 /* Set-up for a pose over a UTM package: CT_ERR_CRS when the package is not
  * on a UTM zone, CT_ERR_RANGE / CT_ERR_RAY for a camera outside the
  * projection's or the tracer's domain.  fitted != 0: fit the map (above)
- * when the cube needed is at most 2^47 nm (else the exact map is kept).  */
+ * when the cube needed is at most 2^47 nm (else the exact map is kept);
+ * map != NULL (checked by the caller: ct_earth_map_fits): use it instead. */
 ct_status ct_earth_setup(const ct_package *pkg, const ct_pose *pose, int32_t refr_k_q16, int64_t radius_nm,
-                         int64_t chord_nm, uint32_t bend_flags, int fitted, ct_earth *es);
+                         int64_t chord_nm, uint32_t bend_flags, int fitted, const ct_earth_map *map, ct_earth *es);
+
+/* 1 when `map` is a fitted map for this package's georeference.          */
+int ct_earth_map_fits(const ct_package *pkg, const ct_earth_map *map);
 
 /* The image of the ECEF point c + D (|D| <= 2^50 nm per axis) in the grid
  * frame, Q24: fitted (CT_ERR_RANGE when there is no fit or D is outside

@@ -197,16 +197,17 @@ static int rel_q(int64_t v, ct_i128 c, int64_t s, uint32_t fb, int64_t *f)
 }
 
 /* The exact image of the ECEF point P (nm) in the grid frame less the
- * camera's grid point (ox, oy, oz), with fb[k] fraction bits per axis (26
- * .. 32): f = (e - e0) 2^fb / pe - (ox 2^(fb - 16) + 2^(fb - 1)) (as
- * ct_map_to_grid with fb - 16 more bits), likewise n, and (h - h0) 2^fb /
- * hs - oz 2^(fb - 16).  CT_ERR_RANGE when |f| > 2^55. */
-static ct_status image_rel(const ct_package *p, const ct_earth *es, const int64_t P[3], int64_t f[3])
+ * map's grid point g16, with fb[k] fraction bits per axis (26 .. 32): f =
+ * (e - e0) 2^fb / pe - (gx 2^(fb - 16) + 2^(fb - 1)) (as ct_map_to_grid
+ * with fb - 16 more bits), likewise n, and (h - h0) 2^fb / hs - gz 2^(fb -
+ * 16).  CT_ERR_RANGE when |f| > 2^55. */
+static ct_status image_rel(const ct_package *p, const ct_utm *zone, const ct_earth_map *mp, const int64_t P[3],
+                           int64_t f[3])
 {
     int64_t lat, lon, h, e, n;
     ct_status st = ct_wgs84_from_ecef(P, &lat, &lon, &h);
     if (st == CT_OK) {
-        st = ct_utm_forward(&es->zone, lat, lon, &e, &n);
+        st = ct_utm_forward(zone, lat, lon, &e, &n);
     }
     if (st != CT_OK) {
         return st;
@@ -215,18 +216,18 @@ static ct_status image_rel(const ct_package *p, const ct_earth *es, const int64_
         return CT_ERR_RANGE;
     }
     /* the origin and offset are the package's (|.| <= 2^61, checked at
-     * open), so the differences stay below 2^62; |ox| <= 2^46 (set-up):
-     * (ox 2^(fb - 16) + 2^(fb - 1)) |pe| < 2^63 2^50 */
+     * open), so the differences stay below 2^62; |g16| <= 2^46 (set-up):
+     * (g 2^(fb - 16) + 2^(fb - 1)) |pe| < 2^63 2^50 */
     if (!rel_q(e - p->origin_e_nm,
-               ct_i128_mul(es->ox * (INT64_C(1) << (es->fit_fb[0] - 16u)) + (INT64_C(1) << (es->fit_fb[0] - 1u)),
+               ct_i128_mul(mp->g16[0] * (INT64_C(1) << (mp->fb[0] - 16u)) + (INT64_C(1) << (mp->fb[0] - 1u)),
                            p->posting_e_nm),
-               p->posting_e_nm, es->fit_fb[0], &f[0]) ||
+               p->posting_e_nm, mp->fb[0], &f[0]) ||
         !rel_q(n - p->origin_n_nm,
-               ct_i128_mul(es->oy * (INT64_C(1) << (es->fit_fb[1] - 16u)) + (INT64_C(1) << (es->fit_fb[1] - 1u)),
+               ct_i128_mul(mp->g16[1] * (INT64_C(1) << (mp->fb[1] - 16u)) + (INT64_C(1) << (mp->fb[1] - 1u)),
                            p->posting_n_nm),
-               p->posting_n_nm, es->fit_fb[1], &f[1]) ||
-        !rel_q(h - p->height_offset_nm, ct_i128_mul(es->oz * (INT64_C(1) << (es->fit_fb[2] - 16u)), p->height_scale_nm),
-               p->height_scale_nm, es->fit_fb[2], &f[2])) {
+               p->posting_n_nm, mp->fb[1], &f[1]) ||
+        !rel_q(h - p->height_offset_nm, ct_i128_mul(mp->g16[2] * (INT64_C(1) << (mp->fb[2] - 16u)), p->height_scale_nm),
+               p->height_scale_nm, mp->fb[2], &f[2])) {
         return CT_ERR_RANGE;
     }
     return CT_OK;
@@ -270,12 +271,12 @@ static int64_t mul30(int64_t x, int64_t y)
  *     sum.
  *   The sum (Q(fb + 60), < 2^125) is rounded once to Q24.  The rounding of
  *   cf' (2^(sh - 1) per term) costs under 2 um at 141 km (fit_map). */
-static void fit_eval(const ct_earth *es, const int64_t D[3], int64_t g[3])
+static void fit_eval(const ct_earth_map *mp, const int64_t D[3], int64_t g[3])
 {
-    int64_t T[3][3], U[3][CT_EARTH_FIT_DEG + 1], gs[CT_EARTH_FIT_DEG + 1][3];
+    int64_t T[3][3], U[3][CT_EARTH_MAP_DEG + 1], gs[CT_EARTH_MAP_DEG + 1][3];
     ct_i128 acc[3];
-    int a, b, c, k, o, t = 0, deg = es->fit_deg;
-    unsigned q = es->fit_qrho;
+    int a, b, c, k, o, t = 0, deg = mp->deg;
+    unsigned q = mp->qrho;
     for (k = 0; k < 3; ++k) { /* bound: 3 axes */
         int n;
         T[k][0] = T_ONE_Q62;
@@ -283,26 +284,26 @@ static void fit_eval(const ct_earth *es, const int64_t D[3], int64_t g[3])
         T[k][2] = ct_mul_shr(T[k][1], T[k][1], 61u) - T_ONE_Q62;
         U[k][0] = INT64_C(1) << 30;
         U[k][1] = rshr64(D[k], q - 30u); /* |.| <= 2^30 */
-        for (n = 1; n < deg; ++n) { /* bound: CT_EARTH_FIT_DEG - 1; |2 U_1 U_n| < 2^62 */
+        for (n = 1; n < deg; ++n) { /* bound: CT_EARTH_MAP_DEG - 1; |2 U_1 U_n| < 2^62 */
             U[k][n + 1] = rshr64(2 * U[k][1] * U[k][n], 30u) - U[k][n - 1];
         }
         acc[k] = ct_i128_from64(0);
     }
-    for (k = 0; k <= deg; ++k) { /* bound: CT_EARTH_FIT_DEG + 1 */
+    for (k = 0; k <= deg; ++k) { /* bound: CT_EARTH_MAP_DEG + 1 */
         gs[k][0] = gs[k][1] = gs[k][2] = 0;
     }
-    for (a = 0; a <= deg; ++a) {             /* bound: CT_EARTH_FIT_DEG + 1 */
-        for (b = 0; a + b <= deg; ++b) {     /* bound: CT_EARTH_FIT_DEG + 1 */
-            for (c = 0; a + b + c <= deg; ++c) { /* bound: CT_EARTH_FIT_DEG + 1 */
+    for (a = 0; a <= deg; ++a) {             /* bound: CT_EARTH_MAP_DEG + 1 */
+        for (b = 0; a + b <= deg; ++b) {     /* bound: CT_EARTH_MAP_DEG + 1 */
+            for (c = 0; a + b + c <= deg; ++c) { /* bound: CT_EARTH_MAP_DEG + 1 */
                 if (a + b + c <= 2) {
                     int64_t ttt = mul62(mul62(T[0][a], T[1][b]), T[2][c]);
                     for (o = 0; o < 3; ++o) { /* bound: 3 coordinates */
-                        acc[o] = ct_i128_add(acc[o], ct_i128_mul(es->fit_cf[t][o], ttt));
+                        acc[o] = ct_i128_add(acc[o], ct_i128_mul(mp->cf[t][o], ttt));
                     }
                 } else {
                     int64_t ttt = mul30(mul30(U[0][a], U[1][b]), U[2][c]);
                     for (o = 0; o < 3; ++o) { /* bound: 3 coordinates */
-                        gs[a + b + c][o] += es->fit_cf[t][o] * ttt;
+                        gs[a + b + c][o] += mp->cf[t][o] * ttt;
                     }
                 }
                 t++;
@@ -310,10 +311,10 @@ static void fit_eval(const ct_earth *es, const int64_t D[3], int64_t g[3])
         }
     }
     for (o = 0; o < 3; ++o) { /* bound: 3 coordinates */
-        for (k = 3; k <= deg; ++k) { /* bound: CT_EARTH_FIT_DEG - 2 */
-            acc[o] = ct_i128_add(acc[o], ct_i128_shl(ct_i128_from64(gs[k][o]), 32u + es->fit_sh[k][o]));
+        for (k = 3; k <= deg; ++k) { /* bound: CT_EARTH_MAP_DEG - 2 */
+            acc[o] = ct_i128_add(acc[o], ct_i128_shl(ct_i128_from64(gs[k][o]), 32u + mp->sh[k][o]));
         }
-        g[o] = es->fit_base[o] + ct_i128_round_shr(acc[o], 36u + es->fit_fb[o]);
+        g[o] = mp->g16[o] * 256 + ct_i128_round_shr(acc[o], 36u + mp->fb[o]);
     }
 }
 
@@ -326,14 +327,15 @@ static void fit_eval(const ct_earth *es, const int64_t D[3], int64_t g[3])
  * 8 g_a g_b g_c / m^3 (in 128 bits): |c| <= 8 max|f| / 4 < 2^56.  The
  * samples' rounding (2^-33 of a cell or height unit) reaches the fit
  * amplified by the interpolation's Lebesgue constant (< 12 for degree 6):
- * far below a micrometre.  Leaves fit_deg = 0 when a point is outside the
+ * far below a micrometre.  Leaves deg = 0 when a point is outside the
  * projection's domain or too far. */
-static void fit_map(const ct_package *p, ct_earth *es, uint32_t qrho)
+static void fit_map(const ct_package *p, const ct_utm *zone, ct_earth_map *mp, uint32_t qrho)
 {
     int deg = qrho <= 44u ? 4 : (qrho == 45u ? 5 : 6);
     int m = deg + 1, i, j, k, a, b, c, t, o;
-    es->fit_deg = 0;
-    es->fit_qrho = qrho;
+    mp->ready = 0u;
+    mp->deg = 0;
+    mp->qrho = qrho;
     /* fraction bits: the images lie within 2^(qrho + 1) nm of the camera's
      * (the cube's half-diagonal sqrt(3) 2^qrho, stretched by at most 1 %
      * by the projection), so |f| <= 2^(qrho + 1 + fb) / scale <= 2^55 for
@@ -344,30 +346,30 @@ static void fit_map(const ct_package *p, ct_earth *es, uint32_t qrho)
         if (fb < 26) {
             return;
         }
-        es->fit_fb[o] = fb > 32 ? 32u : (uint32_t)fb;
+        mp->fb[o] = fb > 32 ? 32u : (uint32_t)fb;
     }
-    for (t = 0; t < CT_EARTH_FIT_TERMS; ++t) { /* bound: CT_EARTH_FIT_TERMS */
-        es->fit_cf[t][0] = es->fit_cf[t][1] = es->fit_cf[t][2] = 0;
+    for (t = 0; t < CT_EARTH_MAP_TERMS; ++t) { /* bound: CT_EARTH_MAP_TERMS */
+        mp->cf[t][0] = mp->cf[t][1] = mp->cf[t][2] = 0;
     }
-    for (i = 0; i < m; ++i) {             /* bound: CT_EARTH_FIT_DEG + 1 */
-        for (j = 0; j < m; ++j) {         /* bound: CT_EARTH_FIT_DEG + 1 */
-            for (k = 0; k < m; ++k) {     /* bound: CT_EARTH_FIT_DEG + 1 */
+    for (i = 0; i < m; ++i) {             /* bound: CT_EARTH_MAP_DEG + 1 */
+        for (j = 0; j < m; ++j) {         /* bound: CT_EARTH_MAP_DEG + 1 */
+            for (k = 0; k < m; ++k) {     /* bound: CT_EARTH_MAP_DEG + 1 */
                 int64_t P[3], f[3];
                 /* the point: c + 2^qrho x (|x| <= 2^62 in Q62) */
-                P[0] = es->c[0] + ct_mul_shr(cheb_at_node(deg, 1, i), INT64_C(1) << qrho, 62u);
-                P[1] = es->c[1] + ct_mul_shr(cheb_at_node(deg, 1, j), INT64_C(1) << qrho, 62u);
-                P[2] = es->c[2] + ct_mul_shr(cheb_at_node(deg, 1, k), INT64_C(1) << qrho, 62u);
-                if (image_rel(p, es, P, f) != CT_OK) {
+                P[0] = mp->c[0] + ct_mul_shr(cheb_at_node(deg, 1, i), INT64_C(1) << qrho, 62u);
+                P[1] = mp->c[1] + ct_mul_shr(cheb_at_node(deg, 1, j), INT64_C(1) << qrho, 62u);
+                P[2] = mp->c[2] + ct_mul_shr(cheb_at_node(deg, 1, k), INT64_C(1) << qrho, 62u);
+                if (image_rel(p, zone, mp, P, f) != CT_OK) {
                     return;
                 }
                 t = 0;
-                for (a = 0; a <= deg; ++a) {             /* bound: CT_EARTH_FIT_DEG + 1 */
-                    for (b = 0; a + b <= deg; ++b) {     /* bound: CT_EARTH_FIT_DEG + 1 */
+                for (a = 0; a <= deg; ++a) {             /* bound: CT_EARTH_MAP_DEG + 1 */
+                    for (b = 0; a + b <= deg; ++b) {     /* bound: CT_EARTH_MAP_DEG + 1 */
                         int64_t tt = ct_mul_shr(cheb_at_node(deg, a, i), cheb_at_node(deg, b, j), 62u);
-                        for (c = 0; a + b + c <= deg; ++c) { /* bound: CT_EARTH_FIT_DEG + 1 */
+                        for (c = 0; a + b + c <= deg; ++c) { /* bound: CT_EARTH_MAP_DEG + 1 */
                             int64_t ttt = ct_mul_shr(tt, cheb_at_node(deg, c, k), 62u);
                             for (o = 0; o < 3; ++o) { /* bound: 3 coordinates */
-                                es->fit_cf[t][o] += ct_i128_round_shr(ct_i128_mul(f[o], ttt), 64u);
+                                mp->cf[t][o] += ct_i128_round_shr(ct_i128_mul(f[o], ttt), 64u);
                             }
                             t++;
                         }
@@ -377,14 +379,14 @@ static void fit_map(const ct_package *p, ct_earth *es, uint32_t qrho)
         }
     }
     t = 0;
-    for (a = 0; a <= deg; ++a) {             /* bound: CT_EARTH_FIT_DEG + 1 */
-        for (b = 0; a + b <= deg; ++b) {     /* bound: CT_EARTH_FIT_DEG + 1 */
-            for (c = 0; a + b + c <= deg; ++c) { /* bound: CT_EARTH_FIT_DEG + 1 */
+    for (a = 0; a <= deg; ++a) {             /* bound: CT_EARTH_MAP_DEG + 1 */
+        for (b = 0; a + b <= deg; ++b) {     /* bound: CT_EARTH_MAP_DEG + 1 */
+            for (c = 0; a + b + c <= deg; ++c) { /* bound: CT_EARTH_MAP_DEG + 1 */
                 /* 8 g_a g_b g_c = 2^(3 - zeros) */
                 unsigned sh = 3u - (unsigned)((a == 0) + (b == 0) + (c == 0));
                 for (o = 0; o < 3; ++o) { /* bound: 3 coordinates */
-                    es->fit_cf[t][o] =
-                        ct_i128_round_div(ct_i128_shl(ct_i128_from64(es->fit_cf[t][o]), sh), (int64_t)(m * m * m));
+                    mp->cf[t][o] =
+                        ct_i128_round_div(ct_i128_shl(ct_i128_from64(mp->cf[t][o]), sh), (int64_t)(m * m * m));
                 }
                 t++;
             }
@@ -392,16 +394,16 @@ static void fit_map(const ct_package *p, ct_earth *es, uint32_t qrho)
     }
     /* degrees >= 3: cf' = round(cf / 2^sh) with sh the least making every
      * |cf'| < 2^27 (per degree and coordinate; sh <= 29 as |cf| < 2^56) */
-    for (k = 3; k <= deg; ++k) { /* bound: CT_EARTH_FIT_DEG - 2 */
+    for (k = 3; k <= deg; ++k) { /* bound: CT_EARTH_MAP_DEG - 2 */
         for (o = 0; o < 3; ++o) { /* bound: 3 coordinates */
             int64_t mx = 0;
             unsigned sh = 0u;
             t = 0;
-            for (a = 0; a <= deg; ++a) {             /* bound: CT_EARTH_FIT_DEG + 1 */
-                for (b = 0; a + b <= deg; ++b) {     /* bound: CT_EARTH_FIT_DEG + 1 */
-                    for (c = 0; a + b + c <= deg; ++c) { /* bound: CT_EARTH_FIT_DEG + 1 */
+            for (a = 0; a <= deg; ++a) {             /* bound: CT_EARTH_MAP_DEG + 1 */
+                for (b = 0; a + b <= deg; ++b) {     /* bound: CT_EARTH_MAP_DEG + 1 */
+                    for (c = 0; a + b + c <= deg; ++c) { /* bound: CT_EARTH_MAP_DEG + 1 */
                         if (a + b + c == k) {
-                            mx = ct_max64(mx, ct_abs64(es->fit_cf[t][o]));
+                            mx = ct_max64(mx, ct_abs64(mp->cf[t][o]));
                         }
                         t++;
                     }
@@ -411,13 +413,13 @@ static void fit_map(const ct_package *p, ct_earth *es, uint32_t qrho)
             while ((mx >> sh) >= (INT64_C(1) << 27)) {
                 sh++;
             }
-            es->fit_sh[k][o] = sh;
+            mp->sh[k][o] = sh;
             t = 0;
-            for (a = 0; a <= deg; ++a) {             /* bound: CT_EARTH_FIT_DEG + 1 */
-                for (b = 0; a + b <= deg; ++b) {     /* bound: CT_EARTH_FIT_DEG + 1 */
-                    for (c = 0; a + b + c <= deg; ++c) { /* bound: CT_EARTH_FIT_DEG + 1 */
+            for (a = 0; a <= deg; ++a) {             /* bound: CT_EARTH_MAP_DEG + 1 */
+                for (b = 0; a + b <= deg; ++b) {     /* bound: CT_EARTH_MAP_DEG + 1 */
+                    for (c = 0; a + b + c <= deg; ++c) { /* bound: CT_EARTH_MAP_DEG + 1 */
                         if (a + b + c == k && sh > 0u) {
-                            es->fit_cf[t][o] = rshr64(es->fit_cf[t][o], sh);
+                            mp->cf[t][o] = rshr64(mp->cf[t][o], sh);
                         }
                         t++;
                     }
@@ -425,31 +427,105 @@ static void fit_map(const ct_package *p, ct_earth *es, uint32_t qrho)
             }
         }
     }
-    es->fit_deg = deg;
+    for (o = 0; o < 3; ++o) { /* bound: 3 coordinates (degrees < 3 unscaled) */
+        mp->sh[0][o] = mp->sh[1][o] = mp->sh[2][o] = 0u;
+    }
+    mp->georef[0] = p->origin_e_nm;
+    mp->georef[1] = p->origin_n_nm;
+    mp->georef[2] = p->posting_e_nm;
+    mp->georef[3] = p->posting_n_nm;
+    mp->georef[4] = p->height_offset_nm;
+    mp->georef[5] = p->height_scale_nm;
+    mp->georef[6] = (int64_t)p->epsg;
+    mp->deg = deg;
+    mp->ready = CT_EARTH_MAP_READY;
+}
+
+int ct_earth_map_fits(const ct_package *p, const ct_earth_map *mp)
+{
+    return p != NULL && mp != NULL && mp->ready == CT_EARTH_MAP_READY && mp->deg >= 4 &&
+           mp->deg <= CT_EARTH_MAP_DEG && mp->qrho >= 44u && mp->qrho <= 47u && mp->georef[0] == p->origin_e_nm &&
+           mp->georef[1] == p->origin_n_nm && mp->georef[2] == p->posting_e_nm && mp->georef[3] == p->posting_n_nm &&
+           mp->georef[4] == p->height_offset_nm && mp->georef[5] == p->height_scale_nm &&
+           mp->georef[6] == (int64_t)p->epsg;
+}
+
+/* the least q in [44, 47] with 2^q >= need; 48 when none */
+static uint32_t cube_q(int64_t need)
+{
+    uint32_t q = 44u;
+    /* bound: 4 sizes */
+    while (q < 48u && (INT64_C(1) << q) < need) {
+        q++;
+    }
+    return q;
+}
+
+ct_status ct_earth_map_init(const ct_package *p, int64_t e_nm, int64_t n_nm, int64_t h_nm, int64_t radius_nm,
+                            ct_earth_map *mp)
+{
+    ct_utm zone;
+    int64_t lat, lon;
+    int32_t frame[9];
+    uint32_t q;
+    ct_status st;
+    if (p == NULL || mp == NULL) {
+        return CT_ERR_ARG;
+    }
+    mp->ready = 0u;
+    mp->deg = 0;
+    if (p->epsg > 0x7fffffffu || ct_utm_zone_of_epsg((int32_t)p->epsg, &zone) != CT_OK) {
+        return CT_ERR_CRS;
+    }
+    q = cube_q(radius_nm);
+    if (radius_nm <= 0 || q > 47u || ct_abs64(h_nm) > (INT64_C(1) << 50)) {
+        return CT_ERR_RANGE;
+    }
+    st = ct_grid_frame_ecef(&zone, e_nm, n_nm, &lat, &lon, frame);
+    if (st == CT_OK) {
+        st = ct_ecef_from_wgs84(lat, lon, h_nm, mp->c);
+    }
+    if (st != CT_OK || ct_map_to_grid(p, e_nm, n_nm, h_nm, &mp->g16[0], &mp->g16[1], &mp->g16[2]) != CT_OK ||
+        ct_abs64(mp->g16[0]) > CT_MAX_ORIGIN_Q16 || ct_abs64(mp->g16[1]) > CT_MAX_ORIGIN_Q16 ||
+        ct_abs64(mp->g16[2]) > CT_MAX_ORIGIN_Q16) {
+        return CT_ERR_RANGE;
+    }
+    fit_map(p, &zone, mp, q);
+    return mp->deg > 0 ? CT_OK : CT_ERR_RANGE;
 }
 
 ct_status ct_earth_image24(const ct_package *p, const ct_earth *es, const int64_t D[3], int fitted, int64_t g[3])
 {
-    int64_t P[3], f[3];
-    int k, in = fitted && es->fit_deg > 0;
+    int64_t P[3], f[3], Dm[3];
+    int k, in = fitted && es->map != NULL;
     ct_status st;
     for (k = 0; k < 3; ++k) { /* bound: 3 axes */
         if (ct_abs64(D[k]) > (INT64_C(1) << 50)) {
             return CT_ERR_RANGE;
         }
-        in = in && ct_abs64(D[k]) <= (INT64_C(1) << es->fit_qrho);
         P[k] = es->c[k] + D[k];
+        Dm[k] = D[k] + es->moff[k]; /* |moff| <= 2^50 (set-up) */
+        in = in && ct_abs64(Dm[k]) <= (INT64_C(1) << es->map->qrho);
     }
     if (in) {
-        fit_eval(es, D, g);
+        fit_eval(es->map, Dm, g);
         return CT_OK;
     }
     if (fitted) {
         return CT_ERR_RANGE;
     }
-    st = image_rel(p, es, P, f);
-    for (k = 0; k < 3 && st == CT_OK; ++k) { /* bound: 3 axes */
-        g[k] = es->fit_base[k] + ct_i128_round_shr(ct_i128_from64(f[k]), es->fit_fb[k] - 24u);
+    {
+        /* exact, relative to the camera's grid point with 32 fraction bits
+         * (image_rel reads g16 and fb only) */
+        ct_earth_map rel;
+        rel.g16[0] = es->ox;
+        rel.g16[1] = es->oy;
+        rel.g16[2] = es->oz;
+        rel.fb[0] = rel.fb[1] = rel.fb[2] = 32u;
+        st = image_rel(p, &es->zone, &rel, P, f);
+        for (k = 0; k < 3 && st == CT_OK; ++k) { /* bound: 3 axes */
+            g[k] = rel.g16[k] * 256 + ct_i128_round_shr(ct_i128_from64(f[k]), 8u);
+        }
     }
     return st;
 }
@@ -458,8 +534,8 @@ ct_status ct_earth_image24(const ct_package *p, const ct_earth *es, const int64_
  * there is one and P is in its cube. */
 static ct_status vertex_exact(const path *pa, int64_t t, gv *v)
 {
-    int64_t D[3], g[3], bend = 0;
-    int k, in = pa->es->fit_deg > 0;
+    int64_t D[3], Dm[3], g[3], bend = 0;
+    int k, in = pa->es->map != NULL;
     ct_status st;
     if (pa->refract) {
         /* k t^2 / 2R: t < 2^48, t^2 < 2^96, |k| <= 2^17: < 2^113; / 2R
@@ -474,10 +550,11 @@ static ct_status vertex_exact(const path *pa, int64_t t, gv *v)
         if (pa->refract) {
             D[k] -= ct_mul_shr(bend, pa->w[k], 30u);
         }
-        in = in && ct_abs64(D[k]) <= (INT64_C(1) << pa->es->fit_qrho);
+        Dm[k] = D[k] + pa->es->moff[k]; /* |D| < 2^49, |moff| <= 2^50 */
+        in = in && ct_abs64(Dm[k]) <= (INT64_C(1) << pa->es->map->qrho);
     }
     if (in) {
-        fit_eval(pa->es, D, g);
+        fit_eval(pa->es->map, Dm, g);
         v->fx = g[0];
         v->fy = g[1];
         v->fz = g[2];
@@ -712,7 +789,7 @@ CT_NOINLINE static int rise_coeff(ct_i128 num, ct_i128 den, uint64_t *kf, uint32
 }
 
 ct_status ct_earth_setup(const ct_package *p, const ct_pose *pose, int32_t refr_k_q16, int64_t radius_nm,
-                         int64_t chord_nm, uint32_t bend_flags, int fitted, ct_earth *es)
+                         int64_t chord_nm, uint32_t bend_flags, int fitted, const ct_earth_map *map, ct_earth *es)
 {
     int64_t lat, lon, post, far2x, far2y, dz;
     ct_status st;
@@ -765,28 +842,44 @@ ct_status ct_earth_setup(const ct_package *p, const ct_pose *pose, int32_t refr_
         }
         es->tmax_nm = ct_min64(TMAX_LIMIT_NM, dist + dist / 10 + KM_NM);
     }
-    es->fit_deg = 0;
-    es->fit_qrho = 0u;
-    es->fit_base[0] = es->ox * 256; /* |ox| <= 2^46 */
-    es->fit_base[1] = es->oy * 256;
-    es->fit_base[2] = es->oz * 256;
-    es->fit_fb[0] = es->fit_fb[1] = es->fit_fb[2] = 32u;
-    if (fitted) {
+    es->map = NULL;
+    es->moff[0] = es->moff[1] = es->moff[2] = 0;
+    es->fit.ready = 0u;
+    es->fit.deg = 0;
+    if (map != NULL) {
+        es->map = map;
+    } else if (fitted) {
         /* the cube holds every node C + t d - bend w, t <= tmax: its
          * half-width 2^q >= tmax + the bend at tmax (as vertex_exact: |k|
          * tmax^2 / 2R, < 2^62 saturated) + 1 km */
-        int64_t need, bend;
-        uint32_t q = 44u;
+        int64_t bend;
+        uint32_t q;
         ct_i128 num = ct_i128_mul128_64(ct_umul64((uint64_t)es->tmax_nm, (uint64_t)es->tmax_nm),
                                         refr_k_q16 < 0 ? -(int64_t)refr_k_q16 : (int64_t)refr_k_q16);
         bend = ct_floor_div(ct_i128_floor_div_sat(num, 2 * radius_nm), ONE16);
-        need = es->tmax_nm + bend + KM_NM; /* < 2^48 + 2^46 + 2^40 */
-        /* bound: 4 sizes */
-        while (q < 48u && (INT64_C(1) << q) < need) {
-            q++;
-        }
+        q = cube_q(es->tmax_nm + bend + KM_NM); /* < 2^48 + 2^46 + 2^40 */
         if (q <= 47u) {
-            fit_map(p, es, q);
+            int k;
+            for (k = 0; k < 3; ++k) { /* bound: 3 axes */
+                es->fit.c[k] = es->c[k];
+            }
+            es->fit.g16[0] = es->ox;
+            es->fit.g16[1] = es->oy;
+            es->fit.g16[2] = es->oz;
+            fit_map(p, &es->zone, &es->fit, q);
+            if (es->fit.deg > 0) {
+                es->map = &es->fit;
+            }
+        }
+    }
+    if (es->map != NULL) {
+        int k;
+        for (k = 0; k < 3; ++k) { /* bound: 3 axes */
+            es->moff[k] = es->c[k] - es->map->c[k];
+            if (ct_abs64(es->moff[k]) > (INT64_C(1) << 50)) {
+                es->map = NULL; /* the camera is 1,100 km from the map's cube: exact */
+                break;
+            }
         }
     }
     return CT_OK;

@@ -48,7 +48,8 @@ static ct_status effects_to_bend(const ct_package *p, const ct_effects *fx, ct_b
     if (fx == NULL) {
         return CT_OK;
     }
-    if ((fx->flags & ~(CT_EFFECT_ALL | CT_EFFECT_EARTH_FIT)) != 0u) {
+    if ((fx->flags & ~(CT_EFFECT_ALL | CT_EFFECT_EARTH_FIT)) != 0u ||
+        (fx->earth_map != NULL && !ct_earth_map_fits(p, fx->earth_map))) {
         return CT_ERR_EFFECTS;
     }
     if ((fx->flags & CT_EFFECT_CURVATURE) != 0u) {
@@ -116,7 +117,7 @@ static ct_status setup(const ct_package *p, const ct_camera *cam, const ct_pose 
         ct_status st = ct_earth_setup(p, pose,
                                       (effects->flags & CT_EFFECT_REFRACTION) != 0u ? effects->refraction_k_q16 : 0,
                                       CT_EARTH_RADIUS_NM, s->bend.chord_nm, s->bend.flags,
-                                      (effects->flags & CT_EFFECT_EARTH_FIT) != 0u, &s->es);
+                                      (effects->flags & CT_EFFECT_EARTH_FIT) != 0u, effects->earth_map, &s->es);
         if (st == CT_OK) {
             s->earth = 1;
             return CT_OK;

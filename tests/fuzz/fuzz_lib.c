@@ -358,6 +358,27 @@ static void geoloc_mode(const ct_vec_package *vp, const uint8_t *d, size_t n)
                          (int64_t)(b % INT64_C(16000000000000)) - INT64_C(1000000000000), q);
     CHECK(s == CT_OK);
     fx.flags = (uint32_t)(e & 3);
+    /* the fitted map: per call (1 input in 16: 125-343 exact conversions
+     * each), or kept across calls (fitted once around the tile's centre) */
+    if (((e >> 41) & 15) == 0) {
+        fx.flags |= CT_EFFECT_EARTH_FIT;
+    }
+    fx.earth_map = NULL;
+    if ((e >> 40) & 1) {
+        /* one map per package (fitted the first time it is asked for); a
+         * map of another package now and then (refused: CT_ERR_EFFECTS) */
+        static ct_earth_map maps[4];
+        static const ct_vec_package *made_for[4];
+        static int state[4]; /* 1 fitted, 2 refused (not UTM) */
+        size_t slot = (size_t)(((uintptr_t)vp >> 4) % 4u);
+        if (made_for[slot] != vp) {
+            made_for[slot] = vp;
+            state[slot] = ct_earth_map_init(&pkg, pkg.origin_e_nm + (int64_t)(pkg.width / 2u) * pkg.posting_e_nm,
+                                            pkg.origin_n_nm + (int64_t)(pkg.height / 2u) * pkg.posting_n_nm, 0,
+                                            INT64_C(1) << 46, &maps[slot]) == CT_OK ? 1 : 2;
+        }
+        fx.earth_map = state[slot] == 1 ? &maps[((e >> 42) & 7) == 0 ? (slot + 1u) % 4u : slot] : NULL;
+    }
     fx.refraction_k_q16 = (int32_t)((int16_t)(e >> 8)) * 4;
     fx.earth_radius_nm = ((e >> 24) & 1) ? 0 : INT64_C(1) << (40 + ((e >> 25) & 0xf) % 15);
     fx.chord_nm = ((e >> 29) & 1) ? 0 : INT64_C(1) << (10 + ((e >> 30) & 0x3f) % 41);
