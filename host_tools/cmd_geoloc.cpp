@@ -36,6 +36,10 @@
 //   horizontal range rho, c = [curvature] - k [refraction].
 //   --refraction-k K (default 0.13, in [-2, 2]; needs refraction) and
 //   --earth-radius M (metres, default 6371000; needs an effect).
+// --tolerance M: instead of --effects, the least set of curvature and
+//   refraction whose omission stays within M metres horizontally over the
+//   image (ct_effects_for_tolerance: flat-ground bounds from each ray's
+//   range and depression); the bounds and the choice are printed on stderr.
 // --earth-map auto|fitted|exact: with curvature on a UTM package (the true
 //   Earth), map the line of sight into the package's frame through a
 //   polynomial fitted once per chunk of pixels (CT_EFFECT_EARTH_FIT: 125-343
@@ -69,7 +73,7 @@ int cmd_geoloc(int argc, char **argv)
     const std::string err = parse_cmdline(argc, argv, 2,
                                           {"--camera", "--pixels", "--method", "--effects", "--grid-step",
                                            "--refraction-k", "--earth-radius", "--threads", "--pose-wgs84",
-                                           "--pose-map", "--earth-map", "-o"},
+                                           "--pose-map", "--earth-map", "--tolerance", "-o"},
                                           {}, false, &args);
     if (!err.empty()) throw Error("geoloc: " + err);
     const std::vector<std::string> &pos = args.pos;
@@ -81,6 +85,8 @@ int cmd_geoloc(int argc, char **argv)
     // radius 0: the true Earth on UTM packages (the sphere of 6371 km on others)
     ct_effects fx = {0u, CT_REFRACTION_K_STD_Q16, 0, 0, nullptr};
     if (opt.count("--effects")) fx.flags = effects_from_list(opt["--effects"]);
+    const bool by_tolerance = opt.count("--tolerance") > 0;
+    if (by_tolerance && opt.count("--effects")) throw Error("geoloc: give --effects or --tolerance, not both");
     auto number = [&](const char *name, double lo, double hi, const char *what) {
         const std::string &g = opt[name];
         char *end = nullptr;
@@ -90,11 +96,13 @@ int cmd_geoloc(int argc, char **argv)
         return v;
     };
     if (opt.count("--refraction-k")) {
-        if (!(fx.flags & CT_EFFECT_REFRACTION)) throw Error("--refraction-k needs --effects refraction");
+        if (!(fx.flags & CT_EFFECT_REFRACTION) && !by_tolerance)
+            throw Error("--refraction-k needs --effects refraction (or --tolerance)");
         fx.refraction_k_q16 = (int32_t)std::lround(number("--refraction-k", -2, 2, "a coefficient in [-2, 2]") * 65536);
     }
     if (opt.count("--earth-radius")) {
-        if (!fx.flags) throw Error("--earth-radius needs --effects curvature and/or refraction");
+        if (!fx.flags && !by_tolerance)
+            throw Error("--earth-radius needs --effects curvature and/or refraction (or --tolerance)");
         fx.earth_radius_nm = (int64_t)std::llround(
             number("--earth-radius", 1100, 1.8e7, "a radius in metres in [1100, 1.8e7]") * 1e9);
     }
@@ -167,6 +175,30 @@ int cmd_geoloc(int argc, char **argv)
             st = ct_pose_from_map(&cam.pose, std::llround(v[0] * 1e9), std::llround(v[1] * 1e9), h_nm, q);
         }
         if (st != CT_OK) throw Error(std::string(flag) + ": not a valid pose (" + status_name(st) + ")");
+    }
+    if (by_tolerance) {
+        const double tol = number("--tolerance", 0, 1e6, "a tolerance in metres in [0, 1e6]");
+        ct_effects_choice ch;
+        st = ct_effects_for_tolerance(&p, &cam.cam, &cam.pose, fx.refraction_k_q16, fx.earth_radius_nm,
+                                      std::llround(tol * 1e9), &ch);
+        if (st != CT_OK) throw Error("--tolerance: cannot bound the effects for this camera (" + status_name(st) + ")");
+        fx.flags = ch.flags;
+        auto metres = [](int64_t nm) {
+            char b[32];
+            if (nm >= (INT64_C(1) << 62)) return std::string("unbounded");
+            std::snprintf(b, sizeof b, "%.4g m", nm * 1e-9);
+            return std::string(b);
+        };
+        const char *names[4] = {"none", "curvature", "refraction", "curvature, refraction"};
+        std::fprintf(stderr,
+                     "geoloc --tolerance %g m: horizontal error bounds over the image on flat ground (rays to %.1f "
+                     "km, depression down to %.2f deg; k %.3g, R %.0f km): simulating nothing %s, curvature only %s, "
+                     "refraction only %s, both 0 -> effects: %s\n",
+                     tol, ch.range_nm * 1e-12,
+                     ch.tan_min_q30 >= (INT64_C(1) << 62) ? 90.0 : std::atan(ch.tan_min_q30 / 1073741824.0) * 180 / M_PI,
+                     fx.refraction_k_q16 / 65536.0, (fx.earth_radius_nm ? fx.earth_radius_nm : CT_EARTH_RADIUS_NM) * 1e-12,
+                     metres(ch.bound_nm[0]).c_str(), metres(ch.bound_nm[1]).c_str(), metres(ch.bound_nm[2]).c_str(),
+                     names[ch.flags & 3u]);
     }
     std::vector<PixelRow> px = read_pixels_csv(opt["--pixels"]);
 

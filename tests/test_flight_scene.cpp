@@ -528,11 +528,11 @@ void run_pose(World &w, const Camera &cam, const Pose &p, uint64_t seed, Row *ro
     row->pixels = (long)px.size();
 
     ct_effects fx[NM];
-    fx[M_EXACT] = {CT_EFFECT_CURVATURE, CT_REFRACTION_K_STD_Q16, 0, 0};
-    fx[M_EXACT_REFR] = {CT_EFFECT_CURVATURE | CT_EFFECT_REFRACTION, CT_REFRACTION_K_STD_Q16, 0, 0};
-    fx[M_STRAIGHT] = {0, 0, 0, 0};
-    fx[M_PARABOLA] = {CT_EFFECT_CURVATURE, CT_REFRACTION_K_STD_Q16, CT_EARTH_RADIUS_NM, 0};
-    fx[M_PARABOLA_REFR] = {CT_EFFECT_CURVATURE | CT_EFFECT_REFRACTION, CT_REFRACTION_K_STD_Q16, CT_EARTH_RADIUS_NM, 0};
+    fx[M_EXACT] = {CT_EFFECT_CURVATURE, CT_REFRACTION_K_STD_Q16, 0, 0, nullptr};
+    fx[M_EXACT_REFR] = {CT_EFFECT_CURVATURE | CT_EFFECT_REFRACTION, CT_REFRACTION_K_STD_Q16, 0, 0, nullptr};
+    fx[M_STRAIGHT] = {0, 0, 0, 0, nullptr};
+    fx[M_PARABOLA] = {CT_EFFECT_CURVATURE, CT_REFRACTION_K_STD_Q16, CT_EARTH_RADIUS_NM, 0, nullptr};
+    fx[M_PARABOLA_REFR] = {CT_EFFECT_CURVATURE | CT_EFFECT_REFRACTION, CT_REFRACTION_K_STD_Q16, CT_EARTH_RADIUS_NM, 0, nullptr};
     const bool refr[NM] = {false, true, false, false, true};
     for (const Px &s : px) {
         ld ray[3];

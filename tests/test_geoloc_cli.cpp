@@ -673,6 +673,51 @@ void test_geoloc_earth_map()
     fs::remove(g_dir + "/pxe.csv");
 }
 
+// --tolerance M: the effects ct_effects_for_tolerance picks, said on stderr,
+// and the rows are those of --effects with that set; with --effects it is
+// refused, as is a negative tolerance.
+void test_geoloc_tolerance()
+{
+    Setup *s = setup();
+    TEST_ASSERT(s != nullptr);
+    spit(g_dir + "/pxt.csv", kPixels);
+    ct_host::LibCamera lc = ct_host::lib_camera(ct_host::read_cameramodel(g_dir + "/cam.cameramodel"), "cam");
+    std::set<std::string> chosen;
+    for (const char *tol : {"0", "0.00001", "0.001", "1000"}) {
+        Run r = run({"geoloc", "t.ctp", "--camera", "cam.cameramodel", "--pixels", "pxt.csv", "--tolerance", tol, "-o",
+                     "gt.csv"});
+        TEST_ASSERT_MSG(r.code == 0, "--tolerance %s: exit %d: %s", tol, r.code, r.err.c_str());
+        const size_t at = r.err.find("-> effects: ");
+        TEST_ASSERT_MSG(at != std::string::npos, "--tolerance %s: stderr '%s'", tol, r.err.c_str());
+        std::string set = r.err.substr(at + 12);
+        set = set.substr(0, set.find('\n'));
+        chosen.insert(set);
+        // the library's choice, and the rows of --effects with it
+        ct_effects_choice ch;
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_effects_for_tolerance(&s->p, &lc.cam, &lc.pose, CT_REFRACTION_K_STD_Q16, 0,
+                                                              std::llround(std::stod(tol) * 1e9), &ch));
+        const char *names[4] = {"none", "curvature", "refraction", "curvature, refraction"};
+        TEST_ASSERT_MSG(set == names[ch.flags & 3u], "--tolerance %s: said '%s', the library chose %u", tol,
+                        set.c_str(), ch.flags);
+        const std::string got = slurp(g_dir + "/gt.csv");
+        Run e = run({"geoloc", "t.ctp", "--camera", "cam.cameramodel", "--pixels", "pxt.csv", "--effects",
+                     set == "none" ? "" : set, "-o", "ge.csv"});
+        TEST_ASSERT_MSG(e.code == 0, "--effects %s: %s", set.c_str(), e.err.c_str());
+        TEST_ASSERT_MSG(got == slurp(g_dir + "/ge.csv"), "--tolerance %s: rows differ from --effects %s", tol,
+                        set.c_str());
+    }
+    TEST_ASSERT_MSG(chosen.count("curvature, refraction") && chosen.count("none"), "choices: %zu", chosen.size());
+    Run both = run({"geoloc", "t.ctp", "--camera", "cam.cameramodel", "--pixels", "pxt.csv", "--tolerance", "1",
+                    "--effects", "curvature", "-o", "gt.csv"});
+    TEST_ASSERT(both.code != 0 && both.err.find("give --effects or --tolerance, not both") != std::string::npos);
+    Run neg = run({"geoloc", "t.ctp", "--camera", "cam.cameramodel", "--pixels", "pxt.csv", "--tolerance", "-1", "-o",
+                   "gt.csv"});
+    TEST_ASSERT(neg.code != 0 && neg.err.find("--tolerance needs") != std::string::npos);
+    fs::remove(g_dir + "/gt.csv");
+    fs::remove(g_dir + "/ge.csv");
+    fs::remove(g_dir + "/pxt.csv");
+}
+
 // `conetrace demo` (make demo's main job) on the bundled DEM and the
 // oblique30 scene's camera: every geolocated pixel of pixels.csv is the
 // library's (the same package built by `conetrace build --reduce 3`, the same
@@ -996,6 +1041,7 @@ int main()
     RUN_TEST(test_geoloc_pose_map_vs_model);
     RUN_TEST(test_geoloc_threads);
     RUN_TEST(test_geoloc_earth_map);
+    RUN_TEST(test_geoloc_tolerance);
     RUN_TEST(test_demo);
     RUN_TEST(test_geoloc_splined_grid);
     RUN_TEST(test_geoloc_bad_inputs);

@@ -307,6 +307,126 @@ void test_error_budget()
     }
 }
 
+// Effects for a tolerance (ct_effects_for_tolerance): in each scene's world
+// with both curvature and refraction (and its lens as listed), for lines of
+// sight clearing the terrain by more than a left-out bend moves them (near
+// a crest any model error may carry a hit onto another surface), the bounds
+// hold -- the largest measured error of the library simulating nothing,
+// curvature only and refraction only, brought to flat ground (x sin(incidence)
+// / sin(depression), the bounds' own terms), stays within its bound plus the
+// library's own error (measured with both effects simulated); for
+// tolerances from 1 mm to 100 m the chosen set meets the tolerance (plus that
+// floor), and leaving out a chosen effect breaks it wherever the bound of
+// doing so exceeds the tolerance fourfold (the error budget as a selection).
+// Per sample: the library's horizontal error brought to flat ground (x
+// sin(incidence) / sin(depression)); -1 for occluded samples, infinity for
+// a miss.
+std::vector<double> flat_errors(const scene::World &w, const std::vector<scene::Sample> &smp, const ct_effects &fx)
+{
+    std::vector<double> out;
+    for (const scene::Sample &s : smp) {
+        if (!s.visible || s.dep_deg <= 0) {
+            out.push_back(-1);
+            continue;
+        }
+        ct_geo g;
+        const ct_status st = ct_geolocate(&w.p, &w.cam.cam, &w.cam.pose, CT_METHOD_DIRECTIONAL, &fx, s.uq, s.vq, &g);
+        if (st != CT_HIT) {
+            out.push_back(INFINITY);
+            continue;
+        }
+        const double err = (double)std::hypot(g.hit.e_nm * 1e-9L - s.first[0], g.hit.n_nm * 1e-9L - s.first[1]);
+        out.push_back(err * (double)(std::sin(s.inc_deg * (ld)M_PI / 180) / std::sin(s.dep_deg * (ld)M_PI / 180)));
+    }
+    return out;
+}
+
+void test_effect_selection()
+{
+    const double tols[] = {1e-3, 1e-2, 0.1, 1, 10, 100};
+    const char *names[4] = {"none", "curvature", "refraction", "both"};
+    printf("  effects for a tolerance (flat-ground bounds; measured max in brackets): simulating nothing | curvature "
+           "only | refraction only; the choice at 1 mm, 1 cm, 10 cm, 1 m, 10 m, 100 m\n");
+    for (const char *name : kScenes) {
+        scene::World *w = world(name);
+        const unsigned world_fx = (w->s.effects & scene::FX_DISTORTION) | scene::FX_CURVATURE | scene::FX_REFRACTION;
+        const ct_effects both = scene::lib_effects(w->s, scene::FX_CURVATURE | scene::FX_REFRACTION);
+        ct_effects_choice ch;
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_effects_for_tolerance(&w->p, &w->cam.cam, &w->cam.pose, both.refraction_k_q16,
+                                                              both.earth_radius_nm, 0, &ch));
+        TEST_ASSERT(ch.flags == CT_EFFECT_ALL && ch.samples > 300);
+        // lines of sight that clear the terrain before their hit by more than
+        // the largest displacement a left-out bend makes (rho^2 / 2R at the
+        // largest range): closer, any model error may carry the hit over a
+        // crest onto another surface, which no bound of this kind covers
+        scene::SimOptions o;
+        o.n = (int)(200 * ct_test_scale());
+        o.seed = ct_test_seed() * 307 + std::strlen(name);
+        o.effects = world_fx;
+        o.clearance_m = 0.05 + std::pow(ch.range_nm * 1e-9, 2) / (2 * w->s.radius_m);
+        scene::SimStats ss;
+        std::vector<scene::Sample> smp = scene::simulate(*w, o, &ss);
+        TEST_ASSERT(smp.size() >= 50);
+        auto with = [&](unsigned lib_flags) {
+            ct_effects e = both;
+            e.flags = lib_flags;
+            return flat_errors(*w, smp, e);
+        };
+        auto max_of = [](const std::vector<double> &v) { return *std::max_element(v.begin(), v.end()); };
+        const double floor = max_of(with(CT_EFFECT_ALL));
+        const std::vector<double> errs[3] = {with(0u), with(CT_EFFECT_CURVATURE), with(CT_EFFECT_REFRACTION)};
+        const double measured[3] = {max_of(errs[0]), max_of(errs[1]), max_of(errs[2])};
+        // each sample's own bound: |c| rho^2 / 2R / tan(depression), c the
+        // residual of simulating nothing (1 - k), curvature only (k) or
+        // refraction only (1)
+        const double kk = both.refraction_k_q16 / 65536.0, cres[3] = {std::fabs(1 - kk), std::fabs(kk), 1.0};
+        auto own_bound = [&](int ri, const scene::Sample &sm) {
+            return cres[ri] * (double)(sm.range_m * sm.range_m) / (2 * w->s.radius_m) /
+                   std::tan((double)sm.dep_deg * M_PI / 180);
+        };
+        std::string row = std::string("  ") + name + ":";
+        for (int k = 0; k < 3; ++k) {
+            const double b = ch.bound_nm[k] * 1e-9;
+            char cellb[64];
+            std::snprintf(cellb, sizeof cellb, " %.3g m (%.3g)%s", b, measured[k], k < 2 ? " |" : ";");
+            row += cellb;
+            // the bound holds (10 % and 0.1 mm for the flat-ground
+            // normalisation of sloped hits)
+            TEST_ASSERT_MSG(measured[k] <= 1.1 * b + floor + 1e-4, "%s: simulating %s measured %.4g m > bound %.4g m",
+                            name, names[k], measured[k], b);
+        }
+        for (double tol : tols) {
+            TEST_ASSERT_EQUAL_INT(CT_OK, ct_effects_for_tolerance(&w->p, &w->cam.cam, &w->cam.pose,
+                                                                  both.refraction_k_q16, both.earth_radius_nm,
+                                                                  std::llround(tol * 1e9), &ch));
+            const int idx = ch.flags == 0u ? 0 : ch.flags == CT_EFFECT_CURVATURE ? 1 : ch.flags == CT_EFFECT_REFRACTION ? 2 : 3;
+            const double got = idx == 3 ? floor : measured[idx];
+            TEST_ASSERT_MSG(got <= tol + floor + 1e-4, "%s: tolerance %g m, chose %s, measured %.4g m", name, tol,
+                            names[idx], got);
+            row += std::string(" ") + names[idx];
+            // each chosen effect left out: the subset's bound and measure
+            for (unsigned e : {(unsigned)CT_EFFECT_CURVATURE, (unsigned)CT_EFFECT_REFRACTION}) {
+                if (!(ch.flags & e)) continue;
+                const unsigned rest = ch.flags & ~e;
+                const int ri = rest == 0u ? 0 : rest == CT_EFFECT_CURVATURE ? 1 : 2;
+                // where the effect matters -- points whose own bound exceeds
+                // the tolerance fourfold -- leaving it out breaks it
+                long matter = 0, broken = 0;
+                for (size_t q = 0; q < smp.size(); ++q) {
+                    if (errs[ri][q] < 0 || own_bound(ri, smp[q]) < 4 * tol) continue;
+                    matter++;
+                    broken += errs[ri][q] > tol;
+                }
+                TEST_ASSERT_MSG(matter == 0 || broken > 0, "%s: tolerance %g m: %ld points where %s matters, none "
+                                "broken without it", name, tol, matter, names[e == CT_EFFECT_CURVATURE ? 1 : 2]);
+            }
+        }
+        printf("%s (floor %.3g m; rays to %.1f km, depression down to %.2f deg; %zu points clearing the terrain by "
+               "%.2f m, %ld closer left out)\n", row.c_str(), floor, ch.range_nm * 1e-12,
+               std::atan(ch.tan_min_q30 / 1073741824.0) * 180 / M_PI, smp.size(), (double)o.clearance_m, ss.tangent);
+    }
+}
+
 }  // namespace
 
 int main()
@@ -315,5 +435,6 @@ int main()
     RUN_TEST(test_scene_files);
     RUN_TEST(test_scene_accuracy);
     RUN_TEST(test_error_budget);
+    RUN_TEST(test_effect_selection);
     return TEST_END();
 }

@@ -658,6 +658,39 @@ typedef struct {
                                   used with the true Earth (else ignored)   */
 } ct_effects;
 
+/* Effects for a tolerance: which of curvature and refraction a camera over
+ * a package needs for a horizontal geolocation error under tol_nm, from a
+ * bound per pixel over the image (its border every 1/64 and a 15 x 11
+ * grid): leaving out a bend of coefficient c moves the line of sight by c
+ * rho^2 / 2R vertically at horizontal range rho, which moves its meeting
+ * with flat ground by that over tan(depression).  rho is where the ray
+ * reaches the tile's lowest post, at most the tile's farthest corner; a ray
+ * level or rising while the camera is below the tallest post, or a camera
+ * below the lowest post, is unbounded (2^62).  Bounds are for flat ground:
+ * where the ground falls away from the ray (incidence below the
+ * depression) the error grows as 1 / sin(incidence).                     */
+typedef struct {
+    uint32_t flags;            /* the least set: 0, CURVATURE, REFRACTION or
+                                  both (the first, in that order, whose bound
+                                  is within the tolerance; both otherwise)  */
+    int64_t bound_nm[4];       /* bound with [0] nothing simulated (c = 1 -
+                                  k), [1] curvature only (c = k), [2]
+                                  refraction only (c = 1), [3] both (0);
+                                  2^62: unbounded                           */
+    int64_t range_nm;          /* the largest rho of a sampled ray           */
+    int64_t tan_min_q30;       /* the least tan(depression) of a sampled ray
+                                  that reaches the tile (Q30, 2^62: none)    */
+    uint32_t samples;          /* pixels that unprojected                   */
+} ct_effects_choice;
+
+/* refraction_k_q16 in [-2, 2] (Q16), radius_nm 0 (6371 km) or [2^40, 2^54],
+ * tol_nm >= 0.  CT_OK; CT_ERR_ARG (NULL, a camera or pose not set up),
+ * CT_ERR_EFFECTS (k or R out of range), CT_ERR_UNPROJECT (no pixel
+ * unprojects).                                                            */
+ct_status ct_effects_for_tolerance(const ct_package *pkg, const ct_camera *cam, const ct_pose *pose,
+                                   int32_t refraction_k_q16, int64_t radius_nm, int64_t tol_nm,
+                                   ct_effects_choice *out);
+
 /* Fit a ct_earth_map for `pkg` (on a UTM zone) over the cube of half-width
  * 2^q nm >= radius_nm (q = 44..47: 17.6 .. 141 km) around the map point
  * (e, n, h): (d + 1)^3 exact conversions, d = 4, 5, 6 for q = 44, 45, >= 46

@@ -215,3 +215,151 @@ ct_status ct_geolocate_batch(const ct_package *pkg, const ct_camera *cam, const 
     }
     return CT_OK;
 }
+
+/* ---- effects for a tolerance ------------------------------------------ */
+
+#define UNBOUNDED (INT64_C(1) << 62)
+
+/* The bound for one map-frame direction d (Q39) and the coefficients' |c|
+ * (Q16) in cq[3]: H the camera's height above the lowest post (nm, > 0),
+ * top: the camera is below the tallest post, far: the horizontal distance
+ * to the tile's farthest corner (nm, <= 2^50), R (nm). */
+static void ray_bounds(const int64_t d[3], int64_t H, int top, int64_t far, int64_t R, const int64_t cq[3],
+                       int64_t e[3], int64_t *rho, int64_t *tan_q30)
+{
+    int k;
+    /* L = |(dx, dy)| < 2^40.1 */
+    int64_t L = (int64_t)ct_i128_isqrt(ct_i128_add(ct_i128_mul(d[0], d[0]), ct_i128_mul(d[1], d[1])));
+    int64_t dn = -d[2], r, q;
+    *rho = 0;
+    *tan_q30 = UNBOUNDED;
+    if (dn <= 0) {
+        /* level or rising: it reaches terrain only from below the top */
+        for (k = 0; k < 3; ++k) { /* bound: 3 coefficients */
+            e[k] = top && cq[k] != 0 ? UNBOUNDED : 0;
+        }
+        *rho = top ? far : 0;
+        *tan_q30 = top ? 0 : UNBOUNDED;
+        return;
+    }
+    /* rho = min(far, H L / dn): H < 2^62, L < 2^41: in 128 bits */
+    r = ct_min64(far, ct_i128_floor_div_sat(ct_i128_mul(H, L), dn));
+    *rho = r;
+    *tan_q30 = L == 0 ? UNBOUNDED : ct_i128_floor_div_sat(ct_i128_shl(ct_i128_from64(dn), 30u), L);
+    /* rho^2 / 2R: rho <= 2^50, rho^2 < 2^100, / 2^41 at least: < 2^59 */
+    q = ct_i128_floor_div_sat(ct_i128_mul(r, r), 2 * R);
+    for (k = 0; k < 3; ++k) { /* bound: 3 coefficients */
+        /* q |c| L / (dn 2^16): q |c| < 2^59 2^18, times L < 2^41: < 2^118 */
+        ct_i128 num = ct_i128_mul128_64(ct_i128_mul(q, cq[k]), L);
+        ct_i128 den = ct_i128_mul(dn, 65536);
+        /* den < 2^56: a 64-bit divisor */
+        e[k] = ct_i128_floor_div_sat(num, ct_i128_to64(den));
+    }
+}
+
+ct_status ct_effects_for_tolerance(const ct_package *p, const ct_camera *cam, const ct_pose *pose,
+                                   int32_t refraction_k_q16, int64_t radius_nm, int64_t tol_nm,
+                                   ct_effects_choice *out)
+{
+    int64_t R = radius_nm == 0 ? CT_EARTH_RADIUS_NM : radius_nm;
+    int64_t k = refraction_k_q16, H, far = 0, cq[3], u_lo, u_hi, v_lo, v_hi;
+    int64_t lo_nm, hi_nm;
+    uint32_t i, j, n;
+    int top;
+    if (p == NULL || cam == NULL || pose == NULL || out == NULL || cam->ready == 0u || pose->ready == 0u) {
+        return CT_ERR_ARG;
+    }
+    if (k < -K_MAX_Q16 || k > K_MAX_Q16 || R < (INT64_C(1) << 40) || R > (INT64_C(1) << 54) || tol_nm < 0) {
+        return CT_ERR_EFFECTS;
+    }
+    /* residual coefficients: nothing simulated 1 - k, curvature only k,
+     * refraction only 1 (Q16, |.| <= 3 2^16) */
+    cq[0] = ct_abs64(65536 - k);
+    cq[1] = ct_abs64(k);
+    cq[2] = 65536;
+    /* heights: |offset| <= 2^61, codes < 2^16 times scale <= 2^46 */
+    lo_nm = p->height_offset_nm + (int64_t)p->hmin * p->height_scale_nm;
+    hi_nm = p->height_offset_nm + (int64_t)(p->hmax + 1) * p->height_scale_nm;
+    H = pose->h_nm - lo_nm; /* |h| <= 2^61 (ct_pose_init) */
+    top = pose->h_nm <= hi_nm;
+    /* the farthest tile corner, horizontally: origin + size posting - the
+     * camera in 128 bits (|origin|, |e| <= 2^61, size < 2^32 times |posting|
+     * <= 2^50), each offset capped at 2^49 */
+    for (i = 0u; i < 4u; ++i) { /* bound: 4 corners */
+        ct_i128 ce = ct_i128_from64(p->origin_e_nm - pose->e_nm);
+        ct_i128 cn = ct_i128_from64(p->origin_n_nm - pose->n_nm);
+        int64_t de, dn;
+        if ((i & 1u) != 0u) {
+            ce = ct_i128_add(ce, ct_i128_mul((int64_t)p->width, p->posting_e_nm));
+        }
+        if ((i & 2u) != 0u) {
+            cn = ct_i128_add(cn, ct_i128_mul((int64_t)p->height, p->posting_n_nm));
+        }
+        ce = ct_i128_abs(ce);
+        cn = ct_i128_abs(cn);
+        de = ct_i128_cmp(ce, ct_i128_from64(INT64_C(1) << 49)) > 0 ? INT64_C(1) << 49 : ct_i128_to64(ce);
+        dn = ct_i128_cmp(cn, ct_i128_from64(INT64_C(1) << 49)) > 0 ? INT64_C(1) << 49 : ct_i128_to64(cn);
+        far = ct_max64(far, (int64_t)ct_i128_isqrt(ct_i128_add(ct_i128_mul(de, de), ct_i128_mul(dn, dn))));
+    }
+    /* the image: the lens's size, or the grid's supported extent */
+    if (cam->lens.model == CT_LENS_GRID) {
+        u_lo = cam->grid.u0_q16 + cam->grid.step_q16;
+        v_lo = cam->grid.v0_q16 + cam->grid.step_q16;
+        u_hi = cam->grid.u0_q16 + (int64_t)(cam->grid.nu - 2u) * cam->grid.step_q16;
+        v_hi = cam->grid.v0_q16 + (int64_t)(cam->grid.nv - 2u) * cam->grid.step_q16;
+    } else {
+        u_lo = -32768; /* -0.5 px */
+        v_lo = -32768;
+        u_hi = ((int64_t)cam->lens.width << 16) - 32768;
+        v_hi = ((int64_t)cam->lens.height << 16) - 32768;
+    }
+    out->flags = 0u;
+    out->bound_nm[0] = out->bound_nm[1] = out->bound_nm[2] = out->bound_nm[3] = 0;
+    out->range_nm = 0;
+    out->tan_min_q30 = UNBOUNDED;
+    out->samples = 0u;
+    /* 4 edges x 64 points, then a 15 x 11 grid: 421 pixels */
+    n = 4u * 64u + 15u * 11u;
+    for (i = 0u; i < n; ++i) { /* bound: 421 pixels */
+        int64_t u, v, d[3], e[3], rho, tq;
+        int32_t ray[3];
+        uint32_t it;
+        if (i < 256u) {
+            /* edge i / 64: top, right, bottom, left; 64 steps along it */
+            int64_t f = (int64_t)(i % 64u), side = (int64_t)(i / 64u);
+            int64_t du = (u_hi - u_lo) / 64, dv = (v_hi - v_lo) / 64;
+            u = side == 0 ? u_lo + f * du : (side == 1 ? u_hi : (side == 2 ? u_hi - f * du : u_lo));
+            v = side == 0 ? v_lo : (side == 1 ? v_lo + f * dv : (side == 2 ? v_hi : v_hi - f * dv));
+        } else {
+            j = i - 256u;
+            u = u_lo + (u_hi - u_lo) * (int64_t)(j % 15u + 1u) / 16;
+            v = v_lo + (v_hi - v_lo) * (int64_t)(j / 15u + 1u) / 12;
+        }
+        if (ct_camera_unproject(cam, u, v, ray, &it) != CT_OK || ct_pose_rotate(pose, ray, d) != CT_OK) {
+            continue;
+        }
+        out->samples++;
+        if (H <= 0) {
+            e[0] = e[1] = e[2] = UNBOUNDED; /* the camera below every post */
+            rho = far;
+            tq = 0;
+        } else {
+            ray_bounds(d, H, top, far, R, cq, e, &rho, &tq);
+        }
+        for (j = 0u; j < 3u; ++j) { /* bound: 3 coefficients */
+            out->bound_nm[j] = ct_max64(out->bound_nm[j], e[j]);
+        }
+        out->range_nm = ct_max64(out->range_nm, rho);
+        if (rho > 0) {
+            out->tan_min_q30 = ct_min64(out->tan_min_q30, tq);
+        }
+    }
+    if (out->samples == 0u) {
+        return CT_ERR_UNPROJECT;
+    }
+    out->flags = out->bound_nm[0] <= tol_nm   ? 0u
+                 : out->bound_nm[1] <= tol_nm ? CT_EFFECT_CURVATURE
+                 : out->bound_nm[2] <= tol_nm ? CT_EFFECT_REFRACTION
+                                              : CT_EFFECT_ALL;
+    return CT_OK;
+}
