@@ -130,7 +130,7 @@ static int64_t q24_to_16(int64_t v)
     return ct_floor_div(v + 128, 256);
 }
 
-/* ---- the fitted map (CT_EFFECT_EARTH_FIT) ------------------------------
+/* ---- the fitted map (CT_EFFECT_EARTH_FIT, ct_earth_map) -----------------
  * T_a(x_i) = cos(a (2i + 1) pi / 2m) in Q62 for m = deg + 1 points per
  * axis (generated with mpmath at 60 digits); row 1 holds the points x_i. */
 static const int64_t cheb5_q62[5][5] = {
@@ -321,7 +321,7 @@ static void fit_eval(const ct_earth_map *mp, const int64_t D[3], int64_t g[3])
 /* The fit through the exact images at the (deg + 1)^3 Chebyshev points of
  * the cube: c_abc = (2/m)^3 g_a g_b g_c sum_ijk f_ijk T_a(x_i) T_b(x_j)
  * T_c(x_k), m = deg + 1, g_0 = 1/2 and 1 otherwise, f the images less the
- * camera's grid point with fb fraction bits (|f| <= 2^55, else no fit:
+ * centre's grid point g16 with fb fraction bits (|f| <= 2^55, else no fit:
  * image_rel).  Each term f T T T / 2^64 (Q(fb - 2)) < 2^53, the sum over
  * <= 343 points < 2^61.5, kept in the coefficient array itself; then times
  * 8 g_a g_b g_c / m^3 (in 128 bits): |c| <= 8 max|f| / 4 < 2^56.  The
@@ -336,7 +336,7 @@ static void fit_map(const ct_package *p, const ct_utm *zone, ct_earth_map *mp, u
     mp->ready = 0u;
     mp->deg = 0;
     mp->qrho = qrho;
-    /* fraction bits: the images lie within 2^(qrho + 1) nm of the camera's
+    /* fraction bits: the images lie within 2^(qrho + 1) nm of the centre's
      * (the cube's half-diagonal sqrt(3) 2^qrho, stretched by at most 1 %
      * by the projection), so |f| <= 2^(qrho + 1 + fb) / scale <= 2^55 for
      * fb = 54 - qrho + floor(log2 scale), at most 32; below 26 no fit */
