@@ -3,7 +3,7 @@
 BUILD ?= build
 JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 
-.PHONY: all test demo bench cross fuzz coverage clean deps
+.PHONY: all test demo bench tradeoff cross fuzz coverage clean deps
 FUZZ_SECONDS ?= 1800
 
 all: deps
@@ -28,6 +28,12 @@ bench: all
 	$(BUILD)/bench/ct_bench_build
 	$(BUILD)/bench/ct_bench_ddt
 	scripts/bench_m4.sh $(BUILD)
+
+# what each knob buys and costs: build/tradeoff/tradeoff.csv and its plots
+# (a few minutes; docs/benchmarks.md)
+tradeoff: all
+	$(BUILD)/bench/ct_tradeoff --out $(BUILD)/tradeoff
+	/usr/bin/python3 scripts/plot_tradeoff.py $(BUILD)/tradeoff
 
 cross: deps
 	scripts/cross.sh $(BUILD)/cross

@@ -233,15 +233,15 @@ Row measure(scene::World &w, const std::vector<scene::Sample> &smp, const Settin
     const std::vector<int64_t> su = sample_uv(smp);
     const std::vector<ct_geo> gs = locate(pk->p, c, s.method, fx, su);
     const double posting = std::fabs(w.t.geo.posting_e);
-    if (s.effects == "earth" || s.effects == "earth_fit") {
-        r.samples = smp.size();
-        r.err_ref = "not comparable";
-    } else if (s.knob == "chord") {
+    if (s.knob == "chord") {
         Setting fine = s;
         fine.chord_m = std::ldexp(1.0, 10) * 1e-9;
         const std::vector<ct_geo> gr = locate(pk->p, c, s.method, effects_for(w, fine), su);
         error_stats(smp, gs, &gr, posting, &r);
         r.err_ref = "finest chord";
+    } else if (s.effects == "earth" || s.effects == "earth_fit") {
+        r.samples = smp.size();
+        r.err_ref = "not comparable";
     } else {
         error_stats(smp, gs, nullptr, posting, &r);
     }
