@@ -63,7 +63,8 @@ const UsageBlock kUsage[] = {
      "conetrace geoloc PKG --camera C.cameramodel --pixels px.csv [--method M]\n"
      "                 [--pose-wgs84 LAT,LON,H,YAW,PITCH,ROLL | --pose-map E,N,H,YAW,PITCH,ROLL]\n"
      "                 [--effects curvature,refraction] [--refraction-k K]\n"
-     "                 [--tolerance M] [--earth-radius M] [--earth-map auto|fitted|exact] [--grid-step PX]\n"
+     "                 [--tolerance M] [--chord M] [--earth-radius M] [--earth-map auto|fitted|exact]\n"
+     "                 [--grid-step PX]\n"
      "                 [--threads T] -o g.csv\n"
      "                 (curvature on a UTM package: the true Earth, its map fitted once per\n"
      "                 chunk of pixels when there are 256 or more (auto); --earth-radius: a sphere)\n"},

@@ -38,8 +38,11 @@
 //   --earth-radius M (metres, default 6371000; needs an effect).
 // --tolerance M: instead of --effects, the least set of curvature and
 //   refraction whose omission stays within M metres horizontally over the
-//   image (ct_effects_for_tolerance: flat-ground bounds from each ray's
-//   range and depression); the bounds and the choice are printed on stderr.
+//   image, and the largest chord within the rest (ct_effects_for_tolerance:
+//   flat-ground bounds from each ray's range and depression); the bounds
+//   and the choice are printed on stderr.
+// --chord M: the polyline's / the true Earth's piece tolerance (default
+//   0.001 m; ct_effects.chord_nm).
 // --earth-map auto|fitted|exact: with curvature on a UTM package (the true
 //   Earth), map the line of sight into the package's frame through a
 //   polynomial fitted once per chunk of pixels (CT_EFFECT_EARTH_FIT: 125-343
@@ -73,7 +76,7 @@ int cmd_geoloc(int argc, char **argv)
     const std::string err = parse_cmdline(argc, argv, 2,
                                           {"--camera", "--pixels", "--method", "--effects", "--grid-step",
                                            "--refraction-k", "--earth-radius", "--threads", "--pose-wgs84",
-                                           "--pose-map", "--earth-map", "--tolerance", "-o"},
+                                           "--pose-map", "--earth-map", "--tolerance", "--chord", "-o"},
                                           {}, false, &args);
     if (!err.empty()) throw Error("geoloc: " + err);
     const std::vector<std::string> &pos = args.pos;
@@ -99,6 +102,10 @@ int cmd_geoloc(int argc, char **argv)
         if (!(fx.flags & CT_EFFECT_REFRACTION) && !by_tolerance)
             throw Error("--refraction-k needs --effects refraction (or --tolerance)");
         fx.refraction_k_q16 = (int32_t)std::lround(number("--refraction-k", -2, 2, "a coefficient in [-2, 2]") * 65536);
+    }
+    if (opt.count("--chord")) {
+        if (by_tolerance) throw Error("geoloc: --tolerance chooses the chord; give one or the other");
+        fx.chord_nm = (int64_t)std::llround(number("--chord", 1.024e-6, 1.1e6, "a length in metres in [1.024e-6, 1.1e6]") * 1e9);
     }
     if (opt.count("--earth-radius")) {
         if (!fx.flags && !by_tolerance)
@@ -183,6 +190,7 @@ int cmd_geoloc(int argc, char **argv)
                                       std::llround(tol * 1e9), &ch);
         if (st != CT_OK) throw Error("--tolerance: cannot bound the effects for this camera (" + status_name(st) + ")");
         fx.flags = ch.flags;
+        fx.chord_nm = ch.chord_nm;
         auto metres = [](int64_t nm) {
             char b[32];
             if (nm >= (INT64_C(1) << 62)) return std::string("unbounded");
@@ -193,12 +201,12 @@ int cmd_geoloc(int argc, char **argv)
         std::fprintf(stderr,
                      "geoloc --tolerance %g m: horizontal error bounds over the image on flat ground (rays to %.1f "
                      "km, depression down to %.2f deg; k %.3g, R %.0f km): simulating nothing %s, curvature only %s, "
-                     "refraction only %s, both 0 -> effects: %s\n",
+                     "refraction only %s, both 0 -> chord %.6g m, effects: %s\n",
                      tol, ch.range_nm * 1e-12,
                      ch.tan_min_q30 >= (INT64_C(1) << 62) ? 90.0 : std::atan(ch.tan_min_q30 / 1073741824.0) * 180 / M_PI,
                      fx.refraction_k_q16 / 65536.0, (fx.earth_radius_nm ? fx.earth_radius_nm : CT_EARTH_RADIUS_NM) * 1e-12,
                      metres(ch.bound_nm[0]).c_str(), metres(ch.bound_nm[1]).c_str(), metres(ch.bound_nm[2]).c_str(),
-                     names[ch.flags & 3u]);
+                     ch.chord_nm * 1e-9, names[ch.flags & 3u]);
     }
     std::vector<PixelRow> px = read_pixels_csv(opt["--pixels"]);
 

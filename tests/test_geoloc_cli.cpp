@@ -687,9 +687,12 @@ void test_geoloc_tolerance()
         Run r = run({"geoloc", "t.ctp", "--camera", "cam.cameramodel", "--pixels", "pxt.csv", "--tolerance", tol, "-o",
                      "gt.csv"});
         TEST_ASSERT_MSG(r.code == 0, "--tolerance %s: exit %d: %s", tol, r.code, r.err.c_str());
-        const size_t at = r.err.find("-> effects: ");
+        const size_t at = r.err.find("-> chord ");
         TEST_ASSERT_MSG(at != std::string::npos, "--tolerance %s: stderr '%s'", tol, r.err.c_str());
-        std::string set = r.err.substr(at + 12);
+        const size_t eff = r.err.find(" m, effects: ", at);
+        TEST_ASSERT(eff != std::string::npos);
+        const std::string chord = r.err.substr(at + 9, eff - (at + 9));
+        std::string set = r.err.substr(eff + 13);
         set = set.substr(0, set.find('\n'));
         chosen.insert(set);
         // the library's choice, and the rows of --effects with it
@@ -699,9 +702,16 @@ void test_geoloc_tolerance()
         const char *names[4] = {"none", "curvature", "refraction", "curvature, refraction"};
         TEST_ASSERT_MSG(set == names[ch.flags & 3u], "--tolerance %s: said '%s', the library chose %u", tol,
                         set.c_str(), ch.flags);
+        TEST_ASSERT_MSG(std::llabs(std::llround(std::stod(chord) * 1e9) - ch.chord_nm) <= ch.chord_nm / 100000,
+                        "--tolerance %s: chord %s m, library %lld nm", tol, chord.c_str(), (long long)ch.chord_nm);
         const std::string got = slurp(g_dir + "/gt.csv");
+        // the same set with the chord as printed: the rows are the same
+        // where the chord is not used (every effect here but refraction
+        // alone, c < 0) or prints exactly
+        char cbuf[64];
+        std::snprintf(cbuf, sizeof cbuf, "%.9f", ch.chord_nm * 1e-9);
         Run e = run({"geoloc", "t.ctp", "--camera", "cam.cameramodel", "--pixels", "pxt.csv", "--effects",
-                     set == "none" ? "" : set, "-o", "ge.csv"});
+                     set == "none" ? "" : set, "--chord", cbuf, "-o", "ge.csv"});
         TEST_ASSERT_MSG(e.code == 0, "--effects %s: %s", set.c_str(), e.err.c_str());
         TEST_ASSERT_MSG(got == slurp(g_dir + "/ge.csv"), "--tolerance %s: rows differ from --effects %s", tol,
                         set.c_str());

@@ -404,6 +404,38 @@ void test_effect_selection()
             TEST_ASSERT_MSG(got <= tol + floor + 1e-4, "%s: tolerance %g m, chose %s, measured %.4g m", name, tol,
                             names[idx], got);
             row += std::string(" ") + names[idx];
+            // the chord it chose: the true Earth's pieces (where curvature is
+            // simulated on this UTM package) at that chord against the finest
+            // one stay within what the set's bound leaves of the tolerance
+            // (no promise where a level ray reaches the tile: tan_min 0)
+            if ((ch.flags & CT_EFFECT_CURVATURE) && tol >= 0.01 && ch.tan_min_q30 > 0) {
+                ct_effects a = both, b = both;
+                a.flags = b.flags = ch.flags;
+                a.earth_radius_nm = b.earth_radius_nm = 0;
+                a.chord_nm = ch.chord_nm;
+                b.chord_nm = INT64_C(1) << 10;
+                const double used = idx == 3 ? 0 : ch.bound_nm[idx] * 1e-9;
+                double worst = 0;
+                for (const scene::Sample &sm : smp) {
+                    if (!sm.visible || sm.dep_deg <= 0) continue;
+                    ct_geo ga, gb;
+                    const ct_status sa =
+                        ct_geolocate(&w->p, &w->cam.cam, &w->cam.pose, CT_METHOD_DIRECTIONAL, &a, sm.uq, sm.vq, &ga);
+                    const ct_status sb =
+                        ct_geolocate(&w->p, &w->cam.cam, &w->cam.pose, CT_METHOD_DIRECTIONAL, &b, sm.uq, sm.vq, &gb);
+                    TEST_ASSERT(sa == sb);
+                    if (sa != CT_HIT) continue;
+                    const double d = std::hypot((ga.hit.e_nm - gb.hit.e_nm) * 1e-9, (ga.hit.n_nm - gb.hit.n_nm) * 1e-9) *
+                                     (double)(std::sin(sm.inc_deg * (ld)M_PI / 180) / std::sin(sm.dep_deg * (ld)M_PI / 180));
+                    worst = std::max(worst, d);
+                }
+                TEST_ASSERT_MSG(worst <= tol - used + 0.002, "%s: tolerance %g m, chord %.3g m: the true Earth moves by "
+                                "%.4g m (> %.4g m left by the set's bound)", name, tol, ch.chord_nm * 1e-9, worst,
+                                tol - used);
+                char cb[48];
+                std::snprintf(cb, sizeof cb, "(chord %.2g m: %.2g m)", ch.chord_nm * 1e-9, worst);
+                row += cb;
+            }
             // each chosen effect left out: the subset's bound and measure
             for (unsigned e : {(unsigned)CT_EFFECT_CURVATURE, (unsigned)CT_EFFECT_REFRACTION}) {
                 if (!(ch.flags & e)) continue;

@@ -668,11 +668,19 @@ typedef struct {
  * level or rising while the camera is below the tallest post, or a camera
  * below the lowest post, is unbounded (2^62).  Bounds are for flat ground:
  * where the ground falls away from the ray (incidence below the
- * depression) the error grows as 1 / sin(incidence).                     */
+ * depression) the error grows as 1 / sin(incidence).  The chord (the
+ * polyline's and the true Earth's pieces' tolerance) moves a hit by at most
+ * chord / tan(depression) on flat ground: the largest chord within what
+ * the chosen set's bound leaves of the tolerance.                         */
 typedef struct {
     uint32_t flags;            /* the least set: 0, CURVATURE, REFRACTION or
                                   both (the first, in that order, whose bound
                                   is within the tolerance; both otherwise)  */
+    int64_t chord_nm;          /* the largest chord with chord / tan(dep) <=
+                                  tol - the set's bound, in [2^10, 2^50] nm
+                                  (2^10 when nothing is left: the finest;
+                                  CT_EFFECTS_CHORD_NM when a level or rising
+                                  ray reaches the tile: no such bound)      */
     int64_t bound_nm[4];       /* bound with [0] nothing simulated (c = 1 -
                                   k), [1] curvature only (c = k), [2]
                                   refraction only (c = 1), [3] both (0);

@@ -314,6 +314,7 @@ ct_status ct_effects_for_tolerance(const ct_package *p, const ct_camera *cam, co
         v_hi = ((int64_t)cam->lens.height << 16) - 32768;
     }
     out->flags = 0u;
+    out->chord_nm = INT64_C(1) << 10;
     out->bound_nm[0] = out->bound_nm[1] = out->bound_nm[2] = out->bound_nm[3] = 0;
     out->range_nm = 0;
     out->tan_min_q30 = UNBOUNDED;
@@ -361,5 +362,22 @@ ct_status ct_effects_for_tolerance(const ct_package *p, const ct_camera *cam, co
                  : out->bound_nm[1] <= tol_nm ? CT_EFFECT_CURVATURE
                  : out->bound_nm[2] <= tol_nm ? CT_EFFECT_REFRACTION
                                               : CT_EFFECT_ALL;
+    {
+        /* the chord: (tol - bound) tan_min, the rest of the tolerance on
+         * the most grazing ray (tan_min Q30; none reaching: the coarsest) */
+        int64_t used = out->flags == CT_EFFECT_ALL ? 0
+                       : out->bound_nm[out->flags == 0u ? 0 : (out->flags == CT_EFFECT_CURVATURE ? 1 : 2)];
+        int64_t rest = tol_nm - used;
+        int64_t ch = out->tan_min_q30 >= UNBOUNDED
+                         ? INT64_C(1) << 50
+                         : ct_i128_floor_div_sat(ct_i128_mul(ct_max64(rest, 0), ct_min64(out->tan_min_q30, INT64_C(1) << 40)),
+                                                 INT64_C(1) << 30);
+        out->chord_nm = ct_max64(INT64_C(1) << 10, ct_min64(INT64_C(1) << 50, ch));
+        if (out->tan_min_q30 == 0) {
+            /* a level or rising ray can reach the tile: no flat-ground
+             * bound at all, the default chord */
+            out->chord_nm = CT_EFFECTS_CHORD_NM;
+        }
+    }
     return CT_OK;
 }
