@@ -55,7 +55,7 @@ const UsageBlock kUsage[] = {
     {"info", "conetrace info PKG\n"},
     {"trace", "conetrace trace PKG --rays rays.csv [--method M] [--threads T] -o hits.csv\n"},
     {"demo",
-     "conetrace demo DEM --camera C.cameramodel [--effects curvature,refraction] [--step PX]\n"
+     "conetrace demo DEM --camera C.cameramodel [--tolerance M | --effects LIST] [--step PX]\n"
      "               [--sectors N] [--reduce r] [-o DIR]\n"
      "               (the main job: package the DEM, geolocate a grid of the camera's pixels,\n"
      "               draw DIR/footprint.png and list DIR/pixels.csv; DIR defaults to demo)\n"},
@@ -352,7 +352,7 @@ int cmd_trace(int argc, char **argv)
 
 int cmd_demo(int argc, char **argv)
 {
-    Args a = parse(argc, argv, 2, {"--camera", "--effects", "--step", "--sectors", "--reduce", "-o"});
+    Args a = parse(argc, argv, 2, {"--camera", "--effects", "--tolerance", "--step", "--sectors", "--reduce", "-o"});
     if (a.pos.size() != 1) usage("demo needs a DEM file");
     if (!a.opt.count("--camera")) usage("demo needs --camera C.cameramodel");
     Terrain t = load_terrain(a.pos[0], 0, 0);

@@ -1,7 +1,7 @@
 // cmd_demo.cpp -- `conetrace demo`: the main job on a DEM in one command.
 //
-//   conetrace demo DEM --camera C.cameramodel [--effects LIST] [--step PX]
-//                      [--sectors N] [--reduce r] [-o DIR]
+//   conetrace demo DEM --camera C.cameramodel [--tolerance M | --effects LIST]
+//                      [--step PX] [--sectors N] [--reduce r] [-o DIR]
 //
 // Packages the DEM in memory (the slice builder, N = 24, r = 3 by default),
 // geolocates a grid of the camera's pixels (every --step pixels, default
@@ -21,8 +21,10 @@
 // dot's centre in the picture: px = floor(((E - E0) / posting_e - i0) *
 // zoom), likewise py; posts i0..i1 x j0..j1 around the footprint and the
 // camera drawn with zoom pixels each, as the PNG's description says).
-// --effects (default curvature,refraction): as for geoloc; on a UTM
-// package curvature is the true Earth, its map fitted once per batch.
+// --tolerance M (default 0.1): the effects and chord ct_effects_for_tolerance
+// picks for the camera (said in the output); --effects LIST forces a set
+// instead.  On a UTM package curvature is the true Earth, its map fitted
+// once per batch.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -77,8 +79,37 @@ int demo_main_job(const std::vector<uint8_t> &bytes, const Terrain &t, const std
     LibCamera cam = lib_camera(cm, cpath);
     const unsigned W = cm.width, H = cm.height;
     if (W == 0 || H == 0) throw Error(cpath + ": no image size");
-    ct_effects fx = {effects_from_list(opt.count("--effects") ? opt.at("--effects") : "curvature,refraction"),
-                     CT_REFRACTION_K_STD_Q16, 0, 0, nullptr};
+    ct_effects fx = {0u, CT_REFRACTION_K_STD_Q16, 0, 0, nullptr};
+    std::string why;
+    if (opt.count("--effects")) {
+        if (opt.count("--tolerance")) throw Error("demo: give --effects or --tolerance, not both");
+        fx.flags = effects_from_list(opt.at("--effects"));
+        why = "as given";
+    } else {
+        // the effects (and chord) the camera needs for a tolerance
+        const std::string ts = opt.count("--tolerance") ? opt.at("--tolerance") : "0.1";
+        char *end = nullptr;
+        const double tol = std::strtod(ts.c_str(), &end);
+        if (ts.empty() || *end || !(tol >= 0 && tol <= 1e6))
+            throw Error("--tolerance needs a tolerance in metres in [0, 1e6], got '" + ts + "'");
+        ct_effects_choice ch;
+        if (ct_effects_for_tolerance(&p, &cam.cam, &cam.pose, fx.refraction_k_q16, 0, std::llround(tol * 1e9), &ch) !=
+            CT_OK)
+            throw Error(cpath + ": cannot bound the effects for this camera");
+        fx.flags = ch.flags;
+        fx.chord_nm = ch.chord_nm;
+        char b[256];
+        auto m = [](int64_t nm) {
+            char buf[32];
+            std::snprintf(buf, sizeof buf, "%.3g m", nm * 1e-9);
+            return nm >= (INT64_C(1) << 62) ? std::string("unbounded") : std::string(buf);
+        };
+        std::snprintf(b, sizeof b, "chosen for a %g m tolerance: simulating nothing would be off by up to %s, curvature "
+                      "only %s, refraction only %s (flat ground, rays to %.1f km); chord %.3g m", tol,
+                      m(ch.bound_nm[0]).c_str(), m(ch.bound_nm[1]).c_str(), m(ch.bound_nm[2]).c_str(),
+                      ch.range_nm * 1e-12, ch.chord_nm * 1e-9);
+        why = b;
+    }
     fx.flags |= CT_EFFECT_EARTH_FIT;  // batches only; ignored without the true Earth
     ct_utm zone;
     const bool utm = ct_utm_zone_of_epsg((int32_t)p.epsg, &zone) == CT_OK;
@@ -138,12 +169,13 @@ int demo_main_job(const std::vector<uint8_t> &bytes, const Terrain &t, const std
         rmax = std::max(rmax, range_m(cam.pose, gd[k]));
     }
     const double n = (double)std::max<size_t>(1, grid.size());
-    std::printf("camera %s: %ux%u pixels, centre E %.1f N %.1f h %.1f m; effects: %s%s\n", cpath.c_str(), W, H,
+    std::printf("camera %s: %ux%u pixels, centre E %.1f N %.1f h %.1f m; effects: %s%s (%s)\n", cpath.c_str(), W, H,
                 cam.pose.e_nm * 1e-9, cam.pose.n_nm * 1e-9, cam.pose.h_nm * 1e-9,
                 (fx.flags & CT_EFFECT_ALL) == 0u ? "none (straight lines of sight)"
                 : (fx.flags & CT_EFFECT_ALL) == CT_EFFECT_ALL ? "curvature, refraction (k 0.13)"
                 : (fx.flags & CT_EFFECT_CURVATURE) ? "curvature" : "refraction (k 0.13)",
-                (fx.flags & CT_EFFECT_CURVATURE) && utm ? " -- the true Earth (WGS84, map fitted per batch)" : "");
+                (fx.flags & CT_EFFECT_CURVATURE) && utm ? " -- the true Earth (WGS84, map fitted per batch)" : "",
+                why.c_str());
     std::printf("geolocated %zu pixels (every %d px): %ld hit; directional %.2f us and %.1f steps per pixel, "
                 "incremental %.2f us and %.1f steps (the same hits%s)\n\n",
                 grid.size(), step, hits, sd * 1e6 / n, steps_d / n, si * 1e6 / n, steps_i / n,

@@ -768,7 +768,12 @@ void test_demo()
     std::vector<std::string> rows = lines_of(slurp(g_dir + "/demo_out/pixels.csv"));
     TEST_ASSERT(rows.size() > 1 && rows[0] == "u,v,status,E,N,h,range,steps,px,py");
     TEST_ASSERT_EQUAL_INT(16 * 12 + 1, rows.size());  // every 64th pixel of 1024 x 768
-    ct_effects fx = {CT_EFFECT_CURVATURE | CT_EFFECT_REFRACTION | CT_EFFECT_EARTH_FIT, CT_REFRACTION_K_STD_Q16, 0, 0, nullptr};
+    // the demo's effects: those a 10 cm tolerance calls for (its default)
+    TEST_ASSERT(r.out.find("chosen for a 0.1 m tolerance") != std::string::npos);
+    ct_effects_choice ch;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_effects_for_tolerance(&pk, &lc.cam, &lc.pose, CT_REFRACTION_K_STD_Q16, 0,
+                                                          100000000, &ch));
+    ct_effects fx = {ch.flags | CT_EFFECT_EARTH_FIT, CT_REFRACTION_K_STD_Q16, 0, ch.chord_nm, nullptr};
     struct Dot {
         int x, y;
         double range;
