@@ -383,6 +383,20 @@ static void geoloc_mode(const ct_vec_package *vp, const uint8_t *d, size_t n)
     fx.earth_radius_nm = ((e >> 24) & 1) ? 0 : INT64_C(1) << (40 + ((e >> 25) & 0xf) % 15);
     fx.chord_nm = ((e >> 29) & 1) ? 0 : INT64_C(1) << (10 + ((e >> 30) & 0x3f) % 41);
     {
+        /* effects for an arbitrary tolerance, k and radius: a documented
+         * status, and when CT_OK a choice within its ranges */
+        ct_effects_choice ch;
+        const int64_t tol = (b >> 3) ^ e;
+        s = ct_effects_for_tolerance(&pkg, &cam, &pose, fx.refraction_k_q16, fx.earth_radius_nm, tol, &ch);
+        CHECK(s == CT_OK || s == CT_ERR_EFFECTS || s == CT_ERR_UNPROJECT);
+        if (s == CT_OK) {
+            CHECK(ch.flags <= CT_EFFECT_ALL && ch.chord_nm >= (INT64_C(1) << 10) && ch.chord_nm <= (INT64_C(1) << 50));
+            CHECK(ch.bound_nm[0] >= 0 && ch.bound_nm[1] >= 0 && ch.bound_nm[2] >= 0 && ch.bound_nm[3] == 0);
+            CHECK(ch.samples >= 1u && ch.samples <= 421u && ch.range_nm >= 0);
+            CHECK(ch.flags == CT_EFFECT_ALL || ch.bound_nm[ch.flags == 0u ? 0 : (ch.flags == CT_EFFECT_CURVATURE ? 1 : 2)] <= tol);
+        }
+    }
+    {
         const int64_t u = (int64_t)(int32_t)pix % (INT64_C(1500) << 16), v = (int64_t)(int32_t)(pix >> 32) % (INT64_C(1500) << 16);
         s0 = ct_geolocate(&pkg, &cam, &pose, CT_METHOD_INCREMENTAL, &fx, u, v, &g0);
         CHECK(geo_status_ok(s0) && s0 == g0.status);

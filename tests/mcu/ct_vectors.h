@@ -102,6 +102,10 @@ typedef struct {
     uint32_t batch_method;
     const ct_vec_pixel *pixels;
     uint32_t npixels;
+    int64_t tol_nm;                       /* ct_effects_for_tolerance with the
+                                             effects' k and radius           */
+    ct_status tol_status;
+    ct_effects_choice tol_choice;
 } ct_vec_camera;
 
 /* WGS84 <-> UTM (lib/src/geodesy.c): the host's results. */

@@ -671,6 +671,9 @@ struct Cam {
     ct_effects effects{};
     uint32_t batch_method = 0;
     std::vector<ct_vec_pixel> px;
+    int64_t tol_nm = 0;
+    ct_status tol_status = CT_ERR_ARG;
+    ct_effects_choice tol{};
 };
 
 ct_lens make_lens(uint32_t model, double f, double cx, double cy, std::vector<double> dist)
@@ -735,6 +738,10 @@ void run_camera(Rng &g, Cam &c, const ct_package &pkg)
             ct_geolocate(&pkg, &cam, &pose, (ct_method)m, &c.effects, q.u_q16, q.v_q16, &q.geo[m]);
         c.px.push_back(q);
     }
+    // the effects a tolerance calls for (a different tolerance per camera)
+    c.tol_nm = INT64_C(10000000) << (3 * (c.name.size() % 4));
+    c.tol_status = ct_effects_for_tolerance(&pkg, &cam, &pose, c.effects.refraction_k_q16, c.effects.earth_radius_nm,
+                                            c.tol_nm, &c.tol);
     int hits = 0, miss = 0, errors = 0;
     for (const ct_vec_pixel &q : c.px) {
         const ct_status st = q.geo[0].status;
@@ -880,8 +887,14 @@ void emit_cameras(FILE *f, const std::vector<Cam> &cams)
         std::fprintf(f, "   .effects = {.flags = %uu, .refraction_k_q16 = %s, .earth_radius_nm = %s, .chord_nm = %s},\n",
                      c.effects.flags, i32(c.effects.refraction_k_q16).c_str(), i64(c.effects.earth_radius_nm).c_str(),
                      i64(c.effects.chord_nm).c_str());
-        std::fprintf(f, "   .batch_method = %uu, .pixels = cam%zu_pixels, .npixels = %zuu},\n", c.batch_method, k,
+        std::fprintf(f, "   .batch_method = %uu, .pixels = cam%zu_pixels, .npixels = %zuu,\n", c.batch_method, k,
                      c.px.size());
+        std::fprintf(f, "   .tol_nm = %s, .tol_status = %s, .tol_choice = {.flags = %uu, .chord_nm = %s, .bound_nm = {%s, %s, "
+                        "%s, %s}, .range_nm = %s, .tan_min_q30 = %s, .samples = %uu}},\n",
+                     i64(c.tol_nm).c_str(), i32(c.tol_status).c_str(), c.tol.flags, i64(c.tol.chord_nm).c_str(),
+                     i64(c.tol.bound_nm[0]).c_str(), i64(c.tol.bound_nm[1]).c_str(), i64(c.tol.bound_nm[2]).c_str(),
+                     i64(c.tol.bound_nm[3]).c_str(), i64(c.tol.range_nm).c_str(), i64(c.tol.tan_min_q30).c_str(),
+                     c.tol.samples);
     }
     std::fprintf(f, "};\n\n");
 }

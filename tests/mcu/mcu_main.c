@@ -387,6 +387,22 @@ static uint32_t check_camera(const ct_vec_set *vs, const ct_vec_camera *vc, uint
     if (vc->init_status != CT_OK || vc->pose_status != CT_OK) {
         return 0u;
     }
+    {
+        /* the effects for a tolerance: every field of the choice */
+        ct_effects_choice ch;
+        zero_bytes(&ch, sizeof ch);
+        eq_i64("tolerance status", vc->tol_status,
+               ct_effects_for_tolerance(&g_cpkg, &g_cam, &g_pose, vc->effects.refraction_k_q16,
+                                        vc->effects.earth_radius_nm, vc->tol_nm, &ch));
+        eq_i64("tolerance flags", vc->tol_choice.flags, ch.flags);
+        eq_i64("tolerance chord", vc->tol_choice.chord_nm, ch.chord_nm);
+        for (k = 0u; k < 4u; ++k) { /* bound: 4 bounds */
+            eq_i64("tolerance bound", vc->tol_choice.bound_nm[k], ch.bound_nm[k]);
+        }
+        eq_i64("tolerance range", vc->tol_choice.range_nm, ch.range_nm);
+        eq_i64("tolerance tan", vc->tol_choice.tan_min_q30, ch.tan_min_q30);
+        eq_i64("tolerance samples", vc->tol_choice.samples, ch.samples);
+    }
     for (k = 0u; k < vc->npixels; ++k) {
         const ct_vec_pixel *q = &vc->pixels[k];
         int32_t ray[3] = {0, 0, 0};
