@@ -699,6 +699,22 @@ ct_status ct_effects_for_tolerance(const ct_package *pkg, const ct_camera *cam, 
                                    int32_t refraction_k_q16, int64_t radius_nm, int64_t tol_nm,
                                    ct_effects_choice *out);
 
+/* Intervisibility (lib/src/los.c): is map point B (nm) visible from map
+ * point A?  The segment A -> B against the package's surface, exact as
+ * ct_trace (both points as ct_map_to_grid rounds them, Q16); with effects
+ * (curvature, refraction: c > 0 on the sphere of earth_radius_nm, 0 = 6371
+ * km; the true Earth is not used) the line of sight from A through B bent
+ * by c rho^2 / 2R, as ct_trace_bent's lowered walk.  CT_OK: nothing stands
+ * between them (B visible); CT_HIT: the surface meets the line of sight
+ * more than margin_nm (3D distance from A) before B -- *block is that
+ * first point, as ct_trace's hit -- so a target on the ground, met at
+ * itself, is visible; CT_BELOW: A under the surface.  Errors: CT_ERR_ARG
+ * (NULL, margin < 0), CT_ERR_METHOD, CT_ERR_RAY (a point beyond
+ * CT_MAX_ORIGIN_Q16 of the tile, or A = B), CT_ERR_EFFECTS (c < 0, R out
+ * of range, or a bend the lowered walk cannot take from A).               */
+ct_status ct_los(const ct_package *pkg, const int64_t a_nm[3], const int64_t b_nm[3], const ct_effects *effects,
+                 int64_t margin_nm, ct_method method, ct_hit *block);
+
 /* Fit a ct_earth_map for `pkg` (on a UTM zone) over the cube of half-width
  * 2^q nm >= radius_nm (q = 44..47: 17.6 .. 141 km) around the map point
  * (e, n, h): (d + 1)^3 exact conversions, d = 4, 5, 6 for q = 44, 45, >= 46
