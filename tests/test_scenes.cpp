@@ -318,6 +318,57 @@ void test_error_budget()
 // tolerances from 1 mm to 100 m the chosen set meets the tolerance (plus that
 // floor), and leaving out a chosen effect breaks it wherever the bound of
 // doing so exceeds the tolerance fourfold (the error budget as a selection).
+// Inverse location with occlusion (ct_locate_inverse): every scene's
+// sample points P (surface points, visible or behind an occluder, the
+// scene's effects) -- the pixel against mrcal's projection of P's apparent
+// position, and "visible" (a 0.5 m margin) against the reference tracer's
+// first hit of P's line of sight.
+void test_locate_inverse()
+{
+    long all_vis = 0, all_hid = 0;
+    for (const char *name : kScenes) {
+        scene::World *w = world(name);
+        scene::SimOptions o;
+        o.effects = w->s.effects;
+        o.n = (int)(300 * ct_test_scale());
+        o.seed = ct_test_seed() * 401 + std::strlen(name);
+        scene::SimStats ss;
+        std::vector<scene::Sample> smp = scene::simulate(*w, o, &ss);
+        const ct_effects fx = scene::lib_effects(w->s, w->s.effects);
+        double worst_px = 0;
+        long vis = 0, hid = 0, disagree = 0;
+        for (const scene::Sample &s : smp) {
+            const int64_t g[3] = {std::llround(s.P[0] * 1e9L), std::llround(s.P[1] * 1e9L), std::llround(s.P[2] * 1e9L)};
+            int64_t u, v;
+            uint32_t seen;
+            ct_hit blk;
+            TEST_ASSERT_EQUAL_INT(CT_OK, ct_locate_inverse(&w->p, &w->cam.cam, &w->cam.pose, &fx, g, 500000000, &u, &v,
+                                                           &seen, &blk));
+            worst_px = std::max(worst_px, std::hypot(u / 65536.0 - s.u, v / 65536.0 - s.v));
+            // the reference, with the same 0.5 m margin: hidden when its
+            // first hit is more than that before P (ties within 1 cm left out)
+            const ld before = std::sqrt(std::pow(s.P[0] - s.first[0], 2) + std::pow(s.P[1] - s.first[1], 2) +
+                                        std::pow(s.P[2] - s.first[2], 2));
+            if (std::fabs(before - 0.5L) < 0.01L) continue;
+            const bool ref_visible = before <= 0.5L;
+            if ((seen != 0) != ref_visible) {
+                disagree++;
+                std::printf("  %s: P (%.3Lf, %.3Lf, %.3Lf): library %s, reference %s (first hit %.3Lf m before P)\n",
+                            name, s.P[0], s.P[1], s.P[2], seen ? "visible" : "hidden", ref_visible ? "visible" : "hidden",
+                            before);
+            }
+            (seen ? vis : hid)++;
+        }
+        printf("  %-13s %zu points: %ld visible, %ld hidden, %ld disagree with the reference; pixel within %.2g px of "
+               "mrcal's projection\n", name, smp.size(), vis, hid, disagree, worst_px);
+        TEST_ASSERT_EQUAL_INT(0, disagree);
+        TEST_ASSERT_MSG(worst_px <= 1e-3, "%s: pixel %.3g px from mrcal's", name, worst_px);
+        all_vis += vis;
+        all_hid += hid;
+    }
+    TEST_ASSERT(all_vis > 500 && all_hid > 200);
+}
+
 // Per sample: the library's horizontal error brought to flat ground (x
 // sin(incidence) / sin(depression)); -1 for occluded samples, infinity for
 // a miss.
@@ -468,5 +519,6 @@ int main()
     RUN_TEST(test_scene_accuracy);
     RUN_TEST(test_error_budget);
     RUN_TEST(test_effect_selection);
+    RUN_TEST(test_locate_inverse);
     return TEST_END();
 }

@@ -715,6 +715,20 @@ ct_status ct_effects_for_tolerance(const ct_package *pkg, const ct_camera *cam, 
 ct_status ct_los(const ct_package *pkg, const int64_t a_nm[3], const int64_t b_nm[3], const ct_effects *effects,
                  int64_t margin_nm, ct_method method, ct_hit *block);
 
+/* Inverse location with occlusion: where does the camera see the map point
+ * G (nm), and does it see it?  The pixel (Q16) by ct_camera_project of the
+ * direction from the camera centre to G -- with effects, to G lowered by
+ * the line of sight's rise c rho^2 / 2R (the sphere model, as the tracer's
+ * bent rays: the apparent point) -- and *visible from ct_los between the
+ * camera centre and G (the same effects and margin; *block the blocking
+ * point when hidden).  CT_OK (pixel set, *visible 0 or 1); CT_ERR_UNPROJECT
+ * (behind the camera or outside the valid field: no pixel), CT_ERR_LENS
+ * (a grid camera), or ct_los's errors.  A pixel outside the image is still
+ * given: the caller compares it with the imager size.                   */
+ct_status ct_locate_inverse(const ct_package *pkg, const ct_camera *cam, const ct_pose *pose, const ct_effects *effects,
+                            const int64_t g_nm[3], int64_t margin_nm, int64_t *u_q16, int64_t *v_q16,
+                            uint32_t *visible, ct_hit *block);
+
 /* Fit a ct_earth_map for `pkg` (on a UTM zone) over the cube of half-width
  * 2^q nm >= radius_nm (q = 44..47: 17.6 .. 141 km) around the map point
  * (e, n, h): (d + 1)^3 exact conversions, d = 4, 5, 6 for q = 44, 45, >= 46

@@ -121,3 +121,114 @@ ct_status ct_los(const ct_package *p, const int64_t a_nm[3], const int64_t b_nm[
     }
     return st == CT_BELOW ? CT_BELOW : CT_OK;
 }
+
+ct_status ct_locate_inverse(const ct_package *p, const ct_camera *cam, const ct_pose *pose, const ct_effects *effects,
+                            const int64_t g_nm[3], int64_t margin_nm, int64_t *u_q16, int64_t *v_q16,
+                            uint32_t *visible, ct_hit *block)
+{
+    int64_t d[3], c[3], big = 0, rise = 0;
+    int32_t ray[3];
+    int k, j, sh = 0;
+    ct_status st;
+    if (p == NULL || cam == NULL || pose == NULL || g_nm == NULL || u_q16 == NULL || v_q16 == NULL ||
+        visible == NULL || block == NULL || cam->ready == 0u || pose->ready == 0u) {
+        return CT_ERR_ARG;
+    }
+    *visible = 0u;
+    /* the camera centre and the ground point: |.| <= 2^61 each, the
+     * difference capped at 2^62 */
+    c[0] = pose->e_nm;
+    c[1] = pose->n_nm;
+    c[2] = pose->h_nm;
+    for (k = 0; k < 3; ++k) { /* bound: 3 axes */
+        if (ct_abs64(g_nm[k]) > (INT64_C(1) << 61)) {
+            return CT_ERR_RAY;
+        }
+        d[k] = g_nm[k] - c[k];
+    }
+    if (effects != NULL && (effects->flags & CT_EFFECT_ALL) != 0u) {
+        /* the apparent point: the line of sight rises c rho^2 / 2R on its
+         * way, so the camera sees the point along the tangent to the point
+         * lowered by that rise (the sphere of the effects' radius) */
+        int32_t cq = 0;
+        int64_t R = effects->earth_radius_nm == 0 ? CT_EARTH_RADIUS_NM : effects->earth_radius_nm;
+        int64_t rho2h;
+        if ((effects->flags & CT_EFFECT_CURVATURE) != 0u) {
+            cq = 65536;
+        }
+        if ((effects->flags & CT_EFFECT_REFRACTION) != 0u) {
+            cq -= effects->refraction_k_q16;
+        }
+        if (R < (INT64_C(1) << 40) || R > (INT64_C(1) << 54) || effects->refraction_k_q16 < -131072 ||
+            effects->refraction_k_q16 > 131072) {
+            return CT_ERR_EFFECTS;
+        }
+        /* rho^2 / 2R with rho <= 2^50 (capped): < 2^100 / 2^41 */
+        {
+            int64_t de = ct_min64(ct_abs64(d[0]), INT64_C(1) << 50), dn = ct_min64(ct_abs64(d[1]), INT64_C(1) << 50);
+            rho2h = ct_i128_floor_div_sat(ct_i128_add(ct_i128_mul(de, de), ct_i128_mul(dn, dn)), 2 * R);
+        }
+        /* |c| <= 3 2^16: the rise, capped at 2^60 (|d| <= 2^62: no wrap) */
+        rise = ct_i128_floor_div_sat(ct_i128_mul(rho2h, cq), 65536);
+        rise = ct_max64(-(INT64_C(1) << 60), ct_min64(INT64_C(1) << 60, rise));
+        d[2] -= rise;
+    }
+    /* the camera frame: R^T d, with a geodetic pose's horizontal scale
+     * undone first (map metres per ground metre, Q30); d scaled into 2^40
+     * so the Q30 products stay within 128 bits and the result within int32 */
+    for (k = 0; k < 3; ++k) { /* bound: 3 axes */
+        big = ct_max64(big, ct_abs64(d[k]));
+    }
+    /* bound: 63 halvings */
+    while (sh < 63 && (big >> sh) >= (INT64_C(1) << 40)) {
+        sh++;
+    }
+    for (k = 0; k < 3; ++k) { /* bound: 3 axes */
+        d[k] = ct_floor_div(d[k], INT64_C(1) << sh);
+    }
+    if (pose->hscale_q30 != ((int32_t)1 << 30)) {
+        for (k = 0; k < 2; ++k) { /* bound: 2 horizontal axes; |d| < 2^40, hscale >= 2^29 */
+            d[k] = ct_i128_floor_div(ct_i128_shl(ct_i128_from64(d[k]), 30u), pose->hscale_q30);
+        }
+    }
+    {
+        int64_t r[3];
+        int64_t m = 0;
+        for (k = 0; k < 3; ++k) { /* bound: 3 components */
+            ct_i128 s = ct_i128_from64(0);
+            for (j = 0; j < 3; ++j) { /* bound: 3 terms; Q30 x 2^41 */
+                s = ct_i128_add(s, ct_i128_mul(pose->R_map_cam_q30[3 * j + k], d[j]));
+            }
+            r[k] = ct_i128_round_shr(s, 30u); /* < 2^43 */
+            m = ct_max64(m, ct_abs64(r[k]));
+        }
+        if (m == 0) {
+            return CT_ERR_RAY; /* the point is the camera centre */
+        }
+        /* to int32 (|.| < 2^30): the direction is all projection needs */
+        sh = 0;
+        /* bound: 14 halvings */
+        while ((m >> sh) >= (INT64_C(1) << 30)) {
+            sh++;
+        }
+        for (k = 0; k < 3; ++k) { /* bound: 3 components */
+            ray[k] = (int32_t)ct_floor_div(r[k], INT64_C(1) << sh);
+        }
+    }
+    st = ct_camera_project(cam, ray, u_q16, v_q16);
+    if (st != CT_OK) {
+        return st;
+    }
+    {
+        int64_t a[3];
+        a[0] = pose->e_nm;
+        a[1] = pose->n_nm;
+        a[2] = pose->h_nm;
+        st = ct_los(p, a, g_nm, effects, margin_nm, CT_METHOD_DIRECTIONAL, block);
+    }
+    if (st == CT_OK) {
+        *visible = 1u;
+        return CT_OK;
+    }
+    return st == CT_HIT ? CT_OK : st;
+}
