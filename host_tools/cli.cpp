@@ -68,6 +68,10 @@ const UsageBlock kUsage[] = {
      "                 [--threads T] -o g.csv\n"
      "                 (curvature on a UTM package: the true Earth, its map fitted once per\n"
      "                 chunk of pixels when there are 256 or more (auto); --earth-radius: a sphere)\n"},
+    {"viewshed",
+     "conetrace viewshed PKG --observer E,N,H [--target-height M] [--radius M] [--effects LIST]\n"
+     "                   [--margin M] [--threads T] -o vs.tif [--png vs.png]\n"
+     "                   (H above the surface; every post by the library's exact line of sight)\n"},
     {"render",
      "conetrace render DEM_or_PKG --what bitmap|dt|ddt|angles|apex -o OUT.png\n"
      "                 [--slice H | --level k --slices K] [--reduce r] [--sectors N]\n"
@@ -375,6 +379,7 @@ int cmd_demo(int argc, char **argv)
 
 int cmd_geoloc(int argc, char **argv);  // cmd_geoloc.cpp
 int cmd_render(int argc, char **argv);  // cmd_render.cpp
+int cmd_viewshed(int argc, char **argv);  // cmd_viewshed.cpp
 
 int main(int argc, char **argv)
 {
@@ -398,6 +403,7 @@ int main(int argc, char **argv)
         if (cmd == "demo") return cmd_demo(argc, argv);
         if (cmd == "geoloc") return cmd_geoloc(argc, argv);
         if (cmd == "render") return cmd_render(argc, argv);
+        if (cmd == "viewshed") return cmd_viewshed(argc, argv);
         usage("unknown command '" + cmd + "'");
     } catch (const std::exception &e) {
         std::fprintf(stderr, "conetrace: %s\n", e.what());

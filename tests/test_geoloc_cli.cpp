@@ -32,6 +32,8 @@
 #include "picture.hpp"
 #include "conetrace.h"
 #include "dem_cases.hpp"
+#include "dem_io.hpp"
+#include "reference.hpp"
 #include "harness.h"
 #include "host_io.hpp"
 #include "vdatum.hpp"
@@ -728,6 +730,95 @@ void test_geoloc_tolerance()
     fs::remove(g_dir + "/pxt.csv");
 }
 
+// `conetrace viewshed` against a brute-force exact line of sight per post by
+// the independent reference tracer (tests/reference.hpp): the observer 5 m
+// above a post of the test DEM, every post a target 1.75 m above it; hidden
+// when the reference's first hit of the segment lies more than the margin
+// (1 cm) before the post.  Identical except ties (the segment within 1 cm
+// of the surface before the margin, or the first hit within 1 cm of it:
+// counted); straight and with curvature and refraction (the sphere, as the
+// reference's bent segment); plus the GeoTIFF's georeference and the errors.
+void test_viewshed()
+{
+    Setup *s = setup();
+    TEST_ASSERT(s != nullptr);
+    const ct_package &p = s->p;
+    ref::Dem d;
+    d.w = s->c.t.width;
+    d.h = s->c.t.height;
+    d.z.assign(s->c.t.codes.begin(), s->c.t.codes.end());
+    const ref::ld pe = std::fabs(p.posting_e_nm * 1e-9L), pn = std::fabs(p.posting_n_nm * 1e-9L),
+                  hs = p.height_scale_nm * 1e-9L;
+    for (int bent = 0; bent < 2; ++bent)
+        for (int oi : {20, 41}) {
+            const int oj = oi == 20 ? 30 : 12;
+            int64_t e, n, h;
+            TEST_ASSERT_EQUAL_INT(CT_OK, ct_grid_to_map(&p, (int64_t)oi << 16, (int64_t)oj << 16, 0, &e, &n, &h));
+            char obs[96];
+            std::snprintf(obs, sizeof obs, "%.9f,%.9f,5", e * 1e-9, n * 1e-9);
+            std::vector<std::string> args = {"viewshed", "t.ctp", "--observer", obs, "--target-height", "1.75",
+                                             "-o", "vs.tif", "--png", "vs.png"};
+            if (bent) {
+                args.push_back("--effects");
+                args.push_back("curvature,refraction");
+            }
+            Run r = run(args);
+            TEST_ASSERT_MSG(r.code == 0, "viewshed: exit %d: %s", r.code, r.err.c_str());
+            ct_host::DemRaster vs = ct_host::read_dem(g_dir + "/vs.tif");
+            TEST_ASSERT_EQUAL_INT(d.w, vs.width);
+            TEST_ASSERT_EQUAL_INT(d.h, vs.height);
+            TEST_ASSERT(std::fabs(vs.geo.origin_e - p.origin_e_nm * 1e-9) < 1e-6 && vs.geo.epsg == (int)p.epsg);
+            TEST_ASSERT(fs::exists(g_dir + "/vs.png"));
+            // the reference, post by post
+            const ref::ld ox = oi, oy = oj, oz = d.at(oi, oj) + 5 / hs;
+            const ref::ld c = bent ? 1 - (ref::ld)CT_REFRACTION_K_STD_Q16 / 65536 : 0, R = 6371000.0L;
+            long ties = 0, bad = 0, seen = 0;
+            for (int j = 0; j < d.h; ++j)
+                for (int i = 0; i < d.w; ++i) {
+                    const double got = vs.h[(size_t)j * d.w + i];
+                    if (i == oi && j == oj) {
+                        TEST_ASSERT(got == 1);
+                        continue;
+                    }
+                    ref::Ray ry;
+                    ry.ox = ox;
+                    ry.oy = oy;
+                    ry.oz = oz;
+                    ry.dx = i - ox;
+                    ry.dy = j - oy;
+                    const ref::ld rho = std::hypot(ry.dx * pe, ry.dy * pn);
+                    ry.kz = c * rho * rho / (2 * R) / hs;
+                    const ref::ld tz = d.at(i, j) + 1.75L / hs;
+                    ry.dz = tz - oz - ry.kz;
+                    ry.tend = 1;
+                    const ref::ld len = std::sqrt(rho * rho + std::pow((tz - oz) * hs, 2));
+                    const ref::ld tcut = 1 - 0.01L / len, tie_t = 0.01L / len;
+                    ref::Hit hh = ref::trace(d, ry);
+                    const ref::ld clear = ref::min_clearance(d, ry, 0, std::max<ref::ld>(0, tcut - tie_t)) * hs;
+                    if (std::fabs(clear) < 0.01L || (hh.status == ref::HIT && std::fabs(hh.t - tcut) < tie_t)) {
+                        ties++;
+                        continue;
+                    }
+                    const bool ref_seen = !(hh.status == ref::HIT && hh.t < tcut);
+                    if ((got == 1) != ref_seen) bad++;
+                    seen += ref_seen;
+                }
+            std::printf("  viewshed%s from post (%d, %d), 5 m up, targets 1.75 m: %ld posts seen by the reference, %ld "
+                        "ties, %ld disagree\n", bent ? " (curvature, refraction)" : "", oi, oj, seen, ties, bad);
+            TEST_ASSERT_EQUAL_INT(0, bad);
+            TEST_ASSERT(ties * 10 < d.w * d.h && seen > 50);
+        }
+    // errors: an observer off the tile, a bad radius, a missing option
+    Run off = run({"viewshed", "t.ctp", "--observer", "1,2,3", "-o", "vs.tif"});
+    TEST_ASSERT(off.code != 0 && off.err.find("is not over the tile") != std::string::npos);
+    Run rad = run({"viewshed", "t.ctp", "--observer", "500000,4000000,3", "--radius", "0", "-o", "vs.tif"});
+    TEST_ASSERT(rad.code != 0 && rad.err.find("--radius needs") != std::string::npos);
+    Run noobs = run({"viewshed", "t.ctp", "-o", "vs.tif"});
+    TEST_ASSERT(noobs.code != 0 && noobs.err.find("needs --observer") != std::string::npos);
+    fs::remove(g_dir + "/vs.tif");
+    fs::remove(g_dir + "/vs.png");
+}
+
 // `conetrace demo` (make demo's main job) on the bundled DEM and the
 // oblique30 scene's camera: every geolocated pixel of pixels.csv is the
 // library's (the same package built by `conetrace build --reduce 3`, the same
@@ -1058,6 +1149,7 @@ int main()
     RUN_TEST(test_geoloc_earth_map);
     RUN_TEST(test_geoloc_tolerance);
     RUN_TEST(test_demo);
+    RUN_TEST(test_viewshed);
     RUN_TEST(test_geoloc_splined_grid);
     RUN_TEST(test_geoloc_bad_inputs);
     int rc = TEST_END();
