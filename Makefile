@@ -28,6 +28,7 @@ bench: all
 	$(BUILD)/bench/ct_bench_build
 	$(BUILD)/bench/ct_bench_ddt
 	scripts/bench_m4.sh $(BUILD)
+	/usr/bin/python3 scripts/viewshed_vs_gdal.py $(BUILD)
 
 # what each knob buys and costs: build/tradeoff/tradeoff.csv and its plots
 # (a few minutes; docs/benchmarks.md)

@@ -7,7 +7,7 @@ PKGS="cmake make g++ gcc clang libclang-rt-14-dev valgrind
       gcc-arm-none-eabi libnewlib-arm-none-eabi qemu-system-arm
       libembree-dev python3-numpy python3-mpmath python-matplotlib-data python3-matplotlib
       libmrcal-dev python3-opencv pkg-config gcovr libproj-dev proj-data
-      libgdal-dev gdal-bin"
+      libgdal-dev gdal-bin python3-gdal"
 missing=""
 for p in $PKGS; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"
