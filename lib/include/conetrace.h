@@ -721,7 +721,8 @@ ct_status ct_los(const ct_package *pkg, const int64_t a_nm[3], const int64_t b_n
  * the line of sight's rise c rho^2 / 2R (the sphere model, as the tracer's
  * bent rays: the apparent point) -- and *visible from ct_los between the
  * camera centre and G (the same effects and margin; *block the blocking
- * point when hidden).  CT_OK (pixel set, *visible 0 or 1); CT_ERR_UNPROJECT
+ * point when hidden).  CT_OK (pixel set, *visible 0 or 1); CT_BELOW (the
+ * camera under the surface; pixel set, *visible 0); CT_ERR_UNPROJECT
  * (behind the camera or outside the valid field: no pixel), CT_ERR_LENS
  * (a grid camera), or ct_los's errors.  A pixel outside the image is still
  * given: the caller compares it with the imager size.                   */

@@ -383,6 +383,30 @@ static void geoloc_mode(const ct_vec_package *vp, const uint8_t *d, size_t n)
     fx.earth_radius_nm = ((e >> 24) & 1) ? 0 : INT64_C(1) << (40 + ((e >> 25) & 0xf) % 15);
     fx.chord_nm = ((e >> 29) & 1) ? 0 : INT64_C(1) << (10 + ((e >> 30) & 0x3f) % 41);
     {
+        /* line of sight between arbitrary points near the tile (the pose's
+         * centre and a point from the pixel word): a documented status, every
+         * method alike; and the inverse location of that point */
+        int64_t A[3], B[3], u2, v2;
+        uint32_t vis;
+        ct_hit h0, h1;
+        ct_status l0, l1;
+        A[0] = pose.e_nm;
+        A[1] = pose.n_nm;
+        A[2] = pose.h_nm;
+        B[0] = pkg.origin_e_nm + (int64_t)(int32_t)pix * 4096;
+        B[1] = pkg.origin_n_nm + (int64_t)(int32_t)(pix >> 32) * 4096;
+        B[2] = (int64_t)(b % INT64_C(4000000000000));
+        l0 = ct_los(&pkg, A, B, &fx, (e >> 50) & 0xffffff, CT_METHOD_INCREMENTAL, &h0);
+        CHECK(l0 == CT_OK || l0 == CT_HIT || l0 == CT_BELOW || l0 == CT_ERR_RAY || l0 == CT_ERR_EFFECTS);
+        for (m = 1; m < CT_METHOD_COUNT; ++m) { /* bound: 4 methods */
+            l1 = ct_los(&pkg, A, B, &fx, (e >> 50) & 0xffffff, (ct_method)m, &h1);
+            CHECK(l1 == l0);
+        }
+        l1 = ct_locate_inverse(&pkg, &cam, &pose, &fx, B, 0, &u2, &v2, &vis, &h1);
+        CHECK(l1 == CT_OK || l1 == CT_ERR_UNPROJECT || l1 == CT_ERR_RAY || l1 == CT_ERR_EFFECTS || l1 == CT_BELOW);
+        CHECK(vis <= 1u);
+    }
+    {
         /* effects for an arbitrary tolerance, k and radius: a documented
          * status, and when CT_OK a choice within its ranges */
         ct_effects_choice ch;
