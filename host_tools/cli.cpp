@@ -72,6 +72,9 @@ const UsageBlock kUsage[] = {
      "conetrace viewshed PKG --observer E,N,H [--target-height M] [--radius M] [--effects LIST]\n"
      "                   [--margin M] [--threads T] -o vs.tif [--png vs.png]\n"
      "                   (H above the surface; every post by the library's exact line of sight)\n"},
+    {"shadows",
+     "conetrace shadows PKG --sun AZ,EL [--lift M] [--threads T] -o shadow.tif [--png shadow.png]\n"
+     "                  (a ray from every post towards the sun, AZ clockwise from grid north)\n"},
     {"render",
      "conetrace render DEM_or_PKG --what bitmap|dt|ddt|angles|apex -o OUT.png\n"
      "                 [--slice H | --level k --slices K] [--reduce r] [--sectors N]\n"
@@ -380,6 +383,7 @@ int cmd_demo(int argc, char **argv)
 int cmd_geoloc(int argc, char **argv);  // cmd_geoloc.cpp
 int cmd_render(int argc, char **argv);  // cmd_render.cpp
 int cmd_viewshed(int argc, char **argv);  // cmd_viewshed.cpp
+int cmd_shadows(int argc, char **argv);   // cmd_shadows.cpp
 
 int main(int argc, char **argv)
 {
@@ -404,6 +408,7 @@ int main(int argc, char **argv)
         if (cmd == "geoloc") return cmd_geoloc(argc, argv);
         if (cmd == "render") return cmd_render(argc, argv);
         if (cmd == "viewshed") return cmd_viewshed(argc, argv);
+        if (cmd == "shadows") return cmd_shadows(argc, argv);
         usage("unknown command '" + cmd + "'");
     } catch (const std::exception &e) {
         std::fprintf(stderr, "conetrace: %s\n", e.what());

@@ -819,6 +819,74 @@ void test_viewshed()
     fs::remove(g_dir + "/vs.png");
 }
 
+// `conetrace shadows` against a ray to the sun per post by the independent
+// reference tracer (the same grid ray, from ct_ray_from_map, 0.1 m above
+// each post): lit exactly where the reference finds no hit, except ties
+// (the ray passing within 1 cm of the surface: counted); the sun below the
+// horizon is an error.
+void test_shadows()
+{
+    Setup *s = setup();
+    TEST_ASSERT(s != nullptr);
+    const ct_package &p = s->p;
+    ref::Dem d;
+    d.w = s->c.t.width;
+    d.h = s->c.t.height;
+    d.z.assign(s->c.t.codes.begin(), s->c.t.codes.end());
+    const ref::ld hs = p.height_scale_nm * 1e-9L;
+    for (const char *sun : {"135,20", "300,6", "10,60"}) {
+        Run r = run({"shadows", "t.ctp", "--sun", sun, "--lift", "0.1", "-o", "sh.tif", "--png", "sh.png"});
+        TEST_ASSERT_MSG(r.code == 0, "shadows: exit %d: %s", r.code, r.err.c_str());
+        ct_host::DemRaster sh = ct_host::read_dem(g_dir + "/sh.tif");
+        TEST_ASSERT(sh.width == d.w && sh.height == d.h && fs::exists(g_dir + "/sh.png"));
+        double az, el;
+        TEST_ASSERT(std::sscanf(sun, "%lf,%lf", &az, &el) == 2);
+        const double sc = std::ldexp(1.0, 40);
+        const int64_t de = std::llround(std::sin(az * M_PI / 180) * std::cos(el * M_PI / 180) * sc),
+                      dn = std::llround(std::cos(az * M_PI / 180) * std::cos(el * M_PI / 180) * sc),
+                      dh = std::llround(std::sin(el * M_PI / 180) * sc);
+        long lit = 0, ties = 0, bad = 0;
+        for (int j = 0; j < d.h; ++j)
+            for (int i = 0; i < d.w; ++i) {
+                int64_t e, n, h;
+                TEST_ASSERT_EQUAL_INT(CT_OK, ct_grid_to_map(&p, (int64_t)i << 16, (int64_t)j << 16,
+                                                            (int64_t)d.at(i, j) << 16, &e, &n, &h));
+                ct_ray cr;
+                TEST_ASSERT_EQUAL_INT(CT_OK, ct_ray_from_map(&p, e, n, h + 100000000, de, dn, dh, &cr));
+                ref::Ray ry;
+                ry.ox = cr.x_q16 / 65536.0L;
+                ry.oy = cr.y_q16 / 65536.0L;
+                ry.oz = cr.z_q16 / 65536.0L;
+                const ref::ld m = std::max({std::fabs((ref::ld)cr.dx), std::fabs((ref::ld)cr.dy), std::fabs((ref::ld)cr.dz)});
+                ry.dx = cr.dx / m;
+                ry.dy = cr.dy / m;
+                ry.dz = cr.dz / m;
+                ref::ld lo = 0, hi = 1e12L;
+                ref::clip_box(ry.ox, ry.oy, ry.dx, ry.dy, d.w - 1, d.h - 1, &lo, &hi);
+                ry.tend = std::max<ref::ld>(0, hi);
+                ref::Hit rh = ref::trace(d, ry);
+                const ref::ld clear = ref::min_clearance(d, ry, 1e-9L, ry.tend) * hs;
+                if (std::fabs(clear) < 0.01L) {
+                    ties++;
+                    continue;
+                }
+                const bool ref_lit = rh.status != ref::HIT;
+                const bool got = sh.h[(size_t)j * d.w + i] == 1;
+                if (got != ref_lit) bad++;
+                lit += ref_lit;
+            }
+        std::printf("  shadows, sun %s: %ld posts lit by the reference, %ld ties, %ld disagree\n", sun, lit, ties, bad);
+        TEST_ASSERT_EQUAL_INT(0, bad);
+        TEST_ASSERT(ties * 10 < d.w * d.h && lit > 0);
+    }
+    Run below = run({"shadows", "t.ctp", "--sun", "90,-3", "-o", "sh.tif"});
+    TEST_ASSERT(below.code != 0 && below.err.find("below the horizon") != std::string::npos);
+    Run nosun = run({"shadows", "t.ctp", "-o", "sh.tif"});
+    TEST_ASSERT(nosun.code != 0 && nosun.err.find("needs --sun") != std::string::npos);
+    fs::remove(g_dir + "/sh.tif");
+    fs::remove(g_dir + "/sh.png");
+}
+
 // `conetrace demo` (make demo's main job) on the bundled DEM and the
 // oblique30 scene's camera: every geolocated pixel of pixels.csv is the
 // library's (the same package built by `conetrace build --reduce 3`, the same
@@ -1150,6 +1218,7 @@ int main()
     RUN_TEST(test_geoloc_tolerance);
     RUN_TEST(test_demo);
     RUN_TEST(test_viewshed);
+    RUN_TEST(test_shadows);
     RUN_TEST(test_geoloc_splined_grid);
     RUN_TEST(test_geoloc_bad_inputs);
     int rc = TEST_END();
