@@ -75,6 +75,9 @@ const UsageBlock kUsage[] = {
     {"shadows",
      "conetrace shadows PKG --sun AZ,EL [--lift M] [--threads T] -o shadow.tif [--png shadow.png]\n"
      "                  (a ray from every post towards the sun, AZ clockwise from grid north)\n"},
+    {"view",
+     "conetrace view PKG --camera C.cameramodel [--effects LIST] [--threads T] -o view.png\n"
+     "               [--range range.tif]   (every pixel traced: shaded terrain, and its range)\n"},
     {"render",
      "conetrace render DEM_or_PKG --what bitmap|dt|ddt|angles|apex -o OUT.png\n"
      "                 [--slice H | --level k --slices K] [--reduce r] [--sectors N]\n"
@@ -384,6 +387,7 @@ int cmd_geoloc(int argc, char **argv);  // cmd_geoloc.cpp
 int cmd_render(int argc, char **argv);  // cmd_render.cpp
 int cmd_viewshed(int argc, char **argv);  // cmd_viewshed.cpp
 int cmd_shadows(int argc, char **argv);   // cmd_shadows.cpp
+int cmd_view(int argc, char **argv);      // cmd_view.cpp
 
 int main(int argc, char **argv)
 {
@@ -409,6 +413,7 @@ int main(int argc, char **argv)
         if (cmd == "render") return cmd_render(argc, argv);
         if (cmd == "viewshed") return cmd_viewshed(argc, argv);
         if (cmd == "shadows") return cmd_shadows(argc, argv);
+        if (cmd == "view") return cmd_view(argc, argv);
         usage("unknown command '" + cmd + "'");
     } catch (const std::exception &e) {
         std::fprintf(stderr, "conetrace: %s\n", e.what());

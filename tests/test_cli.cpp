@@ -281,21 +281,21 @@ static void test_help(void)
 {
     std::string d = new_dir("help");
     std::vector<Job> jobs;
-    for (const char *c : {"build", "info", "trace", "demo", "geoloc", "render", "viewshed", "shadows"})
+    for (const char *c : {"build", "info", "trace", "demo", "geoloc", "render", "viewshed", "shadows", "view"})
         jobs.push_back(Job{d, {c, "--help"}});
     jobs.push_back(Job{d, {"--help"}});
     jobs.push_back(Job{d, {"-h"}});
     jobs.push_back(Job{d, {"help"}});
     jobs.push_back(Job{d, {"geoloc", "pkg.ctp", "-h"}});
     std::vector<Run> runs = run_all(jobs);
-    const char *cmds[] = {"build", "info", "trace", "demo", "geoloc", "render", "viewshed", "shadows"};
+    const char *cmds[] = {"build", "info", "trace", "demo", "geoloc", "render", "viewshed", "shadows", "view"};
     for (size_t k = 0; k < runs.size(); ++k) {
         const Run &r = runs[k];
         TEST_ASSERT_MSG(r.code == 0, "%s exited %d", r.cmd.c_str(), r.code);
         TEST_ASSERT_MSG(r.err.empty(), "%s wrote to stderr: %s", r.cmd.c_str(), r.err.c_str());
-        if (k < 8 || k == runs.size() - 1) {
+        if (k < 9 || k == runs.size() - 1) {
             // CMD --help: that command's usage alone
-            const char *c = k < 8 ? cmds[k] : "geoloc";
+            const char *c = k < 9 ? cmds[k] : "geoloc";
             TEST_ASSERT_MSG(starts_with(r.out, std::string("usage: conetrace ") + c), "%s: no usage of %s on stdout",
                             r.cmd.c_str(), c);
             for (const char *o : cmds)

@@ -34,6 +34,7 @@
 #include "dem_cases.hpp"
 #include "dem_io.hpp"
 #include "reference.hpp"
+#include "scene.hpp"
 #include "harness.h"
 #include "host_io.hpp"
 #include "vdatum.hpp"
@@ -887,6 +888,68 @@ void test_shadows()
     fs::remove(g_dir + "/sh.png");
 }
 
+// `conetrace view`: the oblique30 scene's camera over its package, no
+// effects; its range image against surface points projected by mrcal
+// (tests/scene.hpp: visible points, their pixel by mrcal_project, their
+// range from the reference tracer's first hit): each point's range lies
+// between its four neighbouring pixel centres' rendered ranges (0.1 % to
+// spare), where those four agree within 2 % (not across an occluding edge).
+void test_view()
+{
+    scene::World *w = scene::load_world(std::string(CT_SCENES_DIR) + "/oblique30.scene");
+    spit(g_dir + "/view.ctp", std::string(w->bytes.begin(), w->bytes.end()));
+    const std::string model = std::string(CT_SCENES_DIR) + "/oblique30.cameramodel";
+    Run r = run({"view", "view.ctp", "--camera", model, "-o", "view.png", "--range", "range.tif"});
+    TEST_ASSERT_MSG(r.code == 0, "view: exit %d: %s", r.code, r.err.c_str());
+    auto png = OIIO::ImageInput::open(g_dir + "/view.png");
+    TEST_ASSERT(png != nullptr && png->spec().width == (int)w->s.width && png->spec().height == (int)w->s.height);
+    png->close();
+    auto in = OIIO::ImageInput::open(g_dir + "/range.tif");
+    TEST_ASSERT(in != nullptr);
+    const int W = in->spec().width, H = in->spec().height;
+    TEST_ASSERT(W == (int)w->s.width && H == (int)w->s.height && in->spec().nchannels == 1);
+    std::vector<float> rg((size_t)W * H);
+    TEST_ASSERT(in->read_image(0, 0, 0, 1, OIIO::TypeDesc::FLOAT, rg.data()));
+    in->close();
+    scene::SimOptions o;
+    o.effects = w->s.effects & scene::FX_DISTORTION;  // the view is traced without bending
+    o.n = 400;
+    o.seed = 99;
+    scene::SimStats ss;
+    std::vector<scene::Sample> smp = scene::simulate(*w, o, &ss);
+    const scene::ld *C = w->cam.host_pose.centre_m;
+    long checked = 0, edges = 0;
+    double worst = 0;
+    for (const scene::Sample &sm : smp) {
+        if (!sm.visible) continue;
+        const int i = (int)std::floor(sm.u), j = (int)std::floor(sm.v);
+        if (i < 0 || j < 0 || i + 1 >= W || j + 1 >= H) continue;
+        const float q[4] = {rg[(size_t)j * W + i], rg[(size_t)j * W + i + 1], rg[(size_t)(j + 1) * W + i],
+                            rg[(size_t)(j + 1) * W + i + 1]};
+        const double lo = *std::min_element(q, q + 4), hi = *std::max_element(q, q + 4);
+        TEST_ASSERT(std::isfinite(lo) && std::isfinite(hi));
+        if (hi > 1.02 * lo) {
+            edges++;
+            continue;
+        }
+        const double range = (double)std::sqrt(std::pow(sm.first[0] - C[0], 2) + std::pow(sm.first[1] - C[1], 2) +
+                                               std::pow(sm.first[2] - C[2], 2));
+        const double out = std::max(0.0, std::max(lo - range, range - hi)) / range;
+        worst = std::max(worst, out);
+        checked++;
+    }
+    std::printf("  view: %ld points between their neighbours' rendered ranges (worst outside by %.2g of the range), "
+                "%ld at occluding edges left out\n", checked, worst, edges);
+    TEST_ASSERT_MSG(worst <= 1e-3, "a point's range %.3g outside its neighbours'", worst);
+    TEST_ASSERT(checked >= 200);
+    Run bad = run({"view", "view.ctp", "-o", "v.png"});
+    TEST_ASSERT(bad.code != 0 && bad.err.find("needs --camera") != std::string::npos);
+    fs::remove(g_dir + "/view.ctp");
+    fs::remove(g_dir + "/view.png");
+    fs::remove(g_dir + "/range.tif");
+    delete w;
+}
+
 // `conetrace demo` (make demo's main job) on the bundled DEM and the
 // oblique30 scene's camera: every geolocated pixel of pixels.csv is the
 // library's (the same package built by `conetrace build --reduce 3`, the same
@@ -1219,6 +1282,7 @@ int main()
     RUN_TEST(test_demo);
     RUN_TEST(test_viewshed);
     RUN_TEST(test_shadows);
+    RUN_TEST(test_view);
     RUN_TEST(test_geoloc_splined_grid);
     RUN_TEST(test_geoloc_bad_inputs);
     int rc = TEST_END();

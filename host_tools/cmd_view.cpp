@@ -1,0 +1,128 @@
+// cmd_view.cpp -- `conetrace view`: the image a camera would see.
+//
+//   conetrace view PKG --camera C.cameramodel [--effects LIST] [--threads T]
+//                  -o view.png [--range range.tif]
+//
+// Every pixel of the camera's image (its extrinsics are the pose, as for
+// geoloc) is geolocated by the flight library (ct_geolocate_batch,
+// directional) and shaded by the terrain's slope there (the bilinear
+// surface's normal against a light from the north-west, 45 degrees up), so
+// a user can hold it next to a real frame to check a pose or a lens; sky
+// and pixels outside the lens's field are light blue.  --range: the range
+// from the camera centre to each pixel's hit in metres, a single-channel
+// float32 TIFF of the image's size (NaN where nothing is hit).
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <unistd.h>
+
+#include <OpenImageIO/imageio.h>
+
+#include "camera_host.hpp"
+#include "conetrace.h"
+#include "host_io.hpp"
+#include "picture.hpp"
+#include "terrain.hpp"
+
+using namespace ct_host;
+
+int cmd_view(int argc, char **argv)
+{
+    CmdLine args;
+    const std::string err =
+        parse_cmdline(argc, argv, 2, {"--camera", "--effects", "--threads", "-o", "--range"}, {}, false, &args);
+    if (!err.empty()) throw Error("view: " + err);
+    std::map<std::string, std::string> &opt = args.opt;
+    if (args.pos.size() != 1) throw Error("view needs exactly one package file");
+    if (!opt.count("--camera")) throw Error("view needs --camera C.cameramodel");
+    if (!opt.count("-o")) throw Error("view needs -o view.png");
+    const int threads = opt.count("--threads") ? threads_option(opt["--threads"], "view") : 0;
+    const std::string &path = args.pos[0];
+    std::vector<uint8_t> bytes = read_file(path);
+    ct_package p;
+    ct_status st = ct_package_open(&p, bytes.data(), bytes.size());
+    if (st != CT_OK) throw Error(path + ": not a valid package (" + status_name(st) + ")");
+    const std::string cpath = opt["--camera"];
+    const CameraModel cm = read_cameramodel(cpath);
+    LibCamera cam = lib_camera(cm, cpath);
+    const int W = (int)cm.width, H = (int)cm.height;
+    if (W <= 0 || H <= 0 || (long)W * H > 64L * 1024 * 1024) throw Error(cpath + ": no usable image size");
+    ct_effects fx = {0u, CT_REFRACTION_K_STD_Q16, 0, 0, nullptr};
+    if (opt.count("--effects")) fx.flags = effects_from_list(opt["--effects"]);
+    fx.flags |= CT_EFFECT_EARTH_FIT;
+    std::vector<int64_t> uv(2 * (size_t)W * H);
+    for (int v = 0; v < H; ++v)
+        for (int u = 0; u < W; ++u) {
+            uv[2 * ((size_t)v * W + u)] = (int64_t)u << 16;
+            uv[2 * ((size_t)v * W + u) + 1] = (int64_t)v << 16;
+        }
+    std::vector<ct_geo> g((size_t)W * H);
+    st = ct_geolocate_batch(&p, &cam.cam, &cam.pose, CT_METHOD_DIRECTIONAL, &fx, uv.data(), 0, g.data(), 0);
+    if (st != CT_OK) throw Error(cpath + ": cannot geolocate from this camera (" + status_name(st) + ")");
+    const size_t n = (size_t)W * H;
+    parallel_chunks(n, threads, std::max<size_t>(4096, n / 16 + 1), [&](size_t b, size_t e) {
+        (void)ct_geolocate_batch(&p, &cam.cam, &cam.pose, CT_METHOD_DIRECTIONAL, &fx, uv.data() + 2 * b, e - b,
+                                 g.data() + b, e - b);
+    });
+    // shading from the bilinear surface's normal at each hit
+    const double post = std::fabs(p.posting_e_nm * 1e-9), hs = p.height_scale_nm * 1e-9;
+    auto code = [&](int i, int j) {
+        i = std::max(0, std::min((int)p.width - 1, i));
+        j = std::max(0, std::min((int)p.height - 1, j));
+        const size_t k = (size_t)j * p.width + (size_t)i;
+        return (double)(p.heights[2 * k] | (p.heights[2 * k + 1] << 8));
+    };
+    // light from the north-west, 45 degrees up, in (east, south, up) like the hillshade
+    const double lx = -0.5, ly = -0.5, lz = std::sqrt(0.5);
+    Image im(W, H);
+    std::vector<float> range(n, NAN);
+    long hits = 0;
+    for (size_t k = 0; k < n; ++k) {
+        const ct_geo &q = g[k];
+        const int u = (int)(k % (size_t)W), v = (int)(k / (size_t)W);
+        if (q.status != CT_HIT && q.status != CT_HIT_VOID) {
+            im.set(u, v, Rgb{200, 222, 245});
+            continue;
+        }
+        hits++;
+        const double x = q.hit.x_q16 / 65536.0, y = q.hit.y_q16 / 65536.0;
+        const int i = std::min((int)p.width - 2, std::max(0, (int)std::floor(x)));
+        const int j = std::min((int)p.height - 2, std::max(0, (int)std::floor(y)));
+        const double fu = x - i, fv = y - j;
+        const double h00 = code(i, j), h10 = code(i + 1, j), h01 = code(i, j + 1), h11 = code(i + 1, j + 1);
+        const double gx = ((h10 - h00) * (1 - fv) + (h11 - h01) * fv) * hs / post;
+        const double gy = ((h01 - h00) * (1 - fu) + (h11 - h10) * fu) * hs / post;  // towards the south (grid y)
+        const double nn = std::sqrt(gx * gx + gy * gy + 1);
+        const double sh = std::max(0.0, (-gx * lx - gy * ly + lz) / nn);
+        const double de = (q.hit.e_nm - cam.pose.e_nm) * 1e-9, dn = (q.hit.n_nm - cam.pose.n_nm) * 1e-9,
+                     dh = (q.hit.h_nm - cam.pose.h_nm) * 1e-9;
+        const double r = std::sqrt(de * de + dn * dn + dh * dh);
+        range[k] = (float)r;
+        // a little atmospheric fade with range (5 % per 10 km)
+        const double fade = std::min(0.5, r / 200000.0);
+        const double val = (0.2 + 0.75 * sh) * (1 - fade) + 0.85 * fade;
+        im.set(u, v, Rgb{(uint8_t)std::lround(255 * val * 0.92), (uint8_t)std::lround(255 * val * 0.95),
+                         (uint8_t)std::lround(255 * val * 0.85)});
+    }
+    write_png_atomic(opt["-o"], im, "conetrace view: " + cpath, "conetrace view");
+    if (opt.count("--range")) {
+        const std::string out = opt["--range"];
+        const std::string tmp = out + ".tmp." + std::to_string((long)getpid()) + ".tif";
+        auto o = OIIO::ImageOutput::create("tiff");
+        if (!o) throw Error(out + ": cannot write TIFF");
+        OIIO::ImageSpec spec(W, H, 1, OIIO::TypeDesc::FLOAT);
+        spec.attribute("ImageDescription", "conetrace view: range from the camera centre, metres (NaN: no hit)");
+        bool ok = o->open(tmp, spec) && o->write_image(OIIO::TypeDesc::FLOAT, range.data());
+        ok = o->close() && ok;
+        if (!ok || std::rename(tmp.c_str(), out.c_str()) != 0) {
+            std::remove(tmp.c_str());
+            throw Error(out + ": cannot write (" + o->geterror() + ")");
+        }
+    }
+    std::fprintf(stderr, "view: %dx%d pixels, %ld hit the terrain\n", W, H, hits);
+    return 0;
+}
