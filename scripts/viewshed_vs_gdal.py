@@ -4,7 +4,9 @@
 # above the ground) and targets on the ground, without curvature (-cc 0):
 # agreement in % of posts, the posts each one alone sees, both times (best of
 # three, one thread for ours; gdal_viewshed's whole process), and a picture
-# of where they differ: BUILD/viewshed/viewshed_vs_gdal.png.
+# of where they differ: BUILD/viewshed/viewshed_vs_gdal.png.  Then
+# conetrace shadows (sun at 135, 20 deg) on packages of N = 8, 24, 64
+# sectors: the same shadow map from each (exact rays), steps and time.
 #
 #   /usr/bin/python3 scripts/viewshed_vs_gdal.py [BUILD]
 import os
@@ -83,6 +85,25 @@ def main():
     ax.set_ylabel("row")
     fig.tight_layout()
     fig.savefig(os.path.join(out, "viewshed_vs_gdal.png"), dpi=100)
+    # shadows per N
+    first = None
+    for nsec in (8, 24, 64):
+        pk = os.path.join(out, "jacksboro_n%d.ctp" % nsec)
+        subprocess.run([cli, "build", dem, "--sectors", str(nsec), "--reduce", "3", "-o", pk], check=True,
+                       stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        sh = os.path.join(out, "shadow_n%d.tif" % nsec)
+        best, line = 1e30, ""
+        for _ in range(3):
+            r = subprocess.run([cli, "shadows", pk, "--sun", "135,20", "--threads", "1", "-o", sh], check=True,
+                               capture_output=True, text=True)
+            t = float(r.stderr.strip().split()[-2])
+            if t < best:
+                best, line = t, r.stderr.strip()
+        m = gdal.Open(sh).ReadAsArray()
+        same = "reference" if first is None else ("identical" if (m == first).all() else "DIFFERENT")
+        if first is None:
+            first = m
+        print("shadows N = %2d: %s -- %s map" % (nsec, line.split(": ", 1)[1], same))
 
 
 if __name__ == "__main__":
