@@ -533,7 +533,7 @@ void compare(unsigned flags)
                                                    INT64_C(500) * 1000000000, INT64_C(60000) * 1000000000, &kept));
     fx_kept.earth_map = &kept;
     double fit_vs_exact = 0;
-    long fit_status_diff = 0;
+    long fit_status_diff = 0, los_checked = 0, los_bad = 0;
     long first_reports = 0;
     auto t0 = std::chrono::steady_clock::now();
     for (const PoseDef &d : defs) {
@@ -618,6 +618,24 @@ void compare(unsigned flags)
             const int lfs = gf[k].status == CT_HIT_VOID ? CT_HIT : gf[k].status;
             judge(fitted[f], lfs, gf[k], true);
             judge(kmap[f], gk[k].status == CT_HIT_VOID ? CT_HIT : gk[k].status, gk[k], true);
+            // ct_los on the true Earth from the camera centre: the
+            // reference's hit is visible (0.5 m margin), a point 30 m under
+            // it hidden
+            if (r.status == CT_HIT && !r.wall) {
+                const int64_t A[3] = {p.pose.e_nm, p.pose.n_nm, p.pose.h_nm};
+                const int64_t B[3] = {std::llround(r.e * 1e9L), std::llround(r.n * 1e9L), std::llround(r.h * 1e9L)};
+                const int64_t B2[3] = {B[0], B[1], B[2] - INT64_C(30000000000)};
+                ct_hit lb;
+                const ct_status v1 = ct_los(&w->p, A, B, &fx, 500000000, CT_METHOD_DIRECTIONAL, &lb);
+                const ct_status v2 = ct_los(&w->p, A, B2, &fx, 500000000, CT_METHOD_DIRECTIONAL, &lb);
+                los_checked++;
+                if (v1 != CT_OK || v2 != CT_HIT) {
+                    los_bad++;
+                    if (los_bad <= 5)
+                        std::printf("    ct_los %s yaw %.0Lf: to the reference hit %d (want %d), 30 m under it %d "
+                                    "(want %d)\n", d.family, d.yaw, v1, CT_OK, v2, CT_HIT);
+                }
+            }
             if (lfs != ls) {
                 fit_status_diff++;
             } else if (ls == CT_HIT) {
@@ -667,6 +685,9 @@ void compare(unsigned flags)
         fn += fitted[f].n;
         fbad += fitted[f].mismatch;
     }
+    std::printf("  ct_los on the true Earth: %ld reference hits visible from the camera, 30 m under them hidden; "
+                "%ld wrong\n", los_checked, los_bad);
+    TEST_ASSERT_MSG(los_bad == 0 && los_checked > 300, "ct_los: %ld wrong of %ld", los_bad, los_checked);
     double kworst = 0, kworst_off = 0, ksum2 = 0;
     long kbad = 0, kn = 0;
     for (int f = 0; f < nf; ++f) {

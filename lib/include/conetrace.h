@@ -702,9 +702,12 @@ ct_status ct_effects_for_tolerance(const ct_package *pkg, const ct_camera *cam, 
 /* Intervisibility (lib/src/los.c): is map point B (nm) visible from map
  * point A?  The segment A -> B against the package's surface, exact as
  * ct_trace (both points as ct_map_to_grid rounds them, Q16); with effects
- * (curvature, refraction: c > 0 on the sphere of earth_radius_nm, 0 = 6371
- * km; the true Earth is not used) the line of sight from A through B bent
- * by c rho^2 / 2R, as ct_trace_bent's lowered walk.  CT_OK: nothing stands
+ * as for geolocation: curvature with earth_radius_nm 0 on a UTM package is
+ * the true Earth (the Earth-fixed line of sight from A aimed at B -- with
+ * refraction at B raised by its drop k t^2 / 2R -- traced by earth.c, the
+ * margin an Earth-fixed distance; earth_map / CT_EFFECT_EARTH_FIT honoured);
+ * otherwise the sphere (c > 0; 0 = 6371 km): the line of sight from A
+ * through B bent by c rho^2 / 2R, as ct_trace_bent's lowered walk.  CT_OK: nothing stands
  * between them (B visible); CT_HIT: the surface meets the line of sight
  * more than margin_nm (3D distance from A) before B -- *block is that
  * first point, as ct_trace's hit -- so a target on the ground, met at

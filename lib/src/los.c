@@ -30,6 +30,116 @@ static int64_t dist_nm(int64_t ae, int64_t an, int64_t ah, int64_t pe, int64_t p
     return (int64_t)ct_i128_isqrt(s);
 }
 
+/* A map point to ECEF (nm) on the package's zone. */
+static ct_status to_ecef(const ct_utm *zone, const int64_t m[3], int64_t x[3])
+{
+    int64_t lat, lon;
+    ct_status st = ct_utm_inverse(zone, m[0], m[1], &lat, &lon);
+    return st == CT_OK ? ct_ecef_from_wgs84(lat, lon, m[2], x) : st;
+}
+
+/* |x - y| for ECEF points (nm, |.| < 2^55: differences < 2^56, squares in
+ * 128 bits) */
+static int64_t dist_ecef(const int64_t x[3], const int64_t y[3])
+{
+    ct_i128 s = ct_i128_from64(0);
+    int k;
+    for (k = 0; k < 3; ++k) { /* bound: 3 axes */
+        s = ct_i128_add(s, ct_i128_mul(x[k] - y[k], x[k] - y[k]));
+    }
+    return (int64_t)ct_i128_isqrt(s);
+}
+
+/* The true Earth (curvature with radius 0 on a UTM package): the Earth-fixed
+ * line of sight from A aimed at B (with refraction, at B raised by k t^2 /
+ * 2R along the vertical at B, the bent path's drop there), traced by
+ * earth.c as geolocation does; hidden when its first hit lies more than the
+ * margin (Earth-fixed distance from A) before B.  CT_ERR_CRS: not UTM. */
+static ct_status los_earth(const ct_package *p, const int64_t a_nm[3], const int64_t b_nm[3],
+                           const ct_effects *fx, int64_t margin_nm, ct_method m, ct_hit *block)
+{
+    static const int32_t ident[9] = {1 << 30, 0, 0, 0, 1 << 30, 0, 0, 0, 1 << 30};
+    ct_utm zone;
+    ct_pose pose;
+    ct_earth es;
+    int64_t A[3], B[3], H[3], d[3], dg[3], big = 0, lim;
+    ct_status st;
+    int k, j;
+    unsigned sh = 0u;
+    if (p->epsg > 0x7fffffffu || ct_utm_zone_of_epsg((int32_t)p->epsg, &zone) != CT_OK) {
+        return CT_ERR_CRS;
+    }
+    if (ct_pose_init(&pose, ident, a_nm[0], a_nm[1], a_nm[2]) != CT_OK) {
+        return CT_ERR_RAY;
+    }
+    st = ct_earth_setup(p, &pose, (fx->flags & CT_EFFECT_REFRACTION) != 0u ? fx->refraction_k_q16 : 0,
+                        CT_EARTH_RADIUS_NM, fx->chord_nm != 0 ? fx->chord_nm : CT_EFFECTS_CHORD_NM, 0u,
+                        (fx->flags & CT_EFFECT_EARTH_FIT) != 0u, fx->earth_map, &es);
+    if (st != CT_OK) {
+        return st == CT_ERR_RAY ? CT_ERR_RAY : CT_ERR_EFFECTS;
+    }
+    if (to_ecef(&zone, a_nm, A) != CT_OK || to_ecef(&zone, b_nm, B) != CT_OK) {
+        return CT_ERR_RAY;
+    }
+    for (k = 0; k < 3; ++k) { /* bound: 3 axes */
+        d[k] = B[k] - A[k]; /* < 2^56 */
+    }
+    if ((fx->flags & CT_EFFECT_REFRACTION) != 0u) {
+        /* aim above B by k t^2 / 2R along the camera's vertical (the
+         * frame's third column): t < 2^50 capped, t^2 |k| < 2^117, / 2R
+         * saturated at 2^62, / 2^16 */
+        int64_t t = ct_min64(dist_ecef(A, B), INT64_C(1) << 50);
+        int64_t up = ct_floor_div(ct_i128_floor_div_sat(ct_i128_mul128_64(ct_i128_mul(t, t), fx->refraction_k_q16),
+                                                        2 * CT_EARTH_RADIUS_NM),
+                                  65536);
+        up = ct_max64(-(INT64_C(1) << 50), ct_min64(INT64_C(1) << 50, up));
+        for (k = 0; k < 3; ++k) { /* bound: 3 axes */
+            d[k] += ct_mul_shr(up, es.frame_q30[3 * k + 2], 30u);
+        }
+    }
+    /* the direction in the grid frame at A (frame^T d), scaled to a Q39
+     * unit vector: |d| < 2^57, shifted below 2^40 first */
+    for (k = 0; k < 3; ++k) { /* bound: 3 axes */
+        big = ct_max64(big, ct_abs64(d[k]));
+    }
+    /* bound: 63 halvings */
+    while (sh < 63u && (big >> sh) >= (INT64_C(1) << 40)) {
+        sh++;
+    }
+    for (k = 0; k < 3; ++k) { /* bound: 3 axes */
+        ct_i128 s = ct_i128_from64(0);
+        for (j = 0; j < 3; ++j) { /* bound: 3 terms, Q30 x 2^40 */
+            s = ct_i128_add(s, ct_i128_mul(es.frame_q30[3 * j + k], ct_floor_div(d[j], INT64_C(1) << sh)));
+        }
+        dg[k] = ct_i128_round_shr(s, 30u); /* < 2^42 */
+    }
+    {
+        int64_t n = (int64_t)ct_i128_isqrt(ct_i128_add(ct_i128_add(ct_i128_mul(dg[0], dg[0]), ct_i128_mul(dg[1], dg[1])),
+                                                        ct_i128_mul(dg[2], dg[2])));
+        if (n == 0) {
+            return CT_ERR_RAY;
+        }
+        for (k = 0; k < 3; ++k) { /* bound: 3 axes; |dg| <= n < 2^43: 2^82 / n */
+            dg[k] = ct_i128_round_div(ct_i128_shl(ct_i128_from64(dg[k]), 39u), n);
+        }
+    }
+    st = ct_trace_earth(p, &es, dg, m, block);
+    if (st == CT_BELOW || st < 0) {
+        return st;
+    }
+    if (st != CT_HIT && st != CT_HIT_VOID) {
+        return CT_OK;
+    }
+    {
+        const int64_t hm[3] = {block->e_nm, block->n_nm, block->h_nm};
+        if (to_ecef(&zone, hm, H) != CT_OK) {
+            return CT_ERR_RAY;
+        }
+        lim = dist_ecef(A, B) - margin_nm;
+        return dist_ecef(A, H) < lim ? CT_HIT : CT_OK;
+    }
+}
+
 ct_status ct_los(const ct_package *p, const int64_t a_nm[3], const int64_t b_nm[3], const ct_effects *effects,
                  int64_t margin_nm, ct_method m, ct_hit *block)
 {
@@ -56,6 +166,13 @@ ct_status ct_los(const ct_package *p, const int64_t a_nm[3], const int64_t b_nm[
         ct_abs64(ay) > CT_MAX_ORIGIN_Q16 || ct_abs64(az) > CT_MAX_ORIGIN_Q16 || ct_abs64(bx) > CT_MAX_ORIGIN_Q16 ||
         ct_abs64(by) > CT_MAX_ORIGIN_Q16 || ct_abs64(bz) > CT_MAX_ORIGIN_Q16) {
         return CT_ERR_RAY;
+    }
+    if (effects != NULL && (effects->flags & CT_EFFECT_CURVATURE) != 0u && effects->earth_radius_nm == 0) {
+        /* the true Earth where the package is on a UTM zone */
+        st = los_earth(p, a_nm, b_nm, effects, margin_nm, m, block);
+        if (st != CT_ERR_CRS) {
+            return st;
+        }
     }
     if (effects != NULL && (effects->flags & CT_EFFECT_ALL) != 0u) {
         /* the sphere model: c = [curvature] - k [refraction] > 0 as a
