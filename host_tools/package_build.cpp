@@ -204,26 +204,26 @@ void build_package_to(const Terrain &t, const BuildOptions &opt, PackageSink &si
     {
         std::vector<uint8_t> h(so[CT_SEC_HEIGHTS], 0);
         if (h.size() < (size_t)CT_HDR_SECTION_TABLE + 8 * CT_SEC_COUNT) throw Error("package layout: short header");
-        std::memcpy(&h[0], CT_PKG_MAGIC, 4);
-        put16(h, 4, CT_PKG_VERSION);
-        put16(h, 6, CT_PKG_HEADER_SIZE);
-        put32(h, 8, total);
-        put16(h, 16, (uint32_t)t.width);
-        put16(h, 18, (uint32_t)t.height);
-        h[20] = (uint8_t)c.r;
-        h[21] = (uint8_t)c.n;
-        h[22] = (uint8_t)levels;
-        h[23] = (uint8_t)((voids ? CT_PKG_FLAG_VOIDS : 0u) | (datum ? CT_PKG_FLAG_DATUM : 0u));
-        put16(h, 24, hmin);
-        put16(h, 26, hmax);
-        put32(h, 28, (uint32_t)slices_header);
-        put64(h, 32, metres_to_nm(t.geo.origin_e));
-        put64(h, 40, metres_to_nm(t.geo.origin_n));
-        put64(h, 48, pe);
-        put64(h, 56, pn);
-        put64(h, 64, metres_to_nm(t.height_offset_m));
-        put64(h, 72, sc);
-        put32(h, 80, (uint32_t)std::max(0, t.geo.epsg));
+        std::memcpy(&h[CT_HDR_MAGIC], CT_PKG_MAGIC, 4);
+        put16(h, CT_HDR_VERSION, CT_PKG_VERSION);
+        put16(h, CT_HDR_HEADER_SIZE, CT_PKG_HEADER_SIZE);
+        put32(h, CT_HDR_TOTAL, total);
+        put16(h, CT_HDR_WIDTH, (uint32_t)t.width);
+        put16(h, CT_HDR_HEIGHT, (uint32_t)t.height);
+        h[CT_HDR_REDUCE] = (uint8_t)c.r;
+        h[CT_HDR_SECTORS] = (uint8_t)c.n;
+        h[CT_HDR_LEVELS] = (uint8_t)levels;
+        h[CT_HDR_FLAGS] = (uint8_t)((voids ? CT_PKG_FLAG_VOIDS : 0u) | (datum ? CT_PKG_FLAG_DATUM : 0u));
+        put16(h, CT_HDR_HMIN, hmin);
+        put16(h, CT_HDR_HMAX, hmax);
+        put32(h, CT_HDR_SLICES, (uint32_t)slices_header);
+        put64(h, CT_HDR_ORIGIN_E, metres_to_nm(t.geo.origin_e));
+        put64(h, CT_HDR_ORIGIN_N, metres_to_nm(t.geo.origin_n));
+        put64(h, CT_HDR_POSTING_E, pe);
+        put64(h, CT_HDR_POSTING_N, pn);
+        put64(h, CT_HDR_HEIGHT_OFFSET, metres_to_nm(t.height_offset_m));
+        put64(h, CT_HDR_HEIGHT_SCALE, sc);
+        put32(h, CT_HDR_EPSG, (uint32_t)std::max(0, t.geo.epsg));
         put32(h, CT_HDR_DATUM, datum ? datum_off : 0u);
         for (int k = 0; k < CT_SEC_COUNT; ++k) {
             put32(h, CT_HDR_SECTION_TABLE + 8 * k, so[k]);
@@ -350,7 +350,7 @@ void build_package_to(const Terrain &t, const BuildOptions &opt, PackageSink &si
     w.flush();
     uint8_t crc[4];
     put32(crc, w.crc());
-    sink.patch(12, crc, 4);
+    sink.patch(CT_HDR_CRC, crc, 4);
     if (stats) {
         stats->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         stats->degenerate_cones = degenerate;

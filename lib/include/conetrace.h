@@ -137,8 +137,29 @@ enum {
  *                                       CT_PKG_FLAG_DATUM; else 0)
  *  88  5 x { u32 offset, u32 size } section table (bytes from package start)
  */
-#define CT_HDR_SECTION_TABLE 88u
+#define CT_HDR_MAGIC 0u
+#define CT_HDR_VERSION 4u
+#define CT_HDR_HEADER_SIZE 6u
+#define CT_HDR_TOTAL 8u
+#define CT_HDR_CRC 12u
+#define CT_HDR_WIDTH 16u
+#define CT_HDR_HEIGHT 18u
+#define CT_HDR_REDUCE 20u
+#define CT_HDR_SECTORS 21u
+#define CT_HDR_LEVELS 22u
+#define CT_HDR_FLAGS 23u
+#define CT_HDR_HMIN 24u
+#define CT_HDR_HMAX 26u
+#define CT_HDR_SLICES 28u
+#define CT_HDR_ORIGIN_E 32u
+#define CT_HDR_ORIGIN_N 40u
+#define CT_HDR_POSTING_E 48u
+#define CT_HDR_POSTING_N 56u
+#define CT_HDR_HEIGHT_OFFSET 64u
+#define CT_HDR_HEIGHT_SCALE 72u
+#define CT_HDR_EPSG 80u
 #define CT_HDR_DATUM 84u
+#define CT_HDR_SECTION_TABLE 88u
 
 /* The datum section (optional; flag CT_PKG_FLAG_DATUM): where the heights
  * and the grid came from, and the geoid over the tile.  8-aligned, after

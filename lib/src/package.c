@@ -323,29 +323,29 @@ ct_status ct_package_open(ct_package *pkg, const uint8_t *b, size_t len)
     if (b[0] != 'C' || b[1] != 'T' || b[2] != 'P' || b[3] != 'K') {
         return CT_ERR_MAGIC;
     }
-    if (ct_ld16(b + 4) != CT_PKG_VERSION) {
+    if (ct_ld16(b + CT_HDR_VERSION) != CT_PKG_VERSION) {
         return CT_ERR_VERSION;
     }
-    if (ct_ld16(b + 6) != CT_PKG_HEADER_SIZE) {
+    if (ct_ld16(b + CT_HDR_HEADER_SIZE) != CT_PKG_HEADER_SIZE) {
         return CT_ERR_HEADER;
     }
-    total = ct_ld32(b + 8);
+    total = ct_ld32(b + CT_HDR_TOTAL);
     if (total < CT_PKG_HEADER_SIZE || (uint64_t)total > (uint64_t)len) {
         return CT_ERR_TRUNCATED;
     }
-    crc_stored = ct_ld32(b + 12);
-    (void)ct_crc32(0u, b, 12u, &crc);
+    crc_stored = ct_ld32(b + CT_HDR_CRC);
+    (void)ct_crc32(0u, b, CT_HDR_CRC, &crc);
     (void)ct_crc32(crc, zero4, 4u, &crc);
-    (void)ct_crc32(crc, b + 16, (size_t)total - 16u, &crc);
+    (void)ct_crc32(crc, b + CT_HDR_CRC + 4u, (size_t)total - (CT_HDR_CRC + 4u), &crc);
     if (crc != crc_stored) {
         return CT_ERR_CRC;
     }
-    w = ct_ld16(b + 16);
-    h = ct_ld16(b + 18);
-    r = b[20];
-    n = b[21];
-    lv = b[22];
-    flags = b[23];
+    w = ct_ld16(b + CT_HDR_WIDTH);
+    h = ct_ld16(b + CT_HDR_HEIGHT);
+    r = b[CT_HDR_REDUCE];
+    n = b[CT_HDR_SECTORS];
+    lv = b[CT_HDR_LEVELS];
+    flags = b[CT_HDR_FLAGS];
     if (w < 2u || h < 2u || w > CT_MAX_POSTS || h > CT_MAX_POSTS) {
         return CT_ERR_DIMS;
     }
@@ -388,17 +388,17 @@ ct_status ct_package_open(ct_package *pkg, const uint8_t *b, size_t len)
     if (st != CT_OK) {
         return st;
     }
-    pkg->hmin = (int32_t)ct_ld16(b + 24);
-    pkg->hmax = (int32_t)ct_ld16(b + 26);
+    pkg->hmin = (int32_t)ct_ld16(b + CT_HDR_HMIN);
+    pkg->hmax = (int32_t)ct_ld16(b + CT_HDR_HMAX);
     if (pkg->hmin > pkg->hmax) {
         return CT_ERR_RANGE;
     }
-    pe = ct_ld64s(b + 48);
-    pn = ct_ld64s(b + 56);
-    pkg->origin_e_nm = ct_ld64s(b + 32);
-    pkg->origin_n_nm = ct_ld64s(b + 40);
-    pkg->height_offset_nm = ct_ld64s(b + 64);
-    pkg->height_scale_nm = ct_ld64s(b + 72);
+    pe = ct_ld64s(b + CT_HDR_POSTING_E);
+    pn = ct_ld64s(b + CT_HDR_POSTING_N);
+    pkg->origin_e_nm = ct_ld64s(b + CT_HDR_ORIGIN_E);
+    pkg->origin_n_nm = ct_ld64s(b + CT_HDR_ORIGIN_N);
+    pkg->height_offset_nm = ct_ld64s(b + CT_HDR_HEIGHT_OFFSET);
+    pkg->height_scale_nm = ct_ld64s(b + CT_HDR_HEIGHT_SCALE);
     if (pe == 0 || pn == 0 || ct_abs64(pe) != ct_abs64(pn) ||
         pkg->height_scale_nm <= 0 || ct_abs64(pe) > (INT64_C(1) << 50) ||
         pkg->height_scale_nm > (INT64_C(1) << 46) ||
@@ -433,8 +433,8 @@ ct_status ct_package_open(ct_package *pkg, const uint8_t *b, size_t len)
     pkg->levels = lv;
     pkg->planes = n == 1u ? 1u : n + 1u;
     pkg->flags = flags;
-    pkg->slices = ct_ld32(b + 28);
-    pkg->epsg = ct_ld32(b + 80);
+    pkg->slices = ct_ld32(b + CT_HDR_SLICES);
+    pkg->epsg = ct_ld32(b + CT_HDR_EPSG);
     pkg->heights = b + so[CT_SEC_HEIGHTS];
     pkg->apex = b + so[CT_SEC_APEX];
     pkg->angles = b + so[CT_SEC_ANGLES];
