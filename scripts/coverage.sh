@@ -7,7 +7,7 @@
 #   scripts/coverage.sh <dir>
 set -eu
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
-DIR=$1
+DIR=$(mkdir -p "$1" && cd "$1" && pwd)  # absolute: the suite runs from inside it
 command -v gcovr >/dev/null 2>&1 || { echo "coverage: gcovr not found (scripts/deps.sh installs it)"; exit 1; }
 cmake -S "$ROOT" -B "$DIR" -DCMAKE_BUILD_TYPE=Release -DCT_COVERAGE=ON >/dev/null
 cmake --build "$DIR" -j"$(nproc 2>/dev/null || echo 2)" >/dev/null
