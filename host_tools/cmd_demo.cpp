@@ -62,12 +62,6 @@ double range_m(const ct_pose &pose, const ct_geo &g)
 
 bool is_hit(ct_status s) { return s == CT_HIT || s == CT_HIT_VOID; }
 
-Rgb mix(Rgb a, Rgb b, double f)
-{
-    auto m = [&](uint8_t x, uint8_t y) { return (uint8_t)std::lround(x + f * (y - x)); };
-    return Rgb{m(a.r, b.r), m(a.g, b.g), m(a.b, b.b)};
-}
-
 }  // namespace
 
 int demo_main_job(const std::vector<uint8_t> &bytes, const Terrain &t, const std::map<std::string, std::string> &opt)
@@ -260,18 +254,14 @@ int demo_main_job(const std::vector<uint8_t> &bytes, const Terrain &t, const std
     const int zoom = std::max(1, (int)std::lround(900.0 / std::max(cw, ch)));
     const int pw = cw * zoom, ph = ch * zoom, LEG = 40;
     Image im(std::max(pw, 300), ph + LEG);
-    const std::vector<double> shade = hillshade(t, 1, t.width - 1, t.height - 1);
-    for (int j = j0; j <= j1; ++j)
-        for (int i = i0; i <= i1; ++i) {
-            const double sh = shade[(size_t)std::min(j, t.height - 2) * (t.width - 1) + std::min(i, t.width - 2)];
-            const uint8_t g = (uint8_t)std::lround(255 * (0.25 + 0.7 * sh));
-            Rgb c{g, g, g};
-            const uint8_t st = state[(size_t)j * t.width + i];
-            if (st == 1) c = mix(c, Rgb{255, 214, 120}, 0.35);
-            if (st == 2) c = mix(c, Rgb{20, 40, 140}, 0.6);
-            for (int y = 0; y < zoom; ++y)
-                for (int x = 0; x < zoom; ++x) im.set((i - i0) * zoom + x, (j - j0) * zoom + y, c);
-        }
+    paint_posts(im, t, i0, j0, i1, j1, zoom, [&](int i, int j, double sh) {
+        const uint8_t g = (uint8_t)std::lround(255 * (0.25 + 0.7 * sh));
+        Rgb c{g, g, g};
+        const uint8_t st = state[(size_t)j * t.width + i];
+        if (st == 1) c = mix(c, Rgb{255, 214, 120}, 0.35);
+        if (st == 2) c = mix(c, Rgb{20, 40, 140}, 0.6);
+        return c;
+    });
     // a map point's place in the picture: post (i, j) covers [i, i + 1) x
     // [j, j + 1) in units of zoom pixels, its centre at (i + 1/2, j + 1/2)
     auto pic = [&](int64_t e_nm, int64_t n_nm, double *x, double *y) {

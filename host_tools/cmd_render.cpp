@@ -58,6 +58,7 @@
 #include "dem_io.hpp"
 #include "picture.hpp"
 #include "host_io.hpp"
+#include "le.hpp"
 #include "terrain.hpp"
 
 using namespace ct_host;
@@ -98,8 +99,6 @@ struct Input {
     ct_package pkg{};
 };
 
-uint16_t rd16(const uint8_t *p) { return (uint16_t)(p[0] | (p[1] << 8)); }
-
 Input load_input(const std::string &path)
 {
     Input in;
@@ -116,19 +115,7 @@ Input load_input(const std::string &path)
         in.bytes = read_file(path);
         ct_status st = ct_package_open(&in.pkg, in.bytes.data(), in.bytes.size());
         if (st != CT_OK) throw Error(path + ": not a valid package (" + status_name(st) + ")");
-        const ct_package &p = in.pkg;
-        Terrain &t = in.t;
-        t.width = (int)p.width;
-        t.height = (int)p.height;
-        t.codes.resize((size_t)p.width * p.height);
-        for (size_t k = 0; k < t.codes.size(); ++k) t.codes[k] = rd16(p.heights + 2 * k);
-        t.geo.origin_e = p.origin_e_nm * 1e-9;
-        t.geo.origin_n = p.origin_n_nm * 1e-9;
-        t.geo.posting_e = p.posting_e_nm * 1e-9;
-        t.geo.posting_n = p.posting_n_nm * 1e-9;
-        t.geo.epsg = (int)p.epsg;
-        t.height_offset_m = p.height_offset_nm * 1e-9;
-        t.height_scale_m = p.height_scale_nm * 1e-9;
+        in.t = terrain_from_package(in.pkg);
     } else {
         DemRaster r = read_dem(path);
         try {
@@ -353,7 +340,7 @@ int cmd_render(int argc, char **argv)
             Panel pn;
             pn.w = wc, pn.h = hc;
             pn.v.resize(plane);
-            for (size_t k = 0; k < plane; ++k) pn.v[k] = t.height_offset_m + rd16(p.apex + 2 * k) * t.height_scale_m;
+            for (size_t k = 0; k < plane; ++k) pn.v[k] = t.height_offset_m + get16(p.apex + 2 * k) * t.height_scale_m;
             panels.push_back(std::move(pn));
             desc << "apex heights (m), " << wc << "x" << hc << " coarse cells, r=" << reduce;
         } else {

@@ -66,7 +66,8 @@ int cmd_shadows(int argc, char **argv)
     ct_package p;
     ct_status st = ct_package_open(&p, bytes.data(), bytes.size());
     if (st != CT_OK) throw Error(path + ": not a valid package (" + status_name(st) + ")");
-    const int W = (int)p.width, H = (int)p.height;
+    const Terrain t = terrain_from_package(p);
+    const int W = t.width, H = t.height;
     const double az = sun[0] * M_PI / 180, el = sun[1] * M_PI / 180;
     // the direction towards the sun, map frame (E, N, up), scaled to 2^40
     const double s = std::ldexp(1.0, 40);
@@ -78,9 +79,8 @@ int cmd_shadows(int argc, char **argv)
     parallel_chunks((size_t)H, threads, 8, [&](size_t b, size_t e) {
         for (size_t j = b; j < e; ++j)
             for (int i = 0; i < W; ++i) {
-                const uint16_t code = (uint16_t)(p.heights[2 * ((size_t)j * W + i)] | (p.heights[2 * ((size_t)j * W + i) + 1] << 8));
                 int64_t pe, pn, ph;
-                (void)ct_grid_to_map(&p, (int64_t)i << 16, (int64_t)j << 16, (int64_t)code << 16, &pe, &pn, &ph);
+                (void)ct_grid_to_map(&p, (int64_t)i << 16, (int64_t)j << 16, (int64_t)t.at(i, (int)j) << 16, &pe, &pn, &ph);
                 ct_ray r;
                 ct_hit h;
                 ct_status s2 = ct_ray_from_map(&p, pe, pn, ph + std::llround(lift * 1e9), de, dn, dh, &r);
@@ -95,38 +95,18 @@ int cmd_shadows(int argc, char **argv)
     for (uint8_t v : lit) nlit += v;
     const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (errors) throw Error("shadows: " + std::to_string(errors) + " posts could not be decided");
-    Georef g;
-    g.origin_e = p.origin_e_nm * 1e-9;
-    g.origin_n = p.origin_n_nm * 1e-9;
-    g.posting_e = p.posting_e_nm * 1e-9;
-    g.posting_n = p.posting_n_nm * 1e-9;
-    g.epsg = (int)p.epsg;
-    write_geotiff(opt["-o"], W, H, std::vector<double>(lit.begin(), lit.end()), SampleType::UInt16, g);
+    write_geotiff(opt["-o"], W, H, std::vector<double>(lit.begin(), lit.end()), SampleType::UInt16, t.geo);
     std::fprintf(stderr, "shadows: sun at azimuth %.2f, elevation %.2f deg: %ld posts lit, %ld in shadow; %.1f steps "
                          "per post; %.2f s\n", sun[0], sun[1], nlit, (long)W * H - nlit, (double)nsteps / ((double)W * H),
                  secs);
     if (opt.count("--png")) {
-        Terrain t;
-        t.width = W;
-        t.height = H;
-        t.codes.resize((size_t)W * H);
-        for (size_t k = 0; k < t.codes.size(); ++k) t.codes[k] = (uint16_t)(p.heights[2 * k] | (p.heights[2 * k + 1] << 8));
-        t.geo = g;
-        t.height_offset_m = p.height_offset_nm * 1e-9;
-        t.height_scale_m = p.height_scale_nm * 1e-9;
         const int zoom = std::max(1, (int)std::lround(900.0 / std::max(W, H)));
         Image im(W * zoom, H * zoom);
-        const std::vector<double> shade = hillshade(t, 1, W - 1, H - 1);
-        for (int j = 0; j < H; ++j)
-            for (int i = 0; i < W; ++i) {
-                const double sh = shade[(size_t)std::min(j, H - 2) * (W - 1) + std::min(i, W - 2)];
-                double v = 0.3 + 0.65 * sh;
-                if (!lit[(size_t)j * W + i]) v *= 0.35;
-                const uint8_t gg = (uint8_t)std::lround(255 * v);
-                const Rgb c = lit[(size_t)j * W + i] ? Rgb{gg, gg, (uint8_t)std::lround(gg * 0.85)} : Rgb{gg, gg, (uint8_t)std::min(255.0, gg * 1.4)};
-                for (int y = 0; y < zoom; ++y)
-                    for (int x = 0; x < zoom; ++x) im.set(i * zoom + x, j * zoom + y, c);
-            }
+        paint_posts(im, t, 0, 0, W - 1, H - 1, zoom, [&](int i, int j, double sh) {
+            const bool on = lit[(size_t)j * W + i] != 0;
+            const uint8_t gg = (uint8_t)std::lround(255 * (on ? 0.3 + 0.65 * sh : (0.3 + 0.65 * sh) * 0.35));
+            return on ? Rgb{gg, gg, (uint8_t)std::lround(gg * 0.85)} : Rgb{gg, gg, (uint8_t)std::min(255.0, gg * 1.4)};
+        });
         // the sun's direction from the picture's corner
         const int cx = 40, cy = 40;
         im.disc(cx, cy, 6, Rgb{255, 200, 40});

@@ -70,11 +70,9 @@ int cmd_view(int argc, char **argv)
     });
     // shading from the bilinear surface's normal at each hit
     const double post = std::fabs(p.posting_e_nm * 1e-9), hs = p.height_scale_nm * 1e-9;
+    const Terrain t = terrain_from_package(p);
     auto code = [&](int i, int j) {
-        i = std::max(0, std::min((int)p.width - 1, i));
-        j = std::max(0, std::min((int)p.height - 1, j));
-        const size_t k = (size_t)j * p.width + (size_t)i;
-        return (double)(p.heights[2 * k] | (p.heights[2 * k + 1] << 8));
+        return (double)t.at(std::max(0, std::min(t.width - 1, i)), std::max(0, std::min(t.height - 1, j)));
     };
     // light from the north-west, 45 degrees up, in (east, south, up) like the hillshade
     const double lx = -0.5, ly = -0.5, lz = std::sqrt(0.5);

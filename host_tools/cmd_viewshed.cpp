@@ -77,7 +77,8 @@ int cmd_viewshed(int argc, char **argv)
     ct_package p;
     ct_status st = ct_package_open(&p, bytes.data(), bytes.size());
     if (st != CT_OK) throw Error(path + ": not a valid package (" + status_name(st) + ")");
-    const int W = (int)p.width, H = (int)p.height;
+    const Terrain t = terrain_from_package(p);
+    const int W = t.width, H = t.height;
     const double pe = p.posting_e_nm * 1e-9, pn = p.posting_n_nm * 1e-9;
     const double E0 = p.origin_e_nm * 1e-9, N0 = p.origin_n_nm * 1e-9;
     // the observer: on the tile, H above the surface
@@ -98,8 +99,8 @@ int cmd_viewshed(int argc, char **argv)
         for (size_t j = b; j < e; ++j)
             for (int i = 0; i < W; ++i) {
                 int64_t pt[3];
-                const uint16_t code = (uint16_t)(p.heights[2 * ((size_t)j * W + i)] | (p.heights[2 * ((size_t)j * W + i) + 1] << 8));
-                (void)ct_grid_to_map(&p, (int64_t)i << 16, (int64_t)j << 16, (int64_t)code << 16, &pt[0], &pt[1], &pt[2]);
+                (void)ct_grid_to_map(&p, (int64_t)i << 16, (int64_t)j << 16, (int64_t)t.at(i, (int)j) << 16, &pt[0], &pt[1],
+                                     &pt[2]);
                 pt[2] += std::llround(th * 1e9);
                 if (radius > 0 && std::hypot((pt[0] - A[0]) * 1e-9, (pt[1] - A[1]) * 1e-9) > radius) continue;
                 if (pt[0] == A[0] && pt[1] == A[1]) {
@@ -123,43 +124,21 @@ int cmd_viewshed(int argc, char **argv)
     for (int j = 0; j < H; ++j) seen += cnt[3 * j], hidden += cnt[3 * j + 1], errors += cnt[3 * j + 2];
     const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (errors) throw Error("viewshed: " + std::to_string(errors) + " posts could not be decided");
-    Georef g;
-    g.origin_e = E0;
-    g.origin_n = N0;
-    g.posting_e = pe;
-    g.posting_n = pn;
-    g.epsg = (int)p.epsg;
-    write_geotiff(opt["-o"], W, H, std::vector<double>(vis.begin(), vis.end()), SampleType::UInt16, g, true, 255);
+    write_geotiff(opt["-o"], W, H, std::vector<double>(vis.begin(), vis.end()), SampleType::UInt16, t.geo, true, 255);
     std::fprintf(stderr, "viewshed: observer (%.3f, %.3f) %.3f m above the surface (h %.3f m); %ld posts seen, %ld "
                          "hidden, %ld out of range; %.2f s\n",
                  ob[0], ob[1], ob[2], A[2] * 1e-9, seen, hidden, (long)W * H - seen - hidden, secs);
     if (opt.count("--png")) {
-        Terrain t;
-        t.width = W;
-        t.height = H;
-        t.codes.resize((size_t)W * H);
-        for (size_t k = 0; k < t.codes.size(); ++k) t.codes[k] = (uint16_t)(p.heights[2 * k] | (p.heights[2 * k + 1] << 8));
-        t.geo = g;
-        t.height_offset_m = p.height_offset_nm * 1e-9;
-        t.height_scale_m = p.height_scale_nm * 1e-9;
         const int zoom = std::max(1, (int)std::lround(900.0 / std::max(W, H)));
         Image im(W * zoom, H * zoom);
-        const std::vector<double> shade = hillshade(t, 1, W - 1, H - 1);
-        for (int j = 0; j < H; ++j)
-            for (int i = 0; i < W; ++i) {
-                const double s = shade[(size_t)std::min(j, H - 2) * (W - 1) + std::min(i, W - 2)];
-                const uint8_t gg = (uint8_t)std::lround(255 * (0.25 + 0.7 * s));
-                Rgb c{gg, gg, gg};
-                const uint8_t v = vis[(size_t)j * W + i];
-                auto mixc = [&](Rgb a, Rgb b, double f) {
-                    auto m = [&](uint8_t x, uint8_t y) { return (uint8_t)std::lround(x + f * (y - x)); };
-                    return Rgb{m(a.r, b.r), m(a.g, b.g), m(a.b, b.b)};
-                };
-                if (v == 1) c = mixc(c, Rgb{255, 214, 120}, 0.45);
-                if (v == 0) c = mixc(c, Rgb{20, 40, 140}, 0.55);
-                for (int y = 0; y < zoom; ++y)
-                    for (int x = 0; x < zoom; ++x) im.set(i * zoom + x, j * zoom + y, c);
-            }
+        paint_posts(im, t, 0, 0, W - 1, H - 1, zoom, [&](int i, int j, double s) {
+            const uint8_t gg = (uint8_t)std::lround(255 * (0.25 + 0.7 * s));
+            Rgb c{gg, gg, gg};
+            const uint8_t v = vis[(size_t)j * W + i];
+            if (v == 1) c = mix(c, Rgb{255, 214, 120}, 0.45);
+            if (v == 0) c = mix(c, Rgb{20, 40, 140}, 0.55);
+            return c;
+        });
         const double cx = (ob[0] - E0) / pe * zoom, cy = (ob[1] - N0) / pn * zoom;
         im.disc((int)cx, (int)cy, 6, kInk);
         im.disc((int)cx, (int)cy, 4, kWhite);

@@ -31,6 +31,9 @@ inline void put16(std::vector<uint8_t> &b, size_t off, uint32_t v) { put16(&b[of
 inline void put32(std::vector<uint8_t> &b, size_t off, uint32_t v) { put32(&b[off], v); }
 inline void put64(std::vector<uint8_t> &b, size_t off, int64_t v) { put64(&b[off], v); }
 
+// The 16-bit field at p.
+inline uint16_t get16(const uint8_t *p) { return (uint16_t)(p[0] | (p[1] << 8)); }
+
 // The 32-bit field at offset off (off + 4 <= b.size()).
 inline uint32_t get32(const std::vector<uint8_t> &b, size_t off)
 {

@@ -13,10 +13,28 @@
 #include <OpenImageIO/imageio.h>
 
 #include "host_io.hpp"
+#include "le.hpp"
 
 namespace ct_host {
 
 // Viridis (matplotlib's), 11 anchors at t = 0, 0.1, ..., 1, linear between.
+Terrain terrain_from_package(const ct_package &p)
+{
+    Terrain t;
+    t.width = (int)p.width;
+    t.height = (int)p.height;
+    t.codes.resize((size_t)p.width * p.height);
+    for (size_t k = 0; k < t.codes.size(); ++k) t.codes[k] = get16(p.heights + 2 * k);
+    t.geo.origin_e = p.origin_e_nm * 1e-9;
+    t.geo.origin_n = p.origin_n_nm * 1e-9;
+    t.geo.posting_e = p.posting_e_nm * 1e-9;
+    t.geo.posting_n = p.posting_n_nm * 1e-9;
+    t.geo.epsg = (int)p.epsg;
+    t.height_offset_m = p.height_offset_nm * 1e-9;
+    t.height_scale_m = p.height_scale_nm * 1e-9;
+    return t;
+}
+
 Rgb viridis(double t)
 {
     static const uint8_t a[11][3] = {{68, 1, 84},    {72, 36, 117},  {65, 68, 135},  {53, 95, 141},
@@ -27,6 +45,12 @@ Rgb viridis(double t)
     double f = t - k;
     auto mix = [&](int c) { return (uint8_t)std::lround(a[k][c] + f * (a[k + 1][c] - a[k][c])); };
     return Rgb{mix(0), mix(1), mix(2)};
+}
+
+Rgb mix(Rgb a, Rgb b, double f)
+{
+    auto m = [&](uint8_t x, uint8_t y) { return (uint8_t)std::lround(x + f * (y - x)); };
+    return Rgb{m(a.r, b.r), m(a.g, b.g), m(a.b, b.b)};
 }
 
 void Image::line(int x0, int y0, int x1, int y1, Rgb c)
@@ -111,6 +135,19 @@ std::vector<double> hillshade(const Terrain &t, int r, int wc, int hc)
         }
     for (size_t k = 0; k < sum.size(); ++k) sum[k] = cnt[k] ? sum[k] / cnt[k] : 1.0;
     return sum;
+}
+
+void paint_posts(Image &im, const Terrain &t, int i0, int j0, int i1, int j1, int zoom,
+                 const std::function<Rgb(int i, int j, double s)> &colour)
+{
+    const std::vector<double> shade = hillshade(t, 1, t.width - 1, t.height - 1);
+    for (int j = j0; j <= j1; ++j)
+        for (int i = i0; i <= i1; ++i) {
+            const double s = shade[(size_t)std::min(j, t.height - 2) * (t.width - 1) + std::min(i, t.width - 2)];
+            const Rgb c = colour(i, j, s);
+            for (int y = 0; y < zoom; ++y)
+                for (int x = 0; x < zoom; ++x) im.set((i - i0) * zoom + x, (j - j0) * zoom + y, c);
+        }
 }
 
 void write_png_atomic(const std::string &path, const Image &im, const std::string &desc,

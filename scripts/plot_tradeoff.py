@@ -29,6 +29,21 @@ def num(x):
         return math.nan
 
 
+def label(ax, xlabel, ylabel, title, legend=True):
+    """Axis labels, title, a log-friendly grid and (when asked) the legend."""
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.set_title(title)
+    ax.grid(True, which="both", alpha=0.3)
+    if legend:
+        ax.legend(fontsize=8)
+
+
+def save(fig, path):
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+
+
 def main():
     d = sys.argv[1] if len(sys.argv) > 1 else "build/tradeoff"
     rows = load(d + "/tradeoff.csv")
@@ -70,11 +85,9 @@ def main():
         ax.annotate(p["value"], (p["ns"], max(p["err"], 1e-5)), fontsize=7, xytext=(4, 3), textcoords="offset points")
     ax.set_xscale("log")
     ax.set_yscale("log")
-    ax.set_xlabel("time per pixel, unprojection included (ns, mean over the 4 scenes on the plain DEM)")
-    ax.set_ylabel("horizontal error RMS vs ground truth (m, worst scene)")
-    ax.set_title("What accuracy costs in time (one knob at a time from the defaults)")
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=8)
+    label(ax, "time per pixel, unprojection included (ns, mean over the 4 scenes on the plain DEM)",
+          "horizontal error RMS vs ground truth (m, worst scene)",
+          "What accuracy costs in time (one knob at a time from the defaults)")
     if chord:
         cs = sorted(chord, key=lambda q: q["ns"])
         bx.plot([p["ns"] for p in cs], [max(p["p99"], 1e-7) for p in cs], "o-", c=colors["chord"])
@@ -82,12 +95,9 @@ def main():
             bx.annotate(p["value"], (p["ns"], max(p["p99"], 1e-7)), fontsize=7, xytext=(4, 3), textcoords="offset points")
         bx.set_xscale("log")
         bx.set_yscale("log")
-        bx.set_xlabel("time per pixel (ns)")
-        bx.set_ylabel("error p99 vs the finest chord (m)")
-        bx.set_title("true Earth: the piece tolerance (chord)")
-        bx.grid(True, which="both", alpha=0.3)
-    fig.tight_layout()
-    fig.savefig(d + "/tradeoff_time_error.png", dpi=110)
+        label(bx, "time per pixel (ns)", "error p99 vs the finest chord (m)", "true Earth: the piece tolerance (chord)",
+              legend=False)
+    save(fig, d + "/tradeoff_time_error.png")
 
     # --- time against package size
     fig, ax = plt.subplots(figsize=(8, 5))
@@ -98,13 +108,9 @@ def main():
         for p in ps:
             ax.annotate(p["value"], (p["size"], p["ns"]), fontsize=7, xytext=(3, 2), textcoords="offset points")
     ax.set_xscale("log")
-    ax.set_xlabel("package size (x the 16-bit DEM)")
-    ax.set_ylabel("time per pixel (ns, mean over the scenes on the plain DEM)")
-    ax.set_title("Time against package size")
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(d + "/tradeoff_time_size.png", dpi=110)
+    label(ax, "package size (x the 16-bit DEM)", "time per pixel (ns, mean over the scenes on the plain DEM)",
+          "Time against package size")
+    save(fig, d + "/tradeoff_time_size.png")
 
     # --- steps against N for each r
     fig, ax = plt.subplots(figsize=(8, 5))
@@ -118,13 +124,9 @@ def main():
         ns = sorted(grid[r])
         ax.plot(ns, [grid[r][n] for n in ns], "o-", label="r = %d" % r)
     ax.set_xscale("log", base=2)
-    ax.set_xlabel("sectors N")
-    ax.set_ylabel("steps per pixel (directional, mean over the scenes)")
-    ax.set_title("Steps against the number of sectors, per reduction r")
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(d + "/tradeoff_steps_N.png", dpi=110)
+    label(ax, "sectors N", "steps per pixel (directional, mean over the scenes)",
+          "Steps against the number of sectors, per reduction r")
+    save(fig, d + "/tradeoff_steps_N.png")
 
     print("| setting | time per pixel (ns) | error RMS / p99 (worst scene) | wrong surface | package (x DEM) |")
     print("|---|---|---|---|---|")

@@ -10,6 +10,7 @@
 
 #include "conetrace.h"
 #include "harness.h"
+#include "reference.hpp"
 #include "terrain.hpp"
 
 #ifndef CT_FIXTURES_DIR
@@ -226,6 +227,16 @@ inline ct_ray to_ray(double x, double y, double z, const double d[3])
     r.dy = std::llround(d[1] * s);
     r.dz = std::llround(d[2] * s);
     return r;
+}
+
+// The terrain's codes as the reference tracer's height field.
+inline ref::Dem ref_dem(const ct_host::Terrain &t)
+{
+    ref::Dem d;
+    d.w = t.width;
+    d.h = t.height;
+    d.z.assign(t.codes.begin(), t.codes.end());
+    return d;
 }
 
 inline void minmax(const ct_host::Terrain &t, double *lo, double *hi)

@@ -64,10 +64,7 @@ void run_scene(const dem_cases::Case &cs, const Scene &sc, long nrays, Counts *c
 {
     ct_package p;
     TEST_ASSERT_EQUAL_INT(CT_OK, ct_package_open(&p, cs.pkg.data(), cs.pkg.size()));
-    ref::Dem d;
-    d.w = cs.t.width;
-    d.h = cs.t.height;
-    d.z.assign(cs.t.codes.begin(), cs.t.codes.end());
+    const ref::Dem d = dem_cases::ref_dem(cs.t);
     double lo, hi;
     dem_cases::minmax(cs.t, &lo, &hi);
     const ld posting = (ld)std::fabs(cs.t.geo.posting_e), scale = (ld)cs.t.height_scale_m;

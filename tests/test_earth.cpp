@@ -475,6 +475,21 @@ struct Stat {
     }
 };
 
+// Stats summed over the families: the worst errors, RMS and status mismatches.
+struct Total {
+    double worst = 0, worst_off = 0, sum2 = 0;
+    long bad = 0, n = 0;
+    void add(const Stat &s)
+    {
+        worst = std::max(worst, s.max);
+        worst_off = std::max(worst_off, s.max_off);
+        sum2 += s.sum2;
+        n += s.n;
+        bad += s.mismatch;
+    }
+    double rms() const { return n ? std::sqrt(sum2 / (double)n) : 0; }
+};
+
 std::vector<PoseDef> pose_defs()
 {
     const ld Ec = 201045, Nc = 4065840;
@@ -656,8 +671,7 @@ void compare(unsigned flags)
     std::printf("  %-10s %5s %5s %5s | %-46s | %-46s\n", "family", "hits", "miss", "skip",
                 "exact mode (radius 0): median / RMS / max, bad, wall",
                 "old parabola (6371 km): median / RMS / max, bad, wall");
-    double worst = 0, worst_off = 0, sum2 = 0;
-    long bad = 0, n = 0;
+    Total ex, fi, km;
     for (int f = 0; f < nf; ++f) {
         std::printf("  %-10s %5ld %5ld %5ld | %8.4f %8.4f %9.4f m %4ld %4ld | %8.4f %8.4f %9.4f m %4ld %4ld  (mean range "
                     "%.0f m)\n",
@@ -665,45 +679,29 @@ void compare(unsigned flags)
                     exact[f].max, exact[f].mismatch, exact[f].wall_below, old[f].median(), old[f].rms(), old[f].max,
                     old[f].mismatch, old[f].wall_below, (double)(rng_sum[f] / std::max<long>(1, ref_hits[f])));
         if (exact[f].n) std::printf("  %-10s   worst (exact mode): %s\n", "", exact[f].worst);
-        worst = std::max(worst, exact[f].max);
-        worst_off = std::max(worst_off, exact[f].max_off);
-        sum2 += exact[f].sum2;
-        n += exact[f].n;
-        bad += exact[f].mismatch;
+        ex.add(exact[f]);
     }
-    double fworst = 0, fworst_off = 0, fsum2 = 0;
-    long fbad = 0, fn = 0;
     for (int f = 0; f < nf; ++f) {
         std::printf("  %-10s fitted map (CT_EFFECT_EARTH_FIT): %5ld hits, median / RMS / max %8.4f %8.4f %9.4f m, "
                     "bad %ld, wall %ld\n",
                     families[f], fitted[f].n, fitted[f].median(), fitted[f].rms(), fitted[f].max, fitted[f].mismatch,
                     fitted[f].wall_below);
         if (fitted[f].n) std::printf("  %-10s   worst (fitted map): %s\n", "", fitted[f].worst);
-        fworst = std::max(fworst, fitted[f].max);
-        fworst_off = std::max(fworst_off, fitted[f].max_off);
-        fsum2 += fitted[f].sum2;
-        fn += fitted[f].n;
-        fbad += fitted[f].mismatch;
+        fi.add(fitted[f]);
     }
     std::printf("  ct_los on the true Earth: %ld reference hits visible from the camera, 30 m under them hidden; "
                 "%ld wrong\n", los_checked, los_bad);
     TEST_ASSERT_MSG(los_bad == 0 && los_checked > 300, "ct_los: %ld wrong of %ld", los_bad, los_checked);
-    double kworst = 0, kworst_off = 0, ksum2 = 0;
-    long kbad = 0, kn = 0;
-    for (int f = 0; f < nf; ++f) {
-        kworst = std::max(kworst, kmap[f].max);
-        kworst_off = std::max(kworst_off, kmap[f].max_off);
-        ksum2 += kmap[f].sum2;
-        kn += kmap[f].n;
-        kbad += kmap[f].mismatch;
-    }
-    const double krms = kn ? std::sqrt(ksum2 / (double)kn) : 0;
+    for (int f = 0; f < nf; ++f) km.add(kmap[f]);
+    const double kworst = km.worst, kworst_off = km.worst_off, krms = km.rms();
+    const long kbad = km.bad, kn = km.n;
     std::printf("  kept map (ct_earth_map_init, one for all poses): %ld hits within %.4f m of the reference path, RMS "
                 "%.4f m, max %.4f m from the reference hit, %ld statuses differ\n",
                 kn, kworst_off, krms, kworst, kbad);
     TEST_ASSERT_MSG(kworst_off <= kMaxOffPathM && krms <= kMaxRmsM && kbad == 0 && kworst <= kMaxErrM,
                     "kept map: off path %.4f, RMS %.4f, %ld bad, max %.4f m", kworst_off, krms, kbad, kworst);
-    const double frms = fn ? std::sqrt(fsum2 / (double)fn) : 0;
+    const double fworst = fi.worst, fworst_off = fi.worst_off, frms = fi.rms();
+    const long fbad = fi.bad;
     std::printf("  fitted map: hits within %.4f m of the reference path, RMS %.4f m, max %.4f m from the reference "
                 "hit; vs the exact map's hits: up to %.4f m apart, %ld statuses differ\n",
                 fworst_off, frms, fworst, fit_vs_exact, fit_status_diff);
@@ -712,7 +710,8 @@ void compare(unsigned flags)
     TEST_ASSERT_MSG(frms <= kMaxRmsM, "fitted map: RMS %.4f m (> %.4f m)", frms, kMaxRmsM);
     TEST_ASSERT_MSG(fbad == 0, "fitted map: %ld rays with a status different from the reference's", fbad);
     TEST_ASSERT_MSG(fworst <= kMaxErrM, "fitted map off the reference by up to %.4f m (> %.4f m)", fworst, kMaxErrM);
-    const double rms = n ? std::sqrt(sum2 / (double)n) : 0;
+    const double worst = ex.worst, worst_off = ex.worst_off, rms = ex.rms();
+    const long bad = ex.bad;
     std::printf("  exact mode: hits within %.4f m of the reference path (bound %.4f m), RMS %.4f m, max %.4f m from "
                 "the reference hit\n", worst_off, kMaxOffPathM, rms, worst);
     TEST_ASSERT_MSG(worst_off <= kMaxOffPathM, "a library hit %.4f m off the reference path (> %.4f m)", worst_off,

@@ -744,10 +744,7 @@ void test_viewshed()
     Setup *s = setup();
     TEST_ASSERT(s != nullptr);
     const ct_package &p = s->p;
-    ref::Dem d;
-    d.w = s->c.t.width;
-    d.h = s->c.t.height;
-    d.z.assign(s->c.t.codes.begin(), s->c.t.codes.end());
+    const ref::Dem d = dem_cases::ref_dem(s->c.t);
     const ref::ld pe = std::fabs(p.posting_e_nm * 1e-9L), pn = std::fabs(p.posting_n_nm * 1e-9L),
                   hs = p.height_scale_nm * 1e-9L;
     for (int bent = 0; bent < 2; ++bent)
@@ -830,10 +827,7 @@ void test_shadows()
     Setup *s = setup();
     TEST_ASSERT(s != nullptr);
     const ct_package &p = s->p;
-    ref::Dem d;
-    d.w = s->c.t.width;
-    d.h = s->c.t.height;
-    d.z.assign(s->c.t.codes.begin(), s->c.t.codes.end());
+    const ref::Dem d = dem_cases::ref_dem(s->c.t);
     const ref::ld hs = p.height_scale_nm * 1e-9L;
     for (const char *sun : {"135,20", "300,6", "10,60"}) {
         Run r = run({"shadows", "t.ctp", "--sun", sun, "--lift", "0.1", "-o", "sh.tif", "--png", "sh.png"});

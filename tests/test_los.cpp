@@ -39,10 +39,7 @@ void run_case(const dem_cases::Case &cs, bool bent, Tally *ty)
 {
     ct_package p;
     TEST_ASSERT_EQUAL_INT(CT_OK, ct_package_open(&p, cs.pkg.data(), cs.pkg.size()));
-    ref::Dem d;
-    d.w = cs.t.width;
-    d.h = cs.t.height;
-    d.z.assign(cs.t.codes.begin(), cs.t.codes.end());
+    const ref::Dem d = dem_cases::ref_dem(cs.t);
     const ld pe = std::fabs(p.posting_e_nm * 1e-9L), pn = std::fabs(p.posting_n_nm * 1e-9L),
              hs = p.height_scale_nm * 1e-9L;
     const ld R = std::ldexp(1.0L, 44) * 1e-9L;               // m

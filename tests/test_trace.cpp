@@ -72,10 +72,7 @@ void check_case(const dem_cases::Case &cs, long nrays, Stats *st, std::map<std::
     ct_package p;
     TEST_ASSERT_EQUAL_INT(CT_OK, ct_package_open(&p, cs.pkg.data(), cs.pkg.size()));
     TEST_ASSERT_EQUAL_INT(CT_OK, ct_package_verify(&p));
-    ref::Dem d;
-    d.w = cs.t.width;
-    d.h = cs.t.height;
-    d.z.assign(cs.t.codes.begin(), cs.t.codes.end());
+    const ref::Dem d = dem_cases::ref_dem(cs.t);
     ct_rng rng;
     ct_rng_seed(&rng, ct_test_seed() * 7919u + (uint64_t)cs.name.size() * 131u + cs.t.width);
     int reported = 0;

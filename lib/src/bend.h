@@ -15,6 +15,13 @@ extern "C" {
  * CT_OK, or CT_ERR_ARG for a parameter out of range or Delta < 1/64 cell. */
 ct_status ct_bend_segment(const ct_package *pkg, const ct_bend *bd, int64_t *delta_q16);
 
+/* The caller's effects as a bend (geoloc.c): c = [curvature] - k
+ * [refraction] in Q16 (0 = straight; fx == NULL: none), the radius and
+ * chord with their defaults, bd->flags 0.  CT_ERR_EFFECTS for an unknown
+ * flag, |k| > 2, an earth_map not fitted for pkg, or a radius or chord out
+ * of ct_bend_segment's ranges (checked whatever c is).                    */
+ct_status ct_effects_to_bend(const ct_package *pkg, const ct_effects *fx, ct_bend *bd);
+
 /* Lowered terrain (trace.c): a bent ray with c > 0 is traced as its straight
  * tangent at the observer against the terrain lowered, post by post, by the
  * bend's rise at that post's horizontal range from the observer:

@@ -36,8 +36,8 @@ typedef struct {
 
 #define K_MAX_Q16 (2 * 65536)
 
-/* Effects to a bend (coeff 0 = none); CT_ERR_EFFECTS when out of range. */
-static ct_status effects_to_bend(const ct_package *p, const ct_effects *fx, ct_bend *bd)
+/* Declared in bend.h (shared with los.c). */
+ct_status ct_effects_to_bend(const ct_package *p, const ct_effects *fx, ct_bend *bd)
 {
     int64_t delta;
     int32_t c = 0;
@@ -93,7 +93,7 @@ static ct_status setup(const ct_package *p, const ct_camera *cam, const ct_pose 
     if ((unsigned)m >= (unsigned)CT_METHOD_COUNT) {
         return CT_ERR_METHOD;
     }
-    if (effects_to_bend(p, effects, &s->bend) != CT_OK) {
+    if (ct_effects_to_bend(p, effects, &s->bend) != CT_OK) {
         return CT_ERR_EFFECTS;
     }
     if (ct_map_to_grid(p, pose->e_nm, pose->n_nm, pose->h_nm, &s->ox, &s->oy, &s->oz) != CT_OK ||
@@ -127,7 +127,7 @@ static ct_status setup(const ct_package *p, const ct_camera *cam, const ct_pose 
         }
     }
     if (s->bend.coeff_q16 != 0 && ct_bent_prepare(p, &s->bend, s->ox, s->oy, &s->bent) != CT_OK) {
-        return CT_ERR_EFFECTS; /* checked by effects_to_bend already */
+        return CT_ERR_EFFECTS; /* checked by ct_effects_to_bend already */
     }
     return CT_OK;
 }

@@ -14,18 +14,16 @@
 #include "bend.h"
 #include "fixed.h"
 
-/* |P - A| for map points in nm (each difference < 2^63 by the callers'
- * ranges, capped at 2^61: squares < 2^123, the sum < 2^125). */
-static int64_t dist_nm(int64_t ae, int64_t an, int64_t ah, int64_t pe, int64_t pn, int64_t ph)
+/* |x - y| for points in nm: map points (|.| <= 2^61, checked by the
+ * callers: each difference capped at 2^61) or ECEF points (|.| < 2^55: the
+ * cap never applies); squares < 2^122, the sum < 2^124. */
+static int64_t dist3(const int64_t x[3], const int64_t y[3])
 {
-    int64_t d[3];
     ct_i128 s = ct_i128_from64(0);
     int k;
-    d[0] = ct_min64(ct_abs64(pe - ae), INT64_C(1) << 61);
-    d[1] = ct_min64(ct_abs64(pn - an), INT64_C(1) << 61);
-    d[2] = ct_min64(ct_abs64(ph - ah), INT64_C(1) << 61);
     for (k = 0; k < 3; ++k) { /* bound: 3 axes */
-        s = ct_i128_add(s, ct_i128_mul(d[k], d[k]));
+        int64_t d = ct_min64(ct_abs64(x[k] - y[k]), INT64_C(1) << 61);
+        s = ct_i128_add(s, ct_i128_mul(d, d));
     }
     return (int64_t)ct_i128_isqrt(s);
 }
@@ -36,18 +34,6 @@ static ct_status to_ecef(const ct_utm *zone, const int64_t m[3], int64_t x[3])
     int64_t lat, lon;
     ct_status st = ct_utm_inverse(zone, m[0], m[1], &lat, &lon);
     return st == CT_OK ? ct_ecef_from_wgs84(lat, lon, m[2], x) : st;
-}
-
-/* |x - y| for ECEF points (nm, |.| < 2^55: differences < 2^56, squares in
- * 128 bits) */
-static int64_t dist_ecef(const int64_t x[3], const int64_t y[3])
-{
-    ct_i128 s = ct_i128_from64(0);
-    int k;
-    for (k = 0; k < 3; ++k) { /* bound: 3 axes */
-        s = ct_i128_add(s, ct_i128_mul(x[k] - y[k], x[k] - y[k]));
-    }
-    return (int64_t)ct_i128_isqrt(s);
 }
 
 /* The true Earth (curvature with radius 0 on a UTM package): the Earth-fixed
@@ -88,7 +74,7 @@ static ct_status los_earth(const ct_package *p, const int64_t a_nm[3], const int
         /* aim above B by k t^2 / 2R along the camera's vertical (the
          * frame's third column): t < 2^50 capped, t^2 |k| < 2^117, / 2R
          * saturated at 2^62, / 2^16 */
-        int64_t t = ct_min64(dist_ecef(A, B), INT64_C(1) << 50);
+        int64_t t = ct_min64(dist3(A, B), INT64_C(1) << 50);
         int64_t up = ct_floor_div(ct_i128_floor_div_sat(ct_i128_mul128_64(ct_i128_mul(t, t), fx->refraction_k_q16),
                                                         2 * CT_EARTH_RADIUS_NM),
                                   65536);
@@ -135,8 +121,8 @@ static ct_status los_earth(const ct_package *p, const int64_t a_nm[3], const int
         if (to_ecef(&zone, hm, H) != CT_OK) {
             return CT_ERR_RAY;
         }
-        lim = dist_ecef(A, B) - margin_nm;
-        return dist_ecef(A, H) < lim ? CT_HIT : CT_OK;
+        lim = dist3(A, B) - margin_nm;
+        return dist3(A, H) < lim ? CT_HIT : CT_OK;
     }
 }
 
@@ -179,27 +165,11 @@ ct_status ct_los(const ct_package *p, const int64_t a_nm[3], const int64_t b_nm[
          * lowered walk from A; c = 0 is a straight line; c < 0 (k > 1) is
          * not offered (CT_ERR_EFFECTS) */
         ct_bend bd;
-        int32_t c = 0;
-        if ((effects->flags & ~(CT_EFFECT_ALL | CT_EFFECT_EARTH_FIT)) != 0u || effects->refraction_k_q16 < -131072 ||
-            effects->refraction_k_q16 > 131072) {
+        if (ct_effects_to_bend(p, effects, &bd) != CT_OK || bd.coeff_q16 < 0) {
             return CT_ERR_EFFECTS;
         }
-        if ((effects->flags & CT_EFFECT_CURVATURE) != 0u) {
-            c = 65536;
-        }
-        if ((effects->flags & CT_EFFECT_REFRACTION) != 0u) {
-            c -= effects->refraction_k_q16;
-        }
-        if (c < 0) {
-            return CT_ERR_EFFECTS;
-        }
-        if (c > 0) {
-            bd.coeff_q16 = c;
-            bd.radius_nm = effects->earth_radius_nm == 0 ? CT_EARTH_RADIUS_NM : effects->earth_radius_nm;
-            bd.chord_nm = CT_EFFECTS_CHORD_NM;
-            bd.flags = 0u;
-            if (bd.radius_nm < (INT64_C(1) << 40) || bd.radius_nm > (INT64_C(1) << 54) ||
-                ct_lower_setup(p, ax, ay, &bd, &lw) != CT_OK) {
+        if (bd.coeff_q16 > 0) {
+            if (ct_lower_setup(p, ax, ay, &bd, &lw) != CT_OK) {
                 return CT_ERR_EFFECTS;
             }
             lwp = &lw;
@@ -232,8 +202,13 @@ ct_status ct_los(const ct_package *p, const int64_t a_nm[3], const int64_t b_nm[
         return st;
     }
     if (st == CT_HIT || st == CT_HIT_VOID) {
-        int64_t dh = dist_nm(a_nm[0], a_nm[1], a_nm[2], block->e_nm, block->n_nm, block->h_nm);
-        int64_t db = dist_nm(a_nm[0], a_nm[1], a_nm[2], b_nm[0], b_nm[1], b_nm[2]);
+        int64_t h[3];
+        int64_t dh, db;
+        h[0] = block->e_nm;
+        h[1] = block->n_nm;
+        h[2] = block->h_nm;
+        dh = dist3(a_nm, h);
+        db = dist3(a_nm, b_nm);
         return dh < db - margin_nm ? CT_HIT : CT_OK;
     }
     return st == CT_BELOW ? CT_BELOW : CT_OK;
@@ -267,26 +242,18 @@ ct_status ct_locate_inverse(const ct_package *p, const ct_camera *cam, const ct_
         /* the apparent point: the line of sight rises c rho^2 / 2R on its
          * way, so the camera sees the point along the tangent to the point
          * lowered by that rise (the sphere of the effects' radius) */
-        int32_t cq = 0;
-        int64_t R = effects->earth_radius_nm == 0 ? CT_EARTH_RADIUS_NM : effects->earth_radius_nm;
+        ct_bend bd;
         int64_t rho2h;
-        if ((effects->flags & CT_EFFECT_CURVATURE) != 0u) {
-            cq = 65536;
-        }
-        if ((effects->flags & CT_EFFECT_REFRACTION) != 0u) {
-            cq -= effects->refraction_k_q16;
-        }
-        if (R < (INT64_C(1) << 40) || R > (INT64_C(1) << 54) || effects->refraction_k_q16 < -131072 ||
-            effects->refraction_k_q16 > 131072) {
+        if (ct_effects_to_bend(p, effects, &bd) != CT_OK) {
             return CT_ERR_EFFECTS;
         }
         /* rho^2 / 2R with rho <= 2^50 (capped): < 2^100 / 2^41 */
         {
             int64_t de = ct_min64(ct_abs64(d[0]), INT64_C(1) << 50), dn = ct_min64(ct_abs64(d[1]), INT64_C(1) << 50);
-            rho2h = ct_i128_floor_div_sat(ct_i128_add(ct_i128_mul(de, de), ct_i128_mul(dn, dn)), 2 * R);
+            rho2h = ct_i128_floor_div_sat(ct_i128_add(ct_i128_mul(de, de), ct_i128_mul(dn, dn)), 2 * bd.radius_nm);
         }
         /* |c| <= 3 2^16: the rise, capped at 2^60 (|d| <= 2^62: no wrap) */
-        rise = ct_i128_floor_div_sat(ct_i128_mul(rho2h, cq), 65536);
+        rise = ct_i128_floor_div_sat(ct_i128_mul(rho2h, bd.coeff_q16), 65536);
         rise = ct_max64(-(INT64_C(1) << 60), ct_min64(INT64_C(1) << 60, rise));
         d[2] -= rise;
     }
