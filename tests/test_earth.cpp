@@ -827,10 +827,17 @@ void test_fitted_map()
         other.origin_e_nm += 1;
         TEST_ASSERT_EQUAL_INT(CT_ERR_EFFECTS,
                               ct_geolocate(&other, &cam.cam, &p.pose, CT_METHOD_DIRECTIONAL, &fx, 100 << 16, 100 << 16, &g));
+        // ct_los refuses the same maps (its effects checked as ct_geolocate's)
+        const int64_t la[3] = {p.pose.e_nm, p.pose.n_nm, p.pose.h_nm};
+        const int64_t lb[3] = {201045000000000, 4065840000000000, 300000000000};
+        ct_hit lh;
+        TEST_ASSERT(ct_los(&pk, la, lb, &fx, 0, CT_METHOD_DIRECTIONAL, &lh) >= 0);
+        TEST_ASSERT_EQUAL_INT(CT_ERR_EFFECTS, ct_los(&other, la, lb, &fx, 0, CT_METHOD_DIRECTIONAL, &lh));
         static ct_earth_map blank;
         fx.earth_map = &blank;
         TEST_ASSERT_EQUAL_INT(CT_ERR_EFFECTS,
                               ct_geolocate(&pk, &cam.cam, &p.pose, CT_METHOD_DIRECTIONAL, &fx, 100 << 16, 100 << 16, &g));
+        TEST_ASSERT_EQUAL_INT(CT_ERR_EFFECTS, ct_los(&pk, la, lb, &fx, 0, CT_METHOD_DIRECTIONAL, &lh));
         TEST_ASSERT_EQUAL_INT(CT_ERR_RANGE, ct_earth_map_init(&pk, 201045000000000, 4065840000000000, 0, 0, &blank));
         TEST_ASSERT_EQUAL_INT(CT_ERR_RANGE, ct_earth_map_init(&pk, 201045000000000, 4065840000000000, 0,
                                                               (INT64_C(1) << 47) + 1, &blank));

@@ -734,8 +734,10 @@ ct_status ct_effects_for_tolerance(const ct_package *pkg, const ct_camera *cam, 
  * first point, as ct_trace's hit -- so a target on the ground, met at
  * itself, is visible; CT_BELOW: A under the surface.  Errors: CT_ERR_ARG
  * (NULL, margin < 0), CT_ERR_METHOD, CT_ERR_RAY (a point beyond
- * CT_MAX_ORIGIN_Q16 of the tile, or A = B), CT_ERR_EFFECTS (c < 0, R out
- * of range, or a bend the lowered walk cannot take from A).               */
+ * CT_MAX_ORIGIN_Q16 of the tile, or A = B), CT_ERR_EFFECTS (effects that
+ * ct_geolocate refuses -- unknown flags, |k| > 2, R or chord out of range,
+ * another package's earth_map -- or, on the sphere, c < 0 or a bend the
+ * lowered walk cannot take from A).                                       */
 ct_status ct_los(const ct_package *pkg, const int64_t a_nm[3], const int64_t b_nm[3], const ct_effects *effects,
                  int64_t margin_nm, ct_method method, ct_hit *block);
 

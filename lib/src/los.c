@@ -40,9 +40,10 @@ static ct_status to_ecef(const ct_utm *zone, const int64_t m[3], int64_t x[3])
  * line of sight from A aimed at B (with refraction, at B raised by k t^2 /
  * 2R along the vertical at B, the bent path's drop there), traced by
  * earth.c as geolocation does; hidden when its first hit lies more than the
- * margin (Earth-fixed distance from A) before B.  CT_ERR_CRS: not UTM. */
+ * margin (Earth-fixed distance from A) before B.  fx checked and its chord
+ * taken by the caller (ct_effects_to_bend).  CT_ERR_CRS: not UTM. */
 static ct_status los_earth(const ct_package *p, const int64_t a_nm[3], const int64_t b_nm[3],
-                           const ct_effects *fx, int64_t margin_nm, ct_method m, ct_hit *block)
+                           const ct_effects *fx, int64_t chord_nm, int64_t margin_nm, ct_method m, ct_hit *block)
 {
     static const int32_t ident[9] = {1 << 30, 0, 0, 0, 1 << 30, 0, 0, 0, 1 << 30};
     ct_utm zone;
@@ -59,7 +60,7 @@ static ct_status los_earth(const ct_package *p, const int64_t a_nm[3], const int
         return CT_ERR_RAY;
     }
     st = ct_earth_setup(p, &pose, (fx->flags & CT_EFFECT_REFRACTION) != 0u ? fx->refraction_k_q16 : 0,
-                        CT_EARTH_RADIUS_NM, fx->chord_nm != 0 ? fx->chord_nm : CT_EFFECTS_CHORD_NM, 0u,
+                        CT_EARTH_RADIUS_NM, chord_nm, 0u,
                         (fx->flags & CT_EFFECT_EARTH_FIT) != 0u, fx->earth_map, &es);
     if (st != CT_OK) {
         return st == CT_ERR_RAY ? CT_ERR_RAY : CT_ERR_EFFECTS;
@@ -131,6 +132,7 @@ ct_status ct_los(const ct_package *p, const int64_t a_nm[3], const int64_t b_nm[
 {
     ct_ray ray;
     ct_prepared pr;
+    ct_bend bd;
     ct_lower lw;
     const ct_lower *lwp = NULL;
     int64_t ax, ay, az, bx, by, bz;
@@ -153,27 +155,28 @@ ct_status ct_los(const ct_package *p, const int64_t a_nm[3], const int64_t b_nm[
         ct_abs64(by) > CT_MAX_ORIGIN_Q16 || ct_abs64(bz) > CT_MAX_ORIGIN_Q16) {
         return CT_ERR_RAY;
     }
+    /* the effects checked as for geolocation (both models below) */
+    if (ct_effects_to_bend(p, effects, &bd) != CT_OK) {
+        return CT_ERR_EFFECTS;
+    }
     if (effects != NULL && (effects->flags & CT_EFFECT_CURVATURE) != 0u && effects->earth_radius_nm == 0) {
         /* the true Earth where the package is on a UTM zone */
-        st = los_earth(p, a_nm, b_nm, effects, margin_nm, m, block);
+        st = los_earth(p, a_nm, b_nm, effects, bd.chord_nm, margin_nm, m, block);
         if (st != CT_ERR_CRS) {
             return st;
         }
     }
-    if (effects != NULL && (effects->flags & CT_EFFECT_ALL) != 0u) {
-        /* the sphere model: c = [curvature] - k [refraction] > 0 as a
-         * lowered walk from A; c = 0 is a straight line; c < 0 (k > 1) is
-         * not offered (CT_ERR_EFFECTS) */
-        ct_bend bd;
-        if (ct_effects_to_bend(p, effects, &bd) != CT_OK || bd.coeff_q16 < 0) {
+    /* the sphere model: c = [curvature] - k [refraction] > 0 as a lowered
+     * walk from A; c = 0 is a straight line; c < 0 (k > 1) is not offered
+     * (CT_ERR_EFFECTS) */
+    if (bd.coeff_q16 < 0) {
+        return CT_ERR_EFFECTS;
+    }
+    if (bd.coeff_q16 > 0) {
+        if (ct_lower_setup(p, ax, ay, &bd, &lw) != CT_OK) {
             return CT_ERR_EFFECTS;
         }
-        if (bd.coeff_q16 > 0) {
-            if (ct_lower_setup(p, ax, ay, &bd, &lw) != CT_OK) {
-                return CT_ERR_EFFECTS;
-            }
-            lwp = &lw;
-        }
+        lwp = &lw;
     }
     ray.x_q16 = ax;
     ray.y_q16 = ay;
