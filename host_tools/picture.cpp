@@ -17,7 +17,6 @@
 
 namespace ct_host {
 
-// Viridis (matplotlib's), 11 anchors at t = 0, 0.1, ..., 1, linear between.
 Terrain terrain_from_package(const ct_package &p)
 {
     Terrain t;
@@ -35,6 +34,7 @@ Terrain terrain_from_package(const ct_package &p)
     return t;
 }
 
+// Viridis (matplotlib's), 11 anchors at t = 0, 0.1, ..., 1, linear between.
 Rgb viridis(double t)
 {
     static const uint8_t a[11][3] = {{68, 1, 84},    {72, 36, 117},  {65, 68, 135},  {53, 95, 141},
