@@ -217,8 +217,8 @@ void build_package_to(const Terrain &t, const BuildOptions &opt, PackageSink &si
         put16(h, CT_HDR_HMIN, hmin);
         put16(h, CT_HDR_HMAX, hmax);
         put32(h, CT_HDR_SLICES, (uint32_t)slices_header);
-        put64(h, CT_HDR_ORIGIN_E, metres_to_nm(t.geo.origin_e));
-        put64(h, CT_HDR_ORIGIN_N, metres_to_nm(t.geo.origin_n));
+        put64(h, CT_HDR_ORIGIN_E, t.geo.origin_nm_set ? t.geo.origin_e_nm : metres_to_nm(t.geo.origin_e));
+        put64(h, CT_HDR_ORIGIN_N, t.geo.origin_nm_set ? t.geo.origin_n_nm : metres_to_nm(t.geo.origin_n));
         put64(h, CT_HDR_POSTING_E, pe);
         put64(h, CT_HDR_POSTING_N, pn);
         put64(h, CT_HDR_HEIGHT_OFFSET, metres_to_nm(t.height_offset_m));

@@ -20,6 +20,10 @@ struct Georef {
     double posting_e = 30.0, posting_n = -30.0;  // metres; |e| == |n|
     int epsg = 0;                                // 0 = unknown
     int source_epsg = 0;  // the source DEM's CRS when it was resampled onto epsg (0: not resampled)
+    // the package header's origin exactly, in nm, instead of origin_e/n
+    // rounded (a tile of a tile set: the set's origin plus whole postings)
+    bool origin_nm_set = false;
+    int64_t origin_e_nm = 0, origin_n_nm = 0;
 };
 
 // A geoid grid as a package's datum section stores it (conetrace.h): node

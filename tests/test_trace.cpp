@@ -19,13 +19,12 @@
 #include "conetrace.h"
 #include "dem_cases.hpp"
 #include "harness.h"
+#include "judge.hpp"
 #include "reference.hpp"
 #include "terrain.hpp"
 
 namespace {
 
-constexpr double POS_TOL_Q16 = 2.5;   // stated bound: 2 Q16 units per axis (+ reference slack)
-constexpr double EPS_LSB = 1e-6;      // tangency band for disputes
 
 struct Stats {
     long rays = 0, hits = 0, misses = 0, below = 0, tangent = 0, wrong = 0, prep_miss = 0;
@@ -33,39 +32,6 @@ struct Stats {
     long steps[4] = {0, 0, 0, 0};
     long iters[4] = {0, 0, 0, 0};
 };
-
-ref::Ray to_ref(const ct_prepared &p)
-{
-    ref::Ray r;
-    r.ox = (ref::ld)p.ox / 65536;
-    r.oy = (ref::ld)p.oy / 65536;
-    r.oz = std::ldexp((ref::ld)p.oz, p.zshift) / 65536;  // z in units of 2^zshift Q16
-    r.dx = (ref::ld)p.dx / 65536;
-    r.dy = (ref::ld)p.dy / 65536;
-    r.dz = std::ldexp((ref::ld)p.dz, p.zshift) / 65536;
-    r.tend = (ref::ld)p.tend_n / (ref::ld)p.tend_d;
-    return r;
-}
-
-// Classify a disagreement; returns true when it is a tangency.
-bool tangent_ok(const ref::Dem &d, const ref::Ray &r, int ls, ref::ld tl, const ref::Hit &rh)
-{
-    const ref::ld e = EPS_LSB, dt = 1.0L / (1 << 25);
-    bool lhit = ls == CT_HIT || ls == CT_HIT_VOID;
-    if (ls == CT_BELOW || rh.status == ref::BELOW) {
-        return std::fabs((double)(r.oz - ref::surface(d, r.ox, r.oy))) <= EPS_LSB;
-    }
-    if (lhit && (rh.status != ref::HIT || tl < rh.t)) {
-        // the library stops earlier: it must be touching there
-        return ref::min_clearance(d, r, tl, tl + dt) <= e;
-    }
-    if (rh.status == ref::HIT && (!lhit || tl > rh.t)) {
-        // the library goes on past the reference's hit: that hit must be a graze
-        ref::ld upto = lhit ? tl : r.tend;
-        return ref::min_clearance(d, r, rh.t - dt, upto) >= -e;
-    }
-    return false;
-}
 
 void check_case(const dem_cases::Case &cs, long nrays, Stats *st, std::map<std::string, Stats> *fam)
 {
@@ -120,25 +86,16 @@ void check_case(const dem_cases::Case &cs, long nrays, Stats *st, std::map<std::
                             (long long)h[0].x_q16, (long long)h[m].y_q16, (long long)h[0].y_q16, (long long)h[m].z_q16,
                             (long long)h[0].z_q16);
         }
-        ref::Ray rr = to_ref(pr);
-        ref::Hit rh = ref::trace(d, rr);
+        ref::Hit rh;
+        double err = 0;
+        const judge::Verdict v = judge::judge(d, pr, s[0], h[0], &rh, &err);
         bool lhit = s[0] == CT_HIT || s[0] == CT_HIT_VOID;
-        bool agree;
-        if (lhit && rh.status == ref::HIT) {
-            double ex = std::fabs((double)(h[0].x_q16 - rh.x * 65536));
-            double ey = std::fabs((double)(h[0].y_q16 - rh.y * 65536));
-            double ez = std::fabs((double)(h[0].z_q16 - rh.z * 65536));
-            double e = std::max(ex, std::max(ey, ez));
-            agree = e <= POS_TOL_Q16;
-            if (agree) st->max_err_q16 = std::max(st->max_err_q16, e);
-        } else {
-            agree = (s[0] == CT_MISS && rh.status == ref::MISS) || (s[0] == CT_BELOW && rh.status == ref::BELOW);
-        }
+        if (v == judge::AGREE && lhit) st->max_err_q16 = std::max(st->max_err_q16, err);
         if (lhit) st->hits++;
         if (s[0] == CT_MISS) st->misses++;
         if (s[0] == CT_BELOW) st->below++;
-        if (agree) continue;
-        if (tangent_ok(d, rr, s[0], (ref::ld)h[0].t_q26 / (1 << 26), rh)) {
+        if (v == judge::AGREE) continue;
+        if (v == judge::TANGENT) {
             st->tangent++;
             fs.tangent++;
             continue;
@@ -183,7 +140,7 @@ void run_cases(const std::vector<dem_cases::Case> &cases)
                     std::printf("    family %-12s wrong %ld of %ld\n", kv.first.c_str(), kv.second.wrong, kv.second.rays);
         }
         TEST_ASSERT_MSG(st.wrong == 0, "%s: %ld wrong-surface results", cs.name.c_str(), st.wrong);
-        TEST_ASSERT_MSG(st.max_err_q16 <= POS_TOL_Q16, "position error above bound");
+        TEST_ASSERT_MSG(st.max_err_q16 <= judge::POS_TOL_Q16, "position error above bound");
     }
 }
 

@@ -934,6 +934,142 @@ ct_status ct_wgs84_from_ecef(const int64_t xyz_nm[3], int64_t *lat_q61, int64_t 
 ct_status ct_utm_inverse(const ct_utm *zone, int64_t e_nm, int64_t n_nm,
                          int64_t *lat_q61, int64_t *lon_q61);
 
+/* ------------------------------------------------------------------------ */
+/* Tile sets (lib/src/tiles.c): terrain larger than one package.             */
+/*                                                                          */
+/* `conetrace build DEM -o DIR --tile-size P` cuts the DEM's posts into a   */
+/* grid of tiles of P posts per side that share their edge posts (tile      */
+/* (col, row) holds posts col (P - 1) .. col (P - 1) + P - 1, and rows      */
+/* alike; the last column and row of tiles may be narrower), each a normal   */
+/* package with the set's height offset and scale, and a manifest.  The     */
+/* library traces a ray over the set as over the one package built from    */
+/* the merged DEM: the ray is prepared against the set's whole extent (its  */
+/* "frame"), and walked tile by tile in order, each tile's walk starting    */
+/* where the ray crosses onto it; the exact cell tests are the same, so a   */
+/* hit is the merged package's bit for bit (steps and iters differ).  A     */
+/* tile's cones promise empty space only inside its own box, which is all   */
+/* its walk uses.  Tiles stay in caller memory: an array of slots (a cache, */
+/* least recently used first out) filled through the caller's loader.  A    */
+/* tile the ray passes over higher than its tallest post (the manifest      */
+/* says) is not loaded.  A ray that reaches a tile the set does not have,  */
+/* that the loader cannot give, or whose bytes fail their checks (CRC, the  */
+/* manifest's size and CRC, its place in the grid) ends with CT_NO_DATA:    */
+/* hit.t_q26 and the position are where the ray entered that tile -- never  */
+/* a hit on terrain the set does not hold.                                  */
+/*                                                                          */
+/* The manifest (little-endian; CRC-32 as a package's):                     */
+/*   0  char[4] "CTTS"      4  u16 version (1)     6  u16 header size (96)   */
+/*   8  u32 total size     12  u32 CRC-32 (over the whole, these 4 bytes 0)  */
+/*  16  u16 tiles_x        18  u16 tiles_y        20  u16 tile posts P      */
+/*  22  u8  reduce r       23  u8  sectors N                                */
+/*  24  u16 width W        26  u16 height H  (merged posts: W <= tiles_x    */
+/*      (P - 1) + 1 < W + P - 1, rows alike; W, H <= CT_MAX_POSTS)          */
+/*  28  u16 hmin code      30  u16 hmax code  (over every tile)             */
+/*  32  i64 origin_e_nm    40  i64 origin_n_nm  (the merged grid's corner)  */
+/*  48  i64 posting_e_nm   56  i64 posting_n_nm                             */
+/*  64  i64 height_offset_nm 72 i64 height_scale_nm                          */
+/*  80  u32 EPSG           84  u16 source vertical datum (CT_VDATUM_*)      */
+/*  86  u16 reserved (0)   88  u32 flags (0)      92  u32 reserved (0)       */
+/*  96  tiles_x * tiles_y entries of 16 bytes, row-major (row 0 north):     */
+/*      u32 package size, u32 package CRC (its header's), u16 hmin, u16     */
+/*      hmax (its codes' range), u8 present (1; 0: no tile, no data there), */
+/*      u8[3] reserved (0).                                                 */
+/* On the host the tiles are files "tile_<col>_<row>.ctp" beside the        */
+/* manifest (docs/package-format.md).                                       */
+enum {
+    CT_NO_DATA = 5 /* result: the ray reached a tile the set does not hold
+                      (missing, not loadable, or failing its checks); the
+                      hit's t_q26, position and cell are where it entered */
+};
+
+#define CT_SET_MAGIC "CTTS"
+#define CT_SET_VERSION 1u
+#define CT_SET_HEADER_SIZE 96u
+#define CT_SET_ENTRY_SIZE 16u
+#define CT_SET_MAX_TILES 4096u     /* tiles_x * tiles_y                     */
+#define CT_SET_HDR_TILES_X 16u
+#define CT_SET_HDR_TILES_Y 18u
+#define CT_SET_HDR_TILE_POSTS 20u
+#define CT_SET_HDR_REDUCE 22u
+#define CT_SET_HDR_SECTORS 23u
+#define CT_SET_HDR_WIDTH 24u
+#define CT_SET_HDR_HEIGHT 26u
+#define CT_SET_HDR_HMIN 28u
+#define CT_SET_HDR_HMAX 30u
+#define CT_SET_HDR_GEOREF 32u      /* six i64, in a package header's order */
+#define CT_SET_HDR_EPSG 80u
+#define CT_SET_HDR_VDATUM 84u
+#define CT_SET_HDR_FLAGS 88u
+
+/* Worst-case iterations of a trace over a tile set: the tiles a ray
+ * crosses (at most tiles_x + tiles_y - 1) times the method's bound for a
+ * full tile, CT_WCET_CELL_ITERS(P - 1, P - 1) or CT_WCET_HIER_ITERS(P - 1,
+ * P - 1, levels); each tile's walk enforces its own bound.                */
+#define CT_WCET_SET_ITERS(tiles_x, tiles_y, tile_bound) \
+    (((uint32_t)(tiles_x) + (uint32_t)(tiles_y)) * (uint32_t)(tile_bound))
+
+/* The caller's loader: put tile (col, row) in reach and say where its
+ * bytes are: fill buf[0..cap) (the slot's memory) and set *bytes = buf, or
+ * point *bytes at memory of its own (flash, a mapped file) that stays
+ * valid until the slot is reused; *len the bytes available.  Return CT_OK,
+ * or anything else for "not available" (the trace then ends CT_NO_DATA).  */
+typedef ct_status (*ct_tile_loader)(void *user, uint32_t col, uint32_t row, uint8_t *buf, size_t cap,
+                                    const uint8_t **bytes, size_t *len);
+
+/* One cache slot: caller memory.  Set buf and cap (or NULL, 0 when the
+ * loader hands out its own memory) before ct_tileset_open.                 */
+typedef struct {
+    ct_package pkg;     /* the tile held, opened                           */
+    uint8_t *buf;       /* memory the loader may fill                      */
+    size_t cap;
+    int32_t tile;       /* row * tiles_x + col held; -1: empty             */
+    uint32_t used;      /* the set's clock at the last use                 */
+} ct_tile_slot;
+
+/* A tile set over caller memory.  Fill with ct_tileset_open.  The
+ * manifest's bytes are kept by reference (zero copy).  Not reentrant: a
+ * trace updates the cache (one set per thread).                           */
+typedef struct {
+    ct_package frame;          /* the merged grid: its size, heights' range
+                                  and georeference (no sections): use it for
+                                  ct_map_to_grid, ct_ray_from_map, ...      */
+    uint32_t tiles_x, tiles_y; /* the tile grid                             */
+    uint32_t tile_posts;       /* P                                         */
+    const uint8_t *entries;    /* the manifest's tile table                 */
+    ct_tile_slot *slots;
+    uint32_t nslots;
+    ct_tile_loader load;
+    void *user;
+    uint32_t clock;            /* uses so far (the cache's order)           */
+    uint32_t loads;            /* tiles loaded and accepted                 */
+    uint32_t refused;          /* loads that failed or were refused         */
+} ct_tileset;
+
+/* Validate the manifest (as ct_package_open a package: CT_ERR_TRUNCATED,
+ * _MAGIC, _VERSION, _HEADER, _CRC; CT_ERR_DIMS for a tile grid that does
+ * not fit W x H or more than CT_SET_MAX_TILES tiles; _SECTORS, _REDUCE,
+ * _RANGE (hmin > hmax, a tile's range outside the set's), _GEOREF, _FLAGS)
+ * and set up *ts over slots[0..nslots) (nslots >= 1).                      */
+ct_status ct_tileset_open(ct_tileset *ts, const uint8_t *manifest, size_t len, ct_tile_slot *slots, uint32_t nslots,
+                          ct_tile_loader load, void *user);
+
+/* ct_trace over the set: ray in the set's grid frame (ts->frame).  Returns
+ * as ct_trace (the hit in the set's grid and map frames, bit-identical to
+ * the merged package's), or CT_NO_DATA.  hit->steps and iters add up over
+ * the tiles walked.                                                        */
+ct_status ct_tileset_trace(ct_tileset *ts, const ct_ray *ray, ct_method method, ct_hit *hit);
+
+/* ct_geolocate / ct_geolocate_batch over a tile set.  Effects: straight
+ * rays and, with curvature (and refraction with k < 1) on a sphere
+ * (earth_radius_nm != 0, or a package not on a UTM zone), the lowered
+ * walk; effects that need the polyline or the true Earth are
+ * CT_ERR_EFFECTS on a tile set for now.                                    */
+ct_status ct_geolocate_tiles(ct_tileset *ts, const ct_camera *cam, const ct_pose *pose, ct_method method,
+                             const ct_effects *effects, int64_t u_q16, int64_t v_q16, ct_geo *out);
+ct_status ct_geolocate_batch_tiles(ct_tileset *ts, const ct_camera *cam, const ct_pose *pose, ct_method method,
+                                   const ct_effects *effects, const int64_t *uv_q16, size_t count, ct_geo *out,
+                                   size_t out_len);
+
 #ifdef __cplusplus
 }
 #endif

@@ -23,6 +23,7 @@
  */
 #include "bend.h"
 #include "fixed.h"
+#include "tiles.h"
 
 typedef struct {
     int64_t ox, oy, oz;   /* camera centre, grid frame, Q16 */
@@ -138,7 +139,8 @@ static int64_t scale_dir(int64_t d, int64_t s, unsigned shift)
     return shift == 0u ? d * s : ct_mul_shr(d, s, shift);
 }
 
-static ct_status one_pixel(const ct_package *p, const ct_camera *cam, const ct_pose *pose, ct_method m,
+/* ts != NULL: trace over the tile set (p is its frame). */
+static ct_status one_pixel(const ct_package *p, ct_tileset *ts, const ct_camera *cam, const ct_pose *pose, ct_method m,
                            const geo_setup *s, int64_t u, int64_t v, ct_geo *out)
 {
     ct_status st;
@@ -170,8 +172,13 @@ static ct_status one_pixel(const ct_package *p, const ct_camera *cam, const ct_p
         ray.dx = scale_dir(out->dir_map_q39[0], s->sx, s->shift);
         ray.dy = scale_dir(out->dir_map_q39[1], s->sy, s->shift);
         ray.dz = scale_dir(out->dir_map_q39[2], s->sz, s->shift);
-        st = s->bend.coeff_q16 == 0 ? ct_trace(p, &ray, m, &out->hit)
-                                    : ct_trace_bent_set(p, &ray, &s->bent, m, &out->hit);
+        if (ts != NULL) {
+            st = s->bend.coeff_q16 == 0 ? ct_tileset_trace(ts, &ray, m, &out->hit)
+                                        : ct_tileset_trace_lowered(ts, &ray, &s->bent.lw, m, &out->hit);
+        } else {
+            st = s->bend.coeff_q16 == 0 ? ct_trace(p, &ray, m, &out->hit)
+                                        : ct_trace_bent_set(p, &ray, &s->bent, m, &out->hit);
+        }
     }
     out->status = st;
     return st;
@@ -191,7 +198,7 @@ ct_status ct_geolocate(const ct_package *pkg, const ct_camera *cam, const ct_pos
         out->status = st;
         return st;
     }
-    return one_pixel(pkg, cam, pose, method, &s, u_q16, v_q16, out);
+    return one_pixel(pkg, NULL, cam, pose, method, &s, u_q16, v_q16, out);
 }
 
 ct_status ct_geolocate_batch(const ct_package *pkg, const ct_camera *cam, const ct_pose *pose, ct_method method,
@@ -211,7 +218,70 @@ ct_status ct_geolocate_batch(const ct_package *pkg, const ct_camera *cam, const 
     }
     /* bound: count pixels (caller's buffers) */
     for (k = 0u; k < count; ++k) {
-        (void)one_pixel(pkg, cam, pose, method, &s, uv_q16[2u * k], uv_q16[2u * k + 1u], &out[k]);
+        (void)one_pixel(pkg, NULL, cam, pose, method, &s, uv_q16[2u * k], uv_q16[2u * k + 1u], &out[k]);
+    }
+    return CT_OK;
+}
+
+/* ---- tile sets ---------------------------------------------------------- */
+
+/* setup over a tile set's frame, refusing the effects a tile set does not
+ * trace yet: the true Earth (curvature with the default radius on a UTM
+ * zone) and the polyline (c < 0, or a bend the lowered walk cannot take). */
+static ct_status setup_tiles(ct_tileset *ts, const ct_camera *cam, const ct_pose *pose, ct_method m,
+                             const ct_effects *effects, geo_setup *s)
+{
+    ct_utm zone;
+    ct_status st;
+    if (ts == NULL) {
+        return CT_ERR_ARG;
+    }
+    if (effects != NULL && (effects->flags & CT_EFFECT_CURVATURE) != 0u && effects->earth_radius_nm == 0 &&
+        ct_utm_zone_of_epsg((int32_t)ts->frame.epsg, &zone) == CT_OK) {
+        return CT_ERR_EFFECTS;
+    }
+    st = setup(&ts->frame, cam, pose, m, effects, s);
+    if (st == CT_OK && s->bend.coeff_q16 != 0 && !s->bent.lowered) {
+        return CT_ERR_EFFECTS;
+    }
+    return st;
+}
+
+ct_status ct_geolocate_tiles(ct_tileset *ts, const ct_camera *cam, const ct_pose *pose, ct_method method,
+                             const ct_effects *effects, int64_t u_q16, int64_t v_q16, ct_geo *out)
+{
+    geo_setup s;
+    ct_status st;
+    CT_ASSERT(ts != NULL && cam != NULL && pose != NULL && out != NULL);
+    if (out == NULL) {
+        return CT_ERR_ARG;
+    }
+    st = setup_tiles(ts, cam, pose, method, effects, &s);
+    if (st != CT_OK) {
+        out->status = st;
+        return st;
+    }
+    return one_pixel(&ts->frame, ts, cam, pose, method, &s, u_q16, v_q16, out);
+}
+
+ct_status ct_geolocate_batch_tiles(ct_tileset *ts, const ct_camera *cam, const ct_pose *pose, ct_method method,
+                                   const ct_effects *effects, const int64_t *uv_q16, size_t count, ct_geo *out,
+                                   size_t out_len)
+{
+    geo_setup s;
+    ct_status st;
+    size_t k;
+    CT_ASSERT(ts != NULL && cam != NULL && pose != NULL && (count == 0u || (uv_q16 != NULL && out != NULL)));
+    if (count > 0u && (uv_q16 == NULL || out == NULL || out_len < count)) {
+        return CT_ERR_ARG;
+    }
+    st = setup_tiles(ts, cam, pose, method, effects, &s);
+    if (st != CT_OK) {
+        return st;
+    }
+    /* bound: count pixels (caller's buffers) */
+    for (k = 0u; k < count; ++k) {
+        (void)one_pixel(&ts->frame, ts, cam, pose, method, &s, uv_q16[2u * k], uv_q16[2u * k + 1u], &out[k]);
     }
     return CT_OK;
 }

@@ -5,6 +5,7 @@
  */
 #include "bend.h"
 #include "fixed.h"
+#include "tiles.h"
 
 /* Sizes are computed in uint64: W, H <= 2^15 so W*H*2 < 2^31 and every
  * section (and the total) fits in uint32; the checks below reject anything
@@ -304,6 +305,75 @@ static ct_status open_datum(ct_package *pkg, const uint8_t *b, uint32_t total,
     return CT_OK;
 }
 
+ct_status ct_package_frame(ct_package *pkg, uint32_t w, uint32_t h, uint32_t r, uint32_t n, int32_t hmin, int32_t hmax,
+                           const int64_t g[6], uint32_t epsg)
+{
+    int64_t pe = g[2], pn = g[3];
+    uint32_t k;
+    if (hmin > hmax) {
+        return CT_ERR_RANGE;
+    }
+    if (pe == 0 || pn == 0 || ct_abs64(pe) != ct_abs64(pn) || g[5] <= 0 || ct_abs64(pe) > (INT64_C(1) << 50) ||
+        g[5] > (INT64_C(1) << 46) || ct_abs64(g[0]) > (INT64_C(1) << 61) || ct_abs64(g[1]) > (INT64_C(1) << 61) ||
+        ct_abs64(g[4]) > (INT64_C(1) << 61)) {
+        return CT_ERR_GEOREF;
+    }
+    pkg->hmin = hmin;
+    pkg->hmax = hmax;
+    pkg->origin_e_nm = g[0];
+    pkg->origin_n_nm = g[1];
+    pkg->posting_e_nm = pe;
+    pkg->posting_n_nm = pn;
+    pkg->height_offset_nm = g[4];
+    pkg->height_scale_nm = g[5];
+    pkg->base = NULL;
+    pkg->size = 0u;
+    pkg->width = w;
+    pkg->height = h;
+    pkg->cells_x = w - 1u;
+    pkg->cells_y = h - 1u;
+    pkg->reduce = r;
+    {
+        /* the coarsest prepared z unit, 2^k Q16 LSB, that is still no larger
+         * in nm than a Q16 cell unit: 2^k * scale <= |posting|, i.e.
+         * scale <= floor(|posting| / 2^k).  bound: 16 doublings */
+        uint32_t zk = 0u;
+        while (zk < (uint32_t)CT_ZSHIFT_MAX && pkg->height_scale_nm <= (ct_abs64(pe) >> (zk + 1u))) {
+            zk++;
+        }
+        pkg->zshift_max = zk;
+    }
+    pkg->reduce_mul = (((uint64_t)1 << 32) + r - 1u) / r;
+    pkg->sectors = n;
+    pkg->coarse_x = (pkg->cells_x + r - 1u) / r;
+    pkg->coarse_y = (pkg->cells_y + r - 1u) / r;
+    pkg->levels = 0u;
+    pkg->planes = n == 1u ? 1u : n + 1u;
+    pkg->flags = 0u;
+    pkg->slices = 0u;
+    pkg->epsg = epsg;
+    pkg->heights = NULL;
+    pkg->apex = NULL;
+    pkg->angles = NULL;
+    pkg->voids = NULL;
+    /* bound: CT_MAX_LEVELS levels */
+    for (k = 0u; k < CT_MAX_LEVELS; ++k) {
+        pkg->mip[k] = NULL;
+        pkg->mip_w[k] = 0u;
+        pkg->mip_h[k] = 0u;
+    }
+    /* bound: N + 1 boundaries */
+    for (k = 0u; k <= CT_MAX_SECTORS; ++k) {
+        if (k <= n) {
+            ct_dir_of_fraction(k, n, &pkg->bound_x[k], &pkg->bound_y[k]);
+        } else {
+            pkg->bound_x[k] = 0;
+            pkg->bound_y[k] = 0;
+        }
+    }
+    return ct_cot_table(pe, pkg->height_scale_nm, pkg->cot_q16, pkg->cot_ok);
+}
+
 ct_status ct_package_open(ct_package *pkg, const uint8_t *b, size_t len)
 {
     uint32_t total, crc_stored, crc, w, h, r, n, lv, flags, k;
@@ -311,7 +381,6 @@ ct_status ct_package_open(ct_package *pkg, const uint8_t *b, size_t len)
     uint64_t prev_end = CT_PKG_HEADER_SIZE;
     const uint8_t zero4[4] = {0u, 0u, 0u, 0u};
     ct_status st;
-    int64_t pe, pn;
 
     CT_ASSERT(pkg != NULL && b != NULL);
     if (pkg == NULL || b == NULL) {
@@ -388,53 +457,25 @@ ct_status ct_package_open(ct_package *pkg, const uint8_t *b, size_t len)
     if (st != CT_OK) {
         return st;
     }
-    pkg->hmin = (int32_t)ct_ld16(b + CT_HDR_HMIN);
-    pkg->hmax = (int32_t)ct_ld16(b + CT_HDR_HMAX);
-    if (pkg->hmin > pkg->hmax) {
-        return CT_ERR_RANGE;
+    {
+        int64_t g[6];
+        g[0] = ct_ld64s(b + CT_HDR_ORIGIN_E);
+        g[1] = ct_ld64s(b + CT_HDR_ORIGIN_N);
+        g[2] = ct_ld64s(b + CT_HDR_POSTING_E);
+        g[3] = ct_ld64s(b + CT_HDR_POSTING_N);
+        g[4] = ct_ld64s(b + CT_HDR_HEIGHT_OFFSET);
+        g[5] = ct_ld64s(b + CT_HDR_HEIGHT_SCALE);
+        st = ct_package_frame(pkg, w, h, r, n, (int32_t)ct_ld16(b + CT_HDR_HMIN), (int32_t)ct_ld16(b + CT_HDR_HMAX), g,
+                              ct_ld32(b + CT_HDR_EPSG));
+        if (st != CT_OK) {
+            return st;
+        }
     }
-    pe = ct_ld64s(b + CT_HDR_POSTING_E);
-    pn = ct_ld64s(b + CT_HDR_POSTING_N);
-    pkg->origin_e_nm = ct_ld64s(b + CT_HDR_ORIGIN_E);
-    pkg->origin_n_nm = ct_ld64s(b + CT_HDR_ORIGIN_N);
-    pkg->height_offset_nm = ct_ld64s(b + CT_HDR_HEIGHT_OFFSET);
-    pkg->height_scale_nm = ct_ld64s(b + CT_HDR_HEIGHT_SCALE);
-    if (pe == 0 || pn == 0 || ct_abs64(pe) != ct_abs64(pn) ||
-        pkg->height_scale_nm <= 0 || ct_abs64(pe) > (INT64_C(1) << 50) ||
-        pkg->height_scale_nm > (INT64_C(1) << 46) ||
-        ct_abs64(pkg->origin_e_nm) > (INT64_C(1) << 61) ||
-        ct_abs64(pkg->origin_n_nm) > (INT64_C(1) << 61) ||
-        ct_abs64(pkg->height_offset_nm) > (INT64_C(1) << 61)) {
-        return CT_ERR_GEOREF;
-    }
-    pkg->posting_e_nm = pe;
-    pkg->posting_n_nm = pn;
     pkg->base = b;
     pkg->size = total;
-    pkg->width = w;
-    pkg->height = h;
-    pkg->cells_x = w - 1u;
-    pkg->cells_y = h - 1u;
-    pkg->reduce = r;
-    {
-        /* the coarsest prepared z unit, 2^k Q16 LSB, that is still no larger
-         * in nm than a Q16 cell unit: 2^k * scale <= |posting|, i.e.
-         * scale <= floor(|posting| / 2^k).  bound: 16 doublings */
-        uint32_t zk = 0u;
-        while (zk < (uint32_t)CT_ZSHIFT_MAX && pkg->height_scale_nm <= (ct_abs64(pe) >> (zk + 1u))) {
-            zk++;
-        }
-        pkg->zshift_max = zk;
-    }
-    pkg->reduce_mul = (((uint64_t)1 << 32) + r - 1u) / r;
-    pkg->sectors = n;
-    pkg->coarse_x = (pkg->cells_x + r - 1u) / r;
-    pkg->coarse_y = (pkg->cells_y + r - 1u) / r;
     pkg->levels = lv;
-    pkg->planes = n == 1u ? 1u : n + 1u;
     pkg->flags = flags;
     pkg->slices = ct_ld32(b + CT_HDR_SLICES);
-    pkg->epsg = ct_ld32(b + CT_HDR_EPSG);
     pkg->heights = b + so[CT_SEC_HEIGHTS];
     pkg->apex = b + so[CT_SEC_APEX];
     pkg->angles = b + so[CT_SEC_ANGLES];
@@ -459,19 +500,6 @@ ct_status ct_package_open(ct_package *pkg, const uint8_t *b, size_t len)
                 pkg->mip_h[k] = 0u;
             }
         }
-    }
-    /* bound: N + 1 boundaries */
-    for (k = 0u; k <= CT_MAX_SECTORS; ++k) {
-        if (k <= n) {
-            ct_dir_of_fraction(k, n, &pkg->bound_x[k], &pkg->bound_y[k]);
-        } else {
-            pkg->bound_x[k] = 0;
-            pkg->bound_y[k] = 0;
-        }
-    }
-    st = ct_cot_table(pe, pkg->height_scale_nm, pkg->cot_q16, pkg->cot_ok);
-    if (st != CT_OK) {
-        return st;
     }
     return CT_OK;
 }
@@ -547,7 +575,7 @@ ct_status ct_package_verify(const ct_package *p)
 ct_status ct_status_name(ct_status s, const char **out)
 {
     static const char *const names[] = {
-        "ok", "hit", "miss", "below", "hit_void"};
+        "ok", "hit", "miss", "below", "hit_void", "no_data"};
     static const char *const errs[] = {
         "err_arg", "err_truncated", "err_magic", "err_version", "err_header",
         "err_crc", "err_dims", "err_sectors", "err_reduce", "err_levels",
@@ -561,7 +589,7 @@ ct_status ct_status_name(ct_status s, const char **out)
     if (out == NULL) {
         return CT_ERR_ARG;
     }
-    if (s >= 0 && s <= CT_HIT_VOID) {
+    if (s >= 0 && s <= CT_NO_DATA) {
         *out = names[s];
         return CT_OK;
     }

@@ -36,6 +36,7 @@
 #include "bend.h"
 #include "conetrace.h"
 #include "fixed.h"
+#include "tiles.h"
 
 #define ONE16 INT64_C(65536)
 #define T_ONE (INT64_C(1) << CT_T_FRAC_BITS)
@@ -45,6 +46,8 @@ enum { FACE_X = 1, FACE_Y = 2, FACE_XY = 3 };
 typedef struct {
     int64_t n, d; /* t = n / d, d > 0 */
 } rt;
+
+static const rt T_ZERO = {0, 1};
 
 typedef struct {
     rt t;      /* parameter at the exit point */
@@ -66,6 +69,8 @@ typedef struct {
     const ct_lower *lw; /* bent ray: the lowered terrain (NULL: straight)  */
     int64_t ratio_q30;  /* lowered culling: floor(2^30 len_lo / |D_p|), in
                            [2^30, 2^30.5]; 0 when culling is off            */
+    rt t0;              /* where the walk starts: 0, or (a tile set) the
+                           canonical entry of the tile's first cell         */
 } ctx;
 
 /* Height code h >= 0 (< 2^17) in the ray's z units: one 32x32 product. */
@@ -814,7 +819,7 @@ static ct_status walk_incremental(const ctx *c, ct_hit *h)
 {
     int32_t i, j;
     uint32_t it, bound = CT_WCET_CELL_ITERS(c->cx, c->cy);
-    rt tin = {0, 1};
+    rt tin = c->t0;
     cexit e;
     locate(c, tin, &i, &j);
     /* bound: each iteration leaves one fine cell */
@@ -851,7 +856,7 @@ static ct_status walk_hierarchical(const ctx *c, ct_hit *h)
     uint32_t lvl = p->levels, it, bound = CT_WCET_HIER_ITERS(c->cx, c->cy, p->levels);
     int32_t lbi = -2, lbj = -2; /* the cell lb was formed for */
     int64_t lb = 0;
-    rt t = {0, 1};
+    rt t = c->t0;
     cexit e;
     locate(c, t, &i, &j);
     /* bound: per fine cell left, at most levels descents + one advance */
@@ -968,8 +973,8 @@ static ct_status walk_cones(const ctx *c, uint32_t plane, ct_hit *h)
     const uint8_t *ang = p->angles + (size_t)plane * p->coarse_x * p->coarse_y;
     int32_t i, j;
     uint32_t it, bound = CT_WCET_CELL_ITERS(c->cx, c->cy);
-    rt t = {0, 1};   /* current point */
-    rt tin = {0, 1}; /* canonical entry of the current cell */
+    rt t = c->t0;   /* current point */
+    rt tin = c->t0; /* canonical entry of the current cell */
     int tin_ok = 1;
     int64_t lb;      /* lower_ahead at (i, j), -1 when not formed */
     cexit e;
@@ -1269,17 +1274,23 @@ static rt box_exit(const ct_package *p, const int64_t O[3], const int32_t D[3], 
     return te;
 }
 
-/* seg != 0: the ray ends at origin + direction (t <= 1 in the caller's
- * parameter) as well as at the box. */
-static ct_status prepare_impl(const ct_package *p, const ct_ray *ray, int seg, const ct_lower *lw, ct_prepared *out)
+/* Preparation in two parts.  prep_geom clips the ray to p's box and
+ * quantises it (origin, direction, zshift, length, sector): geometry only,
+ * no heights read, so a tile set prepares against its whole extent (a
+ * header-only package).  prep_finish decides the first point against the
+ * surface of sp -- the package holding it; in a tile set the tile, whose
+ * grid is p's shifted by (offx, offy) Q16, whole cells -- and forms tend
+ * in p's box.  seg != 0: the ray ends at origin + direction (t <= 1 in the
+ * caller's parameter) as well as at the box.  prep_geom returns CT_OK
+ * (then out->start is not yet set), or CT_MISS / CT_BELOW (out->start set)
+ * or an error. */
+static ct_status prep_geom(const ct_package *p, const ct_ray *ray, int seg, ct_prepared *out)
 {
     int32_t D[3];
     int64_t O[3], U[3], lo[3], hi[3];
     bigrt tin, tout;
     int k, has_out = 0, kin = -1;
     unsigned zs;
-    int64_t zone;
-    ct_status start;
     dir_mag mag;
     int64_t kin_at = 0; /* the entry face's coordinate on axis kin */
     CT_ASSERT(p != NULL && ray != NULL && out != NULL);
@@ -1424,7 +1435,6 @@ static ct_status prepare_impl(const ct_package *p, const ct_ray *ray, int seg, c
         zs = 0u;
         normalize_dir(U, &mag, zs, D);
     }
-    zone = ONE16 >> zs;
     if (zs > 0u) {
         O[2] = floor_shr(O[2] + (INT64_C(1) << (zs - 1u)), zs);
     }
@@ -1452,37 +1462,56 @@ static ct_status prepare_impl(const ct_package *p, const ct_ray *ray, int seg, c
     } else {
         out->sector = -1;
     }
+    return CT_OK;
+}
+
+void ct_prepared_first_cell(const ct_package *p, const ct_prepared *r, int32_t *i, int32_t *j)
+{
+    /* the first point is on the tile; the cell it is in, clamped */
+    int32_t a = axis_cell(r->ox, ONE16, r->dx > 0 ? 1 : (r->dx < 0 ? -1 : 0), (int32_t)p->cells_x);
+    int32_t b = axis_cell(r->oy, ONE16, r->dy > 0 ? 1 : (r->dy < 0 ? -1 : 0), (int32_t)p->cells_y);
+    *i = a < 0 ? 0 : (a >= (int32_t)p->cells_x ? (int32_t)p->cells_x - 1 : a);
+    *j = b < 0 ? 0 : (b >= (int32_t)p->cells_y ? (int32_t)p->cells_y - 1 : b);
+}
+
+static ct_status prep_finish(const ct_package *p, const ct_package *sp, int64_t offx, int64_t offy, const ct_ray *ray,
+                             int seg, const ct_lower *lw, ct_prepared *out)
+{
+    int64_t O[3];
+    int32_t D[3];
+    unsigned zs = (unsigned)out->zshift;
+    int64_t zone = ONE16 >> zs;
+    ct_status start;
+    int k;
+    O[0] = out->ox;
+    O[1] = out->oy;
+    O[2] = out->oz;
+    D[0] = out->dx;
+    D[1] = out->dy;
+    D[2] = out->dz;
     /* the first point: below, on, or above the surface (exact); decided
      * first, so that tend below is formed only for a point at or above the
      * surface (z >= 0: every candidate < 2^34) */
     {
-        int32_t i = axis_cell(O[0], ONE16, D[0] > 0 ? 1 : (D[0] < 0 ? -1 : 0), (int32_t)p->cells_x);
-        int32_t j = axis_cell(O[1], ONE16, D[1] > 0 ? 1 : (D[1] < 0 ? -1 : 0), (int32_t)p->cells_y);
-        int64_t s, f;
-        /* the first point is on the tile; use the cell it is in, clamped */
-        if (i < 0) {
-            i = 0;
-        }
-        if (j < 0) {
-            j = 0;
-        }
-        if (i >= (int32_t)p->cells_x) {
-            i = (int32_t)p->cells_x - 1;
-        }
-        if (j >= (int32_t)p->cells_y) {
-            j = (int32_t)p->cells_y - 1;
-        }
+        int32_t i, j;
+        int64_t s, f, lx = O[0] - offx, ly = O[1] - offy;
+        /* in sp's grid (a tile set's tile: shifted by whole cells) */
+        ct_prepared_first_cell(p, out, &i, &j);
+        i -= (int32_t)(offx >> 16);
+        j -= (int32_t)(offy >> 16);
         if (O[2] < -(INT64_C(1) << (46u - zs))) {
             start = CT_BELOW;
-        } else if (lw != NULL && O[2] * (INT64_C(1) << zs) > (int64_t)cell_hmax(p, i, j) * ONE16) {
+        } else if (sp == NULL) {
+            start = CT_OK; /* a tile set's caller: above every post of the tile */
+        } else if (lw != NULL && O[2] * (INT64_C(1) << zs) > (int64_t)cell_hmax(sp, i, j) * ONE16) {
             start = CT_OK; /* above the cell's tallest post (|O[2] 2^zs| <= 2^46) */
         } else if (lw != NULL) {
             /* the lowered surface, Q16 2^32: z_q16 2^32 < 2^78 */
             int sg = ct_i128_cmp(ct_i128_shl(ct_i128_from64(O[2] * (INT64_C(1) << zs)), 32),
-                                 surface_low_q48(p, lw, i, j, O[0], O[1]));
+                                 surface_low_q48(sp, lw, i, j, lx, ly));
             start = sg < 0 ? CT_BELOW : (sg == 0 ? CT_HIT : CT_OK);
         } else {
-            s = surface_q32(p, i, j, O[0], O[1]);
+            s = surface_q32(sp, i, j, lx, ly);
             f = O[2] * (INT64_C(1) << zs) * ONE16 - s; /* |oz 2^zs| <= 2^46: < 2^62 */
             start = f < 0 ? CT_BELOW : (f == 0 ? CT_HIT : CT_OK);
         }
@@ -1512,7 +1541,7 @@ static ct_status prepare_impl(const ct_package *p, const ct_ray *ray, int seg, c
                     m = k;
                 }
             }
-            e = (m == 0 ? ray->x_q16 : (m == 1 ? ray->y_q16 : ray->z_q16)) + U[m];
+            e = m == 0 ? ray->x_q16 + ray->dx : (m == 1 ? ray->y_q16 + ray->dy : ray->z_q16 + ray->dz);
             num = (e - (m == 2 ? O[2] * (INT64_C(1) << zs) : O[m])) * (D[m] > 0 ? 1 : -1);
             if (num < 0) {
                 num = 0;
@@ -1534,6 +1563,26 @@ static ct_status prepare_impl(const ct_package *p, const ct_ray *ray, int seg, c
     }
     out->start = start;
     return start;
+}
+
+ct_status ct_tile_prep_geom(const ct_package *frame, const ct_ray *ray, ct_prepared *out)
+{
+    return prep_geom(frame, ray, 0, out);
+}
+
+ct_status ct_tile_prep_finish(const ct_package *frame, const ct_package *tile, int64_t offx, int64_t offy,
+                              const ct_ray *ray, const ct_lower *lw, ct_prepared *out)
+{
+    return prep_finish(frame, tile, offx, offy, ray, 0, lw, out);
+}
+
+static ct_status prepare_impl(const ct_package *p, const ct_ray *ray, int seg, const ct_lower *lw, ct_prepared *out)
+{
+    ct_status st = prep_geom(p, ray, seg, out);
+    if (st != CT_OK) {
+        return st;
+    }
+    return prep_finish(p, p, 0, 0, ray, seg, lw, out);
 }
 
 ct_status ct_ray_prepare(const ct_package *p, const ct_ray *ray, ct_prepared *out)
@@ -1599,8 +1648,47 @@ static ct_status check_prepared(const ct_package *p, const ct_prepared *r)
     return CT_OK;
 }
 
+static ct_status walk(const ctx *c, ct_method m, ct_hit *h)
+{
+    switch (m) {
+    case CT_METHOD_INCREMENTAL:
+        return walk_incremental(c, h);
+    case CT_METHOD_HIERARCHICAL:
+        return walk_hierarchical(c, h);
+    case CT_METHOD_CONE:
+        return walk_cones(c, c->p->sectors == 1u ? 0u : c->p->sectors, h);
+    case CT_METHOD_DIRECTIONAL:
+    default:
+        return walk_cones(c, (uint32_t)c->r->sector, h);
+    }
+}
+
+/* The sign of f = z_ray - S at t0 > 0, a point on an entry face of cell
+ * (i, j) (a tile set's seam): exact, as at a cell's exit. */
+static int entry_sign(const ctx *c, int32_t i, int32_t j, rt t0)
+{
+    cexit e;
+    posts4 q;
+    int onx, ony;
+    e.t = t0;
+    e.xf = i + (c->sx < 0 ? 1 : 0);
+    e.yf = j + (c->sy < 0 ? 1 : 0);
+    /* on the x entry face: (xf 2^16 - ox) sx d == n |dx| (< 2^57 each) */
+    onx = c->sx != 0 && ((int64_t)e.xf * ONE16 - c->r->ox) * c->sx * t0.d == t0.n * c->adx;
+    ony = c->sy != 0 && ((int64_t)e.yf * ONE16 - c->r->oy) * c->sy * t0.d == t0.n * c->ady;
+    e.face = onx ? (ony ? FACE_XY : FACE_X) : FACE_Y;
+    load_posts(c->p, i, j, &q);
+    if (c->lw != NULL) {
+        lposts L;
+        lower_posts(c, i, j, &q, &L);
+        return exit_sign_low(c, i, j, &e, &L);
+    }
+    return exit_sign(c, i, j, &e, &q);
+}
+
+/* t0: where the walk starts (tile sets, ct_trace_tile); {0, 1} otherwise. */
 static ct_status trace_impl(const ct_package *p, const ct_prepared *r, ct_method m, int checked,
-                            const ct_lower *lw, ct_hit *h)
+                            const ct_lower *lw, rt t0, ct_hit *h)
 {
     ctx c;
     ct_status st;
@@ -1642,14 +1730,36 @@ static ct_status trace_impl(const ct_package *p, const ct_prepared *r, ct_method
     c.tend.d = r->tend_d;
     c.lw = lw;
     c.ratio_q30 = 0;
+    c.t0 = t0;
     if (lw != NULL && lw->cull && (r->dx != 0 || r->dy != 0)) {
         /* len_lo 2^30 < 2^56.5; the quotient in [2^30, 2^30.5] */
         c.ratio_q30 = (r->len_lo << 30) / (c.adx >= c.ady ? c.adx : c.ady);
     }
+    if (t0.n > 0) {
+        /* a tile set's later tile: the walk starts on the seam, where the
+         * previous tile's walk left the ray above its surface (a cell test
+         * found f > 0 there, or a cone promised no point strictly below the
+         * surface).  f = 0 -- the ray touching the surface on the seam
+         * after a cone jump -- is a hit there. */
+        int32_t i, j;
+        if (r->start != CT_OK || (r->dx == 0 && r->dy == 0)) {
+            return CT_ERR_RAY;
+        }
+        locate(&c, t0, &i, &j);
+        if (!inside(&c, i, j)) {
+            return CT_MISS;
+        }
+        if (entry_sign(&c, i, j, t0) <= 0) {
+            fill_hit(&c, t0.d == T_ONE ? t0.n : ct_floor_div(t0.n * T_ONE, t0.d), i, j, h);
+            h->steps = 1u;
+            h->iters = 1u;
+            return hit_status(p, i, j);
+        }
+        return walk(&c, m, h);
+    }
     if (r->start == CT_HIT) {
         int32_t i, j;
-        rt t0 = {0, 1};
-        locate(&c, t0, &i, &j);
+        locate(&c, T_ZERO, &i, &j);
         i = i < 0 ? 0 : (i >= c.cx ? c.cx - 1 : i);
         j = j < 0 ? 0 : (j >= c.cy ? c.cy - 1 : j);
         fill_hit(&c, 0, i, j, h);
@@ -1663,14 +1773,13 @@ static ct_status trace_impl(const ct_package *p, const ct_prepared *r, ct_method
     if (r->dx == 0 && r->dy == 0) {
         /* vertical: f(0) > 0 was established at preparation */
         int32_t i, j;
-        rt t0 = {0, 1};
         int64_t s, tq;
         h->steps = 1u;
         h->iters = 1u;
         if (r->dz > 0) {
             return CT_MISS;
         }
-        locate(&c, t0, &i, &j);
+        locate(&c, T_ZERO, &i, &j);
         if (lw != NULL) {
             /* the lowered surface rounded up to Q16 2^16 (a hit at or
              * above it); |s| < 2^50 as below */
@@ -1689,17 +1798,7 @@ static ct_status trace_impl(const ct_package *p, const ct_prepared *r, ct_method
         (void)ct_grid_to_map(p, h->x_q16, h->y_q16, h->z_q16, &h->e_nm, &h->n_nm, &h->h_nm);
         return hit_status(p, i, j);
     }
-    switch (m) {
-    case CT_METHOD_INCREMENTAL:
-        return walk_incremental(&c, h);
-    case CT_METHOD_HIERARCHICAL:
-        return walk_hierarchical(&c, h);
-    case CT_METHOD_CONE:
-        return walk_cones(&c, p->sectors == 1u ? 0u : p->sectors, h);
-    case CT_METHOD_DIRECTIONAL:
-    default:
-        return walk_cones(&c, (uint32_t)r->sector, h);
-    }
+    return walk(&c, m, h);
 }
 
 ct_status ct_trace(const ct_package *p, const ct_ray *ray, ct_method m, ct_hit *h)
@@ -1714,17 +1813,37 @@ ct_status ct_trace(const ct_package *p, const ct_ray *ray, ct_method m, ct_hit *
     if (st < 0) {
         return st;
     }
-    return trace_impl(p, &r, m, 1, NULL, h);
+    return trace_impl(p, &r, m, 1, NULL, T_ZERO, h);
+}
+
+ct_status ct_trace_tile(const ct_package *tile, const ct_prepared *r, int64_t t0_n, int64_t t0_d, const ct_lower *lw,
+                        ct_method m, ct_hit *h)
+{
+    rt t0;
+    t0.n = t0_n;
+    t0.d = t0_d;
+    return trace_impl(tile, r, m, 1, lw, t0, h);
+}
+
+void ct_fill_point(const ct_package *p, const ct_prepared *r, const ct_lower *lw, int64_t t_q26, ct_hit *h)
+{
+    ctx c;
+    c.p = p;
+    c.r = r;
+    c.zs = (unsigned)r->zshift;
+    c.zmul = (uint32_t)1 << c.zs;
+    c.lw = lw;
+    fill_hit(&c, t_q26, h->cell_x, h->cell_y, h);
 }
 
 ct_status ct_trace_prepared(const ct_package *p, const ct_prepared *r, ct_method m, ct_hit *h)
 {
-    return trace_impl(p, r, m, 0, NULL, h);
+    return trace_impl(p, r, m, 0, NULL, T_ZERO, h);
 }
 
 ct_status ct_trace_prepared_own(const ct_package *p, const ct_prepared *r, ct_method m, ct_hit *h)
 {
-    return trace_impl(p, r, m, 1, NULL, h);
+    return trace_impl(p, r, m, 1, NULL, T_ZERO, h);
 }
 
 ct_status ct_prepare_lowered_segment(const ct_package *p, const ct_ray *ray, const ct_lower *lw, ct_prepared *out)
@@ -1735,7 +1854,7 @@ ct_status ct_prepare_lowered_segment(const ct_package *p, const ct_ray *ray, con
 ct_status ct_trace_prepared_lowered(const ct_package *p, const ct_prepared *r, const ct_lower *lw, ct_method m,
                                     ct_hit *h)
 {
-    return trace_impl(p, r, m, 1, lw, h);
+    return trace_impl(p, r, m, 1, lw, T_ZERO, h);
 }
 
 ct_status ct_trace_lowered(const ct_package *p, const ct_ray *ray, const ct_lower *lw, ct_method m, ct_hit *h)
@@ -1745,7 +1864,7 @@ ct_status ct_trace_lowered(const ct_package *p, const ct_ray *ray, const ct_lowe
     if (st < 0) {
         return st;
     }
-    return trace_impl(p, &r, m, 1, lw, h);
+    return trace_impl(p, &r, m, 1, lw, T_ZERO, h);
 }
 
 /* ------------------------------------------------------------------------ */

@@ -7,7 +7,9 @@ the frame sizes along the deepest path.  Fails (exit 1) on
 
   * recursion (a cycle in the call graph),
   * a dynamic or unbounded frame ("dynamic" in .su / .ci),
-  * an indirect call (__indirect_call) or an unresolved callee,
+  * an indirect call (__indirect_call) or an unresolved callee -- except
+    at the sites in CALLBACK_SITES, where the library calls a function the
+    caller gave it (its stack is the caller's to add),
   * a public function without a definition.
 
 Frames:
@@ -32,6 +34,11 @@ import os
 import re
 import subprocess
 import sys
+
+# The library's only calls through a pointer: the caller's own functions,
+# called from these (static) functions.  Their stack adds to the figure of
+# every public function above them (docs/library.md says so).
+CALLBACK_SITES = {'tile_get': "the caller's ct_tile_loader (tile sets)"}
 
 NODE_RE = re.compile(r'^node: \{ title: "([^"]*)" label: "([^"]*)"(.*)\}\s*$')
 EDGE_RE = re.compile(r'^edge: \{ sourcename: "([^"]*)" targetname: "([^"]*)"')
@@ -304,7 +311,8 @@ def analyse(funcs, helpers, roots):
             ck, cobj = c, None
             ckind, cobj = resolve(c)
             if ckind == 'indirect':
-                violations.append(('indirect', '%s: indirect call (function pointer)' % display(key)))
+                if display(key) not in CALLBACK_SITES:
+                    violations.append(('indirect', '%s: indirect call (function pointer)' % display(key)))
                 continue
             if ckind == 'unresolved':
                 violations.append(('unresolved', '%s: calls %s, which is not in the call graph or the image' %
@@ -474,8 +482,9 @@ def main():
     if violations:
         print('stack_report %s: FAIL (%d violations: %s)' % (args.cpu, len(violations), ', '.join(kinds)))
         return 1
-    print('stack_report %s: ok (%d public functions, no recursion, no dynamic frames, no indirect calls)' %
-          (args.cpu, len(table)))
+    print('stack_report %s: ok (%d public functions, no recursion, no dynamic frames, no indirect calls but '
+          'the caller callbacks: %s; their own stack comes on top)' %
+          (args.cpu, len(table), ', '.join('%s calls %s' % kv for kv in sorted(CALLBACK_SITES.items()))))
     return 0
 
 

@@ -1,0 +1,398 @@
+/*
+ * tiles.c -- tile sets: a ray traced over many packages as over one.
+ *
+ * The set's frame (a header-only ct_package of the merged grid) is what the
+ * ray is prepared against, so the prepared ray -- origin, direction,
+ * zshift, tend -- is the merged package's.  The walk then visits the tiles
+ * the ray crosses in order (a grid walk over tiles, with the cells' tie
+ * rules), and in each tile runs the method's own walk from the parameter
+ * where the ray crosses onto it (trace.c, ct_trace_tile) on the prepared
+ * ray shifted by the tile's offset (whole cells: x, y - 2^16 * offset, so
+ * every product the walk forms is the merged walk's, bounds included).
+ * The cell tests decide the hit exactly from the posts of the cell and
+ * the prepared ray, and a tile's posts are the merged DEM's, so the hit is
+ * the merged package's bit for bit.  A tile's cones, built from that tile
+ * alone, only promise empty space inside its box: a cone step that leaves
+ * the box ends the tile's walk (CT_MISS) and the next tile's walk starts
+ * at the seam, never where the step landed.
+ *
+ * Numbers: tile offsets are at most CT_MAX_POSTS cells (the merged grid
+ * is a package grid: W, H <= CT_MAX_POSTS), so every coordinate is the
+ * merged walk's less a multiple of 2^16 below 2^31 -- the same ranges
+ * (trace.c's header) hold in the tile's grid.  Seam parameters are
+ * rationals n / d with d = |dx| or |dy| <= 2^26 and n < 2^34, compared as
+ * trace.c compares them (products < 2^60).
+ */
+#include "conetrace.h"
+#include "fixed.h"
+#include "tiles.h"
+
+#define ONE16 INT64_C(65536)
+
+/* a < b for seam parameters: n < 2^34, d <= 2^26 */
+static int t_lt(int64_t an, int64_t ad, int64_t bn, int64_t bd) { return an * bd < bn * ad; }
+
+ct_status ct_tileset_open(ct_tileset *ts, const uint8_t *b, size_t len, ct_tile_slot *slots, uint32_t nslots,
+                          ct_tile_loader load, void *user)
+{
+    uint32_t total, crc, tx, ty, P, w, h, r, n, k, ntiles;
+    int32_t hmin, hmax;
+    int64_t g[6];
+    const uint8_t zero4[4] = {0u, 0u, 0u, 0u};
+    ct_status st;
+    CT_ASSERT(ts != NULL && b != NULL && slots != NULL && load != NULL);
+    if (ts == NULL || b == NULL || slots == NULL || load == NULL || nslots == 0u) {
+        return CT_ERR_ARG;
+    }
+    if (len < CT_SET_HEADER_SIZE) {
+        return CT_ERR_TRUNCATED;
+    }
+    if (b[0] != 'C' || b[1] != 'T' || b[2] != 'T' || b[3] != 'S') {
+        return CT_ERR_MAGIC;
+    }
+    if (ct_ld16(b + CT_HDR_VERSION) != CT_SET_VERSION) {
+        return CT_ERR_VERSION;
+    }
+    if (ct_ld16(b + CT_HDR_HEADER_SIZE) != CT_SET_HEADER_SIZE) {
+        return CT_ERR_HEADER;
+    }
+    total = ct_ld32(b + CT_HDR_TOTAL);
+    if (total < CT_SET_HEADER_SIZE || (uint64_t)total > (uint64_t)len) {
+        return CT_ERR_TRUNCATED;
+    }
+    (void)ct_crc32(0u, b, CT_HDR_CRC, &crc);
+    (void)ct_crc32(crc, zero4, 4u, &crc);
+    (void)ct_crc32(crc, b + CT_HDR_CRC + 4u, (size_t)total - (CT_HDR_CRC + 4u), &crc);
+    if (crc != ct_ld32(b + CT_HDR_CRC)) {
+        return CT_ERR_CRC;
+    }
+    tx = ct_ld16(b + CT_SET_HDR_TILES_X);
+    ty = ct_ld16(b + CT_SET_HDR_TILES_Y);
+    P = ct_ld16(b + CT_SET_HDR_TILE_POSTS);
+    w = ct_ld16(b + CT_SET_HDR_WIDTH);
+    h = ct_ld16(b + CT_SET_HDR_HEIGHT);
+    r = b[CT_SET_HDR_REDUCE];
+    n = b[CT_SET_HDR_SECTORS];
+    /* the tile grid covers W x H exactly: (tiles - 1) (P - 1) < W - 1 <=
+     * tiles (P - 1), so every tile has at least 2 posts per side */
+    if (w < 2u || h < 2u || w > CT_MAX_POSTS || h > CT_MAX_POSTS || P < 2u || P > CT_MAX_POSTS || tx == 0u ||
+        ty == 0u || tx * ty > CT_SET_MAX_TILES || (tx - 1u) * (P - 1u) >= w - 1u || tx * (P - 1u) < w - 1u ||
+        (ty - 1u) * (P - 1u) >= h - 1u || ty * (P - 1u) < h - 1u) {
+        return CT_ERR_DIMS;
+    }
+    ntiles = tx * ty;
+    if ((uint64_t)total != (uint64_t)CT_SET_HEADER_SIZE + (uint64_t)ntiles * CT_SET_ENTRY_SIZE) {
+        return CT_ERR_SIZE;
+    }
+    if (n < 1u || n > CT_MAX_SECTORS) {
+        return CT_ERR_SECTORS;
+    }
+    if (r < 1u || r > CT_MAX_REDUCE) {
+        return CT_ERR_REDUCE;
+    }
+    if (ct_ld32(b + CT_SET_HDR_FLAGS) != 0u || ct_ld16(b + CT_SET_HDR_VDATUM) >= CT_VDATUM_COUNT) {
+        return CT_ERR_FLAGS;
+    }
+    hmin = (int32_t)ct_ld16(b + CT_SET_HDR_HMIN);
+    hmax = (int32_t)ct_ld16(b + CT_SET_HDR_HMAX);
+    /* bound: ntiles <= CT_SET_MAX_TILES entries */
+    for (k = 0u; k < ntiles; ++k) {
+        const uint8_t *e = b + CT_SET_HEADER_SIZE + (size_t)k * CT_SET_ENTRY_SIZE;
+        if (e[12] > 1u) {
+            return CT_ERR_FLAGS;
+        }
+        if (e[12] == 1u && ((int32_t)ct_ld16(e + 8) > (int32_t)ct_ld16(e + 10) || (int32_t)ct_ld16(e + 8) < hmin ||
+                            (int32_t)ct_ld16(e + 10) > hmax)) {
+            return CT_ERR_RANGE;
+        }
+    }
+    /* bound: six georeference values */
+    for (k = 0u; k < 6u; ++k) {
+        g[k] = ct_ld64s(b + CT_SET_HDR_GEOREF + 8u * k);
+    }
+    st = ct_package_frame(&ts->frame, w, h, r, n, hmin, hmax, g, ct_ld32(b + CT_SET_HDR_EPSG));
+    if (st != CT_OK) {
+        return st;
+    }
+    ts->frame.vdatum = ct_ld16(b + CT_SET_HDR_VDATUM);
+    ts->frame.source_epsg = 0u;
+    ts->frame.geoid.w = ts->frame.geoid.h = 0u;
+    ts->frame.geoid.lat0_q61 = ts->frame.geoid.lon0_q61 = ts->frame.geoid.step_q61 = 0;
+    ts->frame.geoid.values = NULL;
+    /* a tile's map coordinates are the frame's plus its offset times the
+     * posting: the corner's stays within the package range (2^61 nm) */
+    if (ct_abs64(g[0]) + (int64_t)w * ct_abs64(g[2]) > (INT64_C(1) << 61) ||
+        ct_abs64(g[1]) + (int64_t)h * ct_abs64(g[3]) > (INT64_C(1) << 61)) {
+        return CT_ERR_GEOREF;
+    }
+    ts->tiles_x = tx;
+    ts->tiles_y = ty;
+    ts->tile_posts = P;
+    ts->entries = b + CT_SET_HEADER_SIZE;
+    ts->slots = slots;
+    ts->nslots = nslots;
+    ts->load = load;
+    ts->user = user;
+    ts->clock = 0u;
+    ts->loads = 0u;
+    ts->refused = 0u;
+    /* bound: nslots (caller's array) */
+    for (k = 0u; k < nslots; ++k) {
+        slots[k].tile = -1;
+        slots[k].used = 0u;
+    }
+    return CT_OK;
+}
+
+/* First post of tile col (or row) a, and its posts: min(P, W - first). */
+static uint32_t tile_first(const ct_tileset *ts, uint32_t a) { return a * (ts->tile_posts - 1u); }
+
+static uint32_t tile_posts_at(const ct_tileset *ts, uint32_t a, uint32_t total)
+{
+    uint32_t f = tile_first(ts, a);
+    return total - f < ts->tile_posts ? total - f : ts->tile_posts;
+}
+
+/* Does the opened package pk have exactly tile (a, b)'s place and values? */
+static int tile_matches(const ct_tileset *ts, const ct_package *pk, const uint8_t *e, uint32_t a, uint32_t bb)
+{
+    const ct_package *F = &ts->frame;
+    int64_t x0 = (int64_t)tile_first(ts, a), y0 = (int64_t)tile_first(ts, bb);
+    return pk->size == ct_ld32(e) && ct_ld32(pk->base + CT_HDR_CRC) == ct_ld32(e + 4) &&
+           pk->hmin == (int32_t)ct_ld16(e + 8) && pk->hmax == (int32_t)ct_ld16(e + 10) &&
+           pk->width == tile_posts_at(ts, a, F->width) && pk->height == tile_posts_at(ts, bb, F->height) &&
+           pk->reduce == F->reduce && pk->sectors == F->sectors && pk->posting_e_nm == F->posting_e_nm &&
+           pk->posting_n_nm == F->posting_n_nm && pk->height_offset_nm == F->height_offset_nm &&
+           pk->height_scale_nm == F->height_scale_nm && pk->epsg == F->epsg &&
+           pk->origin_e_nm == F->origin_e_nm + x0 * F->posting_e_nm &&
+           pk->origin_n_nm == F->origin_n_nm + y0 * F->posting_n_nm;
+}
+
+/* Tile (a, b) in a slot, loading it into the least recently used one if
+ * needed; NULL when the set has no such tile or it cannot be loaded. */
+static const ct_package *tile_get(ct_tileset *ts, uint32_t a, uint32_t bb)
+{
+    uint32_t k = bb * ts->tiles_x + a, s, victim = 0u;
+    const uint8_t *e = ts->entries + (size_t)k * CT_SET_ENTRY_SIZE;
+    const uint8_t *bytes = NULL;
+    size_t len = 0u;
+    ct_tile_slot *sl;
+    if (e[12] == 0u) {
+        return NULL;
+    }
+    ts->clock++;
+    /* bound: nslots */
+    for (s = 0u; s < ts->nslots; ++s) {
+        if (ts->slots[s].tile == (int32_t)k) {
+            ts->slots[s].used = ts->clock;
+            return &ts->slots[s].pkg;
+        }
+        if (ts->slots[s].tile < 0) {
+            if (ts->slots[victim].tile >= 0) {
+                victim = s;
+            }
+        } else if (ts->slots[victim].tile >= 0 && ts->slots[s].used < ts->slots[victim].used) {
+            victim = s;
+        }
+    }
+    sl = &ts->slots[victim];
+    sl->tile = -1;
+    if (ts->load(ts->user, a, bb, sl->buf, sl->cap, &bytes, &len) != CT_OK || bytes == NULL ||
+        ct_package_open(&sl->pkg, bytes, len) != CT_OK || !tile_matches(ts, &sl->pkg, e, a, bb)) {
+        ts->refused++;
+        return NULL;
+    }
+    sl->tile = (int32_t)k;
+    sl->used = ts->clock;
+    ts->loads++;
+    return &sl->pkg;
+}
+
+/* The tile column (or row) holding frame cell i (0 <= i < cells). */
+static uint32_t tile_of(const ct_tileset *ts, int32_t i, uint32_t ntiles)
+{
+    uint32_t a = (uint32_t)i / (ts->tile_posts - 1u);
+    return a < ntiles ? a : ntiles - 1u;
+}
+
+/* CT_NO_DATA: where the ray entered tile (a, b), at t = tn / td. */
+static ct_status no_data(const ct_tileset *ts, const ct_prepared *r, const ct_lower *lw, uint32_t a, uint32_t bb,
+                         int64_t tn, int64_t td, ct_hit *h)
+{
+    int64_t tq = td == (INT64_C(1) << CT_T_FRAC_BITS) ? tn : ct_floor_div(tn * (INT64_C(1) << CT_T_FRAC_BITS), td);
+    int64_t x0 = (int64_t)tile_first(ts, a), y0 = (int64_t)tile_first(ts, bb);
+    int64_t x1 = x0 + (int64_t)tile_posts_at(ts, a, ts->frame.width) - 2;
+    int64_t y1 = y0 + (int64_t)tile_posts_at(ts, bb, ts->frame.height) - 2;
+    ct_fill_point(&ts->frame, r, lw, tq, h);
+    h->cell_x = (int32_t)ct_min64(ct_max64(ct_floor_div(h->x_q16, ONE16), x0), x1);
+    h->cell_y = (int32_t)ct_min64(ct_max64(ct_floor_div(h->y_q16, ONE16), y0), y1);
+    return CT_NO_DATA;
+}
+
+/* The trace over the set; lw: the lowered model in the frame's grid
+ * (NULL: straight). */
+static ct_status set_trace(ct_tileset *ts, const ct_ray *ray, const ct_lower *lw, ct_method m, ct_hit *h)
+{
+    const ct_package *F = &ts->frame;
+    const ct_package *tp;
+    ct_prepared r, rl;
+    ct_lower ll;
+    ct_status st;
+    int32_t i, j, sx, sy;
+    uint32_t a, bb, it;
+    int64_t tn = 0, td = 1, adx, ady;
+    h->steps = 0u;
+    h->iters = 0u;
+    h->x_q16 = h->y_q16 = h->z_q16 = 0;
+    h->e_nm = h->n_nm = h->h_nm = 0;
+    h->t_q26 = 0;
+    h->cell_x = h->cell_y = -1;
+    if ((unsigned)m >= (unsigned)CT_METHOD_COUNT) {
+        return CT_ERR_METHOD;
+    }
+    st = ct_tile_prep_geom(F, ray, &r);
+    if (st != CT_OK) {
+        return st;
+    }
+    ct_prepared_first_cell(F, &r, &i, &j);
+    a = tile_of(ts, i, ts->tiles_x);
+    bb = tile_of(ts, j, ts->tiles_y);
+    sx = r.dx > 0 ? 1 : (r.dx < 0 ? -1 : 0);
+    sy = r.dy > 0 ? 1 : (r.dy < 0 ? -1 : 0);
+    adx = ct_abs64(r.dx);
+    ady = ct_abs64(r.dy);
+    {
+        /* the first point above the tile's tallest post (the manifest
+         * says): started without loading it.  |oz 2^zs| <= 2^46. */
+        const uint8_t *e0 = ts->entries + (size_t)(bb * ts->tiles_x + a) * CT_SET_ENTRY_SIZE;
+        int64_t ox = (int64_t)tile_first(ts, a) * ONE16, oy = (int64_t)tile_first(ts, bb) * ONE16;
+        if (e0[12] != 0u && r.oz * (INT64_C(1) << r.zshift) > (int64_t)ct_ld16(e0 + 10) * ONE16) {
+            st = ct_tile_prep_finish(F, NULL, 0, 0, ray, lw, &r);
+        } else {
+            tp = tile_get(ts, a, bb);
+            if (tp == NULL) {
+                r.tend_n = 0;
+                r.tend_d = 1;
+                r.start = CT_OK;
+                return no_data(ts, &r, lw, a, bb, 0, 1, h);
+            }
+            if (lw != NULL) {
+                ll = *lw;
+                ll.obx -= ox;
+                ll.oby -= oy;
+            }
+            st = ct_tile_prep_finish(F, tp, ox, oy, ray, lw != NULL ? &ll : NULL, &r);
+        }
+    }
+    if (st != CT_OK && st != CT_HIT) {
+        return st; /* CT_BELOW */
+    }
+    /* bound: a ray crosses at most tiles_x + tiles_y - 1 tiles */
+    for (it = 0u; it < ts->tiles_x + ts->tiles_y; ++it) {
+        const uint8_t *e = ts->entries + (size_t)(bb * ts->tiles_x + a) * CT_SET_ENTRY_SIZE;
+        int64_t x0 = (int64_t)tile_first(ts, a), y0 = (int64_t)tile_first(ts, bb);
+        int64_t x1 = x0 + (int64_t)tile_posts_at(ts, a, F->width) - 1;
+        int64_t y1 = y0 + (int64_t)tile_posts_at(ts, bb, F->height) - 1;
+        int64_t nx = 0, ny = 0, en, ed, ln, ld;
+        int face;
+        /* where the ray leaves the tile (as trace.c's cell exit) */
+        if (sx != 0) {
+            nx = ((sx > 0 ? x1 : x0) * ONE16 - r.ox) * sx;
+        }
+        if (sy != 0) {
+            ny = ((sy > 0 ? y1 : y0) * ONE16 - r.oy) * sy;
+        }
+        if (sy == 0) {
+            face = 1;
+        } else if (sx == 0) {
+            face = 2;
+        } else {
+            int64_t lx = nx * ady, ly = ny * adx;
+            face = lx < ly ? 1 : (ly < lx ? 2 : 3);
+        }
+        en = face == 2 ? ny : nx;
+        ed = face == 2 ? ady : adx;
+        if (sx == 0 && sy == 0) {
+            en = r.tend_n; /* a vertical ray stays in its tile */
+            ed = r.tend_d;
+        }
+        /* the ray's lowest point on the tile: at its exit (descending, the
+         * earlier of the exit and tend) or entry; above the tile's tallest
+         * post, nothing there can be hit (lowered terrain is lower still):
+         * z d = oz d + n dz < 2^61 (trace.c's exit_sign), hmax 2^16 d <
+         * 2^59 */
+        ln = tn;
+        ld = td;
+        if (r.dz < 0) {
+            ln = en;
+            ld = ed;
+            if (t_lt(r.tend_n, r.tend_d, ln, ld)) {
+                ln = r.tend_n;
+                ld = r.tend_d;
+            }
+        }
+        if (e[12] == 0u || r.oz * ld + ln * (int64_t)r.dz <= (int64_t)ct_ld16(e + 10) * (ONE16 >> r.zshift) * ld) {
+            ct_hit th;
+            tp = tile_get(ts, a, bb);
+            if (tp == NULL) {
+                return no_data(ts, &r, lw, a, bb, tn, td, h);
+            }
+            rl = r;
+            rl.ox -= x0 * ONE16;
+            rl.oy -= y0 * ONE16;
+            if (lw != NULL) {
+                ll = *lw;
+                ll.obx -= x0 * ONE16;
+                ll.oby -= y0 * ONE16;
+            }
+            st = ct_trace_tile(tp, &rl, tn, td, lw != NULL ? &ll : NULL, m, &th);
+            h->steps += th.steps;
+            h->iters += th.iters;
+            if (st != CT_MISS) {
+                if (st == CT_HIT || st == CT_HIT_VOID) {
+                    h->x_q16 = th.x_q16 + x0 * ONE16;
+                    h->y_q16 = th.y_q16 + y0 * ONE16;
+                    h->z_q16 = th.z_q16;
+                    h->t_q26 = th.t_q26;
+                    h->cell_x = th.cell_x + (int32_t)x0;
+                    h->cell_y = th.cell_y + (int32_t)y0;
+                    (void)ct_grid_to_map(F, h->x_q16, h->y_q16, h->z_q16, &h->e_nm, &h->n_nm, &h->h_nm);
+                }
+                return st;
+            }
+        }
+        if (!t_lt(en, ed, r.tend_n, r.tend_d)) {
+            return CT_MISS;
+        }
+        /* onto the next tile (through a corner: the diagonal one) */
+        if (face & 1) {
+            if ((sx < 0 && a == 0u) || (sx > 0 && a + 1u >= ts->tiles_x)) {
+                return CT_MISS;
+            }
+            a = sx > 0 ? a + 1u : a - 1u;
+        }
+        if (face & 2) {
+            if ((sy < 0 && bb == 0u) || (sy > 0 && bb + 1u >= ts->tiles_y)) {
+                return CT_MISS;
+            }
+            bb = sy > 0 ? bb + 1u : bb - 1u;
+        }
+        tn = en;
+        td = ed;
+    }
+    return CT_ERR_INTERNAL;
+}
+
+ct_status ct_tileset_trace(ct_tileset *ts, const ct_ray *ray, ct_method m, ct_hit *h)
+{
+    CT_ASSERT(ts != NULL && ray != NULL && h != NULL);
+    if (ts == NULL || ray == NULL || h == NULL) {
+        return CT_ERR_ARG;
+    }
+    return set_trace(ts, ray, NULL, m, h);
+}
+
+ct_status ct_tileset_trace_lowered(ct_tileset *ts, const ct_ray *ray, const ct_lower *lw, ct_method m, ct_hit *h)
+{
+    return set_trace(ts, ray, lw, m, h);
+}

@@ -1,0 +1,61 @@
+/*
+ * tiles.h -- what tiles.c needs from the tracer (private; trace.c).
+ *
+ * A tile set traces a ray prepared against the whole set (a header-only
+ * package, the "frame": the merged grid's extent, heights and
+ * georeference) and walks it tile by tile, each tile's grid being the
+ * frame's shifted by whole cells (offx, offy: Q16, multiples of 2^16).
+ */
+#ifndef CT_TILES_H
+#define CT_TILES_H
+
+#include "bend.h"
+#include "conetrace.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ct_ray_prepare's clipping and quantisation against frame's box (no
+ * heights read): CT_OK (out->start not yet decided), CT_MISS / CT_BELOW, or
+ * an error.                                                                */
+ct_status ct_tile_prep_geom(const ct_package *frame, const ct_ray *ray, ct_prepared *out);
+
+/* The cell of frame holding a prepared ray's first point (clamped). */
+void ct_prepared_first_cell(const ct_package *frame, const ct_prepared *r, int32_t *i, int32_t *j);
+
+/* The rest of ct_ray_prepare: the first point decided against tile (whose
+ * grid is frame's shifted by offx, offy; lw, if any, in tile's grid), tend
+ * in frame's box.  tile NULL: the caller knows the first point is above
+ * every post of its tile (start CT_OK, nothing read).  Returns out->start. */
+ct_status ct_tile_prep_finish(const ct_package *frame, const ct_package *tile, int64_t offx, int64_t offy,
+                              const ct_ray *ray, const ct_lower *lw, ct_prepared *out);
+
+/* The walk of r (a frame-prepared ray shifted into tile's grid) in tile
+ * from t0 = t0_n / t0_d: 0 for the first tile (as ct_trace_prepared), else
+ * the parameter where the ray crosses onto the tile (d <= 2^26).  CT_MISS
+ * when it leaves the tile (or, by a cone, shows the rest of the ray in the
+ * tile is above its surface) without a hit.                                */
+ct_status ct_trace_tile(const ct_package *tile, const ct_prepared *r, int64_t t0_n, int64_t t0_d, const ct_lower *lw,
+                        ct_method method, ct_hit *hit);
+
+/* hit's position at t_q26 on r (x, y, z Q16 and map nm in p's frame; for a
+ * bent ray, on the curve); hit->cell_x, cell_y are kept.                   */
+void ct_fill_point(const ct_package *p, const ct_prepared *r, const ct_lower *lw, int64_t t_q26, ct_hit *hit);
+
+/* ct_tileset_trace for the lowered model (lw in the frame's grid, its
+ * observer the ray's origin): geoloc.c.                                   */
+ct_status ct_tileset_trace_lowered(ct_tileset *ts, const ct_ray *ray, const ct_lower *lw, ct_method method,
+                                   ct_hit *hit);
+
+/* Fill the derived fields of a package view from header values (package.c;
+ * ct_package_open's second half): sections NULL, levels 0.  CT_OK or the
+ * georeference's error.                                                    */
+ct_status ct_package_frame(ct_package *pkg, uint32_t width, uint32_t height, uint32_t reduce, uint32_t sectors,
+                           int32_t hmin, int32_t hmax, const int64_t georef_nm[6], uint32_t epsg);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* CT_TILES_H */
