@@ -17,6 +17,8 @@
 #include <fstream>
 #include <iostream>
 #include <map>
+#include <memory>
+#include <atomic>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -28,6 +30,7 @@
 #include "emit_c.hpp"
 #include "host_io.hpp"
 #include "terrain.hpp"
+#include "tileset.hpp"
 #include "vdatum.hpp"
 #include "warp.hpp"
 
@@ -51,21 +54,24 @@ const UsageBlock kUsage[] = {
      "                [--height-scale M] [--posting M] [--threads T]\n"
      "                [--builder slices|brute] [--window R] [--levels H1,H2,...]\n"
      "                [--emit-c NAME] [--vdatum egm96|ellipsoid|unknown]\n"
-     "                [--utm ZONE{N|S}]   (geographic DEMs: resampled onto UTM at --posting M)\n"},
-    {"info", "conetrace info PKG\n"},
-    {"trace", "conetrace trace PKG --rays rays.csv [--method M] [--threads T] -o hits.csv\n"},
+     "                [--utm ZONE{N|S}]   (geographic DEMs: resampled onto UTM at --posting M)\n"
+     "                [--tile-size P|auto]  (a tile set: -o names a directory of tiles of P posts\n"
+     "                and their manifest; auto: tiles of at most 4 MB)\n"},
+    {"info", "conetrace info PKG_or_TILESET\n"},
+    {"trace", "conetrace trace PKG_or_TILESET --rays rays.csv [--method M] [--threads T] [--cache-tiles K]\n"
+              "                -o hits.csv\n"},
     {"demo",
      "conetrace demo DEM --camera C.cameramodel [--tolerance M | --effects LIST] [--step PX]\n"
      "               [--sectors N] [--reduce r] [-o DIR]\n"
      "               (the main job: package the DEM, geolocate a grid of the camera's pixels,\n"
      "               draw DIR/footprint.png and list DIR/pixels.csv; DIR defaults to demo)\n"},
     {"geoloc",
-     "conetrace geoloc PKG --camera C.cameramodel --pixels px.csv [--method M]\n"
+     "conetrace geoloc PKG_or_TILESET --camera C.cameramodel --pixels px.csv [--method M]\n"
      "                 [--pose-wgs84 LAT,LON,H,YAW,PITCH,ROLL | --pose-map E,N,H,YAW,PITCH,ROLL]\n"
      "                 [--effects curvature,refraction] [--refraction-k K]\n"
      "                 [--tolerance M] [--chord M] [--earth-radius M] [--earth-map auto|fitted|exact]\n"
      "                 [--grid-step PX]\n"
-     "                 [--threads T] -o g.csv\n"
+     "                 [--threads T] [--cache-tiles K] -o g.csv\n"
      "                 (curvature on a UTM package: the true Earth, its map fitted once per\n"
      "                 chunk of pixels when there are 256 or more (auto); --earth-radius: a sphere)\n"},
     {"viewshed",
@@ -181,10 +187,33 @@ Terrain load_terrain(const std::string &path, double posting, double hscale, int
     }
 }
 
+// `build --tile-size P`: a tile set in directory `out`.
+int build_tiles(const Terrain &t, const BuildOptions &o, int P, const std::string &out,
+                std::chrono::steady_clock::time_point t0, const std::string &resampled)
+{
+    const TileGrid g = tile_grid(t.width, t.height, P);
+    Progress bar("building " + std::to_string(g.tiles_x * g.tiles_y) + " tiles");
+    TileSetBytes sum;
+    build_tileset_dir(t, o, P, out, o.threads, [&](size_t d, size_t n) { bar.update(d, n); }, &sum);
+    bar.finish();
+    size_t bytes = sum.manifest.size(), largest = 0;
+    for (const auto &tile : sum.tiles) {
+        bytes += tile.size();
+        largest = std::max(largest, tile.size());
+    }
+    const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    std::printf("%s/: %dx%d posts%s in %d x %d tiles of %d posts (edge posts shared), %d sectors, r=%d, "
+                "%zu bytes in all (%.2fx the 16-bit DEM), largest tile %zu bytes; %s and tile_<col>_<row>.ctp; "
+                "built in %.2f s\n",
+                out.c_str(), t.width, t.height, resampled.c_str(), g.tiles_x, g.tiles_y, P, o.sectors, o.reduce, bytes,
+                (double)bytes / (2.0 * t.width * t.height), largest, kManifestName, secs);
+    return 0;
+}
+
 int cmd_build(int argc, char **argv)
 {
     Args a = parse(argc, argv, 2,
-                   {"-o", "--sectors", "--reduce", "--slices", "--height-scale", "--posting", "--threads", "--emit-c", "--builder", "--window", "--levels", "--vdatum", "--utm"});
+                   {"-o", "--sectors", "--reduce", "--slices", "--height-scale", "--posting", "--threads", "--emit-c", "--builder", "--window", "--levels", "--vdatum", "--utm", "--tile-size"});
     if (a.pos.size() != 1) usage("build needs exactly one DEM file");
     if (!a.opt.count("-o")) usage("build needs -o OUT.ctp");
     BuildOptions o;
@@ -236,9 +265,17 @@ int cmd_build(int argc, char **argv)
             throw Error(std::string("--utm: ") + e.what());
         }
     }
+    int tile_posts = 0;
+    if (a.opt.count("--tile-size")) {
+        if (a.opt.count("--emit-c")) usage("--emit-c and --tile-size exclude each other (emit a tile's package instead)");
+        tile_posts = a.opt["--tile-size"] == "auto" ? default_tile_posts(o.reduce, o.sectors)
+                                                    : to_int(a, "--tile-size", 0);
+        if (tile_posts < 2 || tile_posts > CT_MAX_POSTS) usage("--tile-size must be auto or 2..32768 posts");
+    }
     std::string resampled;
     Terrain t = load_terrain(a.pos[0], to_double(a, "--posting", 0), to_double(a, "--height-scale", 0), vdatum, utm,
                              &resampled);
+    if (tile_posts > 0) return build_tiles(t, o, tile_posts, out, t0, resampled);
     Progress bar("building cones");
     o.progress = [&](size_t d, size_t n) { bar.update(d, n); };
     BuildStats st;
@@ -280,10 +317,60 @@ int cmd_build(int argc, char **argv)
     return 0;
 }
 
+// `info` on a tile set: the grid, its coverage and sizes, every tile checked
+// by loading it as the library would (CRC, the manifest's size and CRC, its
+// place).
+int info_tiles(const std::string &path)
+{
+    TileSetFiles files(path);
+    TileCache cache(files, 1);
+    ct_tileset *ts = cache.set();
+    const ct_package &f = ts->frame;
+    const size_t n = (size_t)ts->tiles_x * ts->tiles_y;
+    size_t present = 0, bytes = files.manifest().size(), largest = 0, bad = 0;
+    std::vector<std::string> problems;
+    for (uint32_t row = 0; row < ts->tiles_y; ++row)
+        for (uint32_t col = 0; col < ts->tiles_x; ++col) {
+            const uint8_t *e = ts->entries + (size_t)(row * ts->tiles_x + col) * CT_SET_ENTRY_SIZE;
+            if (!e[12]) continue;
+            present++;
+            const uint32_t sz = (uint32_t)e[0] | (uint32_t)e[1] << 8 | (uint32_t)e[2] << 16 | (uint32_t)e[3] << 24;
+            bytes += sz;
+            largest = std::max<size_t>(largest, sz);
+            // one ray straight down through the tile's first cell loads it
+            ct_ray r{};
+            r.x_q16 = ((int64_t)col * (ts->tile_posts - 1) << 16) + 32768;
+            r.y_q16 = ((int64_t)row * (ts->tile_posts - 1) << 16) + 32768;
+            r.z_q16 = ((int64_t)f.hmax + 1) << 16;
+            r.dz = -1;
+            ct_hit h;
+            if (ct_tileset_trace(ts, &r, CT_METHOD_INCREMENTAL, &h) == CT_NO_DATA) {
+                bad++;
+                if (problems.size() < 8) problems.push_back(files.dir() + "/" + tile_file_name((int)col, (int)row));
+            }
+        }
+    std::printf("tile set      %s (manifest %s)\n", files.dir().c_str(), kManifestName);
+    std::printf("tiles         %u x %u of %u posts (edge posts shared), %zu of %zu present (%.1f%% coverage)\n",
+                ts->tiles_x, ts->tiles_y, ts->tile_posts, present, n, 100.0 * present / std::max<size_t>(1, n));
+    std::printf("posts         %u x %u (cells %u x %u), merged\n", f.width, f.height, f.cells_x, f.cells_y);
+    std::printf("sectors       %u\nreduce        %u\n", f.sectors, f.reduce);
+    std::printf("heights       codes %d..%d = %.4f..%.4f m (%.6g m per LSB)\n", f.hmin, f.hmax,
+                (f.height_offset_nm + f.hmin * f.height_scale_nm) * 1e-9,
+                (f.height_offset_nm + f.hmax * f.height_scale_nm) * 1e-9, f.height_scale_nm * 1e-9);
+    std::printf("origin        E %.9f N %.9f (corner of pixel 0,0)\n", f.origin_e_nm * 1e-9, f.origin_n_nm * 1e-9);
+    std::printf("posting       %.9f x %.9f m\nepsg          %u\n", f.posting_e_nm * 1e-9, f.posting_n_nm * 1e-9, f.epsg);
+    std::printf("size          %zu bytes in all (%.2fx the 16-bit DEM), largest tile %zu bytes\n", bytes,
+                (double)bytes / (2.0 * f.width * f.height), largest);
+    std::printf("verify        %s\n", bad == 0 ? "ok (every tile loads and matches the manifest)" : "FAILED");
+    for (const std::string &pth : problems) std::printf("  bad tile    %s\n", pth.c_str());
+    return bad == 0 ? 0 : 1;
+}
+
 int cmd_info(int argc, char **argv)
 {
     Args a = parse(argc, argv, 2, {});
     if (a.pos.size() != 1) usage("info needs exactly one package file");
+    if (is_tileset_path(a.pos[0])) return info_tiles(a.pos[0]);
     std::vector<uint8_t> bytes = read_file(a.pos[0]);
     ct_package p;
     ct_status st = ct_package_open(&p, bytes.data(), bytes.size());
@@ -316,33 +403,55 @@ int cmd_info(int argc, char **argv)
 
 int cmd_trace(int argc, char **argv)
 {
-    Args a = parse(argc, argv, 2, {"--rays", "--method", "--threads", "-o"});
-    if (a.pos.size() != 1) usage("trace needs exactly one package file");
+    Args a = parse(argc, argv, 2, {"--rays", "--method", "--threads", "--cache-tiles", "-o"});
+    if (a.pos.size() != 1) usage("trace needs exactly one package file or tile set");
     if (!a.opt.count("--rays")) usage("trace needs --rays rays.csv");
     if (!a.opt.count("-o")) usage("trace needs -o hits.csv");
     ct_method m = parse_method(a.opt.count("--method") ? a.opt["--method"] : "directional");
     const int threads = a.opt.count("--threads") ? threads_option(a.opt["--threads"], "trace") : 0;
-    std::vector<uint8_t> bytes = read_file(a.pos[0]);
+    // a package, or a tile set read through per-thread caches of K tiles
+    std::vector<uint8_t> bytes;
     ct_package p;
-    ct_status st = ct_package_open(&p, bytes.data(), bytes.size());
-    if (st != CT_OK) throw Error(a.pos[0] + ": not a valid package (" + status_name(st) + ")");
+    std::unique_ptr<TileSetFiles> tiles;
+    const int cache_tiles = to_int(a, "--cache-tiles", 16);
+    if (is_tileset_path(a.pos[0])) {
+        if (cache_tiles < 1) usage("--cache-tiles must be at least 1");
+        tiles = std::make_unique<TileSetFiles>(a.pos[0]);
+        TileCache probe(*tiles, 1);
+        p = probe.set()->frame;
+    } else {
+        if (a.opt.count("--cache-tiles")) usage("--cache-tiles needs a tile set");
+        bytes = read_file(a.pos[0]);
+        ct_status st = ct_package_open(&p, bytes.data(), bytes.size());
+        if (st != CT_OK) throw Error(a.pos[0] + ": not a valid package (" + status_name(st) + ")");
+    }
     std::vector<MapRay> rays = read_rays_csv(a.opt["--rays"]);
     // rows formatted by the threads into their slots, written in input order
     std::vector<std::string> rows(rays.size());
-    parallel_chunks(rays.size(), threads, 1024, [&](size_t b, size_t e) {
+    std::atomic<uint64_t> loads{0}, nodata{0};
+    std::atomic<size_t> caches{0}, cache_bytes{0};
+    parallel_chunks(rays.size(), threads, tiles ? 8192 : 1024, [&](size_t b, size_t e) {
+        std::unique_ptr<TileCache> cache;
+        if (tiles) {
+            cache = std::make_unique<TileCache>(*tiles, cache_tiles);
+            caches++;
+            cache_bytes = std::max(cache_bytes.load(), cache->slot_bytes());
+        }
         char line[256];
         for (size_t k = b; k < e; ++k) {
             const MapRay &r = rays[k];
             ct_ray gr;
             ct_hit h;
             ct_status s = map_ray_to_grid(p, r, &gr);
-            if (s == CT_OK) s = ct_trace(&p, &gr, m, &h);
-            if (s == CT_HIT || s == CT_HIT_VOID) {
+            if (s == CT_OK) s = cache ? ct_tileset_trace(cache->set(), &gr, m, &h) : ct_trace(&p, &gr, m, &h);
+            if (s == CT_HIT || s == CT_HIT_VOID || s == CT_NO_DATA) {
+                // no_data: where the ray reached terrain the set does not hold
                 double e_m = h.e_nm * 1e-9, n_m = h.n_nm * 1e-9, hh = h.h_nm * 1e-9;
                 double d2 = r.de * r.de + r.dn * r.dn + r.dh * r.dh;
                 double t = ((e_m - r.e) * r.de + (n_m - r.n) * r.dn + (hh - r.h) * r.dh) / d2;
                 std::snprintf(line, sizeof line, "%s,%.6f,%.6f,%.6f,%.9g,%u\n", status_name(s).c_str(), e_m, n_m, hh, t,
                               h.steps);
+                if (s == CT_NO_DATA) nodata++;
             } else if (s >= 0) {
                 std::snprintf(line, sizeof line, "%s,nan,nan,nan,nan,%u\n", status_name(s).c_str(),
                               s == CT_MISS || s == CT_BELOW ? h.steps : 0u);
@@ -351,12 +460,21 @@ int cmd_trace(int argc, char **argv)
             }
             rows[k] = line;
         }
+        if (cache) loads += cache->set()->loads;
     });
     std::ostringstream out;
     out << "status,E,N,h,t,steps\n";
     for (const std::string &row : rows) out << row;
     std::string txt = out.str();
     write_file_atomic(a.opt["-o"], std::vector<uint8_t>(txt.begin(), txt.end()));
+    if (tiles)
+        std::fprintf(stderr,
+                     "trace: %zu rays over %u x %u tiles: %llu tile loads (%zu caches of %d slots, one per chunk of "
+                     "8192 rays), %.1f MB of tiles in memory per cache, %llu files read, %llu rays reached missing "
+                     "or bad tiles (no_data)\n",
+                     rays.size(), tiles->tiles_x(), tiles->tiles_y(), (unsigned long long)loads.load(), caches.load(),
+                     cache_tiles, cache_bytes.load() / 1e6, (unsigned long long)tiles->files_read.load(),
+                     (unsigned long long)nodata.load());
     return 0;
 }
 

@@ -58,7 +58,9 @@
 #include <cstdio>
 #include <cmath>
 #include <cstdlib>
+#include <atomic>
 #include <map>
+#include <memory>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -67,6 +69,7 @@
 #include "conetrace.h"
 #include "host_io.hpp"
 #include "terrain.hpp"
+#include "tileset.hpp"
 
 using namespace ct_host;
 
@@ -76,12 +79,12 @@ int cmd_geoloc(int argc, char **argv)
     const std::string err = parse_cmdline(argc, argv, 2,
                                           {"--camera", "--pixels", "--method", "--effects", "--grid-step",
                                            "--refraction-k", "--earth-radius", "--threads", "--pose-wgs84",
-                                           "--pose-map", "--earth-map", "--tolerance", "--chord", "-o"},
+                                           "--pose-map", "--earth-map", "--tolerance", "--chord", "--cache-tiles", "-o"},
                                           {}, false, &args);
     if (!err.empty()) throw Error("geoloc: " + err);
     const std::vector<std::string> &pos = args.pos;
     std::map<std::string, std::string> &opt = args.opt;
-    if (pos.size() != 1) throw Error("geoloc needs exactly one package file");
+    if (pos.size() != 1) throw Error("geoloc needs exactly one package file or tile set");
     if (!opt.count("--camera")) throw Error("geoloc needs --camera C.cameramodel");
     if (!opt.count("--pixels")) throw Error("geoloc needs --pixels pixels.csv");
     if (!opt.count("-o")) throw Error("geoloc needs -o out.csv");
@@ -134,10 +137,42 @@ int cmd_geoloc(int argc, char **argv)
 
     const int threads = opt.count("--threads") ? threads_option(opt["--threads"], "geoloc") : 0;
 
-    std::vector<uint8_t> bytes = read_file(pos[0]);
-    ct_package p;
-    ct_status st = ct_package_open(&p, bytes.data(), bytes.size());
-    if (st != CT_OK) throw Error(pos[0] + ": not a valid package (" + status_name(st) + ")");
+    // a package, or a tile set read through per-chunk caches of K tiles
+    // (then p is the set's frame, and gp a tile for the geoid)
+    std::vector<uint8_t> bytes, gbytes;
+    ct_package p, gp;
+    ct_status st;
+    std::unique_ptr<TileSetFiles> tiles;
+    int cache_tiles = 16;
+    if (opt.count("--cache-tiles")) {
+        char *end = nullptr;
+        const long k = std::strtol(opt["--cache-tiles"].c_str(), &end, 10);
+        if (opt["--cache-tiles"].empty() || *end || k < 1 || k > 4096)
+            throw Error("--cache-tiles needs a number of tiles in [1, 4096], got '" + opt["--cache-tiles"] + "'");
+        cache_tiles = (int)k;
+    }
+    if (is_tileset_path(pos[0])) {
+        tiles = std::make_unique<TileSetFiles>(pos[0]);
+        TileCache probe(*tiles, 1);
+        p = probe.set()->frame;
+        gp = p;
+        for (uint32_t k = 0; k < tiles->tiles_x() * tiles->tiles_y() && p.vdatum == CT_VDATUM_EGM96; ++k) {
+            const std::string tp = tiles->dir() + "/" + tile_file_name((int)(k % tiles->tiles_x()), (int)(k / tiles->tiles_x()));
+            try {
+                gbytes = read_file(tp);
+            } catch (const Error &) {
+                continue;
+            }
+            if (ct_package_open(&gp, gbytes.data(), gbytes.size()) == CT_OK) break;
+            gp = p;
+        }
+    } else {
+        if (opt.count("--cache-tiles")) throw Error("--cache-tiles needs a tile set");
+        bytes = read_file(pos[0]);
+        st = ct_package_open(&p, bytes.data(), bytes.size());
+        if (st != CT_OK) throw Error(pos[0] + ": not a valid package (" + status_name(st) + ")");
+        gp = p;
+    }
     const std::string &cpath = opt["--camera"];
     LibCamera cam = lib_camera(read_cameramodel(cpath), cpath, grid_step);
     ct_utm zone = {0, 0};
@@ -226,11 +261,30 @@ int cmd_geoloc(int argc, char **argv)
     std::vector<ct_geo> g(px.size());
     // the set-up's status (the same for every chunk; an empty input still
     // checks the camera and the effects)
-    st = ct_geolocate_batch(&p, &cam.cam, &cam.pose, m, &fx, uv.data(), 0, g.data(), 0);
+    std::atomic<uint64_t> loads{0}, nodata{0};
+    std::atomic<size_t> caches{0};
+    if (tiles) {
+        TileCache probe(*tiles, 1);
+        st = ct_geolocate_batch_tiles(probe.set(), &cam.cam, &cam.pose, m, &fx, uv.data(), 0, g.data(), 0);
+    } else {
+        st = ct_geolocate_batch(&p, &cam.cam, &cam.pose, m, &fx, uv.data(), 0, g.data(), 0);
+    }
     if (st == CT_OK)
         parallel_chunks(px.size(), threads, chunk, [&](size_t b, size_t e) {
-            (void)ct_geolocate_batch(&p, &cam.cam, &cam.pose, m, &fx, uv.data() + 2 * b, e - b, g.data() + b, e - b);
+            if (!tiles) {
+                (void)ct_geolocate_batch(&p, &cam.cam, &cam.pose, m, &fx, uv.data() + 2 * b, e - b, g.data() + b, e - b);
+                return;
+            }
+            TileCache cache(*tiles, cache_tiles);
+            caches++;
+            (void)ct_geolocate_batch_tiles(cache.set(), &cam.cam, &cam.pose, m, &fx, uv.data() + 2 * b, e - b,
+                                           g.data() + b, e - b);
+            loads += cache.set()->loads;
+            for (size_t k = b; k < e; ++k) nodata += g[k].status == CT_NO_DATA;
         });
+    if (st == CT_ERR_EFFECTS && tiles && (fx.flags & CT_EFFECT_CURVATURE) && fx.earth_radius_nm == 0 && utm)
+        throw Error("--effects: curvature over a tile set is traced on a sphere only for now (the true Earth "
+                    "needs one package); give --earth-radius 6371000");
     if (st == CT_ERR_EFFECTS)
         throw Error("--effects: the effect parameters are out of range for this package (" + status_name(st) + ")");
     if (st != CT_OK) throw Error(cpath + ": cannot geolocate from this camera (" + status_name(st) + ")");
@@ -258,7 +312,7 @@ int cmd_geoloc(int argc, char **argv)
                 // the datum is known) less the geoid for EGM96 DEMs
                 int64_t und = 0;
                 const bool geoid_ok = p.vdatum == CT_VDATUM_EGM96 &&
-                                      ct_package_geoid(&p, g[k].hit.e_nm, g[k].hit.n_nm, &und) == CT_OK;
+                                      ct_package_geoid(&gp, g[k].hit.e_nm, g[k].hit.n_nm, &und) == CT_OK;
                 if (p.vdatum == CT_VDATUM_EGM96 && !geoid_ok)
                     o += "nan";
                 else
@@ -290,5 +344,12 @@ int cmd_geoloc(int argc, char **argv)
     std::string txt = "u,v,status,E,N,h,steps,lat,lon,h_ell\n";
     for (const std::string &part : parts) txt += part;
     write_file_atomic(opt["-o"], std::vector<uint8_t>(txt.begin(), txt.end()));
+    if (tiles)
+        std::fprintf(stderr,
+                     "geoloc: %zu pixels over %u x %u tiles: %llu tile loads (%zu caches of %d slots, one per chunk), "
+                     "%.1f MB of tiles in memory per cache, %llu pixels reached missing or bad tiles (no_data)\n",
+                     px.size(), tiles->tiles_x(), tiles->tiles_y(), (unsigned long long)loads.load(), caches.load(),
+                     cache_tiles, (double)cache_tiles * (double)tiles->largest_tile() / 1e6,
+                     (unsigned long long)nodata.load());
     return 0;
 }
