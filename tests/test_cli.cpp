@@ -865,6 +865,101 @@ static void test_failed_run_keeps_output(void)
 }
 
 // ---------------------------------------------------------------------------
+// 6. tile sets: build --tile-size, info, trace over a set (the package's
+// rows but the steps), a missing tile (no_data, the other rows unchanged),
+// failures that leave nothing behind
+
+// rows of a hits file without the steps column
+static std::vector<std::string> rows_sans_steps(const std::string &text)
+{
+    std::vector<std::string> out;
+    for (const std::string &l : lines_of(text)) out.push_back(l.substr(0, l.rfind(',')));
+    return out;
+}
+
+static void test_tile_sets(void)
+{
+    TEST_ASSERT_MSG(load_fixture(), "cannot read the fixture DEM");
+    std::string d = new_dir("tiles");
+    // grazing and oblique rays across the whole DEM: many cross seams
+    std::vector<TRay> rays = fixture_rays();
+    ct_rng rng;
+    ct_rng_seed(&rng, 9);
+    for (int k = 0; k < 400; ++k) {
+        const double e = kOE + ct_rng_unit(&rng) * kW * kPost, n = kON - ct_rng_unit(&rng) * kH * kPost;
+        const double az = ct_rng_unit(&rng) * 6.283, el = (k % 2 ? 0.02 : 0.4) * ct_rng_unit(&rng) + 0.001;
+        rays.push_back({e, n, 1100.0 + 300 * ct_rng_unit(&rng), std::cos(az), std::sin(az), -std::tan(el), "any", 0, 0});
+    }
+    write_rays(d + "/rays.csv", rays, false);
+    std::vector<Run> runs = run_all({
+        Job{d, {"build", fixture_dem(), "-o", "set", "--tile-size", "129", "--reduce", "3", "--sectors", "16"}},
+        Job{d, {"build", fixture_dem(), "-o", "one.ctp", "--reduce", "3", "--sectors", "16"}},
+    });
+    TEST_ASSERT_MSG(runs[0].code == 0 && runs[1].code == 0, "build failed: %s %s", runs[0].err.c_str(),
+                    runs[1].err.c_str());
+    TEST_ASSERT_MSG(contains(runs[0].out, "4 x 3 tiles of 129 posts"), "build summary: %s", runs[0].out.c_str());
+    const std::set<std::string> files = listing(d + "/set");
+    TEST_ASSERT_EQUAL_INT(13, (int)files.size());  // 12 tiles and the manifest
+    TEST_ASSERT(files.count("manifest.ctm") == 1 && files.count("tile_3_2.ctp") == 1);
+    Run info = run_cli(d, {"info", "set"});
+    TEST_ASSERT_EQUAL_INT(0, info.code);
+    TEST_ASSERT_MSG(starts_with(info_value(info.out, "verify"), "ok"), "info: %s", info.out.c_str());
+    TEST_ASSERT_MSG(starts_with(info_value(info.out, "tiles"), "4 x 3 of 129 posts"), "info: %s", info.out.c_str());
+    TEST_ASSERT_MSG(starts_with(info_value(info.out, "posts"), "403 x 344"), "info: %s", info.out.c_str());
+
+    // a copy without tile (1, 1)
+    fs::copy(d + "/set", d + "/holed");
+    fs::remove(d + "/holed/tile_1_1.ctp");
+    runs = run_all({
+        Job{d, {"trace", "one.ctp", "--rays", "rays.csv", "-o", "h_one.csv"}},
+        Job{d, {"trace", "set", "--rays", "rays.csv", "--cache-tiles", "1", "-o", "h_set1.csv"}},
+        Job{d, {"trace", "set/manifest.ctm", "--rays", "rays.csv", "--threads", "3", "-o", "h_set.csv"}},
+        Job{d, {"trace", "holed", "--rays", "rays.csv", "-o", "h_holed.csv"}},
+        Job{d, {"info", "holed"}},
+    });
+    for (int k = 0; k < 4; ++k) TEST_ASSERT_MSG(runs[k].code == 0, "`%s`: %s", runs[k].cmd.c_str(), runs[k].err.c_str());
+    TEST_ASSERT_MSG(contains(runs[1].err, "tile loads"), "trace over a set reports its loads: %s", runs[1].err.c_str());
+    const auto one = rows_sans_steps(slurp(d + "/h_one.csv"));
+    TEST_ASSERT(one.size() == rays.size() + 1);
+    TEST_ASSERT_MSG(rows_sans_steps(slurp(d + "/h_set1.csv")) == one, "a 1-slot cache changed the rows");
+    TEST_ASSERT_MSG(rows_sans_steps(slurp(d + "/h_set.csv")) == one, "the tile set's rows differ from the package's");
+    const auto holed = rows_sans_steps(slurp(d + "/h_holed.csv"));
+    TEST_ASSERT(holed.size() == one.size());
+    size_t nodata = 0, same = 0;
+    for (size_t k = 1; k < holed.size() && k < one.size(); ++k) {
+        if (starts_with(holed[k], "no_data,")) nodata++;
+        else same += holed[k] == one[k];
+    }
+    TEST_ASSERT_MSG(nodata > 0 && nodata + same == holed.size() - 1, "holed set: %zu no_data, %zu as the package of %zu",
+                    nodata, same, holed.size() - 1);
+    TEST_ASSERT_MSG(runs[4].code != 0 && contains(runs[4].out, "tile_1_1.ctp"), "info on the holed set: %d %s",
+                    runs[4].code, runs[4].out.c_str());
+
+    // failures: nothing written, nothing left behind
+    fs::create_directory(d + "/notaset");
+    spit(d + "/notaset/keep.txt", "keep");
+    const std::set<std::string> before = listing(d);
+    runs = run_all({
+        Job{d, {"build", "missing.tif", "-o", "set2", "--tile-size", "129"}},
+        Job{d, {"build", fixture_dem(), "-o", "notaset", "--tile-size", "129"}},
+        Job{d, {"build", fixture_dem(), "-o", "set3", "--tile-size", "1"}},
+        Job{d, {"trace", "one.ctp", "--rays", "rays.csv", "--cache-tiles", "2", "-o", "x.csv"}},
+        Job{d, {"trace", "set", "--rays", "rays.csv", "--cache-tiles", "0", "-o", "x.csv"}},
+    });
+    CHECK_FAILURE(runs[0], d, before, "missing.tif");
+    CHECK_FAILURE(runs[1], d, before, "notaset", "not a tile set");
+    CHECK_FAILURE(runs[2], d, before, "", "--tile-size", true);
+    CHECK_FAILURE(runs[3], d, before, "", "--cache-tiles", true);
+    CHECK_FAILURE(runs[4], d, before, "", "--cache-tiles", true);
+    TEST_ASSERT(listing(d + "/notaset") == std::set<std::string>{"keep.txt"});
+    // rebuilding over an existing set replaces it whole
+    Run again = run_cli(d, {"build", fixture_dem(), "-o", "set", "--tile-size", "200", "--reduce", "3"});
+    TEST_ASSERT_MSG(again.code == 0, "rebuild: %s", again.err.c_str());
+    TEST_ASSERT_EQUAL_INT(7, (int)listing(d + "/set").size());  // 3 x 2 tiles and the manifest
+    TEST_ASSERT_MSG(listing(d) == before, "scratch files left beside the set: {%s}", join(listing(d)).c_str());
+}
+
+// ---------------------------------------------------------------------------
 
 int main(void)
 {
@@ -886,6 +981,7 @@ int main(void)
     RUN_TEST(test_nodata_policy);
     RUN_TEST(test_bad_inputs);
     RUN_TEST(test_failed_run_keeps_output);
+    RUN_TEST(test_tile_sets);
     int rc = TEST_END();
     if (getenv("CT_TEST_KEEP"))
         printf("scratch directory kept: %s\n", g_root.c_str());
