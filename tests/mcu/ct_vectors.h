@@ -168,6 +168,29 @@ typedef struct {
     uint32_t npoints;
 } ct_vec_datum_package;
 
+/* A tile set (conetrace.h, "Tile sets"): the manifest and its tiles as
+ * const arrays; the target loads them into nslots RAM slots of
+ * CT_VEC_TILE_CAP bytes (tile `missing` refused; ntiles: none) and traces
+ * the cases' rays with every method in order: the statuses, hits and the
+ * final load count are the host's (prep fields unused). */
+#define CT_VEC_TILE_CAP 4096u
+typedef struct {
+    const uint8_t *bytes;
+    uint32_t size;
+} ct_vec_tile;
+
+typedef struct {
+    const char *name;
+    const uint8_t *manifest;
+    uint32_t manifest_size;
+    const ct_vec_tile *tiles;             /* row-major                        */
+    uint32_t ntiles;
+    uint32_t nslots, missing;
+    const ct_vec_case *cases;
+    uint32_t ncases;
+    uint32_t loads;                       /* ct_tileset.loads after the cases */
+} ct_vec_tileset;
+
 typedef struct {
     const ct_vec_package *packages;
     uint32_t npackages;
@@ -188,6 +211,8 @@ typedef struct {
     uint32_t ngeoid;
     const ct_vec_datum_package *datum;
     uint32_t ndatum;
+    const ct_vec_tileset *tilesets;
+    uint32_t ntilesets;
 } ct_vec_set;
 
 extern const ct_vec_set ct_vectors;

@@ -36,6 +36,7 @@ extern "C" {
 #include "ct_vectors.h"
 #include "le.hpp"
 #include "terrain.hpp"
+#include "tileset.hpp"
 
 namespace {
 
@@ -127,7 +128,7 @@ const char *builder_name(ct_host::PptBuilder b)
     return b == ct_host::PptBuilder::Degenerate ? "degenerate cones" : "slice builder";
 }
 
-std::vector<uint8_t> build_with_builder(const Dem &d, int n, int r, ct_host::PptBuilder b)
+ct_host::Terrain dem_terrain(const Dem &d)
 {
     ct_host::Terrain t;
     t.width = W;
@@ -141,6 +142,12 @@ std::vector<uint8_t> build_with_builder(const Dem &d, int n, int r, ct_host::Ppt
     t.geo.epsg = EPSG;
     t.height_offset_m = OFFSET_M;
     t.height_scale_m = SCALE_M;
+    return t;
+}
+
+std::vector<uint8_t> build_with_builder(const Dem &d, int n, int r, ct_host::PptBuilder b)
+{
+    const ct_host::Terrain t = dem_terrain(d);
     ct_host::BuildOptions o;
     o.sectors = n;
     o.reduce = r;
@@ -901,6 +908,106 @@ void emit_cameras(FILE *f, const std::vector<Cam> &cams)
 
 }  // namespace
 
+// ------------------------------------------------------------------ tile sets
+// The DEM cut into 3 x 3 tiles; traced on the host through the same slots
+// and loader the target uses (a copy from the const tiles into RAM slots;
+// `missing` refused), so results, steps and loads must match bit for bit.
+struct TSet {
+    std::string name;
+    ct_host::TileSetBytes b;
+    uint32_t nslots = 2, missing = 0;  // missing == tiles: none
+    std::vector<ct_vec_case> cases;
+    uint32_t loads = 0;
+};
+
+struct TLoad {
+    const TSet *s;
+};
+
+ct_status tset_loader(void *user, uint32_t col, uint32_t row, uint8_t *buf, size_t cap, const uint8_t **bytes,
+                      size_t *len)
+{
+    const TSet *s = static_cast<TLoad *>(user)->s;
+    const uint32_t k = row * (uint32_t)s->b.grid.tiles_x + col;
+    const std::vector<uint8_t> &v = s->b.tiles[k];
+    if (k == s->missing || v.size() > cap) return CT_ERR_ARG;
+    std::memcpy(buf, v.data(), v.size());
+    *bytes = buf;
+    *len = v.size();
+    return CT_OK;
+}
+
+void run_tileset(Rng &g, TSet &s, const ct_package &merged, int nrays)
+{
+    std::vector<ct_tile_slot> slots(s.nslots);
+    std::vector<std::vector<uint8_t>> bufs(s.nslots, std::vector<uint8_t>(CT_VEC_TILE_CAP));
+    for (uint32_t k = 0; k < s.nslots; ++k) {
+        slots[k] = ct_tile_slot{};
+        slots[k].buf = bufs[k].data();
+        slots[k].cap = bufs[k].size();
+    }
+    TLoad tl{&s};
+    ct_tileset ts;
+    if (ct_tileset_open(&ts, s.b.manifest.data(), s.b.manifest.size(), slots.data(), s.nslots, tset_loader, &tl) != CT_OK)
+        die("host: ct_tileset_open failed");
+    int nodata = 0;
+    for (int k = 0; k < nrays; ++k) {
+        ct_vec_case c;
+        std::memset(&c, 0, sizeof c);
+        c.ray = make_ray(g, merged, pick_kind(g));
+        for (int m = 0; m < CT_METHOD_COUNT; ++m) {
+            c.status[m] = ct_tileset_trace(&ts, &c.ray, (ct_method)m, &c.hit[m]);
+            nodata += c.status[m] == CT_NO_DATA;
+            if (s.missing >= s.b.tiles.size()) {
+                ct_hit h;
+                std::memset(&h, 0, sizeof h);
+                const ct_status sm = ct_trace(&merged, &c.ray, (ct_method)m, &h);
+                if (sm != c.status[m] || h.t_q26 != c.hit[m].t_q26 || h.x_q16 != c.hit[m].x_q16)
+                    die("host: a tile set differs from the merged package");
+            }
+        }
+        s.cases.push_back(c);
+    }
+    s.loads = ts.loads;
+    std::fprintf(stderr, "gen_vectors: tile set %s: %zu tiles, %u slots, %d rays x 4 methods, %u loads, %d no_data\n",
+                 s.name.c_str(), s.b.tiles.size(), s.nslots, nrays, s.loads, nodata);
+}
+
+void emit_tilesets(FILE *f, const std::vector<TSet> &sets)
+{
+    for (size_t k = 0; k < sets.size(); ++k) {
+        const TSet &s = sets[k];
+        std::fprintf(f, "static const union {\n    uint64_t align;\n    uint8_t b[%zu];\n} tset%zu_manifest = {.b = {",
+                     s.b.manifest.size(), k);
+        for (size_t i = 0; i < s.b.manifest.size(); ++i)
+            std::fprintf(f, "%s0x%02x,", (i % 16) ? " " : "\n    ", s.b.manifest[i]);
+        std::fprintf(f, "\n}};\n\n");
+        for (size_t t = 0; t < s.b.tiles.size(); ++t) {
+            const std::vector<uint8_t> &v = s.b.tiles[t];
+            std::fprintf(f, "static const union {\n    uint64_t align;\n    uint8_t b[%zu];\n} tset%zu_tile%zu = {.b = {",
+                         v.size(), k, t);
+            for (size_t i = 0; i < v.size(); ++i) std::fprintf(f, "%s0x%02x,", (i % 16) ? " " : "\n    ", v[i]);
+            std::fprintf(f, "\n}};\n\n");
+        }
+        std::fprintf(f, "static const ct_vec_tile tset%zu_tiles[%zu] = {\n", k, s.b.tiles.size());
+        for (size_t t = 0; t < s.b.tiles.size(); ++t)
+            std::fprintf(f, "  {tset%zu_tile%zu.b, %zuu},\n", k, t, s.b.tiles[t].size());
+        std::fprintf(f, "};\n\nstatic const ct_vec_case tset%zu_cases[%zu] = {\n", k, s.cases.size());
+        for (const ct_vec_case &c : s.cases) emit_case(f, c);
+        std::fprintf(f, "};\n\n");
+    }
+    std::fprintf(f, "static const ct_vec_tileset tilesets[%zu] = {\n", sets.size());
+    for (size_t k = 0; k < sets.size(); ++k) {
+        const TSet &s = sets[k];
+        std::fprintf(f,
+                     "  {.name = \"%s\", .manifest = tset%zu_manifest.b, .manifest_size = %zuu, .tiles = tset%zu_tiles,\n"
+                     "   .ntiles = %zuu, .nslots = %uu, .missing = %uu, .cases = tset%zu_cases, .ncases = %zuu, .loads = %uu},\n",
+                     s.name.c_str(), k, s.b.manifest.size(), k, s.b.tiles.size(), s.nslots, s.missing, k,
+                     s.cases.size(), s.loads);
+    }
+    std::fprintf(f, "};\n\n");
+}
+
 int main(int argc, char **argv)
 {
     if (argc < 2) {
@@ -985,6 +1092,30 @@ int main(int argc, char **argv)
                      P.name.c_str(), P.bytes.size(), P.cone_codes, counts[CT_HIT], counts[CT_MISS], counts[CT_BELOW],
                      counts[CT_HIT_VOID], counts[5], fewer_cone, fewer_dir);
         pkgs.push_back(std::move(P));
+    }
+
+    // tile sets: the DEM in 3 x 3 tiles (N = 8, r = 2, the first package's
+    // builder), all tiles in 2 slots, and tile (1, 1) refused with 1 slot
+    std::vector<TSet> tsets;
+    {
+        ct_host::BuildOptions o;
+        o.sectors = 8;
+        o.reduce = 2;
+        o.threads = 1;
+        o.builder = pkgs[0].cone_codes > 0 ? ct_host::PptBuilder::Slices : ct_host::PptBuilder::Degenerate;
+        const ct_host::TileSetBytes b = ct_host::build_tileset(dem_terrain(dem), o, 12, 1);
+        for (const auto &t : b.tiles)
+            if (t.size() > CT_VEC_TILE_CAP) die("a tile is larger than CT_VEC_TILE_CAP");
+        Rng gt(16u);
+        for (int v = 0; v < 2; ++v) {
+            TSet s;
+            s.name = v == 0 ? "3x3_tiles_2_slots" : "3x3_tiles_1_slot_centre_missing";
+            s.b = b;
+            s.nslots = v == 0 ? 2u : 1u;
+            s.missing = v == 0 ? (uint32_t)b.tiles.size() : 4u;
+            run_tileset(gt, s, pkgs[0].p, 120);
+            tsets.push_back(std::move(s));
+        }
     }
 
     // fixed-point vectors (native __int128 on the host)
@@ -1087,6 +1218,7 @@ int main(int argc, char **argv)
     }
     std::fprintf(f, "\n};\n\n");
     emit_cameras(f, cams);
+    emit_tilesets(f, tsets);
     // geodesy: points across zones and hemispheres, some out of range
     std::vector<ct_vec_geo> geo;
     {
@@ -1316,9 +1448,9 @@ int main(int argc, char **argv)
     }
     std::fprintf(f,
                  "const ct_vec_set ct_vectors = {packages, %zuu, fixed, %zuu, dirs, %zuu, \"%s\", cameras, %zuu, geo, "
-                 "%zuu, ecef, %zuu,\n    geoid_grids, %zuu, geoid, %zuu, datum, 1u};\n",
+                 "%zuu, ecef, %zuu,\n    geoid_grids, %zuu, geoid, %zuu, datum, 1u, tilesets, %zuu};\n",
                  pkgs.size(), fx.size(), dirs.size(), generator.c_str(), cams.size(), geo.size(), ecef.size(),
-                 ggrids.size(), gpts.size());
+                 ggrids.size(), gpts.size(), tsets.size());
     if (std::fclose(f) != 0) die("write error");
     return 0;
 }

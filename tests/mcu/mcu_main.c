@@ -168,10 +168,21 @@ static void eq_prep(const ct_prepared *w, const ct_prepared *g)
 
 /* ---- stack measurement ---------------------------------------------------- */
 
-enum { ST_OPEN, ST_PREPARE, ST_TRACE, ST_TRACE_PREP, ST_UNPROJECT, ST_PROJECT, ST_GEOLOCATE, ST_BATCH, ST_COUNT };
-static const char *const st_names[ST_COUNT] = {"ct_package_open",     "ct_ray_prepare",    "ct_trace",
+enum {
+    ST_OPEN,
+    ST_PREPARE,
+    ST_TRACE,
+    ST_TRACE_PREP,
+    ST_UNPROJECT,
+    ST_PROJECT,
+    ST_GEOLOCATE,
+    ST_BATCH,
+    ST_TILESET,
+    ST_COUNT
+};
+static const char *const st_names[ST_COUNT] = {"ct_package_open",     "ct_ray_prepare",      "ct_trace",
                                                "ct_trace_prepared",   "ct_camera_unproject", "ct_camera_project",
-                                               "ct_geolocate",        "ct_geolocate_batch"};
+                                               "ct_geolocate",        "ct_geolocate_batch",  "ct_tileset_trace"};
 static unsigned st_max[ST_COUNT];
 
 static void st_note(int k)
@@ -633,6 +644,77 @@ static uint32_t check_datum(const ct_vec_set *vs)
     return n;
 }
 
+/* ---- tile sets: tiles copied from flash into a few RAM slots --------------- */
+
+#define TS_MAX_SLOTS 4u
+static ct_tile_slot g_slots[TS_MAX_SLOTS];
+static union {
+    uint64_t align;
+    uint8_t b[TS_MAX_SLOTS][CT_VEC_TILE_CAP];
+} g_slot_mem;
+static ct_tileset g_ts;
+
+static ct_status vec_loader(void *user, uint32_t col, uint32_t row, uint8_t *buf, size_t cap, const uint8_t **bytes,
+                            size_t *len)
+{
+    const ct_vec_tileset *vt = (const ct_vec_tileset *)user;
+    uint32_t k = row * ct_ld16(vt->manifest + CT_SET_HDR_TILES_X) + col, i;
+    if (k >= vt->ntiles || k == vt->missing || vt->tiles[k].size > cap) {
+        return CT_ERR_ARG;
+    }
+    /* bound: the tile's bytes */
+    for (i = 0u; i < vt->tiles[k].size; ++i) {
+        buf[i] = vt->tiles[k].bytes[i];
+    }
+    *bytes = buf;
+    *len = vt->tiles[k].size;
+    return CT_OK;
+}
+
+static uint32_t check_tileset(const ct_vec_tileset *vt, uint32_t *hits)
+{
+    uint32_t k, m, s, ok = 0u;
+    ct_status st;
+    g_where = vt->name;
+    g_idx = 0u;
+    g_method = 0u;
+    if (vt->nslots > TS_MAX_SLOTS) {
+        eq_u64("slots", TS_MAX_SLOTS, vt->nslots);
+        return 0u;
+    }
+    /* bound: TS_MAX_SLOTS */
+    for (s = 0u; s < vt->nslots; ++s) {
+        zero_bytes(&g_slots[s], sizeof g_slots[s]);
+        g_slots[s].buf = g_slot_mem.b[s];
+        g_slots[s].cap = CT_VEC_TILE_CAP;
+    }
+    st = ct_tileset_open(&g_ts, vt->manifest, vt->manifest_size, g_slots, vt->nslots, vec_loader, (void *)(uintptr_t)vt);
+    eq_i64("tileset open", CT_OK, st);
+    if (st != CT_OK) {
+        return 0u;
+    }
+    /* bound: the vectors' cases and methods */
+    for (k = 0u; k < vt->ncases; ++k) {
+        const ct_vec_case *c = &vt->cases[k];
+        g_idx = k;
+        for (m = 0u; m < (uint32_t)CT_METHOD_COUNT; ++m) {
+            ct_hit h;
+            uint32_t before = g_fail;
+            g_method = m;
+            zero_bytes(&h, sizeof h);
+            ct_plat_stack_paint();
+            st = ct_tileset_trace(&g_ts, &c->ray, (ct_method)m, &h);
+            st_note(ST_TILESET);
+            eq_i64("tileset status", c->status[m], st);
+            eq_hit(&c->hit[m], &h);
+            ok += g_fail == before;
+            *hits += st == CT_HIT || st == CT_HIT_VOID;
+        }
+    }
+    eq_u64("tileset loads", vt->loads, g_ts.loads);
+    return ok;
+}
+
 int main(void)
 {
     const ct_vec_set *vs = &ct_vectors;
@@ -710,6 +792,31 @@ int main(void)
         put_str("/");
         put_u64(n);
         put_str(" geolocations identical (batch checked too), ");
+        put_u64(g_fail - before);
+        put_str(" mismatching fields");
+        flush_line();
+    }
+    for (p = 0u; p < vs->ntilesets; ++p) {
+        const ct_vec_tileset *vt = &vs->tilesets[p];
+        uint32_t h = 0u, before = g_fail;
+        const uint32_t ok = check_tileset(vt, &h);
+        total += vt->ncases * (uint32_t)CT_METHOD_COUNT;
+        traces += ok;
+        put_str("  tile set ");
+        put_str(vt->name);
+        put_str(": ");
+        put_u64(vt->ncases);
+        put_str(" rays x 4 methods: ");
+        put_u64(ok);
+        put_str("/");
+        put_u64(vt->ncases * (uint64_t)CT_METHOD_COUNT);
+        put_str(" identical (");
+        put_u64(h);
+        put_str(" hits, ");
+        put_u64(vt->loads);
+        put_str(" tile loads into ");
+        put_u64(vt->nslots);
+        put_str(" slots), ");
         put_u64(g_fail - before);
         put_str(" mismatching fields");
         flush_line();
