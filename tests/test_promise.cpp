@@ -20,6 +20,7 @@
 #include "dem_cases.hpp"
 #include "harness.h"
 #include "terrain.hpp"
+#include "tileset.hpp"
 
 namespace {
 
@@ -513,6 +514,29 @@ void test_promise_slice_builder()
     }
 }
 
+// Tile sets (conetrace.h, "Tile sets"): each tile's cones are built from the
+// tile alone and promise empty space only inside the tile's box -- all a walk
+// over the set uses (a tile's walk ends at its seam; the next tile's starts
+// there: test_tiles).  So the promise to check is each tile's, against the
+// merged DEM inside that box, which is the tile's own terrain: for several
+// N and r, every tile of a DEM cut into 2 x 2 tiles (edge posts shared).
+void test_promise_tiles()
+{
+    const ct_host::Terrain merged[2] = {small(1, 23, 21), small(2, 21, 23)};
+    const char *names[2] = {"spikes_wall tile", "smooth tile"};
+    for (int which = 0; which < 2; ++which) {
+        const ct_host::TileGrid g = ct_host::tile_grid(merged[which].width, merged[which].height, 12);
+        TEST_ASSERT(g.tiles_x == 2 && g.tiles_y == 2);
+        for (int n : {3, 8, 24})
+            for (int r = 1; r <= 3; ++r)
+                for (int row = 0; row < g.tiles_y; ++row)
+                    for (int col = 0; col < g.tiles_x; ++col) {
+                        check_package(names[which], ct_host::tile_terrain(merged[which], g, col, row), n, r);
+                        if (ct_harness_g.current_failed) return;
+                    }
+    }
+}
+
 // The slice builder's far terms come from capped directional DT queries, or,
 // where those would visit too many rows, from full line-traversal DTs: two
 // independent implementations that must give byte-identical packages.  Run
@@ -564,5 +588,6 @@ int main()
     RUN_TEST(test_promise_reduce_and_slices);
     RUN_TEST(test_promise_slice_builder);
     RUN_TEST(test_slice_dt_paths_agree);
+    RUN_TEST(test_promise_tiles);
     return TEST_END();
 }
