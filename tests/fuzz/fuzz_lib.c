@@ -31,6 +31,18 @@
  *                     the domain implies, and the round trips (geodetic ->
  *                     Earth-fixed -> geodetic -> Earth-fixed, and Earth-fixed
  *                     -> geodetic -> Earth-fixed) come back within 2 nm.
+ *   mode 4 (tile set, byte 0 = 4 mod 8, a share of mode 0's bytes): the
+ *                     MCU vectors' 3 x 3 tile set of the first package's
+ *                     DEM (same N, r: that package is the merged one);
+ *                     byte 1: bit 0 edit tile byte 2 % 9 with the (u16
+ *                     offset, u8 value) edits that follow (count byte 3 %
+ *                     9), its CRC re-stamped; bit 1 the manifest vouching
+ *                     for the edited tile (entry and CRC re-stamped); bit 2
+ *                     zero copy; bits 3-4 slots - 1; then up to 4 rays
+ *                     traced with every method: documented statuses
+ *                     (CT_NO_DATA included), the bound, hits in the box,
+ *                     and with no tile accepted edited, each result is the
+ *                     merged package's, or CT_NO_DATA no later than it.
  * Contracts asserted (abort on violation):
  *   - every status is one the API documents for the call;
  *   - on a package that opens and verifies, the four methods return the same
@@ -168,6 +180,151 @@ static void ray_mode(const ct_vec_package *vp, uint32_t idx, const uint8_t *d, s
         bd.flags = (uint32_t)((e >> 30) & 1);
     }
     trace_all(pkg, &r, &bd, 1);
+}
+
+/* ---- mode 4: tile sets --------------------------------------------------- */
+
+static union {
+    uint64_t align;
+    uint8_t b[9][CT_VEC_TILE_CAP];
+} g_tiles;
+static uint32_t g_tile_size[9];
+static union {
+    uint64_t align;
+    uint8_t b[4096];
+} g_manifest;
+static union {
+    uint64_t align;
+    uint8_t b[4][CT_VEC_TILE_CAP];
+} g_slot_bufs;
+
+static void st32(uint8_t *p, uint32_t v)
+{
+    p[0] = (uint8_t)v;
+    p[1] = (uint8_t)(v >> 8);
+    p[2] = (uint8_t)(v >> 16);
+    p[3] = (uint8_t)(v >> 24);
+}
+
+/* CRC of a package or manifest with its CRC field (offset 12) zeroed,
+ * written into that field. */
+static void restamp(uint8_t *b, uint32_t size)
+{
+    uint32_t c = 0u;
+    st32(b + 12, 0u);
+    (void)ct_crc32(0u, b, size, &c);
+    st32(b + 12, c);
+}
+
+static int g_zero_copy;
+
+static ct_status fuzz_loader(void *user, uint32_t col, uint32_t row, uint8_t *buf, size_t cap, const uint8_t **bytes,
+                             size_t *len)
+{
+    uint32_t k = row * 3u + col;
+    (void)user;
+    if (k >= 9u || g_tile_size[k] > cap) {
+        return CT_ERR_ARG;
+    }
+    if (g_zero_copy) {
+        *bytes = g_tiles.b[k];
+    } else {
+        memcpy(buf, g_tiles.b[k], g_tile_size[k]);
+        *bytes = buf;
+    }
+    *len = g_tile_size[k];
+    return CT_OK;
+}
+
+static void tileset_mode(const uint8_t *d, size_t n)
+{
+    static ct_package merged;
+    static int opened;
+    const ct_vec_tileset *vt;
+    ct_tile_slot slots[4];
+    ct_tileset ts;
+    uint32_t k, nslots, edited = 9u, nedits;
+    size_t pos = 3u;
+    int r;
+    if (ct_vectors.ntilesets == 0u || n < 3u) {
+        return;
+    }
+    vt = &ct_vectors.tilesets[0];
+    CHECK(vt->ntiles == 9u && vt->manifest_size <= sizeof g_manifest.b);
+    if (!opened) {
+        CHECK(ct_package_open(&merged, ct_vectors.packages[0].bytes, ct_vectors.packages[0].size) == CT_OK);
+        opened = 1;
+    }
+    memcpy(g_manifest.b, vt->manifest, vt->manifest_size);
+    for (k = 0u; k < 9u; ++k) {
+        memcpy(g_tiles.b[k], vt->tiles[k].bytes, vt->tiles[k].size);
+        g_tile_size[k] = vt->tiles[k].size;
+    }
+    if (d[0] & 1u) {
+        edited = d[1] % 9u;
+        nedits = d[2] % 9u;
+        for (k = 0u; k < nedits && pos + 3u <= n; ++k, pos += 3u) {
+            uint32_t off = ((uint32_t)d[pos] | (uint32_t)d[pos + 1] << 8) % g_tile_size[edited];
+            g_tiles.b[edited][off] = d[pos + 2];
+        }
+        restamp(g_tiles.b[edited], g_tile_size[edited]);
+        if (d[0] & 2u) {
+            uint8_t *e = g_manifest.b + CT_SET_HEADER_SIZE + edited * CT_SET_ENTRY_SIZE;
+            memcpy(e + 4, g_tiles.b[edited] + 12, 4u);
+            restamp(g_manifest.b, vt->manifest_size);
+        }
+    }
+    g_zero_copy = (d[0] >> 2) & 1;
+    nslots = 1u + ((d[0] >> 3) & 3u);
+    for (k = 0u; k < nslots; ++k) {
+        memset(&slots[k], 0, sizeof slots[k]);
+        slots[k].buf = g_slot_bufs.b[k];
+        slots[k].cap = CT_VEC_TILE_CAP;
+    }
+    CHECK(ct_tileset_open(&ts, g_manifest.b, vt->manifest_size, slots, nslots, fuzz_loader, NULL) == CT_OK);
+    for (r = 0; r < 4 && pos < n; ++r) {
+        ct_ray ray;
+        int m;
+        ray.x_q16 = rd64(d, n, &pos);
+        ray.y_q16 = rd64(d, n, &pos);
+        ray.z_q16 = rd64(d, n, &pos);
+        ray.dx = rd64(d, n, &pos);
+        ray.dy = rd64(d, n, &pos);
+        ray.dz = rd64(d, n, &pos);
+        if (r & 1) { /* a ray of the merged box's scale, as most real ones */
+            ray.x_q16 = (ray.x_q16 & 0x3fffff) - 0x40000;
+            ray.y_q16 = (ray.y_q16 & 0x3fffff) - 0x40000;
+            ray.z_q16 = ray.z_q16 & 0x3fffffff;
+            ray.dx >>= 40;
+            ray.dy >>= 40;
+            ray.dz >>= 44;
+        }
+        for (m = 0; m < CT_METHOD_COUNT; ++m) {
+            ct_hit hm, hs;
+            const ct_status sm = ct_trace(&merged, &ray, (ct_method)m, &hm);
+            const ct_status ss = ct_tileset_trace(&ts, &ray, (ct_method)m, &hs);
+            const uint32_t tile_bound = m == CT_METHOD_HIERARCHICAL ? CT_WCET_HIER_ITERS(11u, 11u, CT_MAX_LEVELS)
+                                                                    : CT_WCET_CELL_ITERS(11u, 11u);
+            CHECK(trace_status_ok(ss) || ss == CT_NO_DATA);
+            if (ss >= 0) {
+                CHECK(hs.iters <= CT_WCET_SET_ITERS(3u, 3u, tile_bound));
+            }
+            if (ss == CT_HIT || ss == CT_HIT_VOID || ss == CT_NO_DATA) {
+                CHECK(hs.cell_x >= 0 && hs.cell_y >= 0 && (uint32_t)hs.cell_x < merged.cells_x &&
+                      (uint32_t)hs.cell_y < merged.cells_y);
+            }
+            if (edited == 9u || (d[0] & 2u) == 0u) {
+                /* every accepted tile is intact: the merged package's result,
+                 * or no data (the refused tile) no later than it */
+                if (ss == CT_NO_DATA) {
+                    CHECK(edited != 9u);
+                    CHECK(sm == CT_MISS || sm == CT_BELOW || ((sm == CT_HIT || sm == CT_HIT_VOID) && hs.t_q26 <= hm.t_q26));
+                } else {
+                    CHECK(same_hit(sm, &hm, ss, &hs));
+                }
+            }
+        }
+    }
 }
 
 static void package_mode(const ct_vec_package *vp, int stamp_crc, const uint8_t *d, size_t n)
@@ -513,6 +670,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *d, size_t n)
         geodesy_mode(d + 2, n - 2u);
     } else if ((d[0] & 3u) == 2u) {
         geoloc_mode(vp, d + 2, n - 2u);
+    } else if ((d[0] & 7u) == 4u) {
+        tileset_mode(d + 1, n - 1u);
     } else if ((d[0] & 1u) == 0u) {
         ray_mode(vp, idx, d + 2, n - 2u);
     } else {
