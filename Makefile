@@ -25,6 +25,7 @@ demo: deps
 bench: all
 	$(BUILD)/bench/ct_bench
 	$(BUILD)/bench/ct_bench_geoloc
+	$(BUILD)/bench/ct_bench_tiles
 	$(BUILD)/bench/ct_bench_build
 	$(BUILD)/bench/ct_bench_ddt
 	scripts/bench_m4.sh $(BUILD)

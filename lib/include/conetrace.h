@@ -1041,6 +1041,7 @@ typedef struct {
     ct_tile_loader load;
     void *user;
     uint32_t clock;            /* uses so far (the cache's order)           */
+    uint32_t last;             /* the slot used last                        */
     uint32_t loads;            /* tiles loaded and accepted                 */
     uint32_t refused;          /* loads that failed or were refused         */
 } ct_tileset;

@@ -134,6 +134,7 @@ ct_status ct_tileset_open(ct_tileset *ts, const uint8_t *b, size_t len, ct_tile_
     ts->load = load;
     ts->user = user;
     ts->clock = 0u;
+    ts->last = 0u;
     ts->loads = 0u;
     ts->refused = 0u;
     /* bound: nslots (caller's array) */
@@ -181,17 +182,23 @@ static const ct_package *tile_get(ct_tileset *ts, uint32_t a, uint32_t bb)
         return NULL;
     }
     ts->clock++;
+    if (ts->slots[ts->last].tile == (int32_t)k) {
+        /* the tile of the previous call: the usual case */
+        ts->slots[ts->last].used = ts->clock;
+        return &ts->slots[ts->last].pkg;
+    }
     /* bound: nslots */
     for (s = 0u; s < ts->nslots; ++s) {
         if (ts->slots[s].tile == (int32_t)k) {
             ts->slots[s].used = ts->clock;
+            ts->last = s;
             return &ts->slots[s].pkg;
         }
-        if (ts->slots[s].tile < 0) {
-            if (ts->slots[victim].tile >= 0) {
-                victim = s;
-            }
-        } else if (ts->slots[victim].tile >= 0 && ts->slots[s].used < ts->slots[victim].used) {
+    }
+    /* not held: the first empty slot, else the least recently used.
+     * bound: nslots */
+    for (s = 1u; s < ts->nslots && ts->slots[victim].tile >= 0; ++s) {
+        if (ts->slots[s].tile < 0 || ts->slots[s].used < ts->slots[victim].used) {
             victim = s;
         }
     }
@@ -204,6 +211,7 @@ static const ct_package *tile_get(ct_tileset *ts, uint32_t a, uint32_t bb)
     }
     sl->tile = (int32_t)k;
     sl->used = ts->clock;
+    ts->last = victim;
     ts->loads++;
     return &sl->pkg;
 }
@@ -356,7 +364,12 @@ static ct_status set_trace(ct_tileset *ts, const ct_ray *ray, const ct_lower *lw
                     h->t_q26 = th.t_q26;
                     h->cell_x = th.cell_x + (int32_t)x0;
                     h->cell_y = th.cell_y + (int32_t)y0;
-                    (void)ct_grid_to_map(F, h->x_q16, h->y_q16, h->z_q16, &h->e_nm, &h->n_nm, &h->h_nm);
+                    /* the tile's map position is the frame's: its origin is
+                     * the frame's plus x0 postings exactly, so ct_grid_to_map
+                     * rounds the same product (less x0 2^16 posting) */
+                    h->e_nm = th.e_nm;
+                    h->n_nm = th.n_nm;
+                    h->h_nm = th.h_nm;
                 }
                 return st;
             }

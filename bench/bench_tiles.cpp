@@ -1,0 +1,256 @@
+// bench_tiles.cpp -- `make bench`, tile sets: rays and a 1024 x 768 image
+// over a 4 x 4 tile set against the merged package of the same DEM (the
+// fixture mirror-tiled to 2049 x 2049 posts, N = 24, r = 3; tiles of 513
+// posts), one thread, directional method.  Per ray family (20,000 rays)
+// and for the image: ns per ray on the merged package and on the set with
+// every tile resident (16 slots, warmed), their ratio (the median of
+// per-round ratios over 11 rounds; the sides alternate, each round the best of 3), and
+// with caches of 4 and 1 slots the ns per ray and tile loads per ray (for
+// the ray families on their first 1,000 rays); the steps per ray of both.  A
+// load here is a zero-copy hand-over of the tile's bytes (a memory-mapped
+// file or flash) plus ct_package_open's checks, its CRC over the whole
+// tile included -- what a flight computer pays per tile switch besides
+// reading the tile.  Every result is also compared with the merged
+// package's (it must be bit-identical; a difference is reported loudly).
+// Target: with every tile it needs resident, a tile set costs <= 1.1x the
+// merged package's time.
+//
+// Options: --quick (5,000 rays per family, every 4th pixel of the image).
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "conetrace.h"
+#include "dem_cases.hpp"
+#include "tileset.hpp"
+
+namespace {
+
+using clk = std::chrono::steady_clock;
+
+double now_ns()
+{
+    return (double)std::chrono::duration_cast<std::chrono::nanoseconds>(clk::now().time_since_epoch()).count();
+}
+
+const ct_host::TileSetBytes *g_set;
+
+ct_status zero_copy_loader(void *, uint32_t col, uint32_t row, uint8_t *, size_t, const uint8_t **bytes, size_t *len)
+{
+    const std::vector<uint8_t> &t = g_set->tiles[(size_t)row * g_set->grid.tiles_x + col];
+    *bytes = t.data();
+    *len = t.size();
+    return CT_OK;
+}
+
+struct Cache {
+    std::vector<ct_tile_slot> slots;
+    ct_tileset ts{};
+    explicit Cache(int n) : slots((size_t)n)
+    {
+        for (auto &s : slots) s = ct_tile_slot{};
+        if (ct_tileset_open(&ts, g_set->manifest.data(), g_set->manifest.size(), slots.data(), (uint32_t)n,
+                            zero_copy_loader, nullptr) != CT_OK)
+            std::printf("  ct_tileset_open failed\n");
+    }
+};
+
+bool same(ct_status a, const ct_hit &x, ct_status b, const ct_hit &y)
+{
+    return a == b && (a != CT_HIT || (x.x_q16 == y.x_q16 && x.y_q16 == y.y_q16 && x.z_q16 == y.z_q16 &&
+                                      x.t_q26 == y.t_q26));
+}
+
+// ns per item of f() over n items: the best of 3 runs
+template <class F> double best_of3(F f, size_t n)
+{
+    double best = 1e300;
+    for (int k = 0; k < 3; ++k) {
+        const double t0 = now_ns();
+        f();
+        best = std::min(best, (now_ns() - t0) / (double)n);
+    }
+    return best;
+}
+
+double median(std::vector<double> v)
+{
+    std::sort(v.begin(), v.end());
+    return v.empty() ? 0 : v[v.size() / 2];
+}
+
+struct Row {
+    std::string what;
+    size_t n = 0;
+    double merged = 0, set = 0, ratio = 0, ns4 = 0, loads4 = 0, ns1 = 0, loads1 = 0, steps_m = 0, steps_s = 0;
+    long differ = 0;
+};
+
+void print_row(const Row &r)
+{
+    std::printf("%-14s %7zu | %8.0f %8.0f %6.3f | %6.1f %6.1f | %9.0f %7.3f | %9.0f %7.3f%s\n", r.what.c_str(), r.n,
+                r.merged, r.set, r.ratio, r.steps_m, r.steps_s, r.ns4, r.loads4, r.ns1, r.loads1,
+                r.differ ? "  DIFFERS FROM THE MERGED PACKAGE" : "");
+}
+
+}  // namespace
+
+int main(int argc, char **argv)
+{
+    const bool quick = argc > 1 && std::strcmp(argv[1], "--quick") == 0;
+    const size_t nrays = quick ? 5000 : 20000;
+    const ct_host::Terrain t = dem_cases::mirror_tiled(dem_cases::real_terrain(), 2049, 2049);
+    ct_host::BuildOptions o;
+    o.sectors = 24;
+    o.reduce = 3;
+    double t0 = now_ns();
+    const std::vector<uint8_t> merged = ct_host::build_package(t, o);
+    const double build_merged = (now_ns() - t0) * 1e-9;
+    t0 = now_ns();
+    const ct_host::TileSetBytes set = ct_host::build_tileset(t, o, 513, 0);
+    const double build_set = (now_ns() - t0) * 1e-9;
+    g_set = &set;
+    ct_package mp;
+    if (ct_package_open(&mp, merged.data(), merged.size()) != CT_OK) {
+        std::printf("bench_tiles: the merged package does not open\n");
+        return 1;
+    }
+    size_t bytes = set.manifest.size();
+    for (const auto &tile : set.tiles) bytes += tile.size();
+    std::printf("tile sets: 2049 x 2049 posts (the fixture mirror-tiled), N = 24, r = 3: merged package %.1f MB "
+                "(built in %.1f s), 4 x 4 tiles of 513 posts %.1f MB in all (built in %.1f s); one thread, "
+                "directional; ns per ray (the best; ratio: the median of per-round ratios, 11 alternating rounds, best of 3 each)\n",
+                merged.size() / 1e6, build_merged, bytes / 1e6, build_set);
+    std::printf("%-14s %7s | %8s %8s %6s | %6s %6s | %9s %7s | %9s %7s\n", "family", "rays", "merged", "set/16",
+                "ratio", "steps", "steps", "set/4", "loads", "set/1", "loads");
+    std::printf("%-14s %7s | %8s %8s %6s | %6s %6s | %9s %7s | %9s %7s\n", "", "", "ns/ray", "ns/ray", "", "merged",
+                "set", "ns/ray", "/ray", "ns/ray", "/ray");
+    std::vector<Row> rows;
+    const dem_cases::Family fams[] = {dem_cases::OBLIQUE, dem_cases::GRAZING, dem_cases::HORIZONTAL,
+                                      dem_cases::OUTSIDE};
+    double worst = 0;
+    for (dem_cases::Family f : fams) {
+        ct_rng rng;
+        ct_rng_seed(&rng, 1234u + (uint64_t)f);
+        std::vector<ct_ray> rays(nrays);
+        for (auto &r : rays) r = dem_cases::make_ray(t, f, &rng);
+        std::vector<ct_hit> hm(nrays), hs(nrays);
+        std::vector<ct_status> sm(nrays), ss(nrays);
+        Cache all(16);
+        auto run_merged = [&] {
+            for (size_t k = 0; k < nrays; ++k) sm[k] = ct_trace(&mp, &rays[k], CT_METHOD_DIRECTIONAL, &hm[k]);
+        };
+        auto run_set = [&](Cache &c) {
+            for (size_t k = 0; k < nrays; ++k) ss[k] = ct_tileset_trace(&c.ts, &rays[k], CT_METHOD_DIRECTIONAL, &hs[k]);
+        };
+        run_set(all);  // warm: every tile resident
+        Row row;
+        row.what = dem_cases::family_name(f);
+        row.n = nrays;
+        std::vector<double> ratios;
+        for (int round = 0; round < 11; ++round) {
+            const double a = best_of3(run_merged, nrays), b = best_of3([&] { run_set(all); }, nrays);
+            ratios.push_back(b / a);
+            row.merged = round == 0 ? a : std::min(row.merged, a);
+            row.set = round == 0 ? b : std::min(row.set, b);
+        }
+        row.ratio = median(ratios);
+        for (size_t k = 0; k < nrays; ++k) {
+            row.differ += !same(sm[k], hm[k], ss[k], hs[k]);
+            row.steps_m += hm[k].steps / (double)nrays;
+            row.steps_s += hs[k].steps / (double)nrays;
+        }
+        // small caches: every load checks the whole tile (its CRC), so on
+        // the first 1,000 rays only
+        const size_t nl = std::min<size_t>(nrays, 1000);
+        for (int slots : {4, 1}) {
+            Cache c(slots);
+            const double t1 = now_ns();
+            for (size_t k = 0; k < nl; ++k) ss[k] = ct_tileset_trace(&c.ts, &rays[k], CT_METHOD_DIRECTIONAL, &hs[k]);
+            const double ns = (now_ns() - t1) / (double)nl;
+            for (size_t k = 0; k < nl; ++k) row.differ += !same(sm[k], hm[k], ss[k], hs[k]);
+            (slots == 4 ? row.ns4 : row.ns1) = ns;
+            (slots == 4 ? row.loads4 : row.loads1) = (double)c.ts.loads / (double)nl;
+        }
+        worst = std::max(worst, row.ratio);
+        print_row(row);
+        rows.push_back(row);
+    }
+    // a 1024 x 768 pinhole image, 30 deg down from 3 km over the set's
+    // north-west quarter, looking south-east across the seams
+    {
+        ct_lens lens{};
+        lens.model = CT_LENS_PINHOLE;
+        lens.width = 1024;
+        lens.height = 768;
+        lens.fx_q32 = lens.fy_q32 = (int64_t)900 << 32;
+        lens.cx_q32 = (int64_t)1023 << 31;
+        lens.cy_q32 = (int64_t)767 << 31;
+        ct_camera cam;
+        int32_t q[4];
+        ct_pose pose;
+        const double deg = M_PI / 180 * 2305843009213693952.0;
+        ct_camera_init(&cam, &lens);
+        ct_quat_from_ypr(std::llround(135 * deg), std::llround(-30 * deg), 0, q);
+        ct_pose_from_map(&pose, mp.origin_e_nm + 500 * mp.posting_e_nm, mp.origin_n_nm + 500 * mp.posting_n_nm,
+                         (int64_t)3000 * 1000000000, q);
+        const int step = quick ? 4 : 1;
+        std::vector<int64_t> uv;
+        for (int v = 0; v < 768; v += step)
+            for (int u = 0; u < 1024; u += step) {
+                uv.push_back((int64_t)u << 16);
+                uv.push_back((int64_t)v << 16);
+            }
+        const size_t np = uv.size() / 2;
+        std::vector<ct_geo> gm(np), gs(np);
+        Cache all(16);
+        auto run_merged = [&] {
+            ct_geolocate_batch(&mp, &cam, &pose, CT_METHOD_DIRECTIONAL, nullptr, uv.data(), np, gm.data(), np);
+        };
+        auto run_set = [&](Cache &c) {
+            ct_geolocate_batch_tiles(&c.ts, &cam, &pose, CT_METHOD_DIRECTIONAL, nullptr, uv.data(), np, gs.data(), np);
+        };
+        run_set(all);
+        Row row;
+        row.what = "image 1024x768";
+        row.n = np;
+        std::vector<double> ratios;
+        for (int round = 0; round < 11; ++round) {
+            const double a = best_of3(run_merged, np), b = best_of3([&] { run_set(all); }, np);
+            ratios.push_back(b / a);
+            row.merged = round == 0 ? a : std::min(row.merged, a);
+            row.set = round == 0 ? b : std::min(row.set, b);
+        }
+        row.ratio = median(ratios);
+        auto diff = [&] {
+            long d = 0;
+            for (size_t k = 0; k < np; ++k) d += !same(gm[k].status, gm[k].hit, gs[k].status, gs[k].hit);
+            return d;
+        };
+        row.differ = diff();
+        for (size_t k = 0; k < np; ++k) {
+            row.steps_m += gm[k].hit.steps / (double)np;
+            row.steps_s += gs[k].hit.steps / (double)np;
+        }
+        for (int slots : {4, 1}) {
+            Cache c(slots);
+            const double t1 = now_ns();
+            run_set(c);
+            (slots == 4 ? row.ns4 : row.ns1) = (now_ns() - t1) / (double)np;
+            (slots == 4 ? row.loads4 : row.loads1) = (double)c.ts.loads / (double)np;
+            row.differ += diff();
+        }
+        long hits = 0;
+        for (const ct_geo &g : gm) hits += g.status == CT_HIT;
+        worst = std::max(worst, row.ratio);
+        print_row(row);
+        std::printf("  (image: %ld of %zu pixels hit; ns per pixel include the unprojection)\n", hits, np);
+    }
+    std::printf("tile set / merged package, every tile resident: worst %.3fx (target <= 1.10x: %s)\n", worst,
+                worst <= 1.10 ? "met" : "NOT met");
+    return 0;
+}
