@@ -935,6 +935,41 @@ static void test_tile_sets(void)
     TEST_ASSERT_MSG(runs[4].code != 0 && contains(runs[4].out, "tile_1_1.ctp"), "info on the holed set: %d %s",
                     runs[4].code, runs[4].out.c_str());
 
+    // geoloc over the set: the package's rows but the steps (column 7), with
+    // the true Earth (curvature and refraction on the UTM fixture)
+    {
+        std::string px = "u,v\n";
+        for (int v = 0; v < 768; v += 48)
+            for (int u = 0; u < 1024; u += 48) px += std::to_string(u) + "," + std::to_string(v) + "\n";
+        spit(d + "/px.csv", px);
+        const std::string cam = std::string(CT_FIXTURES_DIR) + "/scenes/oblique30.cameramodel";
+        runs = run_all({
+            Job{d, {"geoloc", "one.ctp", "--camera", cam, "--pixels", "px.csv", "--effects", "curvature,refraction",
+                    "-o", "g_one.csv"}},
+            Job{d, {"geoloc", "set", "--camera", cam, "--pixels", "px.csv", "--effects", "curvature,refraction",
+                    "--cache-tiles", "2", "-o", "g_set.csv"}},
+        });
+        TEST_ASSERT_MSG(runs[0].code == 0 && runs[1].code == 0, "geoloc: %s %s", runs[0].err.c_str(), runs[1].err.c_str());
+        auto sans_steps = [](const std::string &text) {
+            std::vector<std::string> out;
+            for (const std::string &l : lines_of(text)) {
+                size_t c = 0, k = 0;
+                for (; k < l.size() && c < 6; ++k) c += l[k] == ',';
+                const size_t e = l.find(',', k);
+                out.push_back(l.substr(0, k) + (e == std::string::npos ? "" : l.substr(e)));
+            }
+            return out;
+        };
+        const auto g1 = sans_steps(slurp(d + "/g_one.csv")), g2 = sans_steps(slurp(d + "/g_set.csv"));
+        size_t hit = 0;
+        for (const std::string &l : g1) hit += contains(l, ",hit,");
+        TEST_ASSERT_MSG(g1 == g2 && g1.size() > 300 && hit > 100, "geoloc over the set: %zu rows (%zu hits) vs %zu",
+                        g1.size(), hit, g2.size());
+        fs::remove(d + "/px.csv");
+        fs::remove(d + "/g_one.csv");
+        fs::remove(d + "/g_set.csv");
+    }
+
     // failures: nothing written, nothing left behind
     fs::create_directory(d + "/notaset");
     spit(d + "/notaset/keep.txt", "keep");

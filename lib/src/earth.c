@@ -38,6 +38,7 @@
  * (< 2^48: 281 km), grid Q16 as everywhere.
  */
 #include "bend.h"
+#include "tiles.h"
 #include "fixed.h"
 
 #define ONE16 INT64_C(65536)
@@ -938,14 +939,15 @@ CT_NOINLINE static ct_status quarter_errors(const path *pa, int64_t ta, int64_t 
  * iterations so far), CT_BELOW (the first piece starting below the
  * surface) or an error otherwise.  Out of line: the prepared ray and the
  * piece's hit are on the stack only while it runs. */
-CT_NOINLINE static ct_status trace_piece(const ct_package *p, const gv *A, const gv *B, const fit *f,
-                                         const ct_lower *lw, int64_t dB, int first, ct_method m, ct_hit *h,
-                                         uint32_t *steps, uint32_t *iters)
+CT_NOINLINE static ct_status trace_piece(const ct_package *p, ct_tileset *ts, const gv *A, const gv *B,
+                                         const fit *f, const ct_lower *lw, int64_t dB, int first, ct_method m,
+                                         ct_hit *h, uint32_t *steps, uint32_t *iters)
 {
     ct_ray ray;
     ct_prepared pr;
     ct_hit sh;
     ct_status st;
+    int64_t tend_n, tend_d;
     ray.x_q16 = A->x;
     ray.y_q16 = A->y;
     ray.z_q16 = A->z;
@@ -955,31 +957,52 @@ CT_NOINLINE static ct_status trace_piece(const ct_package *p, const gv *A, const
     if (ray.dx == 0 && ray.dy == 0 && ray.dz == 0) {
         return CT_MISS;
     }
-    st = ct_prepare_lowered_segment(p, &ray, lw, &pr);
-    if (st < 0) {
-        return st;
-    }
-    if (st == CT_BELOW && first) {
-        h->steps = *steps;
-        h->iters = *iters;
-        return CT_BELOW;
-    }
-    if (st == CT_MISS) {
-        return CT_MISS;
-    }
-    if (st == CT_BELOW) {
-        /* the previous piece ended above the surface: the path met it
-         * within the models' tolerance at A */
-        pr.start = CT_HIT;
-    }
-    st = ct_trace_prepared_lowered(p, &pr, lw, m, &sh);
-    if (st < 0) {
-        return st;
+    if (ts != NULL) {
+        /* a tile set: the same segment, walked tile by tile (below the
+         * surface at A after the first piece: a hit there, as below) */
+        st = ct_tileset_trace_segment(ts, &ray, lw, !first, m, &sh, &tend_n, &tend_d);
+        if (st < 0 || st == CT_NO_DATA) {
+            if (st == CT_NO_DATA) {
+                *h = sh;
+                h->steps = *steps + sh.steps;
+                h->iters = *iters + sh.iters;
+            }
+            return st;
+        }
+        if (st == CT_BELOW) {
+            h->steps = *steps;
+            h->iters = *iters;
+            return CT_BELOW;
+        }
+    } else {
+        st = ct_prepare_lowered_segment(p, &ray, lw, &pr);
+        if (st < 0) {
+            return st;
+        }
+        if (st == CT_BELOW && first) {
+            h->steps = *steps;
+            h->iters = *iters;
+            return CT_BELOW;
+        }
+        if (st == CT_MISS) {
+            return CT_MISS;
+        }
+        if (st == CT_BELOW) {
+            /* the previous piece ended above the surface: the path met it
+             * within the models' tolerance at A */
+            pr.start = CT_HIT;
+        }
+        st = ct_trace_prepared_lowered(p, &pr, lw, m, &sh);
+        if (st < 0) {
+            return st;
+        }
+        tend_n = pr.tend_n;
+        tend_d = pr.tend_d;
     }
     *steps += sh.steps;
     *iters += sh.iters;
     /* t_q26 < 2^35, tend_d <= 2^26: < 2^61; tend_n < 2^34 */
-    if ((st == CT_HIT || st == CT_HIT_VOID) && sh.t_q26 * pr.tend_d <= pr.tend_n * (INT64_C(1) << CT_T_FRAC_BITS)) {
+    if ((st == CT_HIT || st == CT_HIT_VOID) && sh.t_q26 * tend_d <= tend_n * (INT64_C(1) << CT_T_FRAC_BITS)) {
         *h = sh;
         h->steps = *steps;
         h->iters = *iters;
@@ -989,6 +1012,12 @@ CT_NOINLINE static ct_status trace_piece(const ct_package *p, const gv *A, const
 }
 
 ct_status ct_trace_earth(const ct_package *p, const ct_earth *es, const int64_t dg[3], ct_method m, ct_hit *h)
+{
+    return ct_trace_earth_set(p, NULL, es, dg, m, h);
+}
+
+ct_status ct_trace_earth_set(const ct_package *p, ct_tileset *ts, const ct_earth *es, const int64_t dg[3], ct_method m,
+                             ct_hit *h)
 {
     path pa;
     gv A, B, M;
@@ -1106,7 +1135,7 @@ ct_status ct_trace_earth(const ct_package *p, const ct_earth *es, const int64_t 
             }
         }
         if (!off) {
-            st = trace_piece(p, &A, &B, &f, lwp, dB, ta == 0, m, h, &steps, &iters);
+            st = trace_piece(p, ts, &A, &B, &f, lwp, dB, ta == 0, m, h, &steps, &iters);
             if (st != CT_MISS) {
                 return st; /* a hit, the camera below the surface, or an error */
             }

@@ -164,7 +164,7 @@ static ct_status one_pixel(const ct_package *p, ct_tileset *ts, const ct_camera 
         /* the map-frame direction without the pose's horizontal scale */
         int64_t dg[3];
         ct_pose_rotate_grid(pose, out->ray_cam_q30, dg);
-        st = ct_trace_earth(p, &s->es, dg, m, &out->hit);
+        st = ct_trace_earth_set(p, ts, &s->es, dg, m, &out->hit);
     } else if (st == CT_OK) {
         ray.x_q16 = s->ox;
         ray.y_q16 = s->oy;
@@ -226,22 +226,16 @@ ct_status ct_geolocate_batch(const ct_package *pkg, const ct_camera *cam, const 
 /* ---- tile sets ---------------------------------------------------------- */
 
 /* setup over a tile set's frame, refusing the effects a tile set does not
- * trace yet: the true Earth (curvature with the default radius on a UTM
- * zone) and the polyline (c < 0, or a bend the lowered walk cannot take). */
+ * trace yet: the polyline (c < 0, or a bend the lowered walk cannot take). */
 static ct_status setup_tiles(ct_tileset *ts, const ct_camera *cam, const ct_pose *pose, ct_method m,
                              const ct_effects *effects, geo_setup *s)
 {
-    ct_utm zone;
     ct_status st;
     if (ts == NULL) {
         return CT_ERR_ARG;
     }
-    if (effects != NULL && (effects->flags & CT_EFFECT_CURVATURE) != 0u && effects->earth_radius_nm == 0 &&
-        ct_utm_zone_of_epsg((int32_t)ts->frame.epsg, &zone) == CT_OK) {
-        return CT_ERR_EFFECTS;
-    }
     st = setup(&ts->frame, cam, pose, m, effects, s);
-    if (st == CT_OK && s->bend.coeff_q16 != 0 && !s->bent.lowered) {
+    if (st == CT_OK && !s->earth && s->bend.coeff_q16 != 0 && !s->bent.lowered) {
         return CT_ERR_EFFECTS;
     }
     return st;

@@ -238,8 +238,10 @@ static ct_status no_data(const ct_tileset *ts, const ct_prepared *r, const ct_lo
 }
 
 /* The trace over the set; lw: the lowered model in the frame's grid
- * (NULL: straight). */
-static ct_status set_trace(ct_tileset *ts, const ct_ray *ray, const ct_lower *lw, ct_method m, ct_hit *h)
+ * (NULL: straight); seg, below_hit: ct_tileset_trace_segment's; *tend:
+ * the prepared ray's end (NULL: not wanted). */
+static ct_status set_trace(ct_tileset *ts, const ct_ray *ray, int seg, const ct_lower *lw, int below_hit,
+                           ct_method m, ct_hit *h, int64_t tend[2])
 {
     const ct_package *F = &ts->frame;
     const ct_package *tp;
@@ -258,7 +260,7 @@ static ct_status set_trace(ct_tileset *ts, const ct_ray *ray, const ct_lower *lw
     if ((unsigned)m >= (unsigned)CT_METHOD_COUNT) {
         return CT_ERR_METHOD;
     }
-    st = ct_tile_prep_geom(F, ray, &r);
+    st = ct_tile_prep_geom(F, ray, seg, &r);
     if (st != CT_OK) {
         return st;
     }
@@ -275,7 +277,7 @@ static ct_status set_trace(ct_tileset *ts, const ct_ray *ray, const ct_lower *lw
         const uint8_t *e0 = ts->entries + (size_t)(bb * ts->tiles_x + a) * CT_SET_ENTRY_SIZE;
         int64_t ox = (int64_t)tile_first(ts, a) * ONE16, oy = (int64_t)tile_first(ts, bb) * ONE16;
         if (e0[12] != 0u && r.oz * (INT64_C(1) << r.zshift) > (int64_t)ct_ld16(e0 + 10) * ONE16) {
-            st = ct_tile_prep_finish(F, NULL, 0, 0, ray, lw, &r);
+            st = ct_tile_prep_finish(F, NULL, 0, 0, ray, seg, lw, &r);
         } else {
             tp = tile_get(ts, a, bb);
             if (tp == NULL) {
@@ -289,8 +291,16 @@ static ct_status set_trace(ct_tileset *ts, const ct_ray *ray, const ct_lower *lw
                 ll.obx -= ox;
                 ll.oby -= oy;
             }
-            st = ct_tile_prep_finish(F, tp, ox, oy, ray, lw != NULL ? &ll : NULL, &r);
+            st = ct_tile_prep_finish(F, tp, ox, oy, ray, seg, lw != NULL ? &ll : NULL, &r);
         }
+    }
+    if (st == CT_BELOW && below_hit) {
+        r.start = CT_HIT; /* tend stays 0: the hit is at the first point */
+        st = CT_HIT;
+    }
+    if (tend != NULL) {
+        tend[0] = r.tend_n;
+        tend[1] = r.tend_d;
     }
     if (st != CT_OK && st != CT_HIT) {
         return st; /* CT_BELOW */
@@ -402,10 +412,20 @@ ct_status ct_tileset_trace(ct_tileset *ts, const ct_ray *ray, ct_method m, ct_hi
     if (ts == NULL || ray == NULL || h == NULL) {
         return CT_ERR_ARG;
     }
-    return set_trace(ts, ray, NULL, m, h);
+    return set_trace(ts, ray, 0, NULL, 0, m, h, NULL);
 }
 
 ct_status ct_tileset_trace_lowered(ct_tileset *ts, const ct_ray *ray, const ct_lower *lw, ct_method m, ct_hit *h)
 {
-    return set_trace(ts, ray, lw, m, h);
+    return set_trace(ts, ray, 0, lw, 0, m, h, NULL);
+}
+
+ct_status ct_tileset_trace_segment(ct_tileset *ts, const ct_ray *ray, const ct_lower *lw, int below_hit, ct_method m,
+                                   ct_hit *h, int64_t *tend_n, int64_t *tend_d)
+{
+    int64_t te[2] = {0, 1};
+    ct_status st = set_trace(ts, ray, 1, lw, below_hit, m, h, te);
+    *tend_n = te[0];
+    *tend_d = te[1];
+    return st;
 }

@@ -16,10 +16,10 @@
 extern "C" {
 #endif
 
-/* ct_ray_prepare's clipping and quantisation against frame's box (no
- * heights read): CT_OK (out->start not yet decided), CT_MISS / CT_BELOW, or
- * an error.                                                                */
-ct_status ct_tile_prep_geom(const ct_package *frame, const ct_ray *ray, ct_prepared *out);
+/* ct_ray_prepare's (seg: ct_ray_prepare_segment's) clipping and
+ * quantisation against frame's box (no heights read): CT_OK (out->start
+ * not yet decided), CT_MISS / CT_BELOW, or an error.                      */
+ct_status ct_tile_prep_geom(const ct_package *frame, const ct_ray *ray, int seg, ct_prepared *out);
 
 /* The cell of frame holding a prepared ray's first point (clamped). */
 void ct_prepared_first_cell(const ct_package *frame, const ct_prepared *r, int32_t *i, int32_t *j);
@@ -29,7 +29,7 @@ void ct_prepared_first_cell(const ct_package *frame, const ct_prepared *r, int32
  * in frame's box.  tile NULL: the caller knows the first point is above
  * every post of its tile (start CT_OK, nothing read).  Returns out->start. */
 ct_status ct_tile_prep_finish(const ct_package *frame, const ct_package *tile, int64_t offx, int64_t offy,
-                              const ct_ray *ray, const ct_lower *lw, ct_prepared *out);
+                              const ct_ray *ray, int seg, const ct_lower *lw, ct_prepared *out);
 
 /* The walk of r (a frame-prepared ray shifted into tile's grid) in tile
  * from t0 = t0_n / t0_d: 0 for the first tile (as ct_trace_prepared), else
@@ -47,6 +47,19 @@ void ct_fill_point(const ct_package *p, const ct_prepared *r, const ct_lower *lw
  * observer the ray's origin): geoloc.c.                                   */
 ct_status ct_tileset_trace_lowered(ct_tileset *ts, const ct_ray *ray, const ct_lower *lw, ct_method method,
                                    ct_hit *hit);
+
+/* A segment over the set (origin to origin + direction, as
+ * ct_prepare_lowered_segment + ct_trace_prepared_lowered on one package;
+ * lw NULL: the terrain itself).  below_hit: a first point below the surface
+ * is a hit there (a later piece of a path whose previous piece ended above
+ * it; one package's caller sets pr.start = CT_HIT).  *tend_n / *tend_d: the
+ * prepared segment's end (a hit beyond it is the caller's to discard).    */
+ct_status ct_tileset_trace_segment(ct_tileset *ts, const ct_ray *ray, const ct_lower *lw, int below_hit,
+                                   ct_method method, ct_hit *hit, int64_t *tend_n, int64_t *tend_d);
+
+/* ct_trace_earth over a tile set (p: its frame; ts NULL: one package p). */
+ct_status ct_trace_earth_set(const ct_package *p, ct_tileset *ts, const ct_earth *es, const int64_t dir_grid_q39[3],
+                             ct_method method, ct_hit *hit);
 
 /* Fill the derived fields of a package view from header values (package.c;
  * ct_package_open's second half): sections NULL, levels 0.  CT_OK or the

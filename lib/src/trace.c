@@ -1565,15 +1565,15 @@ static ct_status prep_finish(const ct_package *p, const ct_package *sp, int64_t 
     return start;
 }
 
-ct_status ct_tile_prep_geom(const ct_package *frame, const ct_ray *ray, ct_prepared *out)
+ct_status ct_tile_prep_geom(const ct_package *frame, const ct_ray *ray, int seg, ct_prepared *out)
 {
-    return prep_geom(frame, ray, 0, out);
+    return prep_geom(frame, ray, seg, out);
 }
 
 ct_status ct_tile_prep_finish(const ct_package *frame, const ct_package *tile, int64_t offx, int64_t offy,
-                              const ct_ray *ray, const ct_lower *lw, ct_prepared *out)
+                              const ct_ray *ray, int seg, const ct_lower *lw, ct_prepared *out)
 {
-    return prep_finish(frame, tile, offx, offy, ray, 0, lw, out);
+    return prep_finish(frame, tile, offx, offy, ray, seg, lw, out);
 }
 
 static ct_status prepare_impl(const ct_package *p, const ct_ray *ray, int seg, const ct_lower *lw, ct_prepared *out)
