@@ -1060,11 +1060,13 @@ ct_status ct_tileset_open(ct_tileset *ts, const uint8_t *manifest, size_t len, c
  * the tiles walked.                                                        */
 ct_status ct_tileset_trace(ct_tileset *ts, const ct_ray *ray, ct_method method, ct_hit *hit);
 
-/* ct_geolocate / ct_geolocate_batch over a tile set.  Effects: straight
- * rays and, with curvature (and refraction with k < 1) on a sphere
- * (earth_radius_nm != 0, or a package not on a UTM zone), the lowered
- * walk; effects that need the polyline or the true Earth are
- * CT_ERR_EFFECTS on a tile set for now.                                    */
+/* ct_geolocate / ct_geolocate_batch over a tile set (ts->frame is the
+ * package for every georeference question, e.g. ct_earth_map_init).
+ * Effects as ct_geolocate's -- straight, the sphere's lowered walk, the
+ * true Earth -- with the same results bit for bit; effects that need the
+ * polyline (c < 0: refraction without curvature, or k > 1; or a sphere
+ * the lowered walk cannot take from the camera) are CT_ERR_EFFECTS on a
+ * tile set for now.                                                        */
 ct_status ct_geolocate_tiles(ct_tileset *ts, const ct_camera *cam, const ct_pose *pose, ct_method method,
                              const ct_effects *effects, int64_t u_q16, int64_t v_q16, ct_geo *out);
 ct_status ct_geolocate_batch_tiles(ct_tileset *ts, const ct_camera *cam, const ct_pose *pose, ct_method method,

@@ -245,7 +245,7 @@ static ct_status set_trace(ct_tileset *ts, const ct_ray *ray, int seg, const ct_
 {
     const ct_package *F = &ts->frame;
     const ct_package *tp;
-    ct_prepared r, rl;
+    ct_prepared r;
     ct_lower ll;
     ct_status st;
     int32_t i, j, sx, sy;
@@ -350,36 +350,34 @@ static ct_status set_trace(ct_tileset *ts, const ct_ray *ray, int seg, const ct_
             }
         }
         if (e[12] == 0u || r.oz * ld + ln * (int64_t)r.dz <= (int64_t)ct_ld16(e + 10) * (ONE16 >> r.zshift) * ld) {
-            ct_hit th;
+            const uint32_t steps = h->steps, iters = h->iters;
             tp = tile_get(ts, a, bb);
             if (tp == NULL) {
                 return no_data(ts, &r, lw, a, bb, tn, td, h);
             }
-            rl = r;
-            rl.ox -= x0 * ONE16;
-            rl.oy -= y0 * ONE16;
+            /* the ray (and the observer) in the tile's grid, shifted in
+             * place and back: no copies on the walk's stack */
+            r.ox -= x0 * ONE16;
+            r.oy -= y0 * ONE16;
             if (lw != NULL) {
                 ll = *lw;
                 ll.obx -= x0 * ONE16;
                 ll.oby -= y0 * ONE16;
             }
-            st = ct_trace_tile(tp, &rl, tn, td, lw != NULL ? &ll : NULL, m, &th);
-            h->steps += th.steps;
-            h->iters += th.iters;
+            st = ct_trace_tile(tp, &r, tn, td, lw != NULL ? &ll : NULL, m, h);
+            r.ox += x0 * ONE16;
+            r.oy += y0 * ONE16;
+            h->steps += steps;
+            h->iters += iters;
             if (st != CT_MISS) {
                 if (st == CT_HIT || st == CT_HIT_VOID) {
-                    h->x_q16 = th.x_q16 + x0 * ONE16;
-                    h->y_q16 = th.y_q16 + y0 * ONE16;
-                    h->z_q16 = th.z_q16;
-                    h->t_q26 = th.t_q26;
-                    h->cell_x = th.cell_x + (int32_t)x0;
-                    h->cell_y = th.cell_y + (int32_t)y0;
                     /* the tile's map position is the frame's: its origin is
                      * the frame's plus x0 postings exactly, so ct_grid_to_map
-                     * rounds the same product (less x0 2^16 posting) */
-                    h->e_nm = th.e_nm;
-                    h->n_nm = th.n_nm;
-                    h->h_nm = th.h_nm;
+                     * rounded the same product (less x0 2^16 posting) */
+                    h->x_q16 += x0 * ONE16;
+                    h->y_q16 += y0 * ONE16;
+                    h->cell_x += (int32_t)x0;
+                    h->cell_y += (int32_t)y0;
                 }
                 return st;
             }

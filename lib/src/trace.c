@@ -1648,21 +1648,6 @@ static ct_status check_prepared(const ct_package *p, const ct_prepared *r)
     return CT_OK;
 }
 
-static ct_status walk(const ctx *c, ct_method m, ct_hit *h)
-{
-    switch (m) {
-    case CT_METHOD_INCREMENTAL:
-        return walk_incremental(c, h);
-    case CT_METHOD_HIERARCHICAL:
-        return walk_hierarchical(c, h);
-    case CT_METHOD_CONE:
-        return walk_cones(c, c->p->sectors == 1u ? 0u : c->p->sectors, h);
-    case CT_METHOD_DIRECTIONAL:
-    default:
-        return walk_cones(c, (uint32_t)c->r->sector, h);
-    }
-}
-
 /* The sign of f = z_ray - S at t0 > 0, a point on an entry face of cell
  * (i, j) (a tile set's seam): exact, as at a cell's exit. */
 static int entry_sign(const ctx *c, int32_t i, int32_t j, rt t0)
@@ -1755,9 +1740,7 @@ static ct_status trace_impl(const ct_package *p, const ct_prepared *r, ct_method
             h->iters = 1u;
             return hit_status(p, i, j);
         }
-        return walk(&c, m, h);
-    }
-    if (r->start == CT_HIT) {
+    } else if (r->start == CT_HIT) {
         int32_t i, j;
         locate(&c, T_ZERO, &i, &j);
         i = i < 0 ? 0 : (i >= c.cx ? c.cx - 1 : i);
@@ -1766,11 +1749,9 @@ static ct_status trace_impl(const ct_package *p, const ct_prepared *r, ct_method
         h->steps = 1u;
         h->iters = 1u;
         return hit_status(p, i, j);
-    }
-    if (r->start != CT_OK) {
+    } else if (r->start != CT_OK) {
         return CT_ERR_RAY;
-    }
-    if (r->dx == 0 && r->dy == 0) {
+    } else if (r->dx == 0 && r->dy == 0) {
         /* vertical: f(0) > 0 was established at preparation */
         int32_t i, j;
         int64_t s, tq;
@@ -1798,7 +1779,17 @@ static ct_status trace_impl(const ct_package *p, const ct_prepared *r, ct_method
         (void)ct_grid_to_map(p, h->x_q16, h->y_q16, h->z_q16, &h->e_nm, &h->n_nm, &h->h_nm);
         return hit_status(p, i, j);
     }
-    return walk(&c, m, h);
+    switch (m) {
+    case CT_METHOD_INCREMENTAL:
+        return walk_incremental(&c, h);
+    case CT_METHOD_HIERARCHICAL:
+        return walk_hierarchical(&c, h);
+    case CT_METHOD_CONE:
+        return walk_cones(&c, p->sectors == 1u ? 0u : p->sectors, h);
+    case CT_METHOD_DIRECTIONAL:
+    default:
+        return walk_cones(&c, (uint32_t)r->sector, h);
+    }
 }
 
 ct_status ct_trace(const ct_package *p, const ct_ray *ray, ct_method m, ct_hit *h)
