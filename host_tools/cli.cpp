@@ -317,6 +317,17 @@ int cmd_build(int argc, char **argv)
     return 0;
 }
 
+// info's heights, origin, posting and EPSG lines (a package, or a set's frame)
+void print_heights_georef(const ct_package &p)
+{
+    std::printf("heights       codes %d..%d = %.4f..%.4f m (%.6g m per LSB)\n", p.hmin, p.hmax,
+                (p.height_offset_nm + p.hmin * p.height_scale_nm) * 1e-9,
+                (p.height_offset_nm + p.hmax * p.height_scale_nm) * 1e-9, p.height_scale_nm * 1e-9);
+    std::printf("origin        E %.9f N %.9f (corner of pixel 0,0)\n", p.origin_e_nm * 1e-9, p.origin_n_nm * 1e-9);
+    std::printf("posting       %.9f x %.9f m\n", p.posting_e_nm * 1e-9, p.posting_n_nm * 1e-9);
+    std::printf("epsg          %u\n", p.epsg);
+}
+
 // `info` on a tile set: the grid, its coverage and sizes, every tile checked
 // by loading it as the library would (CRC, the manifest's size and CRC, its
 // place).
@@ -354,11 +365,7 @@ int info_tiles(const std::string &path)
                 ts->tiles_x, ts->tiles_y, ts->tile_posts, present, n, 100.0 * present / std::max<size_t>(1, n));
     std::printf("posts         %u x %u (cells %u x %u), merged\n", f.width, f.height, f.cells_x, f.cells_y);
     std::printf("sectors       %u\nreduce        %u\n", f.sectors, f.reduce);
-    std::printf("heights       codes %d..%d = %.4f..%.4f m (%.6g m per LSB)\n", f.hmin, f.hmax,
-                (f.height_offset_nm + f.hmin * f.height_scale_nm) * 1e-9,
-                (f.height_offset_nm + f.hmax * f.height_scale_nm) * 1e-9, f.height_scale_nm * 1e-9);
-    std::printf("origin        E %.9f N %.9f (corner of pixel 0,0)\n", f.origin_e_nm * 1e-9, f.origin_n_nm * 1e-9);
-    std::printf("posting       %.9f x %.9f m\nepsg          %u\n", f.posting_e_nm * 1e-9, f.posting_n_nm * 1e-9, f.epsg);
+    print_heights_georef(f);
     std::printf("size          %zu bytes in all (%.2fx the 16-bit DEM), largest tile %zu bytes\n", bytes,
                 (double)bytes / (2.0 * f.width * f.height), largest);
     std::printf("verify        %s\n", bad == 0 ? "ok (every tile loads and matches the manifest)" : "FAILED");
@@ -382,12 +389,8 @@ int cmd_info(int argc, char **argv)
     std::printf("posts         %u x %u (cells %u x %u)\n", p.width, p.height, p.cells_x, p.cells_y);
     std::printf("sectors       %u\nreduce        %u (coarse %u x %u)\n", p.sectors, p.reduce, p.coarse_x, p.coarse_y);
     std::printf("slices        %u\nmip levels    %u\n", p.slices, p.levels);
-    std::printf("heights       codes %d..%d = %.4f..%.4f m (%.6g m per LSB)\n", p.hmin, p.hmax,
-                (p.height_offset_nm + p.hmin * p.height_scale_nm) * 1e-9,
-                (p.height_offset_nm + p.hmax * p.height_scale_nm) * 1e-9, p.height_scale_nm * 1e-9);
-    std::printf("origin        E %.9f N %.9f (corner of pixel 0,0)\n", p.origin_e_nm * 1e-9, p.origin_n_nm * 1e-9);
-    std::printf("posting       %.9f x %.9f m\n", p.posting_e_nm * 1e-9, p.posting_n_nm * 1e-9);
-    std::printf("epsg          %u\nvoids         %s\n", p.epsg, p.voids ? "yes" : "no");
+    print_heights_georef(p);
+    std::printf("voids         %s\n", p.voids ? "yes" : "no");
     if (p.source_epsg != 0) std::printf("resampled     from EPSG:%u\n", p.source_epsg);
     if (p.vdatum == CT_VDATUM_UNKNOWN)
         std::printf("vertical      unknown datum (heights as in the DEM)\n");

@@ -305,6 +305,34 @@ static ct_status open_datum(ct_package *pkg, const uint8_t *b, uint32_t total,
     return CT_OK;
 }
 
+ct_status ct_check_stamped(const uint8_t *b, size_t len, const char *magic, uint32_t version, uint32_t header_size,
+                           uint32_t *total)
+{
+    static const uint8_t zero4[4] = {0u, 0u, 0u, 0u};
+    uint32_t crc;
+    if (len < header_size) {
+        return CT_ERR_TRUNCATED;
+    }
+    if (b[0] != (uint8_t)magic[0] || b[1] != (uint8_t)magic[1] || b[2] != (uint8_t)magic[2] ||
+        b[3] != (uint8_t)magic[3]) {
+        return CT_ERR_MAGIC;
+    }
+    if (ct_ld16(b + CT_HDR_VERSION) != version) {
+        return CT_ERR_VERSION;
+    }
+    if (ct_ld16(b + CT_HDR_HEADER_SIZE) != header_size) {
+        return CT_ERR_HEADER;
+    }
+    *total = ct_ld32(b + CT_HDR_TOTAL);
+    if (*total < header_size || (uint64_t)*total > (uint64_t)len) {
+        return CT_ERR_TRUNCATED;
+    }
+    (void)ct_crc32(0u, b, CT_HDR_CRC, &crc);
+    (void)ct_crc32(crc, zero4, 4u, &crc);
+    (void)ct_crc32(crc, b + CT_HDR_CRC + 4u, (size_t)*total - (CT_HDR_CRC + 4u), &crc);
+    return crc == ct_ld32(b + CT_HDR_CRC) ? CT_OK : CT_ERR_CRC;
+}
+
 ct_status ct_package_frame(ct_package *pkg, uint32_t w, uint32_t h, uint32_t r, uint32_t n, int32_t hmin, int32_t hmax,
                            const int64_t g[6], uint32_t epsg)
 {
@@ -376,38 +404,18 @@ ct_status ct_package_frame(ct_package *pkg, uint32_t w, uint32_t h, uint32_t r, 
 
 ct_status ct_package_open(ct_package *pkg, const uint8_t *b, size_t len)
 {
-    uint32_t total, crc_stored, crc, w, h, r, n, lv, flags, k;
+    uint32_t total, w, h, r, n, lv, flags, k;
     uint32_t so[CT_SEC_COUNT], ss[CT_SEC_COUNT], lv_expect, total_expect;
     uint64_t prev_end = CT_PKG_HEADER_SIZE;
-    const uint8_t zero4[4] = {0u, 0u, 0u, 0u};
     ct_status st;
 
     CT_ASSERT(pkg != NULL && b != NULL);
     if (pkg == NULL || b == NULL) {
         return CT_ERR_ARG;
     }
-    if (len < CT_PKG_HEADER_SIZE) {
-        return CT_ERR_TRUNCATED;
-    }
-    if (b[0] != 'C' || b[1] != 'T' || b[2] != 'P' || b[3] != 'K') {
-        return CT_ERR_MAGIC;
-    }
-    if (ct_ld16(b + CT_HDR_VERSION) != CT_PKG_VERSION) {
-        return CT_ERR_VERSION;
-    }
-    if (ct_ld16(b + CT_HDR_HEADER_SIZE) != CT_PKG_HEADER_SIZE) {
-        return CT_ERR_HEADER;
-    }
-    total = ct_ld32(b + CT_HDR_TOTAL);
-    if (total < CT_PKG_HEADER_SIZE || (uint64_t)total > (uint64_t)len) {
-        return CT_ERR_TRUNCATED;
-    }
-    crc_stored = ct_ld32(b + CT_HDR_CRC);
-    (void)ct_crc32(0u, b, CT_HDR_CRC, &crc);
-    (void)ct_crc32(crc, zero4, 4u, &crc);
-    (void)ct_crc32(crc, b + CT_HDR_CRC + 4u, (size_t)total - (CT_HDR_CRC + 4u), &crc);
-    if (crc != crc_stored) {
-        return CT_ERR_CRC;
+    st = ct_check_stamped(b, len, CT_PKG_MAGIC, CT_PKG_VERSION, CT_PKG_HEADER_SIZE, &total);
+    if (st != CT_OK) {
+        return st;
     }
     w = ct_ld16(b + CT_HDR_WIDTH);
     h = ct_ld16(b + CT_HDR_HEIGHT);

@@ -35,36 +35,17 @@ static int t_lt(int64_t an, int64_t ad, int64_t bn, int64_t bd) { return an * bd
 ct_status ct_tileset_open(ct_tileset *ts, const uint8_t *b, size_t len, ct_tile_slot *slots, uint32_t nslots,
                           ct_tile_loader load, void *user)
 {
-    uint32_t total, crc, tx, ty, P, w, h, r, n, k, ntiles;
+    uint32_t total, tx, ty, P, w, h, r, n, k, ntiles;
     int32_t hmin, hmax;
     int64_t g[6];
-    const uint8_t zero4[4] = {0u, 0u, 0u, 0u};
     ct_status st;
     CT_ASSERT(ts != NULL && b != NULL && slots != NULL && load != NULL);
     if (ts == NULL || b == NULL || slots == NULL || load == NULL || nslots == 0u) {
         return CT_ERR_ARG;
     }
-    if (len < CT_SET_HEADER_SIZE) {
-        return CT_ERR_TRUNCATED;
-    }
-    if (b[0] != 'C' || b[1] != 'T' || b[2] != 'T' || b[3] != 'S') {
-        return CT_ERR_MAGIC;
-    }
-    if (ct_ld16(b + CT_HDR_VERSION) != CT_SET_VERSION) {
-        return CT_ERR_VERSION;
-    }
-    if (ct_ld16(b + CT_HDR_HEADER_SIZE) != CT_SET_HEADER_SIZE) {
-        return CT_ERR_HEADER;
-    }
-    total = ct_ld32(b + CT_HDR_TOTAL);
-    if (total < CT_SET_HEADER_SIZE || (uint64_t)total > (uint64_t)len) {
-        return CT_ERR_TRUNCATED;
-    }
-    (void)ct_crc32(0u, b, CT_HDR_CRC, &crc);
-    (void)ct_crc32(crc, zero4, 4u, &crc);
-    (void)ct_crc32(crc, b + CT_HDR_CRC + 4u, (size_t)total - (CT_HDR_CRC + 4u), &crc);
-    if (crc != ct_ld32(b + CT_HDR_CRC)) {
-        return CT_ERR_CRC;
+    st = ct_check_stamped(b, len, CT_SET_MAGIC, CT_SET_VERSION, CT_SET_HEADER_SIZE, &total);
+    if (st != CT_OK) {
+        return st;
     }
     tx = ct_ld16(b + CT_SET_HDR_TILES_X);
     ty = ct_ld16(b + CT_SET_HDR_TILES_Y);
@@ -251,12 +232,7 @@ static ct_status set_trace(ct_tileset *ts, const ct_ray *ray, int seg, const ct_
     int32_t i, j, sx, sy;
     uint32_t a, bb, it;
     int64_t tn = 0, td = 1, adx, ady;
-    h->steps = 0u;
-    h->iters = 0u;
-    h->x_q16 = h->y_q16 = h->z_q16 = 0;
-    h->e_nm = h->n_nm = h->h_nm = 0;
-    h->t_q26 = 0;
-    h->cell_x = h->cell_y = -1;
+    ct_hit_clear(h);
     if ((unsigned)m >= (unsigned)CT_METHOD_COUNT) {
         return CT_ERR_METHOD;
     }

@@ -61,6 +61,16 @@ ct_status ct_tileset_trace_segment(ct_tileset *ts, const ct_ray *ray, const ct_l
 ct_status ct_trace_earth_set(const ct_package *p, ct_tileset *ts, const ct_earth *es, const int64_t dir_grid_q39[3],
                              ct_method method, ct_hit *hit);
 
+/* A result with nothing in it: steps, iters, t 0, positions 0, cell -1. */
+void ct_hit_clear(ct_hit *hit);
+
+/* The checks every stamped file of the format shares (a package, a
+ * manifest): length, magic, version, header size, total size (<= len,
+ * into *total), CRC-32 over the whole with its field zero.  CT_OK or
+ * CT_ERR_TRUNCATED / _MAGIC / _VERSION / _HEADER / _CRC (package.c). */
+ct_status ct_check_stamped(const uint8_t *bytes, size_t len, const char *magic, uint32_t version,
+                           uint32_t header_size, uint32_t *total);
+
 /* Fill the derived fields of a package view from header values (package.c;
  * ct_package_open's second half): sections NULL, levels 0.  CT_OK or the
  * georeference's error.                                                    */

@@ -1671,6 +1671,16 @@ static int entry_sign(const ctx *c, int32_t i, int32_t j, rt t0)
     return exit_sign(c, i, j, &e, &q);
 }
 
+void ct_hit_clear(ct_hit *h)
+{
+    h->steps = 0u;
+    h->iters = 0u;
+    h->x_q16 = h->y_q16 = h->z_q16 = 0;
+    h->e_nm = h->n_nm = h->h_nm = 0;
+    h->t_q26 = 0;
+    h->cell_x = h->cell_y = -1;
+}
+
 /* t0: where the walk starts (tile sets, ct_trace_tile); {0, 1} otherwise. */
 static ct_status trace_impl(const ct_package *p, const ct_prepared *r, ct_method m, int checked,
                             const ct_lower *lw, rt t0, ct_hit *h)
@@ -1684,12 +1694,7 @@ static ct_status trace_impl(const ct_package *p, const ct_prepared *r, ct_method
     if ((unsigned)m >= (unsigned)CT_METHOD_COUNT) {
         return CT_ERR_METHOD;
     }
-    h->steps = 0u;
-    h->iters = 0u;
-    h->x_q16 = h->y_q16 = h->z_q16 = 0;
-    h->e_nm = h->n_nm = h->h_nm = 0;
-    h->t_q26 = 0;
-    h->cell_x = h->cell_y = -1;
+    ct_hit_clear(h);
     if (r->start == CT_MISS || r->start == CT_BELOW) {
         return r->start;
     }

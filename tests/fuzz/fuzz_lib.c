@@ -84,6 +84,17 @@ static int64_t rd64(const uint8_t *d, size_t n, size_t *pos)
     return (int64_t)v;
 }
 
+/* Six int64 at d[*pos..] as a ray (zero past the end). */
+static void read_ray(const uint8_t *d, size_t n, size_t *pos, ct_ray *r)
+{
+    r->x_q16 = rd64(d, n, pos);
+    r->y_q16 = rd64(d, n, pos);
+    r->z_q16 = rd64(d, n, pos);
+    r->dx = rd64(d, n, pos);
+    r->dy = rd64(d, n, pos);
+    r->dz = rd64(d, n, pos);
+}
+
 static int trace_status_ok(ct_status s)
 {
     return s == CT_HIT || s == CT_HIT_VOID || s == CT_MISS || s == CT_BELOW || s == CT_ERR_RAY ||
@@ -165,12 +176,7 @@ static void ray_mode(const ct_vec_package *vp, uint32_t idx, const uint8_t *d, s
         CHECK(ct_package_open(pkg, vp->bytes, vp->size) == CT_OK);
         opened[idx % 8u] = 1;
     }
-    r.x_q16 = rd64(d, n, &pos);
-    r.y_q16 = rd64(d, n, &pos);
-    r.z_q16 = rd64(d, n, &pos);
-    r.dx = rd64(d, n, &pos);
-    r.dy = rd64(d, n, &pos);
-    r.dz = rd64(d, n, &pos);
+    read_ray(d, n, &pos, &r);
     {
         /* a bend: c in [-4, 4] (Q16), R = 2^(40..54) nm, chord 2^(10..50) nm */
         int64_t e = rd64(d, n, &pos);
@@ -285,12 +291,7 @@ static void tileset_mode(const uint8_t *d, size_t n)
     for (r = 0; r < 4 && pos < n; ++r) {
         ct_ray ray;
         int m;
-        ray.x_q16 = rd64(d, n, &pos);
-        ray.y_q16 = rd64(d, n, &pos);
-        ray.z_q16 = rd64(d, n, &pos);
-        ray.dx = rd64(d, n, &pos);
-        ray.dy = rd64(d, n, &pos);
-        ray.dz = rd64(d, n, &pos);
+        read_ray(d, n, &pos, &ray);
         if (r & 1) { /* a ray of the merged box's scale, as most real ones */
             ray.x_q16 = (ray.x_q16 & 0x3fffff) - 0x40000;
             ray.y_q16 = (ray.y_q16 & 0x3fffff) - 0x40000;
@@ -333,7 +334,6 @@ static void package_mode(const ct_vec_package *vp, int stamp_crc, const uint8_t 
     size_t pos = 0u, k;
     size_t edits = n > 0u ? d[0] : 0u;
     ct_status st;
-    uint32_t crc;
     int verified, angles_edited = 0;
     static ct_package base;
     size_t a0, a1;
@@ -354,12 +354,7 @@ static void package_mode(const ct_vec_package *vp, int stamp_crc, const uint8_t 
         g_buf[off] = d[pos + 2u];
     }
     if (stamp_crc) {
-        memset(g_buf + 12, 0, 4);
-        CHECK(ct_crc32(0u, g_buf, vp->size, &crc) == CT_OK);
-        g_buf[12] = (uint8_t)crc;
-        g_buf[13] = (uint8_t)(crc >> 8);
-        g_buf[14] = (uint8_t)(crc >> 16);
-        g_buf[15] = (uint8_t)(crc >> 24);
+        restamp(g_buf, vp->size);
     }
     st = ct_package_open(&pkg, g_buf, vp->size);
     CHECK(st == CT_OK || (st <= CT_ERR_ARG && st >= CT_ERR_FLAGS));

@@ -644,6 +644,23 @@ static uint32_t check_datum(const ct_vec_set *vs)
     return n;
 }
 
+/* The start of a summary line: "<what><name>: N rays x 4 methods: ok/4N
+ * identical (H hits, " (the caller ends it). */
+static void put_rays_line(const char *what, const char *name, uint32_t ncases, uint32_t ok, uint32_t hits)
+{
+    put_str(what);
+    put_str(name);
+    put_str(": ");
+    put_u64(ncases);
+    put_str(" rays x 4 methods: ");
+    put_u64(ok);
+    put_str("/");
+    put_u64(ncases * (uint64_t)CT_METHOD_COUNT);
+    put_str(" identical (");
+    put_u64(hits);
+    put_str(" hits, ");
+}
+
 /* ---- tile sets: tiles copied from flash into a few RAM slots --------------- */
 
 #define TS_MAX_SLOTS 4u
@@ -760,17 +777,7 @@ int main(void)
         total += vp->ncases * (uint32_t)CT_METHOD_COUNT;
         traces += t;
         hits += h;
-        put_str("  package ");
-        put_str(vp->name);
-        put_str(": ");
-        put_u64(vp->ncases);
-        put_str(" rays x 4 methods: ");
-        put_u64(t);
-        put_str("/");
-        put_u64(vp->ncases * (uint64_t)CT_METHOD_COUNT);
-        put_str(" identical (");
-        put_u64(h);
-        put_str(" hits, ");
+        put_rays_line("  package ", vp->name, vp->ncases, t, h);
         put_u64(vp->cone_codes);
         put_str(" cone codes), ");
         put_u64(g_fail - before);
@@ -802,17 +809,7 @@ int main(void)
         const uint32_t ok = check_tileset(vt, &h);
         total += vt->ncases * (uint32_t)CT_METHOD_COUNT;
         traces += ok;
-        put_str("  tile set ");
-        put_str(vt->name);
-        put_str(": ");
-        put_u64(vt->ncases);
-        put_str(" rays x 4 methods: ");
-        put_u64(ok);
-        put_str("/");
-        put_u64(vt->ncases * (uint64_t)CT_METHOD_COUNT);
-        put_str(" identical (");
-        put_u64(h);
-        put_str(" hits, ");
+        put_rays_line("  tile set ", vt->name, vt->ncases, ok, h);
         put_u64(vt->loads);
         put_str(" tile loads into ");
         put_u64(vt->nslots);
