@@ -1017,14 +1017,16 @@ typedef ct_status (*ct_tile_loader)(void *user, uint32_t col, uint32_t row, uint
                                     const uint8_t **bytes, size_t *len);
 
 /* One cache slot: caller memory.  Set buf and cap (or NULL, 0 when the
- * loader hands out its own memory) before ct_tileset_open.                 */
+ * loader hands out its own memory) before ct_tileset_open.  Which tile a
+ * slot holds is kept in the set (compactly: the lookup touches one or two
+ * cache lines, not one per slot).                                          */
 typedef struct {
     ct_package pkg;     /* the tile held, opened                           */
     uint8_t *buf;       /* memory the loader may fill                      */
     size_t cap;
-    int32_t tile;       /* row * tiles_x + col held; -1: empty             */
-    uint32_t used;      /* the set's clock at the last use                 */
 } ct_tile_slot;
+
+#define CT_SET_MAX_SLOTS 64u       /* slots per set                         */
 
 /* A tile set over caller memory.  Fill with ct_tileset_open.  The
  * manifest's bytes are kept by reference (zero copy).  Not reentrant: a
@@ -1037,9 +1039,12 @@ typedef struct {
     uint32_t tile_posts;       /* P                                         */
     const uint8_t *entries;    /* the manifest's tile table                 */
     ct_tile_slot *slots;
-    uint32_t nslots;
+    uint32_t nslots;           /* 1..CT_SET_MAX_SLOTS                       */
     ct_tile_loader load;
     void *user;
+    int16_t held[CT_SET_MAX_SLOTS]; /* tile (row * tiles_x + col) in slot k;
+                                  -1: empty                                 */
+    uint32_t used[CT_SET_MAX_SLOTS]; /* the clock at slot k's last use      */
     uint32_t clock;            /* uses so far (the cache's order)           */
     uint32_t last;             /* the slot used last                        */
     uint32_t loads;            /* tiles loaded and accepted                 */
@@ -1050,7 +1055,8 @@ typedef struct {
  * _MAGIC, _VERSION, _HEADER, _CRC; CT_ERR_DIMS for a tile grid that does
  * not fit W x H or more than CT_SET_MAX_TILES tiles; _SECTORS, _REDUCE,
  * _RANGE (hmin > hmax, a tile's range outside the set's), _GEOREF, _FLAGS)
- * and set up *ts over slots[0..nslots) (nslots >= 1).                      */
+ * and set up *ts over slots[0..nslots) (1 <= nslots <= CT_SET_MAX_SLOTS;
+ * else CT_ERR_ARG).                                                        */
 ct_status ct_tileset_open(ct_tileset *ts, const uint8_t *manifest, size_t len, ct_tile_slot *slots, uint32_t nslots,
                           ct_tile_loader load, void *user);
 

@@ -40,7 +40,7 @@ ct_status ct_tileset_open(ct_tileset *ts, const uint8_t *b, size_t len, ct_tile_
     int64_t g[6];
     ct_status st;
     CT_ASSERT(ts != NULL && b != NULL && slots != NULL && load != NULL);
-    if (ts == NULL || b == NULL || slots == NULL || load == NULL || nslots == 0u) {
+    if (ts == NULL || b == NULL || slots == NULL || load == NULL || nslots == 0u || nslots > CT_SET_MAX_SLOTS) {
         return CT_ERR_ARG;
     }
     st = ct_check_stamped(b, len, CT_SET_MAGIC, CT_SET_VERSION, CT_SET_HEADER_SIZE, &total);
@@ -118,10 +118,10 @@ ct_status ct_tileset_open(ct_tileset *ts, const uint8_t *b, size_t len, ct_tile_
     ts->last = 0u;
     ts->loads = 0u;
     ts->refused = 0u;
-    /* bound: nslots (caller's array) */
-    for (k = 0u; k < nslots; ++k) {
-        slots[k].tile = -1;
-        slots[k].used = 0u;
+    /* bound: CT_SET_MAX_SLOTS */
+    for (k = 0u; k < CT_SET_MAX_SLOTS; ++k) {
+        ts->held[k] = -1;
+        ts->used[k] = 0u;
     }
     return CT_OK;
 }
@@ -163,35 +163,35 @@ static const ct_package *tile_get(ct_tileset *ts, uint32_t a, uint32_t bb)
         return NULL;
     }
     ts->clock++;
-    if (ts->slots[ts->last].tile == (int32_t)k) {
+    if (ts->held[ts->last] == (int16_t)k) {
         /* the tile of the previous call: the usual case */
-        ts->slots[ts->last].used = ts->clock;
+        ts->used[ts->last] = ts->clock;
         return &ts->slots[ts->last].pkg;
     }
-    /* bound: nslots */
+    /* bound: nslots <= CT_SET_MAX_SLOTS */
     for (s = 0u; s < ts->nslots; ++s) {
-        if (ts->slots[s].tile == (int32_t)k) {
-            ts->slots[s].used = ts->clock;
+        if (ts->held[s] == (int16_t)k) {
+            ts->used[s] = ts->clock;
             ts->last = s;
             return &ts->slots[s].pkg;
         }
     }
     /* not held: the first empty slot, else the least recently used.
      * bound: nslots */
-    for (s = 1u; s < ts->nslots && ts->slots[victim].tile >= 0; ++s) {
-        if (ts->slots[s].tile < 0 || ts->slots[s].used < ts->slots[victim].used) {
+    for (s = 1u; s < ts->nslots && ts->held[victim] >= 0; ++s) {
+        if (ts->held[s] < 0 || ts->used[s] < ts->used[victim]) {
             victim = s;
         }
     }
     sl = &ts->slots[victim];
-    sl->tile = -1;
+    ts->held[victim] = -1;
     if (ts->load(ts->user, a, bb, sl->buf, sl->cap, &bytes, &len) != CT_OK || bytes == NULL ||
         ct_package_open(&sl->pkg, bytes, len) != CT_OK || !tile_matches(ts, &sl->pkg, e, a, bb)) {
         ts->refused++;
         return NULL;
     }
-    sl->tile = (int32_t)k;
-    sl->used = ts->clock;
+    ts->held[victim] = (int16_t)k;
+    ts->used[victim] = ts->clock;
     ts->last = victim;
     ts->loads++;
     return &sl->pkg;

@@ -71,6 +71,7 @@ typedef struct {
                            [2^30, 2^30.5]; 0 when culling is off            */
     rt t0;              /* where the walk starts: 0, or (a tile set) the
                            canonical entry of the tile's first cell         */
+    int32_t i0, j0;     /* the cell holding the ray at t0 (locate)          */
 } ctx;
 
 /* Height code h >= 0 (< 2^17) in the ray's z units: one 32x32 product. */
@@ -159,7 +160,8 @@ static int rt_lt(rt a, rt b) { return a.n * b.d < b.n * a.d; }
  * num = o*den + n*d: o < 2^31 (or 2^47 at prep) ... callers bound it.      */
 static int32_t axis_cell(int64_t num, int64_t den16, int32_t s, int32_t ncell)
 {
-    int64_t k = ct_floor_div(num, den16);
+    /* den16 = 2^16 (a Q16 coordinate itself, t = 0 / 1): a shift */
+    int64_t k = den16 == ONE16 ? floor_shr(num, 16u) : ct_floor_div(num, den16);
     if (k * den16 == num) {
         if (s < 0) {
             k -= 1;
@@ -821,7 +823,8 @@ static ct_status walk_incremental(const ctx *c, ct_hit *h)
     uint32_t it, bound = CT_WCET_CELL_ITERS(c->cx, c->cy);
     rt tin = c->t0;
     cexit e;
-    locate(c, tin, &i, &j);
+    i = c->i0;
+    j = c->j0;
     /* bound: each iteration leaves one fine cell */
     for (it = 0u; it < bound; ++it) {
         if (!inside(c, i, j)) {
@@ -858,7 +861,8 @@ static ct_status walk_hierarchical(const ctx *c, ct_hit *h)
     int64_t lb = 0;
     rt t = c->t0;
     cexit e;
-    locate(c, t, &i, &j);
+    i = c->i0;
+    j = c->j0;
     /* bound: per fine cell left, at most levels descents + one advance */
     for (it = 0u; it < bound; ++it) {
         if (!inside(c, i, j)) {
@@ -978,7 +982,8 @@ static ct_status walk_cones(const ctx *c, uint32_t plane, ct_hit *h)
     int tin_ok = 1;
     int64_t lb;      /* lower_ahead at (i, j), -1 when not formed */
     cexit e;
-    locate(c, t, &i, &j);
+    i = c->i0;
+    j = c->j0;
     /* bound: each iteration leaves at least one fine cell */
     for (it = 0u; it < bound; ++it) {
         uint32_t code;
@@ -1745,6 +1750,8 @@ static ct_status trace_impl(const ct_package *p, const ct_prepared *r, ct_method
             h->iters = 1u;
             return hit_status(p, i, j);
         }
+        c.i0 = i;
+        c.j0 = j;
     } else if (r->start == CT_HIT) {
         int32_t i, j;
         locate(&c, T_ZERO, &i, &j);
@@ -1783,6 +1790,9 @@ static ct_status trace_impl(const ct_package *p, const ct_prepared *r, ct_method
         h->z_q16 = -ct_floor_div(-s, ONE16) + (lw != NULL ? ct_lower_at(lw, h->x_q16, h->y_q16) : 0);
         (void)ct_grid_to_map(p, h->x_q16, h->y_q16, h->z_q16, &h->e_nm, &h->n_nm, &h->h_nm);
         return hit_status(p, i, j);
+    }
+    if (t0.n == 0) {
+        locate(&c, T_ZERO, &c.i0, &c.j0);
     }
     switch (m) {
     case CT_METHOD_INCREMENTAL:
