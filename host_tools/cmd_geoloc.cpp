@@ -282,9 +282,6 @@ int cmd_geoloc(int argc, char **argv)
             loads += cache.set()->loads;
             for (size_t k = b; k < e; ++k) nodata += g[k].status == CT_NO_DATA;
         });
-    if (st == CT_ERR_EFFECTS && tiles)
-        throw Error("--effects: the effect parameters are out of range, or need the polyline (refraction without "
-                    "curvature, or k > 1), which is traced on one package only for now, not over a tile set");
     if (st == CT_ERR_EFFECTS)
         throw Error("--effects: the effect parameters are out of range for this package (" + status_name(st) + ")");
     if (st != CT_OK) throw Error(cpath + ": cannot geolocate from this camera (" + status_name(st) + ")");

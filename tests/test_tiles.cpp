@@ -14,7 +14,8 @@
 //    beyond it, nothing read after it; rays that stop before it unchanged;
 //  - the manifest's checks; geolocation over a set equals the merged
 //    package's (straight, on a sphere, on the true Earth with the exact and
-//    the fitted map); the published iteration bound.
+//    the fitted map, refraction alone: the polyline); the published
+//    iteration bound.
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -558,12 +559,25 @@ void test_geolocation()
             TEST_ASSERT_EQUAL_INT(0, (int)differ);
             TEST_ASSERT(hits > (long)np / 2);
         }
-    // refraction alone on a sphere (c < 0: the polyline) is not traced over
-    // tile sets yet: refused, not wrong
+    // refraction alone on a sphere (c < 0: the polyline, each segment walked
+    // tile by tile): the merged package's results too
     ct_effects refr = {CT_EFFECT_REFRACTION, CT_REFRACTION_K_STD_Q16, (int64_t)6371000 * 1000000000, 0, NULL};
-    ct_geo g;
-    TEST_ASSERT_EQUAL_INT(CT_ERR_EFFECTS,
-                          ct_geolocate_tiles(&set.ts, &cam, &pose, CT_METHOD_DIRECTIONAL, &refr, uv[0], uv[1], &g));
+    for (int m : {0, 3}) {
+        std::vector<ct_geo> a(np), b(np);
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_geolocate_batch(&mp, &cam, &pose, (ct_method)m, &refr, uv.data(), np, a.data(), np));
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_geolocate_batch_tiles(&set.ts, &cam, &pose, (ct_method)m, &refr, uv.data(), np,
+                                                              b.data(), np));
+        long hits = 0, differ = 0;
+        for (size_t k = 0; k < np; ++k) {
+            hits += a[k].status == CT_HIT;
+            differ += !same_hit(a[k].status, a[k].hit, b[k].status, b[k].hit);
+        }
+        if (m == 3)
+            std::printf("  geolocation refraction alone (the polyline): %zu pixels, %ld hits, %ld differ\n", np, hits,
+                        differ);
+        TEST_ASSERT_EQUAL_INT(0, (int)differ);
+        TEST_ASSERT(hits > (long)np / 2);
+    }
 }
 
 }  // namespace

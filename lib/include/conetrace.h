@@ -1068,11 +1068,9 @@ ct_status ct_tileset_trace(ct_tileset *ts, const ct_ray *ray, ct_method method, 
 
 /* ct_geolocate / ct_geolocate_batch over a tile set (ts->frame is the
  * package for every georeference question, e.g. ct_earth_map_init).
- * Effects as ct_geolocate's -- straight, the sphere's lowered walk, the
- * true Earth -- with the same results bit for bit; effects that need the
- * polyline (c < 0: refraction without curvature, or k > 1; or a sphere
- * the lowered walk cannot take from the camera) are CT_ERR_EFFECTS on a
- * tile set for now.                                                        */
+ * Every effect ct_geolocate takes -- straight, the sphere's lowered walk
+ * or polyline, the true Earth -- with the same results bit for bit, and
+ * CT_NO_DATA where the line of sight reaches a tile the set does not hold. */
 ct_status ct_geolocate_tiles(ct_tileset *ts, const ct_camera *cam, const ct_pose *pose, ct_method method,
                              const ct_effects *effects, int64_t u_q16, int64_t v_q16, ct_geo *out);
 ct_status ct_geolocate_batch_tiles(ct_tileset *ts, const ct_camera *cam, const ct_pose *pose, ct_method method,

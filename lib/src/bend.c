@@ -20,6 +20,7 @@
  *   vertex        O + s * U / L: s * U < 2^63 * 2^30 (128-bit), / L.
  */
 #include "bend.h"
+#include "tiles.h"
 #include "fixed.h"
 
 #define ONE16 INT64_C(65536)
@@ -427,18 +428,24 @@ ct_status ct_trace_bent(const ct_package *p, const ct_ray *ray, const ct_bend *b
     return ct_trace_bent_set(p, ray, &bs, m, h);
 }
 
-static ct_status trace_polyline(const ct_package *p, const ct_ray *ray, const ct_bent_setup *bs, ct_method m,
-                                ct_hit *h);
+static ct_status trace_polyline(const ct_package *p, ct_tileset *ts, const ct_ray *ray, const ct_bent_setup *bs,
+                                ct_method m, ct_hit *h);
 
 ct_status ct_trace_bent_set(const ct_package *p, const ct_ray *ray, const ct_bent_setup *bs, ct_method m,
                             ct_hit *h)
+{
+    return ct_trace_bent_set_ts(p, NULL, ray, bs, m, h);
+}
+
+ct_status ct_trace_bent_set_ts(const ct_package *p, ct_tileset *ts, const ct_ray *ray, const ct_bent_setup *bs,
+                               ct_method m, ct_hit *h)
 {
     CT_ASSERT(p != NULL && ray != NULL && bs != NULL && h != NULL);
     if (p == NULL || ray == NULL || bs == NULL || h == NULL) {
         return CT_ERR_ARG;
     }
     if (bs->bend.coeff_q16 == 0 || (ray->dx == 0 && ray->dy == 0)) {
-        return ct_trace(p, ray, m, h);
+        return ts != NULL ? ct_tileset_trace(ts, ray, m, h) : ct_trace(p, ray, m, h);
     }
     if ((uint32_t)m >= (uint32_t)CT_METHOD_COUNT) {
         return CT_ERR_METHOD;
@@ -453,16 +460,18 @@ ct_status ct_trace_bent_set(const ct_package *p, const ct_ray *ray, const ct_ben
             return CT_ERR_ARG; /* set up for another observer */
         }
         /* one straight walk against the lowered terrain */
-        return ct_trace_lowered(p, ray, &bs->lw, m, h);
+        return ts != NULL ? ct_tileset_trace_lowered(ts, ray, &bs->lw, m, h) : ct_trace_lowered(p, ray, &bs->lw, m, h);
     }
-    return trace_polyline(p, ray, bs, m, h);
+    return trace_polyline(p, ts, ray, bs, m, h);
 }
 
 /* The polyline (c < 0, or the lowered model out of range); its own
  * function, kept out of line, so that its large frame is not on the
- * lowered walk's stack.  The ray is checked by the caller. */
-CT_NOINLINE static ct_status trace_polyline(const ct_package *p, const ct_ray *ray, const ct_bent_setup *bs,
-                                            ct_method m, ct_hit *h)
+ * lowered walk's stack.  The ray is checked by the caller.  ts != NULL: a
+ * tile set (p its frame): each segment walked tile by tile, without the
+ * mipmap culling (the frame has no mipmap; culling changes no result). */
+CT_NOINLINE static ct_status trace_polyline(const ct_package *p, ct_tileset *ts, const ct_ray *ray,
+                                            const ct_bent_setup *bs, ct_method m, ct_hit *h)
 {
     const ct_bend *bd = &bs->bend;
     bent b;
@@ -496,7 +505,7 @@ CT_NOINLINE static ct_status trace_polyline(const ct_package *p, const ct_ray *r
     }
     if (b.ux == 0 && b.uy == 0) {
         /* horizontal part below 2^-31 of the ray: no bending over the tile */
-        return ct_trace(p, ray, m, h);
+        return ts != NULL ? ct_tileset_trace(ts, ray, m, h) : ct_trace(p, ray, m, h);
     }
     /* ux^2 + uy^2 <= 2^61 */
     b.L = (int64_t)ct_isqrt64((uint64_t)(b.ux * b.ux + b.uy * b.uy));
@@ -548,7 +557,7 @@ CT_NOINLINE static ct_status trace_polyline(const ct_package *p, const ct_ray *r
         if (!run && b.coeff > 0 && va.z > ztop && vb.z >= va.z) {
             break;
         }
-        if ((bd->flags & CT_BEND_NO_CULL) == 0u && run_above_terrain(p, &va, &vb, run, chord_q16, &over)) {
+        if (ts == NULL && (bd->flags & CT_BEND_NO_CULL) == 0u && run_above_terrain(p, &va, &vb, run, chord_q16, &over)) {
             int inside = run_inside(p, &va, &vb, ztop);
             /* skipped when ct_ray_prepare_segment's answer for each segment
              * is known without it: off the tile or above the box (CT_MISS),
@@ -594,6 +603,33 @@ CT_NOINLINE static ct_status trace_polyline(const ct_package *p, const ct_ray *r
         va = vb;
         k = kn;
         if (seg.dx == 0 && seg.dy == 0 && seg.dz == 0) {
+            continue;
+        }
+        if (ts != NULL) {
+            /* the segment over the set (below the surface at its start
+             * after the polyline entered the box: a hit there, as below) */
+            int64_t tn, td;
+            st = ct_tileset_trace_segment(ts, &seg, NULL, entered, m, &sh, &tn, &td);
+            if (st < 0) {
+                return st;
+            }
+            if (td == 0) {
+                continue; /* never in the box */
+            }
+            steps += sh.steps;
+            iters += sh.iters;
+            entered = 1;
+            if (st == CT_NO_DATA || ((st == CT_HIT || st == CT_HIT_VOID) && sh.t_q26 * td <= tn * (INT64_C(1) << CT_T_FRAC_BITS))) {
+                *h = sh;
+                h->steps = steps;
+                h->iters = iters;
+                return st;
+            }
+            if (st == CT_BELOW) {
+                h->steps = steps;
+                h->iters = iters;
+                return CT_BELOW;
+            }
             continue;
         }
         st = ct_ray_prepare_segment(p, &seg, &pr);

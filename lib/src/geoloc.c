@@ -174,7 +174,7 @@ static ct_status one_pixel(const ct_package *p, ct_tileset *ts, const ct_camera 
         ray.dz = scale_dir(out->dir_map_q39[2], s->sz, s->shift);
         if (ts != NULL) {
             st = s->bend.coeff_q16 == 0 ? ct_tileset_trace(ts, &ray, m, &out->hit)
-                                        : ct_tileset_trace_lowered(ts, &ray, &s->bent.lw, m, &out->hit);
+                                        : ct_trace_bent_set_ts(p, ts, &ray, &s->bent, m, &out->hit);
         } else {
             st = s->bend.coeff_q16 == 0 ? ct_trace(p, &ray, m, &out->hit)
                                         : ct_trace_bent_set(p, &ray, &s->bent, m, &out->hit);
@@ -225,20 +225,14 @@ ct_status ct_geolocate_batch(const ct_package *pkg, const ct_camera *cam, const 
 
 /* ---- tile sets ---------------------------------------------------------- */
 
-/* setup over a tile set's frame, refusing the effects a tile set does not
- * trace yet: the polyline (c < 0, or a bend the lowered walk cannot take). */
+/* setup over a tile set's frame. */
 static ct_status setup_tiles(ct_tileset *ts, const ct_camera *cam, const ct_pose *pose, ct_method m,
                              const ct_effects *effects, geo_setup *s)
 {
-    ct_status st;
     if (ts == NULL) {
         return CT_ERR_ARG;
     }
-    st = setup(&ts->frame, cam, pose, m, effects, s);
-    if (st == CT_OK && !s->earth && s->bend.coeff_q16 != 0 && !s->bent.lowered) {
-        return CT_ERR_EFFECTS;
-    }
-    return st;
+    return setup(&ts->frame, cam, pose, m, effects, s);
 }
 
 ct_status ct_geolocate_tiles(ct_tileset *ts, const ct_camera *cam, const ct_pose *pose, ct_method method,

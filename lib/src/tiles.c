@@ -397,7 +397,7 @@ ct_status ct_tileset_trace_lowered(ct_tileset *ts, const ct_ray *ray, const ct_l
 ct_status ct_tileset_trace_segment(ct_tileset *ts, const ct_ray *ray, const ct_lower *lw, int below_hit, ct_method m,
                                    ct_hit *h, int64_t *tend_n, int64_t *tend_d)
 {
-    int64_t te[2] = {0, 1};
+    int64_t te[2] = {0, 0}; /* d 0: the segment never entered the box */
     ct_status st = set_trace(ts, ray, 1, lw, below_hit, m, h, te);
     *tend_n = te[0];
     *tend_d = te[1];

@@ -53,9 +53,15 @@ ct_status ct_tileset_trace_lowered(ct_tileset *ts, const ct_ray *ray, const ct_l
  * lw NULL: the terrain itself).  below_hit: a first point below the surface
  * is a hit there (a later piece of a path whose previous piece ended above
  * it; one package's caller sets pr.start = CT_HIT).  *tend_n / *tend_d: the
- * prepared segment's end (a hit beyond it is the caller's to discard).    */
+ * prepared segment's end (a hit beyond it is the caller's to discard);
+ * *tend_d 0 when the segment never enters the set's box (CT_MISS, as
+ * ct_ray_prepare_segment's).                                               */
 ct_status ct_tileset_trace_segment(ct_tileset *ts, const ct_ray *ray, const ct_lower *lw, int below_hit,
                                    ct_method method, ct_hit *hit, int64_t *tend_n, int64_t *tend_d);
+
+/* ct_trace_bent_set over a tile set (p: its frame; ts NULL: one package). */
+ct_status ct_trace_bent_set_ts(const ct_package *p, ct_tileset *ts, const ct_ray *ray, const ct_bent_setup *bs,
+                               ct_method method, ct_hit *hit);
 
 /* ct_trace_earth over a tile set (p: its frame; ts NULL: one package p). */
 ct_status ct_trace_earth_set(const ct_package *p, ct_tileset *ts, const ct_earth *es, const int64_t dir_grid_q39[3],
