@@ -562,6 +562,38 @@ void test_geolocation()
     // refraction alone on a sphere (c < 0: the polyline, each segment walked
     // tile by tile): the merged package's results too
     ct_effects refr = {CT_EFFECT_REFRACTION, CT_REFRACTION_K_STD_Q16, (int64_t)6371000 * 1000000000, 0, NULL};
+    // a tile missing, with every effect: the merged result or CT_NO_DATA,
+    // never a hit on the missing tile
+    {
+        const int mc = 2, mr = 2;  // a tile the camera sees
+        const TileSetBytes holed = ct_host::build_tileset(t, o, 129, 0, [&](int c, int r) { return c == mc && r == mr; });
+        Set hs;
+        TEST_ASSERT_EQUAL_INT(CT_OK, hs.open(holed, 4));
+        const ct_effects *all[5] = {nullptr, &sphere, &earth, &earth_fit, &refr};
+        const int x0 = holed.grid.first_col(mc), y0 = holed.grid.first_row(mr);
+        for (int f = 0; f < 5; ++f) {
+            std::vector<ct_geo> a(np), b(np);
+            ct_geolocate_batch(&mp, &cam, &pose, CT_METHOD_DIRECTIONAL, all[f], uv.data(), np, a.data(), np);
+            TEST_ASSERT_EQUAL_INT(CT_OK, ct_geolocate_batch_tiles(&hs.ts, &cam, &pose, CT_METHOD_DIRECTIONAL, all[f],
+                                                                  uv.data(), np, b.data(), np));
+            long nodata = 0, on_hole = 0;
+            for (size_t k = 0; k < np; ++k) {
+                const bool hole = a[k].status == CT_HIT && a[k].hit.cell_x >= x0 && a[k].hit.cell_x < x0 + 128 &&
+                                  a[k].hit.cell_y >= y0 && a[k].hit.cell_y < y0 + 128;
+                on_hole += hole;
+                if (b[k].status == CT_NO_DATA) {
+                    nodata++;
+                    TEST_ASSERT(b[k].hit.cell_x >= x0 && b[k].hit.cell_x < x0 + 128 && b[k].hit.cell_y >= y0 &&
+                                b[k].hit.cell_y < y0 + 128);
+                } else {
+                    TEST_ASSERT_MSG(!hole && same_hit(a[k].status, a[k].hit, b[k].status, b[k].hit),
+                                    "effects %d pixel %zu: %d vs merged %d", f, k, b[k].status, a[k].status);
+                }
+            }
+            std::printf("  a missing tile, effects %d: %ld pixels no_data (%ld merged hits on it)\n", f, nodata, on_hole);
+            TEST_ASSERT(nodata >= on_hole && on_hole > 0);
+        }
+    }
     for (int m : {0, 3}) {
         std::vector<ct_geo> a(np), b(np);
         TEST_ASSERT_EQUAL_INT(CT_OK, ct_geolocate_batch(&mp, &cam, &pose, (ct_method)m, &refr, uv.data(), np, a.data(), np));

@@ -613,7 +613,7 @@ CT_NOINLINE static ct_status trace_polyline(const ct_package *p, ct_tileset *ts,
             if (st < 0) {
                 return st;
             }
-            if (td == 0) {
+            if (td == 0 && st != CT_NO_DATA) {
                 continue; /* never in the box */
             }
             steps += sh.steps;

@@ -260,6 +260,10 @@ static ct_status set_trace(ct_tileset *ts, const ct_ray *ray, int seg, const ct_
                 r.tend_n = 0;
                 r.tend_d = 1;
                 r.start = CT_OK;
+                if (tend != NULL) { /* in the box, stopped at its first point */
+                    tend[0] = 0;
+                    tend[1] = 1;
+                }
                 return no_data(ts, &r, lw, a, bb, 0, 1, h);
             }
             if (lw != NULL) {
