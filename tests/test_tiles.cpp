@@ -17,6 +17,7 @@
 //    the fitted map, refraction alone: the polyline); the published
 //    iteration bound.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <map>
@@ -612,6 +613,67 @@ void test_geolocation()
     }
 }
 
+// Intervisibility over a set: ct_los_tiles = ct_los on the merged package
+// (straight, a sphere, the true Earth), and with a tile missing the merged
+// answer or CT_NO_DATA, never "visible" through or "blocked" on that tile.
+void test_los()
+{
+    const ct_host::Terrain t = dem_cases::mirror_tiled(dem_cases::real_terrain(), 500, 500);
+    ct_host::BuildOptions o;
+    o.sectors = 16;
+    o.reduce = 3;
+    const TileSetBytes tb = ct_host::build_tileset(t, o, 129, 0);
+    const TileSetBytes holed = ct_host::build_tileset(t, o, 129, 0, [](int c, int r) { return c == 1 && r == 2; });
+    const std::vector<uint8_t> merged = ct_host::build_package(t, o);
+    ct_package mp;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_package_open(&mp, merged.data(), merged.size()));
+    Set set, hs;
+    TEST_ASSERT_EQUAL_INT(CT_OK, set.open(tb, 3));
+    TEST_ASSERT_EQUAL_INT(CT_OK, hs.open(holed, 3));
+    ct_effects sphere = {CT_EFFECT_CURVATURE | CT_EFFECT_REFRACTION, CT_REFRACTION_K_STD_Q16,
+                         (int64_t)6371000 * 1000000000, 0, NULL};
+    ct_effects earth = {CT_EFFECT_CURVATURE | CT_EFFECT_REFRACTION, CT_REFRACTION_K_STD_Q16, 0, 0, NULL};
+    const ct_effects *fxs[3] = {nullptr, &sphere, &earth};
+    ct_rng rng;
+    ct_rng_seed(&rng, 4242);
+    long counts[3] = {0, 0, 0}, nodata = 0, hidden = 0;
+    const int hx0 = holed.grid.first_col(1), hy0 = holed.grid.first_row(2);
+    for (int k = 0; k < 1500; ++k) {
+        // A 2-300 m above a post, B on or above the surface elsewhere
+        auto point = [&](double lift) {
+            const double i = ct_rng_unit(&rng) * 498, j = ct_rng_unit(&rng) * 498;
+            std::array<int64_t, 3> q;
+            q[0] = mp.origin_e_nm + (int64_t)std::llround((i + 0.5) * mp.posting_e_nm);
+            q[1] = mp.origin_n_nm + (int64_t)std::llround((j + 0.5) * mp.posting_n_nm);
+            q[2] = mp.height_offset_nm + (int64_t)std::llround(dem_cases::surf(t, i, j) * mp.height_scale_nm) +
+                   (int64_t)std::llround(lift * 1e9);
+            return q;
+        };
+        const auto A = point(2 + 300 * ct_rng_unit(&rng)), B = point(ct_rng_unit(&rng) < 0.5 ? 0.5 : 30);
+        const ct_effects *fx = fxs[k % 3];
+        ct_hit hm, hs1, hh;
+        const ct_status sm = ct_los(&mp, A.data(), B.data(), fx, 1000000, CT_METHOD_DIRECTIONAL, &hm);
+        const ct_status ss = ct_los_tiles(&set.ts, A.data(), B.data(), fx, 1000000, CT_METHOD_DIRECTIONAL, &hs1);
+        const ct_status sh = ct_los_tiles(&hs.ts, A.data(), B.data(), fx, 1000000, CT_METHOD_DIRECTIONAL, &hh);
+        TEST_ASSERT_MSG(sm >= 0, "ct_los %d", sm);
+        TEST_ASSERT_MSG(same_hit(sm, hm, ss, hs1), "pair %d effects %d: set %d vs merged %d", k, k % 3, ss, sm);
+        counts[sm == CT_OK ? 0 : (sm == CT_HIT ? 1 : 2)]++;
+        const bool on_hole = sm == CT_HIT && hm.cell_x >= hx0 && hm.cell_x < hx0 + 128 && hm.cell_y >= hy0 &&
+                             hm.cell_y < hy0 + 128;
+        hidden += on_hole;
+        if (sh == CT_NO_DATA) {
+            nodata++;
+        } else {
+            TEST_ASSERT_MSG(!on_hole && same_hit(sm, hm, sh, hh), "holed pair %d: %d vs merged %d", k, sh, sm);
+        }
+        if (ct_harness_g.current_failed) return;
+    }
+    std::printf("  line of sight: 1500 pairs (straight, sphere, true Earth): %ld visible, %ld blocked, %ld below; "
+                "with a tile missing %ld no_data (%ld blocked on it)\n",
+                counts[0], counts[1], counts[2], nodata, hidden);
+    TEST_ASSERT(counts[0] > 100 && counts[1] > 100 && nodata >= hidden && hidden > 0);
+}
+
 }  // namespace
 
 int main()
@@ -623,5 +685,6 @@ int main()
     RUN_TEST(test_missing_and_corrupt);
     RUN_TEST(test_manifest_checks);
     RUN_TEST(test_geolocation);
+    RUN_TEST(test_los);
     return TEST_END();
 }

@@ -1077,6 +1077,13 @@ ct_status ct_geolocate_batch_tiles(ct_tileset *ts, const ct_camera *cam, const c
                                    const ct_effects *effects, const int64_t *uv_q16, size_t count, ct_geo *out,
                                    size_t out_len);
 
+/* ct_los over a tile set: the same answers as on the merged package (the
+ * segment, or the true Earth's pieces, walked tile by tile), and
+ * CT_NO_DATA when the line of sight reaches a tile the set does not hold
+ * before anything blocks it (*block: where it entered that tile).        */
+ct_status ct_los_tiles(ct_tileset *ts, const int64_t a_nm[3], const int64_t b_nm[3], const ct_effects *effects,
+                       int64_t margin_nm, ct_method method, ct_hit *block);
+
 #ifdef __cplusplus
 }
 #endif

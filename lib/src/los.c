@@ -12,6 +12,7 @@
  * otherwise -- a target on the ground is met at itself.
  */
 #include "bend.h"
+#include "tiles.h"
 #include "fixed.h"
 
 /* |x - y| for points in nm: map points (|.| <= 2^61, checked by the
@@ -42,7 +43,7 @@ static ct_status to_ecef(const ct_utm *zone, const int64_t m[3], int64_t x[3])
  * earth.c as geolocation does; hidden when its first hit lies more than the
  * margin (Earth-fixed distance from A) before B.  fx checked and its chord
  * taken by the caller (ct_effects_to_bend).  CT_ERR_CRS: not UTM. */
-static ct_status los_earth(const ct_package *p, const int64_t a_nm[3], const int64_t b_nm[3],
+static ct_status los_earth(const ct_package *p, ct_tileset *ts, const int64_t a_nm[3], const int64_t b_nm[3],
                            const ct_effects *fx, int64_t chord_nm, int64_t margin_nm, ct_method m, ct_hit *block)
 {
     static const int32_t ident[9] = {1 << 30, 0, 0, 0, 1 << 30, 0, 0, 0, 1 << 30};
@@ -110,8 +111,8 @@ static ct_status los_earth(const ct_package *p, const int64_t a_nm[3], const int
             dg[k] = ct_i128_round_div(ct_i128_shl(ct_i128_from64(dg[k]), 39u), n);
         }
     }
-    st = ct_trace_earth(p, &es, dg, m, block);
-    if (st == CT_BELOW || st < 0) {
+    st = ct_trace_earth_set(p, ts, &es, dg, m, block);
+    if (st == CT_BELOW || st == CT_NO_DATA || st < 0) {
         return st;
     }
     if (st != CT_HIT && st != CT_HIT_VOID) {
@@ -127,8 +128,9 @@ static ct_status los_earth(const ct_package *p, const int64_t a_nm[3], const int
     }
 }
 
-ct_status ct_los(const ct_package *p, const int64_t a_nm[3], const int64_t b_nm[3], const ct_effects *effects,
-                 int64_t margin_nm, ct_method m, ct_hit *block)
+/* ct_los on one package (ts NULL) or over a tile set (p its frame). */
+static ct_status los_impl(const ct_package *p, ct_tileset *ts, const int64_t a_nm[3], const int64_t b_nm[3],
+                          const ct_effects *effects, int64_t margin_nm, ct_method m, ct_hit *block)
 {
     ct_ray ray;
     ct_prepared pr;
@@ -161,7 +163,7 @@ ct_status ct_los(const ct_package *p, const int64_t a_nm[3], const int64_t b_nm[
     }
     if (effects != NULL && (effects->flags & CT_EFFECT_CURVATURE) != 0u && effects->earth_radius_nm == 0) {
         /* the true Earth where the package is on a UTM zone */
-        st = los_earth(p, a_nm, b_nm, effects, bd.chord_nm, margin_nm, m, block);
+        st = los_earth(p, ts, a_nm, b_nm, effects, bd.chord_nm, margin_nm, m, block);
         if (st != CT_ERR_CRS) {
             return st;
         }
@@ -189,20 +191,29 @@ ct_status ct_los(const ct_package *p, const int64_t a_nm[3], const int64_t b_nm[
     if (ray.dx == 0 && ray.dy == 0 && ray.dz == 0) {
         return CT_ERR_RAY; /* A and B the same grid point */
     }
-    st = ct_prepare_lowered_segment(p, &ray, lwp, &pr);
-    if (st < 0) {
-        return st;
-    }
-    block->steps = block->iters = 0u;
-    if (st == CT_MISS) {
-        return CT_OK; /* the segment never meets the tile's box */
-    }
-    if (st == CT_BELOW) {
-        return CT_BELOW; /* A under the surface */
-    }
-    st = ct_trace_prepared_lowered(p, &pr, lwp, m, block);
-    if (st < 0) {
-        return st;
+    if (ts != NULL) {
+        /* over a tile set: the same segment, walked tile by tile */
+        int64_t tn, td;
+        st = ct_tileset_trace_segment(ts, &ray, lwp, 0, m, block, &tn, &td);
+        if (st < 0 || st == CT_NO_DATA || st == CT_BELOW) {
+            return st;
+        }
+    } else {
+        st = ct_prepare_lowered_segment(p, &ray, lwp, &pr);
+        if (st < 0) {
+            return st;
+        }
+        block->steps = block->iters = 0u;
+        if (st == CT_MISS) {
+            return CT_OK; /* the segment never meets the tile's box */
+        }
+        if (st == CT_BELOW) {
+            return CT_BELOW; /* A under the surface */
+        }
+        st = ct_trace_prepared_lowered(p, &pr, lwp, m, block);
+        if (st < 0) {
+            return st;
+        }
     }
     if (st == CT_HIT || st == CT_HIT_VOID) {
         int64_t h[3];
@@ -215,6 +226,21 @@ ct_status ct_los(const ct_package *p, const int64_t a_nm[3], const int64_t b_nm[
         return dh < db - margin_nm ? CT_HIT : CT_OK;
     }
     return st == CT_BELOW ? CT_BELOW : CT_OK;
+}
+
+ct_status ct_los(const ct_package *p, const int64_t a_nm[3], const int64_t b_nm[3], const ct_effects *effects,
+                 int64_t margin_nm, ct_method m, ct_hit *block)
+{
+    return los_impl(p, NULL, a_nm, b_nm, effects, margin_nm, m, block);
+}
+
+ct_status ct_los_tiles(ct_tileset *ts, const int64_t a_nm[3], const int64_t b_nm[3], const ct_effects *effects,
+                       int64_t margin_nm, ct_method m, ct_hit *block)
+{
+    if (ts == NULL) {
+        return CT_ERR_ARG;
+    }
+    return los_impl(&ts->frame, ts, a_nm, b_nm, effects, margin_nm, m, block);
 }
 
 ct_status ct_locate_inverse(const ct_package *p, const ct_camera *cam, const ct_pose *pose, const ct_effects *effects,
