@@ -541,6 +541,7 @@ CT_NOINLINE static ct_status trace_polyline(const ct_package *p, ct_tileset *ts,
         ct_ray seg;
         ct_prepared pr;
         ct_hit sh;
+        int64_t tn, td;
         int over = 0, run = 0;
         int64_t kn = k + ((int64_t)1 << q);
         if (q > 0 && kn > k1) {
@@ -608,7 +609,6 @@ CT_NOINLINE static ct_status trace_polyline(const ct_package *p, ct_tileset *ts,
         if (ts != NULL) {
             /* the segment over the set (below the surface at its start
              * after the polyline entered the box: a hit there, as below) */
-            int64_t tn, td;
             st = ct_tileset_trace_segment(ts, &seg, NULL, entered, m, &sh, &tn, &td);
             if (st < 0) {
                 return st;
@@ -616,53 +616,40 @@ CT_NOINLINE static ct_status trace_polyline(const ct_package *p, ct_tileset *ts,
             if (td == 0 && st != CT_NO_DATA) {
                 continue; /* never in the box */
             }
-            steps += sh.steps;
-            iters += sh.iters;
-            entered = 1;
-            if (st == CT_NO_DATA || ((st == CT_HIT || st == CT_HIT_VOID) && sh.t_q26 * td <= tn * (INT64_C(1) << CT_T_FRAC_BITS))) {
-                *h = sh;
-                h->steps = steps;
-                h->iters = iters;
+        } else {
+            st = ct_ray_prepare_segment(p, &seg, &pr);
+            if (st < 0) {
                 return st;
             }
-            if (st == CT_BELOW) {
-                h->steps = steps;
-                h->iters = iters;
-                return CT_BELOW;
-            }
-            continue;
-        }
-        st = ct_ray_prepare_segment(p, &seg, &pr);
-        if (st < 0) {
-            return st;
-        }
-        if (st == CT_MISS) {
-            continue;
-        }
-        if (st == CT_BELOW) {
-            if (!entered) {
-                h->steps = steps;
-                h->iters = iters;
-                return CT_BELOW;
-            }
-            /* the polyline crossed the surface within the vertex rounding
-             * between the previous segment's end and this start */
-            pr.start = CT_HIT;
-        }
-        entered = 1;
-        st = ct_trace_prepared_own(p, &pr, m, &sh);
-        if (st < 0) {
-            return st;
-        }
-        steps += sh.steps;
-        iters += sh.iters;
-        if (st == CT_HIT || st == CT_HIT_VOID) {
-            /* a hit in the last cell beyond the segment's end belongs to
-             * the extension of the chord, not to the polyline.
-             * t_q26 < 2^35, tend_d <= 2^26: < 2^61; tend_n < 2^34: 2^60 */
-            if (sh.t_q26 * pr.tend_d > pr.tend_n * (INT64_C(1) << CT_T_FRAC_BITS)) {
+            if (st == CT_MISS) {
                 continue;
             }
+            if (st == CT_BELOW) {
+                if (!entered) {
+                    h->steps = steps;
+                    h->iters = iters;
+                    return CT_BELOW;
+                }
+                /* the polyline crossed the surface within the vertex
+                 * rounding between the previous segment's end and this
+                 * start */
+                pr.start = CT_HIT;
+            }
+            st = ct_trace_prepared_own(p, &pr, m, &sh);
+            if (st < 0) {
+                return st;
+            }
+            tn = pr.tend_n;
+            td = pr.tend_d;
+        }
+        entered = 1;
+        steps += sh.steps;
+        iters += sh.iters;
+        /* a hit in the last cell beyond the segment's end belongs to the
+         * extension of the chord, not to the polyline.  t_q26 < 2^35,
+         * tend_d <= 2^26: < 2^61; tend_n < 2^34: 2^60 */
+        if (st == CT_NO_DATA ||
+            ((st == CT_HIT || st == CT_HIT_VOID) && sh.t_q26 * td <= tn * (INT64_C(1) << CT_T_FRAC_BITS))) {
             *h = sh;
             h->steps = steps;
             h->iters = iters;
