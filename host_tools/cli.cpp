@@ -378,10 +378,9 @@ int cmd_info(int argc, char **argv)
     Args a = parse(argc, argv, 2, {});
     if (a.pos.size() != 1) usage("info needs exactly one package file");
     if (is_tileset_path(a.pos[0])) return info_tiles(a.pos[0]);
-    std::vector<uint8_t> bytes = read_file(a.pos[0]);
+    std::vector<uint8_t> bytes;
     ct_package p;
-    ct_status st = ct_package_open(&p, bytes.data(), bytes.size());
-    if (st != CT_OK) throw Error(a.pos[0] + ": not a valid package (" + status_name(st) + ")");
+    open_package_file(a.pos[0], &bytes, &p);
     size_t deg = 0, cones = (size_t)p.coarse_x * p.coarse_y * p.sectors;
     for (size_t k = 0; k < cones; ++k) deg += p.angles[k] == 0;
     std::printf("file          %s\n", a.pos[0].c_str());
@@ -424,9 +423,7 @@ int cmd_trace(int argc, char **argv)
         p = probe.set()->frame;
     } else {
         if (a.opt.count("--cache-tiles")) usage("--cache-tiles needs a tile set");
-        bytes = read_file(a.pos[0]);
-        ct_status st = ct_package_open(&p, bytes.data(), bytes.size());
-        if (st != CT_OK) throw Error(a.pos[0] + ": not a valid package (" + status_name(st) + ")");
+        open_package_file(a.pos[0], &bytes, &p);
     }
     std::vector<MapRay> rays = read_rays_csv(a.opt["--rays"]);
     // rows formatted by the threads into their slots, written in input order

@@ -168,9 +168,7 @@ int cmd_geoloc(int argc, char **argv)
         }
     } else {
         if (opt.count("--cache-tiles")) throw Error("--cache-tiles needs a tile set");
-        bytes = read_file(pos[0]);
-        st = ct_package_open(&p, bytes.data(), bytes.size());
-        if (st != CT_OK) throw Error(pos[0] + ": not a valid package (" + status_name(st) + ")");
+        open_package_file(pos[0], &bytes, &p);
         gp = p;
     }
     const std::string &cpath = opt["--camera"];

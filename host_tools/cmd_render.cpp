@@ -112,9 +112,7 @@ Input load_input(const std::string &path)
         in.is_pkg = n == 4 && std::memcmp(m, CT_PKG_MAGIC, 4) == 0;
     }
     if (in.is_pkg) {
-        in.bytes = read_file(path);
-        ct_status st = ct_package_open(&in.pkg, in.bytes.data(), in.bytes.size());
-        if (st != CT_OK) throw Error(path + ": not a valid package (" + status_name(st) + ")");
+        open_package_file(path, &in.bytes, &in.pkg);
         in.t = terrain_from_package(in.pkg);
     } else {
         DemRaster r = read_dem(path);

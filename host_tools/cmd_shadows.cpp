@@ -62,10 +62,9 @@ int cmd_shadows(int argc, char **argv)
     }
     const int threads = opt.count("--threads") ? threads_option(opt["--threads"], "shadows") : 0;
     const std::string &path = args.pos[0];
-    std::vector<uint8_t> bytes = read_file(path);
+    std::vector<uint8_t> bytes;
     ct_package p;
-    ct_status st = ct_package_open(&p, bytes.data(), bytes.size());
-    if (st != CT_OK) throw Error(path + ": not a valid package (" + status_name(st) + ")");
+    open_package_file(path, &bytes, &p);
     const Terrain t = terrain_from_package(p);
     const int W = t.width, H = t.height;
     const double az = sun[0] * M_PI / 180, el = sun[1] * M_PI / 180;

@@ -42,10 +42,9 @@ int cmd_view(int argc, char **argv)
     if (!opt.count("-o")) throw Error("view needs -o view.png");
     const int threads = opt.count("--threads") ? threads_option(opt["--threads"], "view") : 0;
     const std::string &path = args.pos[0];
-    std::vector<uint8_t> bytes = read_file(path);
+    std::vector<uint8_t> bytes;
     ct_package p;
-    ct_status st = ct_package_open(&p, bytes.data(), bytes.size());
-    if (st != CT_OK) throw Error(path + ": not a valid package (" + status_name(st) + ")");
+    open_package_file(path, &bytes, &p);
     const std::string cpath = opt["--camera"];
     const CameraModel cm = read_cameramodel(cpath);
     LibCamera cam = lib_camera(cm, cpath);
@@ -61,7 +60,7 @@ int cmd_view(int argc, char **argv)
             uv[2 * ((size_t)v * W + u) + 1] = (int64_t)v << 16;
         }
     std::vector<ct_geo> g((size_t)W * H);
-    st = ct_geolocate_batch(&p, &cam.cam, &cam.pose, CT_METHOD_DIRECTIONAL, &fx, uv.data(), 0, g.data(), 0);
+    const ct_status st = ct_geolocate_batch(&p, &cam.cam, &cam.pose, CT_METHOD_DIRECTIONAL, &fx, uv.data(), 0, g.data(), 0);
     if (st != CT_OK) throw Error(cpath + ": cannot geolocate from this camera (" + status_name(st) + ")");
     const size_t n = (size_t)W * H;
     parallel_chunks(n, threads, std::max<size_t>(4096, n / 16 + 1), [&](size_t b, size_t e) {

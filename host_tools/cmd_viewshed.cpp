@@ -73,10 +73,9 @@ int cmd_viewshed(int argc, char **argv)
     const int threads = opt.count("--threads") ? threads_option(opt["--threads"], "viewshed") : 0;
 
     const std::string &path = args.pos[0];
-    std::vector<uint8_t> bytes = read_file(path);
+    std::vector<uint8_t> bytes;
     ct_package p;
-    ct_status st = ct_package_open(&p, bytes.data(), bytes.size());
-    if (st != CT_OK) throw Error(path + ": not a valid package (" + status_name(st) + ")");
+    open_package_file(path, &bytes, &p);
     const Terrain t = terrain_from_package(p);
     const int W = t.width, H = t.height;
     const double pe = p.posting_e_nm * 1e-9, pn = p.posting_n_nm * 1e-9;

@@ -28,6 +28,13 @@ std::vector<uint8_t> read_file(const std::string &path)
     return b;
 }
 
+void open_package_file(const std::string &path, std::vector<uint8_t> *bytes, ct_package *pkg)
+{
+    *bytes = read_file(path);
+    const ct_status st = ct_package_open(pkg, bytes->data(), bytes->size());
+    if (st != CT_OK) throw Error(path + ": not a valid package (" + status_name(st) + ")");
+}
+
 AtomicFile::AtomicFile(const std::string &path) : path_(path), tmp_(path + ".tmp." + std::to_string((long)getpid()))
 {
     f_ = std::fopen(tmp_.c_str(), "wb");

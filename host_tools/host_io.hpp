@@ -19,6 +19,11 @@ namespace ct_host {
 // Whole-file read; throws Error("<path>: <reason>").
 std::vector<uint8_t> read_file(const std::string &path);
 
+// A package file read whole into *bytes and opened as *pkg (a view of
+// *bytes: keep them together); throws Error("<path>: not a valid package
+// (<status>)") or read_file's.
+void open_package_file(const std::string &path, std::vector<uint8_t> *bytes, ct_package *pkg);
+
 // An output file written atomically: bytes go to "<path>.tmp.<pid>", which
 // commit() renames to path; destroyed without commit() (an error on the
 // way), the temporary is removed.  Never a partial output file.  Every

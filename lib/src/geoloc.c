@@ -184,94 +184,74 @@ static ct_status one_pixel(const ct_package *p, ct_tileset *ts, const ct_camera 
     return st;
 }
 
-ct_status ct_geolocate(const ct_package *pkg, const ct_camera *cam, const ct_pose *pose, ct_method method,
-                       const ct_effects *effects, int64_t u_q16, int64_t v_q16, ct_geo *out)
+/* ct_geolocate on one package (ts NULL) or over a tile set (pkg its frame). */
+static ct_status geolocate_one(const ct_package *pkg, ct_tileset *ts, const ct_camera *cam, const ct_pose *pose,
+                               ct_method method, const ct_effects *effects, int64_t u_q16, int64_t v_q16, ct_geo *out)
 {
     geo_setup s;
     ct_status st;
-    CT_ASSERT(pkg != NULL && cam != NULL && pose != NULL && out != NULL);
     if (out == NULL) {
         return CT_ERR_ARG;
     }
-    st = setup(pkg, cam, pose, method, effects, &s);
+    st = setup(pkg, cam, pose, method, effects, &s); /* NULL pkg: CT_ERR_ARG */
     if (st != CT_OK) {
         out->status = st;
         return st;
     }
-    return one_pixel(pkg, NULL, cam, pose, method, &s, u_q16, v_q16, out);
+    return one_pixel(pkg, ts, cam, pose, method, &s, u_q16, v_q16, out);
+}
+
+/* ct_geolocate_batch likewise. */
+static ct_status geolocate_many(const ct_package *pkg, ct_tileset *ts, const ct_camera *cam, const ct_pose *pose,
+                                ct_method method, const ct_effects *effects, const int64_t *uv_q16, size_t count,
+                                ct_geo *out, size_t out_len)
+{
+    geo_setup s;
+    ct_status st;
+    size_t k;
+    if (count > 0u && (uv_q16 == NULL || out == NULL || out_len < count)) {
+        return CT_ERR_ARG;
+    }
+    st = setup(pkg, cam, pose, method, effects, &s); /* NULL pkg: CT_ERR_ARG */
+    if (st != CT_OK) {
+        return st;
+    }
+    /* bound: count pixels (caller's buffers) */
+    for (k = 0u; k < count; ++k) {
+        (void)one_pixel(pkg, ts, cam, pose, method, &s, uv_q16[2u * k], uv_q16[2u * k + 1u], &out[k]);
+    }
+    return CT_OK;
+}
+
+ct_status ct_geolocate(const ct_package *pkg, const ct_camera *cam, const ct_pose *pose, ct_method method,
+                       const ct_effects *effects, int64_t u_q16, int64_t v_q16, ct_geo *out)
+{
+    CT_ASSERT(pkg != NULL && cam != NULL && pose != NULL && out != NULL);
+    return geolocate_one(pkg, NULL, cam, pose, method, effects, u_q16, v_q16, out);
 }
 
 ct_status ct_geolocate_batch(const ct_package *pkg, const ct_camera *cam, const ct_pose *pose, ct_method method,
                              const ct_effects *effects, const int64_t *uv_q16, size_t count, ct_geo *out,
                              size_t out_len)
 {
-    geo_setup s;
-    ct_status st;
-    size_t k;
     CT_ASSERT(pkg != NULL && cam != NULL && pose != NULL && (count == 0u || (uv_q16 != NULL && out != NULL)));
-    if (count > 0u && (uv_q16 == NULL || out == NULL || out_len < count)) {
-        return CT_ERR_ARG;
-    }
-    st = setup(pkg, cam, pose, method, effects, &s);
-    if (st != CT_OK) {
-        return st;
-    }
-    /* bound: count pixels (caller's buffers) */
-    for (k = 0u; k < count; ++k) {
-        (void)one_pixel(pkg, NULL, cam, pose, method, &s, uv_q16[2u * k], uv_q16[2u * k + 1u], &out[k]);
-    }
-    return CT_OK;
-}
-
-/* ---- tile sets ---------------------------------------------------------- */
-
-/* setup over a tile set's frame. */
-static ct_status setup_tiles(ct_tileset *ts, const ct_camera *cam, const ct_pose *pose, ct_method m,
-                             const ct_effects *effects, geo_setup *s)
-{
-    if (ts == NULL) {
-        return CT_ERR_ARG;
-    }
-    return setup(&ts->frame, cam, pose, m, effects, s);
+    return geolocate_many(pkg, NULL, cam, pose, method, effects, uv_q16, count, out, out_len);
 }
 
 ct_status ct_geolocate_tiles(ct_tileset *ts, const ct_camera *cam, const ct_pose *pose, ct_method method,
                              const ct_effects *effects, int64_t u_q16, int64_t v_q16, ct_geo *out)
 {
-    geo_setup s;
-    ct_status st;
     CT_ASSERT(ts != NULL && cam != NULL && pose != NULL && out != NULL);
-    if (out == NULL) {
-        return CT_ERR_ARG;
-    }
-    st = setup_tiles(ts, cam, pose, method, effects, &s);
-    if (st != CT_OK) {
-        out->status = st;
-        return st;
-    }
-    return one_pixel(&ts->frame, ts, cam, pose, method, &s, u_q16, v_q16, out);
+    return geolocate_one(ts != NULL ? &ts->frame : NULL, ts, cam, pose, method, effects, u_q16, v_q16, out);
 }
 
 ct_status ct_geolocate_batch_tiles(ct_tileset *ts, const ct_camera *cam, const ct_pose *pose, ct_method method,
                                    const ct_effects *effects, const int64_t *uv_q16, size_t count, ct_geo *out,
                                    size_t out_len)
 {
-    geo_setup s;
-    ct_status st;
-    size_t k;
     CT_ASSERT(ts != NULL && cam != NULL && pose != NULL && (count == 0u || (uv_q16 != NULL && out != NULL)));
-    if (count > 0u && (uv_q16 == NULL || out == NULL || out_len < count)) {
-        return CT_ERR_ARG;
-    }
-    st = setup_tiles(ts, cam, pose, method, effects, &s);
-    if (st != CT_OK) {
-        return st;
-    }
-    /* bound: count pixels (caller's buffers) */
-    for (k = 0u; k < count; ++k) {
-        (void)one_pixel(&ts->frame, ts, cam, pose, method, &s, uv_q16[2u * k], uv_q16[2u * k + 1u], &out[k]);
-    }
-    return CT_OK;
+    return geolocate_many(ts != NULL ? &ts->frame : NULL, ts, cam, pose, method, effects, uv_q16, count, out,
+                          out_len);
 }
 
 /* ---- effects for a tolerance ------------------------------------------ */

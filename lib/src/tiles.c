@@ -253,7 +253,7 @@ static ct_status set_trace(ct_tileset *ts, const ct_ray *ray, int seg, const ct_
         const uint8_t *e0 = ts->entries + (size_t)(bb * ts->tiles_x + a) * CT_SET_ENTRY_SIZE;
         int64_t ox = (int64_t)tile_first(ts, a) * ONE16, oy = (int64_t)tile_first(ts, bb) * ONE16;
         if (e0[12] != 0u && r.oz * (INT64_C(1) << r.zshift) > (int64_t)ct_ld16(e0 + 10) * ONE16) {
-            st = ct_tile_prep_finish(F, NULL, 0, 0, ray, seg, lw, &r);
+            st = ct_tile_prep_finish(F, NULL, 0, 0, i, j, ray, seg, lw, &r);
         } else {
             tp = tile_get(ts, a, bb);
             if (tp == NULL) {
@@ -271,7 +271,7 @@ static ct_status set_trace(ct_tileset *ts, const ct_ray *ray, int seg, const ct_
                 ll.obx -= ox;
                 ll.oby -= oy;
             }
-            st = ct_tile_prep_finish(F, tp, ox, oy, ray, seg, lw != NULL ? &ll : NULL, &r);
+            st = ct_tile_prep_finish(F, tp, ox, oy, i, j, ray, seg, lw != NULL ? &ll : NULL, &r);
         }
     }
     if (st == CT_BELOW && below_hit) {

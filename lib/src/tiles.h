@@ -24,12 +24,13 @@ ct_status ct_tile_prep_geom(const ct_package *frame, const ct_ray *ray, int seg,
 /* The cell of frame holding a prepared ray's first point (clamped). */
 void ct_prepared_first_cell(const ct_package *frame, const ct_prepared *r, int32_t *i, int32_t *j);
 
-/* The rest of ct_ray_prepare: the first point decided against tile (whose
- * grid is frame's shifted by offx, offy; lw, if any, in tile's grid), tend
- * in frame's box.  tile NULL: the caller knows the first point is above
- * every post of its tile (start CT_OK, nothing read).  Returns out->start. */
-ct_status ct_tile_prep_finish(const ct_package *frame, const ct_package *tile, int64_t offx, int64_t offy,
-                              const ct_ray *ray, int seg, const ct_lower *lw, ct_prepared *out);
+/* The rest of ct_ray_prepare: the first point -- in frame's cell (fi, fj),
+ * from ct_prepared_first_cell -- decided against tile (whose grid is
+ * frame's shifted by offx, offy; lw, if any, in tile's grid), tend in
+ * frame's box.  tile NULL: the caller knows the first point is above every
+ * post of its tile (start CT_OK, nothing read).  Returns out->start.      */
+ct_status ct_tile_prep_finish(const ct_package *frame, const ct_package *tile, int64_t offx, int64_t offy, int32_t fi,
+                              int32_t fj, const ct_ray *ray, int seg, const ct_lower *lw, ct_prepared *out);
 
 /* The walk of r (a frame-prepared ray shifted into tile's grid) in tile
  * from t0 = t0_n / t0_d: 0 for the first tile (as ct_trace_prepared), else

@@ -1479,8 +1479,9 @@ void ct_prepared_first_cell(const ct_package *p, const ct_prepared *r, int32_t *
     *j = b < 0 ? 0 : (b >= (int32_t)p->cells_y ? (int32_t)p->cells_y - 1 : b);
 }
 
-static ct_status prep_finish(const ct_package *p, const ct_package *sp, int64_t offx, int64_t offy, const ct_ray *ray,
-                             int seg, const ct_lower *lw, ct_prepared *out)
+/* (fi, fj): the first point's cell of p (ct_prepared_first_cell). */
+static ct_status prep_finish(const ct_package *p, const ct_package *sp, int64_t offx, int64_t offy, int32_t fi,
+                             int32_t fj, const ct_ray *ray, int seg, const ct_lower *lw, ct_prepared *out)
 {
     int64_t O[3];
     int32_t D[3];
@@ -1498,12 +1499,9 @@ static ct_status prep_finish(const ct_package *p, const ct_package *sp, int64_t 
      * first, so that tend below is formed only for a point at or above the
      * surface (z >= 0: every candidate < 2^34) */
     {
-        int32_t i, j;
-        int64_t s, f, lx = O[0] - offx, ly = O[1] - offy;
         /* in sp's grid (a tile set's tile: shifted by whole cells) */
-        ct_prepared_first_cell(p, out, &i, &j);
-        i -= (int32_t)(offx >> 16);
-        j -= (int32_t)(offy >> 16);
+        int32_t i = fi - (int32_t)(offx >> 16), j = fj - (int32_t)(offy >> 16);
+        int64_t s, f, lx = O[0] - offx, ly = O[1] - offy;
         if (O[2] < -(INT64_C(1) << (46u - zs))) {
             start = CT_BELOW;
         } else if (sp == NULL) {
@@ -1575,19 +1573,21 @@ ct_status ct_tile_prep_geom(const ct_package *frame, const ct_ray *ray, int seg,
     return prep_geom(frame, ray, seg, out);
 }
 
-ct_status ct_tile_prep_finish(const ct_package *frame, const ct_package *tile, int64_t offx, int64_t offy,
-                              const ct_ray *ray, int seg, const ct_lower *lw, ct_prepared *out)
+ct_status ct_tile_prep_finish(const ct_package *frame, const ct_package *tile, int64_t offx, int64_t offy, int32_t fi,
+                              int32_t fj, const ct_ray *ray, int seg, const ct_lower *lw, ct_prepared *out)
 {
-    return prep_finish(frame, tile, offx, offy, ray, seg, lw, out);
+    return prep_finish(frame, tile, offx, offy, fi, fj, ray, seg, lw, out);
 }
 
 static ct_status prepare_impl(const ct_package *p, const ct_ray *ray, int seg, const ct_lower *lw, ct_prepared *out)
 {
+    int32_t i, j;
     ct_status st = prep_geom(p, ray, seg, out);
     if (st != CT_OK) {
         return st;
     }
-    return prep_finish(p, p, 0, 0, ray, seg, lw, out);
+    ct_prepared_first_cell(p, out, &i, &j);
+    return prep_finish(p, p, 0, 0, i, j, ray, seg, lw, out);
 }
 
 ct_status ct_ray_prepare(const ct_package *p, const ct_ray *ray, ct_prepared *out)
