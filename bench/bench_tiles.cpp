@@ -4,10 +4,12 @@
 // posts), one thread, directional method.  Per ray family (20,000 rays)
 // and for the image: ns per ray on the merged package and on the set with
 // every tile resident (16 slots, warmed), their ratio (the median of
-// per-round ratios over 11 rounds; the sides alternate, each round the best of 3), and
+// per-round ratios over 11 rounds; within a round the sides alternate
+// every 500 rays -- 1,024 pixels -- in the order ab ba ab ..., so both
+// see the same machine; ns per ray: each side's best round), and
 // with caches of 4 and 1 slots the ns per ray and tile loads per ray (on
-// the first 1,000 rays of each family, the first quarter of the image's
-// rows); the steps per ray of both.  A
+// the first 1,000 rays of each family, 12 image rows from the middle
+// down); the steps per ray of both.  A
 // load here is a zero-copy hand-over of the tile's bytes (a memory-mapped
 // file or flash) plus ct_package_open's checks, its CRC over the whole
 // tile included -- what a flight computer pays per tile switch besides
@@ -32,6 +34,8 @@
 namespace {
 
 using clk = std::chrono::steady_clock;
+
+constexpr int kRounds = 11;
 
 double now_ns()
 {
@@ -66,16 +70,27 @@ bool same(ct_status a, const ct_hit &x, ct_status b, const ct_hit &y)
                                       x.t_q26 == y.t_q26));
 }
 
-// ns per item of f() over n items: the best of 3 runs
-template <class F> double best_of3(F f, size_t n)
+// One round of the two sides, interleaved chunk by chunk (a(k0, k1) and
+// b(k0, k1) run items [k0, k1)): chunks of `chunk` items, in the order
+// a b, b a, a b, ... so that both see the same machine at millisecond
+// granularity.  *na, *nb: ns per item of each side over the round.
+template <class A, class B> void abba_round(A a, B b, size_t n, size_t chunk, double *na, double *nb)
 {
-    double best = 1e300;
-    for (int k = 0; k < 3; ++k) {
-        const double t0 = now_ns();
-        f();
-        best = std::min(best, (now_ns() - t0) / (double)n);
+    double ta = 0, tb = 0;
+    for (size_t k0 = 0, c = 0; k0 < n; k0 += chunk, ++c) {
+        const size_t k1 = std::min(n, k0 + chunk);
+        for (int side = 0; side < 2; ++side) {
+            const bool first_a = (c & 1) == 0;
+            const double t0 = now_ns();
+            if ((side == 0) == first_a)
+                a(k0, k1);
+            else
+                b(k0, k1);
+            ((side == 0) == first_a ? ta : tb) += now_ns() - t0;
+        }
     }
-    return best;
+    *na = ta / (double)n;
+    *nb = tb / (double)n;
 }
 
 double median(std::vector<double> v)
@@ -91,6 +106,21 @@ struct Row {
     long differ = 0;
 };
 
+// Rounds of abba_round: each side's best ns per item, and the median of
+// the rounds' ratios b / a.
+template <class A, class B> void compare(A a, B b, size_t n, size_t chunk, int rounds, Row *row)
+{
+    std::vector<double> ratios;
+    for (int round = 0; round < rounds; ++round) {
+        double na, nb;
+        abba_round(a, b, n, chunk, &na, &nb);
+        ratios.push_back(nb / na);
+        row->merged = round == 0 ? na : std::min(row->merged, na);
+        row->set = round == 0 ? nb : std::min(row->set, nb);
+    }
+    row->ratio = median(ratios);
+}
+
 void print_row(const Row &r)
 {
     std::printf("%-14s %7zu | %8.0f %8.0f %6.3f | %6.1f %6.1f | %9.0f %7.3f | %9.0f %7.3f%s\n", r.what.c_str(), r.n,
@@ -102,6 +132,7 @@ void print_row(const Row &r)
 
 int main(int argc, char **argv)
 {
+    std::setvbuf(stdout, nullptr, _IOLBF, 0);  // rows as they come
     const bool quick = argc > 1 && std::strcmp(argv[1], "--quick") == 0;
     const size_t nrays = quick ? 5000 : 20000;
     const ct_host::Terrain t = dem_cases::mirror_tiled(dem_cases::real_terrain(), 2049, 2049);
@@ -124,7 +155,7 @@ int main(int argc, char **argv)
     for (const auto &tile : set.tiles) bytes += tile.size();
     std::printf("tile sets: 2049 x 2049 posts (the fixture mirror-tiled), N = 24, r = 3: merged package %.1f MB "
                 "(built in %.1f s), 4 x 4 tiles of 513 posts %.1f MB in all (built in %.1f s); one thread, "
-                "directional; ns per ray (the best; ratio: the median of per-round ratios, 11 alternating rounds, best of 3 each)\n",
+                "directional; ns per ray (the best round; ratio: the median of 11 rounds' ratios, the sides alternating every 500 rays)\n",
                 merged.size() / 1e6, build_merged, bytes / 1e6, build_set);
     std::printf("%-14s %7s | %8s %8s %6s | %6s %6s | %9s %7s | %9s %7s\n", "family", "rays", "merged", "set/16",
                 "ratio", "steps", "steps", "set/4", "loads", "set/1", "loads");
@@ -133,33 +164,28 @@ int main(int argc, char **argv)
     std::vector<Row> rows;
     const dem_cases::Family fams[] = {dem_cases::OBLIQUE, dem_cases::GRAZING, dem_cases::HORIZONTAL,
                                       dem_cases::OUTSIDE};
-    double worst = 0;
+    double worst = 0, lo, hi;
+    dem_cases::minmax(t, &lo, &hi);
     for (dem_cases::Family f : fams) {
         ct_rng rng;
         ct_rng_seed(&rng, 1234u + (uint64_t)f);
         std::vector<ct_ray> rays(nrays);
-        for (auto &r : rays) r = dem_cases::make_ray(t, f, &rng);
+        for (auto &r : rays) r = dem_cases::make_ray(t, f, &rng, lo, hi);
         std::vector<ct_hit> hm(nrays), hs(nrays);
         std::vector<ct_status> sm(nrays), ss(nrays);
         Cache all(16);
-        auto run_merged = [&] {
-            for (size_t k = 0; k < nrays; ++k) sm[k] = ct_trace(&mp, &rays[k], CT_METHOD_DIRECTIONAL, &hm[k]);
+        auto run_merged = [&](size_t k0, size_t k1) {
+            for (size_t k = k0; k < k1; ++k) sm[k] = ct_trace(&mp, &rays[k], CT_METHOD_DIRECTIONAL, &hm[k]);
         };
-        auto run_set = [&](Cache &c) {
-            for (size_t k = 0; k < nrays; ++k) ss[k] = ct_tileset_trace(&c.ts, &rays[k], CT_METHOD_DIRECTIONAL, &hs[k]);
+        auto run_set = [&](size_t k0, size_t k1) {
+            for (size_t k = k0; k < k1; ++k)
+                ss[k] = ct_tileset_trace(&all.ts, &rays[k], CT_METHOD_DIRECTIONAL, &hs[k]);
         };
-        run_set(all);  // warm: every tile resident
+        run_set(0, nrays);  // warm: every tile resident
         Row row;
         row.what = dem_cases::family_name(f);
         row.n = nrays;
-        std::vector<double> ratios;
-        for (int round = 0; round < 11; ++round) {
-            const double a = best_of3(run_merged, nrays), b = best_of3([&] { run_set(all); }, nrays);
-            ratios.push_back(b / a);
-            row.merged = round == 0 ? a : std::min(row.merged, a);
-            row.set = round == 0 ? b : std::min(row.set, b);
-        }
-        row.ratio = median(ratios);
+        compare(run_merged, run_set, nrays, 500, kRounds, &row);
         for (size_t k = 0; k < nrays; ++k) {
             row.differ += !same(sm[k], hm[k], ss[k], hs[k]);
             row.steps_m += hm[k].steps / (double)nrays;
@@ -209,24 +235,19 @@ int main(int argc, char **argv)
         const size_t np = uv.size() / 2;
         std::vector<ct_geo> gm(np), gs(np);
         Cache all(16);
-        auto run_merged = [&] {
-            ct_geolocate_batch(&mp, &cam, &pose, CT_METHOD_DIRECTIONAL, nullptr, uv.data(), np, gm.data(), np);
+        auto run_merged = [&](size_t k0, size_t k1) {
+            ct_geolocate_batch(&mp, &cam, &pose, CT_METHOD_DIRECTIONAL, nullptr, uv.data() + 2 * k0, k1 - k0,
+                               gm.data() + k0, k1 - k0);
         };
-        auto run_set = [&](Cache &c) {
-            ct_geolocate_batch_tiles(&c.ts, &cam, &pose, CT_METHOD_DIRECTIONAL, nullptr, uv.data(), np, gs.data(), np);
+        auto run_set = [&](size_t k0, size_t k1) {
+            ct_geolocate_batch_tiles(&all.ts, &cam, &pose, CT_METHOD_DIRECTIONAL, nullptr, uv.data() + 2 * k0,
+                                     k1 - k0, gs.data() + k0, k1 - k0);
         };
-        run_set(all);
+        run_set(0, np);
         Row row;
         row.what = "image 1024x768";
         row.n = np;
-        std::vector<double> ratios;
-        for (int round = 0; round < 11; ++round) {
-            const double a = best_of3(run_merged, np), b = best_of3([&] { run_set(all); }, np);
-            ratios.push_back(b / a);
-            row.merged = round == 0 ? a : std::min(row.merged, a);
-            row.set = round == 0 ? b : std::min(row.set, b);
-        }
-        row.ratio = median(ratios);
+        compare(run_merged, run_set, np, 1024, kRounds, &row);
         auto diff = [&] {
             long d = 0;
             for (size_t k = 0; k < np; ++k) d += !same(gm[k].status, gm[k].hit, gs[k].status, gs[k].hit);
@@ -237,16 +258,18 @@ int main(int argc, char **argv)
             row.steps_m += gm[k].hit.steps / (double)np;
             row.steps_s += gs[k].hit.steps / (double)np;
         }
-        // small caches: the first quarter of the image's rows (each load
+        // small caches: 12 image rows from the middle down (each load
         // checks a whole tile's CRC)
-        const size_t nq = np / 4;
+        const size_t q0 = np / 2, nq = 12 * (1024 / step);
         for (int slots : {4, 1}) {
             Cache c(slots);
             const double t1 = now_ns();
-            ct_geolocate_batch_tiles(&c.ts, &cam, &pose, CT_METHOD_DIRECTIONAL, nullptr, uv.data(), nq, gs.data(), nq);
+            ct_geolocate_batch_tiles(&c.ts, &cam, &pose, CT_METHOD_DIRECTIONAL, nullptr, uv.data() + 2 * q0, nq,
+                                     gs.data() + q0, nq);
             (slots == 4 ? row.ns4 : row.ns1) = (now_ns() - t1) / (double)nq;
             (slots == 4 ? row.loads4 : row.loads1) = (double)c.ts.loads / (double)nq;
-            for (size_t k = 0; k < nq; ++k) row.differ += !same(gm[k].status, gm[k].hit, gs[k].status, gs[k].hit);
+            for (size_t k = q0; k < q0 + nq; ++k)
+                row.differ += !same(gm[k].status, gm[k].hit, gs[k].status, gs[k].hit);
         }
         long hits = 0;
         for (const ct_geo &g : gm) hits += g.status == CT_HIT;

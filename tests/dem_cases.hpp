@@ -246,10 +246,11 @@ inline void minmax(const ct_host::Terrain &t, double *lo, double *hi)
     *hi = *mm.second;
 }
 
-inline ct_ray make_ray(const ct_host::Terrain &t, Family f, ct_rng *r)
+// A ray of family f over terrain t whose lowest and highest codes are lo
+// and hi (minmax: pass them when drawing many rays over a large DEM).
+inline ct_ray make_ray(const ct_host::Terrain &t, Family f, ct_rng *r, double lo, double hi)
 {
-    double cw = t.width - 1, ch = t.height - 1, lo, hi;
-    minmax(t, &lo, &hi);
+    double cw = t.width - 1, ch = t.height - 1;
     double x = ct_rng_unit(r) * cw, y = ct_rng_unit(r) * ch, az = ct_rng_unit(r) * 6.283185307179586;
     double d[3];
     double span = std::max(1.0, hi - lo);
@@ -345,6 +346,13 @@ inline ct_ray make_ray(const ct_host::Terrain &t, Family f, ct_rng *r)
         return to_ray(ox, oy, oz, dv);
     }
     }
+}
+
+inline ct_ray make_ray(const ct_host::Terrain &t, Family f, ct_rng *r)
+{
+    double lo, hi;
+    minmax(t, &lo, &hi);
+    return make_ray(t, f, r, lo, hi);
 }
 
 // Does the ray cross the interior of the tile's box (long double slab test)?

@@ -126,8 +126,10 @@ ct_ray seam_ray(const ct_host::Terrain &t, const ct_host::TileGrid &g, int kind,
         const double s = dem_cases::surf(t, x, y);
         return dem_cases::to_ray(x, y, s + ct_rng_unit(r) * (hi + 1 - s), d);
     }
-    case 1: {  // exactly through a tile corner post, from up to 60 cells back
-        const int i = (int)seam_x, j = (int)seam_y;
+    case 1: {  // exactly through a post on a seam (a tile corner, or one on a seam line), from up to 60 cells back
+        const int pick = (int)ct_rng_range(r, 0, 2);
+        const int i = pick == 1 ? (int)ct_rng_range(r, 0, t.width - 1) : (int)seam_x;
+        const int j = pick == 2 ? (int)ct_rng_range(r, 0, t.height - 1) : (int)seam_y;
         int64_t D[3] = {ct_rng_range(r, -(1 << 20), 1 << 20), ct_rng_range(r, -(1 << 20), 1 << 20),
                         ct_rng_range(r, -(1 << 17), 1 << 8)};
         if (ct_rng_range(r, 0, 2) == 0) D[1] = ct_rng_range(r, 0, 1) ? D[0] : -D[0];  // diagonal
@@ -210,10 +212,13 @@ void check_seams(const char *name, const ct_host::Terrain &t, const ct_host::Bui
     ct_rng rng;
     ct_rng_seed(&rng, ct_test_seed() * 104729u + (uint64_t)P * 31u + (uint64_t)t.width);
     int reported = 0;
+    double lo, hi;
+    dem_cases::minmax(t, &lo, &hi);
     for (long k = 0; k < n; ++k) {
         // two thirds from the ray families, a third built for the seams
-        const ct_ray ray = (k % 3 == 2) ? seam_ray(t, tb.grid, (int)((k / 3) % 3), &rng)
-                                        : dem_cases::make_ray(t, (dem_cases::Family)(k % dem_cases::FAMILY_COUNT), &rng);
+        const ct_ray ray = (k % 3 == 2)
+                               ? seam_ray(t, tb.grid, (int)((k / 3) % 3), &rng)
+                               : dem_cases::make_ray(t, (dem_cases::Family)(k % dem_cases::FAMILY_COUNT), &rng, lo, hi);
         ct_hit hm[4], hs[4];
         ct_status sm[4], ss[4];
         for (int m = 0; m < 4; ++m) {
@@ -301,8 +306,10 @@ void test_cache_sizes()
     ct_rng rng;
     ct_rng_seed(&rng, 77);
     std::vector<ct_ray> rays;
+    double lo, hi;
+    dem_cases::minmax(t, &lo, &hi);
     for (int k = 0; k < 3000; ++k)
-        rays.push_back(dem_cases::make_ray(t, (k & 1) ? dem_cases::GRAZING : dem_cases::OUTSIDE, &rng));
+        rays.push_back(dem_cases::make_ray(t, (k & 1) ? dem_cases::GRAZING : dem_cases::OUTSIDE, &rng, lo, hi));
     uint32_t loads[3] = {0, 0, 0};
     const int nslots[3] = {1, 2, 16};
     for (int c = 0; c < 3; ++c) {
@@ -406,8 +413,10 @@ void test_missing_and_corrupt()
         ct_rng_seed(&rng, 500 + variant);
         long nodata = 0, same = 0, inside = 0;
         const double x0 = g.first_col(1), x1 = g.first_col(2), y0 = g.first_row(1), y1 = g.first_row(2);
+        double lo, hi;
+        dem_cases::minmax(t, &lo, &hi);
         for (int k = 0; k < 4000; ++k) {
-            const ct_ray ray = dem_cases::make_ray(t, (dem_cases::Family)(k % dem_cases::FAMILY_COUNT), &rng);
+            const ct_ray ray = dem_cases::make_ray(t, (dem_cases::Family)(k % dem_cases::FAMILY_COUNT), &rng, lo, hi);
             ct_hit hm, hs;
             const ct_status sm = ct_trace(&mp, &ray, CT_METHOD_DIRECTIONAL, &hm);
             std::fill(set.mem.calls.begin(), set.mem.calls.end(), 0);

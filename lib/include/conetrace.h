@@ -1027,6 +1027,7 @@ typedef struct {
 } ct_tile_slot;
 
 #define CT_SET_MAX_SLOTS 64u       /* slots per set                         */
+#define CT_SET_HINTS 64u           /* slot guesses, by tile number mod 64   */
 
 /* A tile set over caller memory.  Fill with ct_tileset_open.  The
  * manifest's bytes are kept by reference (zero copy).  Not reentrant: a
@@ -1046,7 +1047,8 @@ typedef struct {
                                   -1: empty                                 */
     uint32_t used[CT_SET_MAX_SLOTS]; /* the clock at slot k's last use      */
     uint32_t clock;            /* uses so far (the cache's order)           */
-    uint32_t last;             /* the slot used last                        */
+    uint8_t hint[CT_SET_HINTS]; /* the slot tile k was last found in, at
+                                  k mod CT_SET_HINTS (checked against held) */
     uint32_t loads;            /* tiles loaded and accepted                 */
     uint32_t refused;          /* loads that failed or were refused         */
 } ct_tileset;

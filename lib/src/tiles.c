@@ -115,13 +115,16 @@ ct_status ct_tileset_open(ct_tileset *ts, const uint8_t *b, size_t len, ct_tile_
     ts->load = load;
     ts->user = user;
     ts->clock = 0u;
-    ts->last = 0u;
     ts->loads = 0u;
     ts->refused = 0u;
     /* bound: CT_SET_MAX_SLOTS */
     for (k = 0u; k < CT_SET_MAX_SLOTS; ++k) {
         ts->held[k] = -1;
         ts->used[k] = 0u;
+    }
+    /* bound: CT_SET_HINTS */
+    for (k = 0u; k < CT_SET_HINTS; ++k) {
+        ts->hint[k] = 0u;
     }
     return CT_OK;
 }
@@ -163,16 +166,18 @@ static const ct_package *tile_get(ct_tileset *ts, uint32_t a, uint32_t bb)
         return NULL;
     }
     ts->clock++;
-    if (ts->held[ts->last] == (int16_t)k) {
-        /* the tile of the previous call: the usual case */
-        ts->used[ts->last] = ts->clock;
-        return &ts->slots[ts->last].pkg;
+    s = ts->hint[k % CT_SET_HINTS];
+    if (ts->held[s] == (int16_t)k) {
+        /* where the tile was found last: the usual case (s < nslots: a
+         * hint only names a slot that held a tile) */
+        ts->used[s] = ts->clock;
+        return &ts->slots[s].pkg;
     }
     /* bound: nslots <= CT_SET_MAX_SLOTS */
     for (s = 0u; s < ts->nslots; ++s) {
         if (ts->held[s] == (int16_t)k) {
             ts->used[s] = ts->clock;
-            ts->last = s;
+            ts->hint[k % CT_SET_HINTS] = (uint8_t)s;
             return &ts->slots[s].pkg;
         }
     }
@@ -192,7 +197,7 @@ static const ct_package *tile_get(ct_tileset *ts, uint32_t a, uint32_t bb)
     }
     ts->held[victim] = (int16_t)k;
     ts->used[victim] = ts->clock;
-    ts->last = victim;
+    ts->hint[k % CT_SET_HINTS] = (uint8_t)victim;
     ts->loads++;
     return &sl->pkg;
 }
@@ -225,13 +230,14 @@ static ct_status set_trace(ct_tileset *ts, const ct_ray *ray, int seg, const ct_
                            ct_method m, ct_hit *h, int64_t tend[2])
 {
     const ct_package *F = &ts->frame;
-    const ct_package *tp;
+    const ct_package *tp = NULL; /* tile (a, bb) when already fetched */
     ct_prepared r;
     ct_lower ll;
     ct_status st;
-    int32_t i, j, sx, sy;
+    int32_t i, j, ci, cj, sx, sy;
     uint32_t a, bb, it;
     int64_t tn = 0, td = 1, adx, ady;
+    int eface = 0; /* the walk's entry face(s) in tile (a, bb): 0 the first */
     ct_hit_clear(h);
     if ((unsigned)m >= (unsigned)CT_METHOD_COUNT) {
         return CT_ERR_METHOD;
@@ -240,9 +246,13 @@ static ct_status set_trace(ct_tileset *ts, const ct_ray *ray, int seg, const ct_
     if (st != CT_OK) {
         return st;
     }
+    /* (i, j): the cell the walk starts in (in tile (a, bb)'s grid below);
+     * (ci, cj): the cell the first point is on */
     ct_prepared_first_cell(F, &r, &i, &j);
-    a = tile_of(ts, i, ts->tiles_x);
-    bb = tile_of(ts, j, ts->tiles_y);
+    ci = ct_clamp_cell(i, F->cells_x);
+    cj = ct_clamp_cell(j, F->cells_y);
+    a = tile_of(ts, ci, ts->tiles_x);
+    bb = tile_of(ts, cj, ts->tiles_y);
     sx = r.dx > 0 ? 1 : (r.dx < 0 ? -1 : 0);
     sy = r.dy > 0 ? 1 : (r.dy < 0 ? -1 : 0);
     adx = ct_abs64(r.dx);
@@ -253,7 +263,7 @@ static ct_status set_trace(ct_tileset *ts, const ct_ray *ray, int seg, const ct_
         const uint8_t *e0 = ts->entries + (size_t)(bb * ts->tiles_x + a) * CT_SET_ENTRY_SIZE;
         int64_t ox = (int64_t)tile_first(ts, a) * ONE16, oy = (int64_t)tile_first(ts, bb) * ONE16;
         if (e0[12] != 0u && r.oz * (INT64_C(1) << r.zshift) > (int64_t)ct_ld16(e0 + 10) * ONE16) {
-            st = ct_tile_prep_finish(F, NULL, 0, 0, i, j, ray, seg, lw, &r);
+            st = ct_tile_prep_finish(F, NULL, 0, 0, ci, cj, ray, seg, lw, &r);
         } else {
             tp = tile_get(ts, a, bb);
             if (tp == NULL) {
@@ -271,8 +281,10 @@ static ct_status set_trace(ct_tileset *ts, const ct_ray *ray, int seg, const ct_
                 ll.obx -= ox;
                 ll.oby -= oy;
             }
-            st = ct_tile_prep_finish(F, tp, ox, oy, i, j, ray, seg, lw != NULL ? &ll : NULL, &r);
+            st = ct_tile_prep_finish(F, tp, ox, oy, ci, cj, ray, seg, lw != NULL ? &ll : NULL, &r);
         }
+        i -= (int32_t)(ox >> 16);
+        j -= (int32_t)(oy >> 16);
     }
     if (st == CT_BELOW && below_hit) {
         r.start = CT_HIT; /* tend stays 0: the hit is at the first point */
@@ -331,9 +343,11 @@ static ct_status set_trace(ct_tileset *ts, const ct_ray *ray, int seg, const ct_
         }
         if (e[12] == 0u || r.oz * ld + ln * (int64_t)r.dz <= (int64_t)ct_ld16(e + 10) * (ONE16 >> r.zshift) * ld) {
             const uint32_t steps = h->steps, iters = h->iters;
-            tp = tile_get(ts, a, bb);
             if (tp == NULL) {
-                return no_data(ts, &r, lw, a, bb, tn, td, h);
+                tp = tile_get(ts, a, bb);
+                if (tp == NULL) {
+                    return no_data(ts, &r, lw, a, bb, tn, td, h);
+                }
             }
             /* the ray (and the observer) in the tile's grid, shifted in
              * place and back: no copies on the walk's stack */
@@ -344,7 +358,7 @@ static ct_status set_trace(ct_tileset *ts, const ct_ray *ray, int seg, const ct_
                 ll.obx -= x0 * ONE16;
                 ll.oby -= y0 * ONE16;
             }
-            st = ct_trace_tile(tp, &r, tn, td, lw != NULL ? &ll : NULL, m, h);
+            st = ct_trace_tile(tp, &r, tn, td, eface, i, j, lw != NULL ? &ll : NULL, m, h);
             r.ox += x0 * ONE16;
             r.oy += y0 * ONE16;
             h->steps += steps;
@@ -365,19 +379,24 @@ static ct_status set_trace(ct_tileset *ts, const ct_ray *ray, int seg, const ct_
         if (!t_lt(en, ed, r.tend_n, r.tend_d)) {
             return CT_MISS;
         }
-        /* onto the next tile (through a corner: the diagonal one) */
+        /* onto the next tile (through a corner: the diagonal one), in the
+         * cell column (row) on its entry face */
         if (face & 1) {
             if ((sx < 0 && a == 0u) || (sx > 0 && a + 1u >= ts->tiles_x)) {
                 return CT_MISS;
             }
             a = sx > 0 ? a + 1u : a - 1u;
+            i = sx > 0 ? 0 : (int32_t)tile_posts_at(ts, a, F->width) - 2;
         }
         if (face & 2) {
             if ((sy < 0 && bb == 0u) || (sy > 0 && bb + 1u >= ts->tiles_y)) {
                 return CT_MISS;
             }
             bb = sy > 0 ? bb + 1u : bb - 1u;
+            j = sy > 0 ? 0 : (int32_t)tile_posts_at(ts, bb, F->height) - 2;
         }
+        eface = face;
+        tp = NULL;
         tn = en;
         td = ed;
     }

@@ -21,8 +21,16 @@ extern "C" {
  * not yet decided), CT_MISS / CT_BELOW, or an error.                      */
 ct_status ct_tile_prep_geom(const ct_package *frame, const ct_ray *ray, int seg, ct_prepared *out);
 
-/* The cell of frame holding a prepared ray's first point (clamped). */
+/* The cell of frame holding a prepared ray's first point, as the walk
+ * locates it (-1 .. cells on an axis: clamp with ct_clamp_cell for the
+ * cell the point is on). */
 void ct_prepared_first_cell(const ct_package *frame, const ct_prepared *r, int32_t *i, int32_t *j);
+
+/* i clamped to 0 .. cells - 1. */
+static inline int32_t ct_clamp_cell(int32_t i, uint32_t cells)
+{
+    return i < 0 ? 0 : (i >= (int32_t)cells ? (int32_t)cells - 1 : i);
+}
 
 /* The rest of ct_ray_prepare: the first point -- in frame's cell (fi, fj),
  * from ct_prepared_first_cell -- decided against tile (whose grid is
@@ -33,12 +41,15 @@ ct_status ct_tile_prep_finish(const ct_package *frame, const ct_package *tile, i
                               int32_t fj, const ct_ray *ray, int seg, const ct_lower *lw, ct_prepared *out);
 
 /* The walk of r (a frame-prepared ray shifted into tile's grid) in tile
- * from t0 = t0_n / t0_d: 0 for the first tile (as ct_trace_prepared), else
- * the parameter where the ray crosses onto the tile (d <= 2^26).  CT_MISS
- * when it leaves the tile (or, by a cone, shows the rest of the ray in the
- * tile is above its surface) without a hit.                                */
-ct_status ct_trace_tile(const ct_package *tile, const ct_prepared *r, int64_t t0_n, int64_t t0_d, const ct_lower *lw,
-                        ct_method method, ct_hit *hit);
+ * from t0 = t0_n / t0_d: 0 for the first tile (as ct_trace_prepared; face
+ * 0, (i0, j0) the first point's cell in tile's grid, unclamped), else the
+ * parameter where the ray crosses onto the tile (d <= 2^26) through its
+ * entry face(s): face bit 1 the x face (i0 its column), bit 2 the y face
+ * (j0 its row); the other axis is located.  CT_MISS when it leaves the
+ * tile (or, by a cone, shows the rest of the ray in the tile is above its
+ * surface) without a hit.                                                  */
+ct_status ct_trace_tile(const ct_package *tile, const ct_prepared *r, int64_t t0_n, int64_t t0_d, int face,
+                        int32_t i0, int32_t j0, const ct_lower *lw, ct_method method, ct_hit *hit);
 
 /* hit's position at t_q26 on r (x, y, z Q16 and map nm in p's frame; for a
  * bent ray, on the curve); hit->cell_x, cell_y are kept.                   */

@@ -71,7 +71,8 @@ typedef struct {
                            [2^30, 2^30.5]; 0 when culling is off            */
     rt t0;              /* where the walk starts: 0, or (a tile set) the
                            canonical entry of the tile's first cell         */
-    int32_t i0, j0;     /* the cell holding the ray at t0 (locate)          */
+    int32_t i0, j0;     /* the cell holding the ray at t0 (located, or the
+                           tile set's)                                      */
 } ctx;
 
 /* Height code h >= 0 (< 2^17) in the ray's z units: one 32x32 product. */
@@ -198,16 +199,21 @@ static int32_t axis_cell_q26(int64_t num, int32_t s, int32_t ncell)
     return (int32_t)k;
 }
 
-/* Cell holding the ray at t.  ox*d < 2^31 * 2^26, n*dx < 2^60. */
-static void locate(const ctx *c, rt t, int32_t *i, int32_t *j)
+/* The cell index on one axis (origin o, direction d of sign s, n cells)
+ * holding the ray at t.  o*d < 2^31 * 2^26, n*d < 2^60. */
+static int32_t locate_axis(int64_t o, int32_t d, int32_t s, int32_t n, rt t)
 {
     if (t.d == T_ONE) {
-        *i = axis_cell_q26(c->r->ox * T_ONE + t.n * (int64_t)c->r->dx, c->sx, c->cx);
-        *j = axis_cell_q26(c->r->oy * T_ONE + t.n * (int64_t)c->r->dy, c->sy, c->cy);
-        return;
+        return axis_cell_q26(o * T_ONE + t.n * (int64_t)d, s, n);
     }
-    *i = axis_cell(c->r->ox * t.d + t.n * (int64_t)c->r->dx, t.d * ONE16, c->sx, c->cx);
-    *j = axis_cell(c->r->oy * t.d + t.n * (int64_t)c->r->dy, t.d * ONE16, c->sy, c->cy);
+    return axis_cell(o * t.d + t.n * (int64_t)d, t.d * ONE16, s, n);
+}
+
+/* Cell holding the ray at t. */
+static void locate(const ctx *c, rt t, int32_t *i, int32_t *j)
+{
+    *i = locate_axis(c->r->ox, c->r->dx, c->sx, c->cx, t);
+    *j = locate_axis(c->r->oy, c->r->dy, c->sy, c->cy, t);
 }
 
 static int inside(const ctx *c, int32_t i, int32_t j)
@@ -805,6 +811,29 @@ static int cell_test(const ctx *c, int32_t i, int32_t j, rt tin, const cexit *e,
 }
 
 /* ------------------------------------------------------------------------ */
+/* The sign of f = z_ray - S at t0 > 0, a point on an entry face of cell
+ * (i, j) (a tile set's seam): exact, as at a cell's exit. */
+static int entry_sign(const ctx *c, int32_t i, int32_t j, rt t0)
+{
+    cexit e;
+    posts4 q;
+    int onx, ony;
+    e.t = t0;
+    e.xf = i + (c->sx < 0 ? 1 : 0);
+    e.yf = j + (c->sy < 0 ? 1 : 0);
+    /* on the x entry face: (xf 2^16 - ox) sx d == n |dx| (< 2^57 each) */
+    onx = c->sx != 0 && ((int64_t)e.xf * ONE16 - c->r->ox) * c->sx * t0.d == t0.n * c->adx;
+    ony = c->sy != 0 && ((int64_t)e.yf * ONE16 - c->r->oy) * c->sy * t0.d == t0.n * c->ady;
+    e.face = onx ? (ony ? FACE_XY : FACE_X) : FACE_Y;
+    load_posts(c->p, i, j, &q);
+    if (c->lw != NULL) {
+        lposts L;
+        lower_posts(c, i, j, &q, &L);
+        return exit_sign_low(c, i, j, &e, &L);
+    }
+    return exit_sign(c, i, j, &e, &q);
+}
+
 /* Walkers.                                                                  */
 
 static void next_cell(const ctx *c, const cexit *e, int32_t *i, int32_t *j)
@@ -1075,6 +1104,30 @@ static ct_status walk_cones(const ctx *c, uint32_t plane, ct_hit *h)
         tin_ok = 1;
     }
     return CT_ERR_INTERNAL;
+}
+
+/* A seam start's cheap proof of f(t0) > 0, as the cone walk's first test:
+ * the ray at t0 (a lower bound of its z) above the apex of its cell's cone
+ * in plane, the apex being at or above every post under it (for a bent
+ * ray, less the lowering's bound ahead).  0: not shown (test the sign). */
+static int above_apex(const ctx *c, uint32_t plane, int32_t i, int32_t j)
+{
+    const ct_package *p = c->p;
+    const ct_prepared *r = c->r;
+    size_t k = coarse_index(p, i, j);
+    uint32_t code = p->angles[(size_t)plane * p->coarse_x * p->coarse_y + k];
+    int64_t a16, T, Tz;
+    if (!p->cot_ok[code]) {
+        return 0;
+    }
+    a16 = zh(c, ct_ld16(p->apex + 2u * k));
+    if (c->lw != NULL) {
+        a16 -= lower_ahead(c, i, j);
+    }
+    /* as walk_cones: t.n 2^26 < 2^60, the sum < 2^34 */
+    T = c->t0.d == T_ONE ? c->t0.n : ct_floor_div(c->t0.n * T_ONE, c->t0.d);
+    Tz = (c->t0.d != T_ONE && r->dz < 0) ? T + 1 : T;
+    return r->oz + floor_shr(Tz * (int64_t)r->dz, CT_T_FRAC_BITS) - a16 > 0;
 }
 
 /* ------------------------------------------------------------------------ */
@@ -1472,11 +1525,10 @@ static ct_status prep_geom(const ct_package *p, const ct_ray *ray, int seg, ct_p
 
 void ct_prepared_first_cell(const ct_package *p, const ct_prepared *r, int32_t *i, int32_t *j)
 {
-    /* the first point is on the tile; the cell it is in, clamped */
-    int32_t a = axis_cell(r->ox, ONE16, r->dx > 0 ? 1 : (r->dx < 0 ? -1 : 0), (int32_t)p->cells_x);
-    int32_t b = axis_cell(r->oy, ONE16, r->dy > 0 ? 1 : (r->dy < 0 ? -1 : 0), (int32_t)p->cells_y);
-    *i = a < 0 ? 0 : (a >= (int32_t)p->cells_x ? (int32_t)p->cells_x - 1 : a);
-    *j = b < 0 ? 0 : (b >= (int32_t)p->cells_y ? (int32_t)p->cells_y - 1 : b);
+    /* the cell holding the first point (as the walk's locate at t = 0:
+     * -1 .. cells on an axis) */
+    *i = axis_cell(r->ox, ONE16, r->dx > 0 ? 1 : (r->dx < 0 ? -1 : 0), (int32_t)p->cells_x);
+    *j = axis_cell(r->oy, ONE16, r->dy > 0 ? 1 : (r->dy < 0 ? -1 : 0), (int32_t)p->cells_y);
 }
 
 /* (fi, fj): the first point's cell of p (ct_prepared_first_cell). */
@@ -1586,8 +1638,9 @@ static ct_status prepare_impl(const ct_package *p, const ct_ray *ray, int seg, c
     if (st != CT_OK) {
         return st;
     }
+    /* the first point is on the tile: the cell it is in, clamped */
     ct_prepared_first_cell(p, out, &i, &j);
-    return prep_finish(p, p, 0, 0, i, j, ray, seg, lw, out);
+    return prep_finish(p, p, 0, 0, ct_clamp_cell(i, p->cells_x), ct_clamp_cell(j, p->cells_y), ray, seg, lw, out);
 }
 
 ct_status ct_ray_prepare(const ct_package *p, const ct_ray *ray, ct_prepared *out)
@@ -1653,29 +1706,6 @@ static ct_status check_prepared(const ct_package *p, const ct_prepared *r)
     return CT_OK;
 }
 
-/* The sign of f = z_ray - S at t0 > 0, a point on an entry face of cell
- * (i, j) (a tile set's seam): exact, as at a cell's exit. */
-static int entry_sign(const ctx *c, int32_t i, int32_t j, rt t0)
-{
-    cexit e;
-    posts4 q;
-    int onx, ony;
-    e.t = t0;
-    e.xf = i + (c->sx < 0 ? 1 : 0);
-    e.yf = j + (c->sy < 0 ? 1 : 0);
-    /* on the x entry face: (xf 2^16 - ox) sx d == n |dx| (< 2^57 each) */
-    onx = c->sx != 0 && ((int64_t)e.xf * ONE16 - c->r->ox) * c->sx * t0.d == t0.n * c->adx;
-    ony = c->sy != 0 && ((int64_t)e.yf * ONE16 - c->r->oy) * c->sy * t0.d == t0.n * c->ady;
-    e.face = onx ? (ony ? FACE_XY : FACE_X) : FACE_Y;
-    load_posts(c->p, i, j, &q);
-    if (c->lw != NULL) {
-        lposts L;
-        lower_posts(c, i, j, &q, &L);
-        return exit_sign_low(c, i, j, &e, &L);
-    }
-    return exit_sign(c, i, j, &e, &q);
-}
-
 void ct_hit_clear(ct_hit *h)
 {
     h->steps = 0u;
@@ -1686,9 +1716,18 @@ void ct_hit_clear(ct_hit *h)
     h->cell_x = h->cell_y = -1;
 }
 
-/* t0: where the walk starts (tile sets, ct_trace_tile); {0, 1} otherwise. */
+/* Where a tile's walk starts (ct_trace_tile): at t0 = 0 in cell (i, j),
+ * or at t0 > 0 on the tile's entry face(s) (face bit 1: x, i given; bit
+ * 2: y, j given; the other axis located). */
+typedef struct {
+    rt t0;
+    int face;
+    int32_t i, j;
+} wstart;
+
+/* ws: where the walk starts (a tile set's tile); NULL: t = 0, located. */
 static ct_status trace_impl(const ct_package *p, const ct_prepared *r, ct_method m, int checked,
-                            const ct_lower *lw, rt t0, ct_hit *h)
+                            const ct_lower *lw, const wstart *ws, ct_hit *h)
 {
     ctx c;
     ct_status st;
@@ -1725,12 +1764,12 @@ static ct_status trace_impl(const ct_package *p, const ct_prepared *r, ct_method
     c.tend.d = r->tend_d;
     c.lw = lw;
     c.ratio_q30 = 0;
-    c.t0 = t0;
+    c.t0 = ws != NULL ? ws->t0 : T_ZERO;
     if (lw != NULL && lw->cull && (r->dx != 0 || r->dy != 0)) {
         /* len_lo 2^30 < 2^56.5; the quotient in [2^30, 2^30.5] */
         c.ratio_q30 = (r->len_lo << 30) / (c.adx >= c.ady ? c.adx : c.ady);
     }
-    if (t0.n > 0) {
+    if (c.t0.n > 0) {
         /* a tile set's later tile: the walk starts on the seam, where the
          * previous tile's walk left the ray above its surface (a cell test
          * found f > 0 there, or a cone promised no point strictly below the
@@ -1740,15 +1779,21 @@ static ct_status trace_impl(const ct_package *p, const ct_prepared *r, ct_method
         if (r->start != CT_OK || (r->dx == 0 && r->dy == 0)) {
             return CT_ERR_RAY;
         }
-        locate(&c, t0, &i, &j);
+        /* on the entry face the cell is known; the other axis located */
+        i = (ws->face & 1) ? ws->i : locate_axis(r->ox, r->dx, c.sx, c.cx, c.t0);
+        j = (ws->face & 2) ? ws->j : locate_axis(r->oy, r->dy, c.sy, c.cy, c.t0);
         if (!inside(&c, i, j)) {
             return CT_MISS;
         }
-        if (entry_sign(&c, i, j, t0) <= 0) {
-            fill_hit(&c, t0.d == T_ONE ? t0.n : ct_floor_div(t0.n * T_ONE, t0.d), i, j, h);
-            h->steps = 1u;
-            h->iters = 1u;
-            return hit_status(p, i, j);
+        if (m == CT_METHOD_INCREMENTAL || m == CT_METHOD_HIERARCHICAL ||
+            !above_apex(&c, m == CT_METHOD_CONE ? (p->sectors == 1u ? 0u : p->sectors) : (uint32_t)r->sector, i,
+                        j)) {
+            if (entry_sign(&c, i, j, c.t0) <= 0) {
+                fill_hit(&c, c.t0.d == T_ONE ? c.t0.n : ct_floor_div(c.t0.n * T_ONE, c.t0.d), i, j, h);
+                h->steps = 1u;
+                h->iters = 1u;
+                return hit_status(p, i, j);
+            }
         }
         c.i0 = i;
         c.j0 = j;
@@ -1791,7 +1836,10 @@ static ct_status trace_impl(const ct_package *p, const ct_prepared *r, ct_method
         (void)ct_grid_to_map(p, h->x_q16, h->y_q16, h->z_q16, &h->e_nm, &h->n_nm, &h->h_nm);
         return hit_status(p, i, j);
     }
-    if (t0.n == 0) {
+    if (ws != NULL && ws->face == 0) {
+        c.i0 = ws->i; /* the first point's cell, from the set */
+        c.j0 = ws->j;
+    } else if (c.t0.n == 0) {
         locate(&c, T_ZERO, &c.i0, &c.j0);
     }
     switch (m) {
@@ -1819,16 +1867,19 @@ ct_status ct_trace(const ct_package *p, const ct_ray *ray, ct_method m, ct_hit *
     if (st < 0) {
         return st;
     }
-    return trace_impl(p, &r, m, 1, NULL, T_ZERO, h);
+    return trace_impl(p, &r, m, 1, NULL, NULL, h);
 }
 
-ct_status ct_trace_tile(const ct_package *tile, const ct_prepared *r, int64_t t0_n, int64_t t0_d, const ct_lower *lw,
-                        ct_method m, ct_hit *h)
+ct_status ct_trace_tile(const ct_package *tile, const ct_prepared *r, int64_t t0_n, int64_t t0_d, int face,
+                        int32_t i0, int32_t j0, const ct_lower *lw, ct_method m, ct_hit *h)
 {
-    rt t0;
-    t0.n = t0_n;
-    t0.d = t0_d;
-    return trace_impl(tile, r, m, 1, lw, t0, h);
+    wstart ws;
+    ws.t0.n = t0_n;
+    ws.t0.d = t0_d;
+    ws.face = face;
+    ws.i = i0;
+    ws.j = j0;
+    return trace_impl(tile, r, m, 1, lw, &ws, h);
 }
 
 void ct_fill_point(const ct_package *p, const ct_prepared *r, const ct_lower *lw, int64_t t_q26, ct_hit *h)
@@ -1844,12 +1895,12 @@ void ct_fill_point(const ct_package *p, const ct_prepared *r, const ct_lower *lw
 
 ct_status ct_trace_prepared(const ct_package *p, const ct_prepared *r, ct_method m, ct_hit *h)
 {
-    return trace_impl(p, r, m, 0, NULL, T_ZERO, h);
+    return trace_impl(p, r, m, 0, NULL, NULL, h);
 }
 
 ct_status ct_trace_prepared_own(const ct_package *p, const ct_prepared *r, ct_method m, ct_hit *h)
 {
-    return trace_impl(p, r, m, 1, NULL, T_ZERO, h);
+    return trace_impl(p, r, m, 1, NULL, NULL, h);
 }
 
 ct_status ct_prepare_lowered_segment(const ct_package *p, const ct_ray *ray, const ct_lower *lw, ct_prepared *out)
@@ -1860,7 +1911,7 @@ ct_status ct_prepare_lowered_segment(const ct_package *p, const ct_ray *ray, con
 ct_status ct_trace_prepared_lowered(const ct_package *p, const ct_prepared *r, const ct_lower *lw, ct_method m,
                                     ct_hit *h)
 {
-    return trace_impl(p, r, m, 1, lw, T_ZERO, h);
+    return trace_impl(p, r, m, 1, lw, NULL, h);
 }
 
 ct_status ct_trace_lowered(const ct_package *p, const ct_ray *ray, const ct_lower *lw, ct_method m, ct_hit *h)
@@ -1870,7 +1921,7 @@ ct_status ct_trace_lowered(const ct_package *p, const ct_ray *ray, const ct_lowe
     if (st < 0) {
         return st;
     }
-    return trace_impl(p, &r, m, 1, lw, T_ZERO, h);
+    return trace_impl(p, &r, m, 1, lw, NULL, h);
 }
 
 /* ------------------------------------------------------------------------ */
