@@ -280,6 +280,17 @@ void test_seams()
         check_seams(cs.name.c_str(), cs.t, cs.opt, P, per, 3, &st);
         if (ct_harness_g.current_failed) return;
     }
+    {
+        // the smallest tiles: 2 and 3 posts a side (a seam at every cell or
+        // every other one), 16 slots for hundreds of tiles
+        const ct_host::Terrain t = dem_cases::mirror_tiled(dem_cases::real_terrain(), 41, 37);
+        ct_host::BuildOptions o;
+        o.sectors = 8;
+        o.reduce = 1;
+        check_seams("fixture, P = 2", t, o, 2, per / 4, 16, &st);
+        check_seams("fixture, P = 3", t, o, 3, per / 4, 16, &st);
+        if (ct_harness_g.current_failed) return;
+    }
     std::printf("  seams: %ld rays x 4 methods, %ld hits, %ld tangencies; tiles visited 1/2/3/4/5+: %ld/%ld/%ld/%ld/%ld; "
                 "differ from the merged package %ld, wrong %ld, no data %ld\n",
                 st.rays, st.hits, st.tangent, st.by_tiles[0], st.by_tiles[1], st.by_tiles[2], st.by_tiles[3],

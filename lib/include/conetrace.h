@@ -1038,6 +1038,8 @@ typedef struct {
                                   ct_map_to_grid, ct_ray_from_map, ...      */
     uint32_t tiles_x, tiles_y; /* the tile grid                             */
     uint32_t tile_posts;       /* P                                         */
+    uint32_t tile_recip;       /* floor(2^32 / (P - 1)) + 1 (0 for P = 2):
+                                  a cell's tile without a division          */
     const uint8_t *entries;    /* the manifest's tile table                 */
     ct_tile_slot *slots;
     uint32_t nslots;           /* 1..CT_SET_MAX_SLOTS                       */

@@ -109,6 +109,7 @@ ct_status ct_tileset_open(ct_tileset *ts, const uint8_t *b, size_t len, ct_tile_
     ts->tiles_x = tx;
     ts->tiles_y = ty;
     ts->tile_posts = P;
+    ts->tile_recip = P == 2u ? 0u : (uint32_t)((UINT64_C(1) << 32) / (P - 1u) + 1u); /* <= 2^31 + 1 */
     ts->entries = b + CT_SET_HEADER_SIZE;
     ts->slots = slots;
     ts->nslots = nslots;
@@ -205,7 +206,11 @@ static const ct_package *tile_get(ct_tileset *ts, uint32_t a, uint32_t bb)
 /* The tile column (or row) holding frame cell i (0 <= i < cells). */
 static uint32_t tile_of(const ct_tileset *ts, int32_t i, uint32_t ntiles)
 {
-    uint32_t a = (uint32_t)i / (ts->tile_posts - 1u);
+    /* i / d without a division: d = P - 1 in [2, 2^15), m = tile_recip =
+     * (2^32 + e) / d with 0 < e <= d; for i = a d + b (b < d), i m / 2^32
+     * = a + b / d + i e / (d 2^32), and b / d <= 1 - 1 / d while the last
+     * term is < 1 / d (i e <= i d < 2^30): the floor is a.  d = 1: i. */
+    uint32_t a = ts->tile_posts == 2u ? (uint32_t)i : (uint32_t)(((uint64_t)(uint32_t)i * ts->tile_recip) >> 32);
     return a < ntiles ? a : ntiles - 1u;
 }
 
