@@ -156,8 +156,11 @@ void read_number_csv(const std::string &path, const std::vector<std::string> &na
     std::vector<int> col(n);
     for (size_t k = 0; k < n; ++k) {
         col[k] = -1;
-        for (size_t c = 0; c < hdr.size(); ++c)
-            if (hdr[c] == names[k]) col[k] = (int)c;
+        for (size_t c = 0; c < hdr.size(); ++c) {
+            if (hdr[c] != names[k]) continue;
+            if (col[k] >= 0) throw Error(path + ":1: column '" + names[k] + "' appears twice in the header");
+            col[k] = (int)c;
+        }
         if (col[k] < 0) throw Error(path + ":1: header lacks column '" + names[k] + "' (need " + need + ")");
     }
     std::vector<double> v(n);

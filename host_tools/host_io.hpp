@@ -79,7 +79,8 @@ std::string parse_cmdline(int argc, char **argv, int first, const std::vector<st
 // ignored; blanks and CR dropped from every field; blank lines skipped):
 // row(v, text) for each data row, v[k] and text[k] the value and field of
 // column names[k].  Throws Error "<path>: empty file (expected a header
-// A,B,..)", "<path>:1: header lacks column 'A' (need A,B,..)",
+// A,B,..)", "<path>:1: header lacks column 'A' (need A,B,..)" / ": column
+// 'A' appears twice in the header",
 // "<path>:<line>: too few columns" / ": bad number 'x' in column A".
 void read_number_csv(const std::string &path, const std::vector<std::string> &names,
                      const std::function<void(const double *v, const std::vector<std::string> &text)> &row);

@@ -742,6 +742,13 @@ static void test_bad_inputs(void)
     } catch (const std::exception &e) {
         TEST_FAIL_MSG("write_geotiff (wide): %s", e.what());
     }
+    try {  // one post: no cell to trace
+        ct_host::write_geotiff(in + "/one.tif", 1, 1, std::vector<double>(1, 100.0), SampleType::Int16,
+                               small_geo(-30.0), false, 0);
+    } catch (const std::exception &e) {
+        TEST_FAIL_MSG("write_geotiff (1 x 1): %s", e.what());
+    }
+    spit(in + "/empty.csv", "");
     const std::string pkg = fixture_package();
     TEST_ASSERT_MSG(!pkg.empty(), "no fixture package");
     std::string bytes = slurp(pkg);
@@ -761,17 +768,30 @@ static void test_bad_inputs(void)
         // a .tif that starts like a GIF: OpenImageIO's GIF reader takes it
         {"gif", {"build", "@gif.tif", "-o", "X.ctp"}, "gif.tif", "", false, ""},
         {"nonsquare", {"build", "@nonsq.tif", "-o", "X.ctp"}, "nonsq.tif", "non-square", false, ""},
+        {"onepost", {"build", "@one.tif", "-o", "X.ctp"}, "one.tif", "", false, ""},
         // output problems
         {"nodir", {"build", "@ok.tif", "-o", "nodir/X.ctp"}, "nodir/X.ctp", "", false, ""},
         {"outisdir", {"build", "@ok.tif", "-o", "adir"}, "adir", "", false, ""},
+        // not writable even for root
+        {"readonly", {"build", "@ok.tif", "-o", "/proc/conetrace-test.ctp"}, "/proc/conetrace-test.ctp", "", false,
+         ""},
         // damaged packages
-        {"trunc", {"info", "@trunc.ctp"}, "trunc.ctp", "", false, ""},
+        {"trunc", {"info", "@trunc.ctp"}, "trunc.ctp", "err_truncated", false, ""},
         {"flip", {"info", "@flip.ctp"}, "flip.ctp", "err_crc", false, ""},
         // bad rays.csv: file and line
         {"nodh", {"trace", pkg, "--rays", "rays.csv", "-o", "hits.csv"}, "rays.csv:1:", "dh", false,
          "E,N,h,dE,dN\n195600,4068000,1500,0,0\n"},
         {"badnum", {"trace", pkg, "--rays", "rays.csv", "-o", "hits.csv"}, "rays.csv:3:", "15x0", false,
          good + "195600,4068000,15x0,0,0,-1\n"},
+        {"emptycsv", {"trace", pkg, "--rays", "@empty.csv", "-o", "hits.csv"}, "empty.csv", "empty file", false, ""},
+        {"inf", {"trace", pkg, "--rays", "rays.csv", "-o", "hits.csv"}, "rays.csv:3:", "inf", false,
+         good + "195600,4068000,inf,0,0,-1\n"},
+        {"nan", {"trace", pkg, "--rays", "rays.csv", "-o", "hits.csv"}, "rays.csv:2:", "nan", false,
+         "E,N,h,dE,dN,dh\n195600,4068000,1500,nan,0,-1\n"},
+        {"dupcol", {"trace", pkg, "--rays", "rays.csv", "-o", "hits.csv"}, "rays.csv:1:", "twice", false,
+         "E,N,h,dE,dN,dh,dh\n195600,4068000,1500,0,0,-1,-1\n"},
+        {"short", {"trace", pkg, "--rays", "rays.csv", "-o", "hits.csv"}, "rays.csv:3:", "too few", false,
+         good + "195600,4068000,1500,0,0\n"},
         // usage errors
         {"method", {"trace", pkg, "--rays", "rays.csv", "--method", "bogus", "-o", "hits.csv"}, "", "bogus", true, good},
         {"threads", {"trace", pkg, "--rays", "rays.csv", "--threads", "x", "-o", "hits.csv"}, "", "--threads", false,
@@ -779,6 +799,8 @@ static void test_bad_inputs(void)
         {"threads257", {"trace", pkg, "--rays", "rays.csv", "--threads", "257", "-o", "hits.csv"}, "", "--threads",
          false, good},
         {"option", {"build", fix, "-o", "X.ctp", "--frobnicate", "1"}, "", "--frobnicate", true, ""},
+        {"command", {"frobnicate"}, "", "frobnicate", true, ""},
+        {"noargs", {"trace", pkg}, "", "--rays|-o", true, ""},
         {"sectors0", {"build", fix, "-o", "X.ctp", "--sectors", "0"}, "", "--sectors", true, ""},
         {"sectors65", {"build", fix, "-o", "X.ctp", "--sectors", "65"}, "", "--sectors", true, ""},
         {"reduce9", {"build", fix, "-o", "X.ctp", "--reduce", "9"}, "", "--reduce", true, ""},
@@ -817,8 +839,53 @@ static void test_bad_inputs(void)
         }
     }
     TEST_ASSERT_MSG(bad.empty(), "%d of %zu bad-input cases wrong:%s", nbad, cases.size(), bad.c_str());
-    TEST_ASSERT_MSG(fs::is_empty(dirs[5] + "/adir"), "case outisdir: something was written into adir");
+    for (size_t k = 0; k < cases.size(); ++k)
+        if (std::string(cases[k].tag) == "outisdir")
+            TEST_ASSERT_MSG(fs::is_empty(dirs[k] + "/adir"), "case outisdir: something was written into adir");
+    TEST_ASSERT_MSG(!fs::exists("/proc/conetrace-test.ctp"), "case readonly: a file appeared");
     TEST_ASSERT_MSG(listing(in) == inputs, "the input directory changed: {%s}", join(listing(in)).c_str());
+}
+
+// Rows the library answers with a status of their own: the run succeeds and
+// says so per row (docs/cli.md, "Bad input").
+static void test_bad_rows(void)
+{
+    const std::string pkg = fixture_package();
+    TEST_ASSERT_MSG(!pkg.empty(), "no fixture package");
+    const std::string hdr = "E,N,h,dE,dN,dh\n", ok = "195600,4068000,1500,0,0,-1\n";
+    struct R {
+        const char *tag;
+        std::string rays;
+        std::vector<std::string> extra;  // more options
+        std::vector<std::string> rows;   // expected status column, in order
+    };
+    const std::vector<R> cases = {
+        {"header only", hdr, {}, {}},
+        {"huge origin", hdr + ok + "195600,4068000,1e300,0,0,-1\n", {}, {"hit", "err_ray"}},
+        {"zero direction", hdr + "195600,4068000,1500,0,0,0\n" + ok, {}, {"err_ray", "hit"}},
+        // only a direction's ratios count: 1e300 east is due east (above the terrain here)
+        {"huge direction", hdr + "195600,4068000,1500,1e300,0,-1\n", {}, {"miss"}},
+        {"threads 0 (all cores)", hdr + ok + ok, {"--threads", "0"}, {"hit", "hit"}},
+    };
+    std::vector<Job> jobs;
+    for (const R &c : cases) {
+        const std::string d = new_dir("rows");
+        spit(d + "/rays.csv", c.rays);
+        Job j{d, {"trace", pkg, "--rays", "rays.csv", "-o", "hits.csv"}};
+        j.args.insert(j.args.end(), c.extra.begin(), c.extra.end());
+        jobs.push_back(j);
+    }
+    const std::vector<Run> runs = run_all(jobs);
+    for (size_t k = 0; k < cases.size(); ++k) {
+        TEST_ASSERT_MSG(runs[k].code == 0, "case %s: `%s` exit %d: %s", cases[k].tag, runs[k].cmd.c_str(), runs[k].code,
+                        runs[k].err.c_str());
+        const std::vector<std::string> l = lines_of(slurp(jobs[k].dir + "/hits.csv"));
+        TEST_ASSERT_MSG(!l.empty() && starts_with(l[0], "status,"), "case %s: no header", cases[k].tag);
+        std::vector<std::string> st;
+        for (size_t r = 1; r < l.size(); ++r) st.push_back(l[r].substr(0, l[r].find(',')));
+        TEST_ASSERT_MSG(st == cases[k].rows, "case %s: statuses {%s}, expected {%s}", cases[k].tag, join({st.begin(), st.end()}).c_str(),
+                        join({cases[k].rows.begin(), cases[k].rows.end()}).c_str());
+    }
 }
 
 // ---------------------------------------------------------------------------
@@ -1015,6 +1082,7 @@ int main(void)
     RUN_TEST(test_trace_methods);
     RUN_TEST(test_nodata_policy);
     RUN_TEST(test_bad_inputs);
+    RUN_TEST(test_bad_rows);
     RUN_TEST(test_failed_run_keeps_output);
     RUN_TEST(test_tile_sets);
     int rc = TEST_END();
