@@ -114,12 +114,13 @@ struct Run {
 struct Job {
     std::string dir;
     std::vector<std::string> args;
+    std::string shell = "";  // run before the binary (e.g. a file-size limit)
 };
 
 static Run run_job(const Job &j, int slot)
 {
     Run r;
-    std::string cmd = "cd " + quote(j.dir) + " && exec " + quote(CT_CLI);
+    std::string cmd = "cd " + quote(j.dir) + " && " + j.shell + "exec " + quote(CT_CLI);
     r.cmd = "conetrace";
     for (const auto &a : j.args) {
         cmd += " " + quote(a);
@@ -901,11 +902,20 @@ static void test_failed_run_keeps_output(void)
     const std::string pkg = fixture_package();
     TEST_ASSERT_MSG(!pkg.empty(), "no fixture package");
 
+    std::string many = "E,N,h,dE,dN,dh\n";
+    for (int k = 0; k < 3000; ++k) many += "195600,4068000,1500,0,0,-1\n";
+    spit(in + "/many.csv", many);
+    // a full disk, as the process sees it: writes beyond 4 KB fail (EFBIG;
+    // SIGXFSZ ignored so that write() reports it)
+    const std::string full = "trap '' XFSZ; ulimit -f 8; ";
     struct K {
         std::vector<std::string> args;
         std::string kept, name;
+        std::string shell = "";
     };
     const std::vector<K> cases = {
+        {{"build", fixture_dem(), "-o", "out.ctp"}, "out.ctp", "out.ctp", full},
+        {{"trace", pkg, "--rays", in + "/many.csv", "-o", "hits.csv"}, "hits.csv", "hits.csv", full},
         {{"build", "missing.tif", "-o", "out.ctp"}, "out.ctp", "missing.tif"},
         {{"build", in + "/garbage.tif", "-o", "out.ctp"}, "out.ctp", "garbage.tif"},
         {{"build", in + "/allnd.tif", "-o", "out.ctp"}, "out.ctp", "allnd.tif"},
@@ -917,7 +927,7 @@ static void test_failed_run_keeps_output(void)
     for (const K &c : cases) {
         std::string d = new_dir("keep");
         spit(d + "/" + c.kept, "keep");
-        jobs.push_back(Job{d, c.args});
+        jobs.push_back(Job{d, c.args, c.shell});
         befores.push_back(listing(d));
     }
     std::vector<Run> runs = run_all(jobs);
