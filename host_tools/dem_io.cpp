@@ -72,6 +72,14 @@ std::string one_line(std::string s)
     return s.substr(b);
 }
 
+// A library's error text cut to a readable length (OIIO records one message
+// per failed strip: megabytes for a file that lies about its size).
+std::string clipped(std::string s, size_t max = 300)
+{
+    if (s.size() > max) s = s.substr(0, max) + " ...";
+    return s;
+}
+
 struct MsgSink {
     std::string errors;  // "module: message; module: message"
     void add(const char *module, const char *fmt, va_list ap)
@@ -250,7 +258,7 @@ void read_pixels(const std::string &path, DemRaster &r, bool &is_tiff)
 
     auto in = OIIO::ImageInput::open(path);
     if (!in) {
-        std::string e = one_line(OIIO::geterror());
+        std::string e = clipped(one_line(OIIO::geterror()));
         throw fail("cannot read image" + (e.empty() ? std::string() : ": " + e));
     }
     const OIIO::ImageSpec spec = in->spec();
@@ -287,12 +295,23 @@ void read_pixels(const std::string &path, DemRaster &r, bool &is_tiff)
     const size_t n = (size_t)spec.width * (size_t)spec.height;
     if (n / (size_t)spec.width != (size_t)spec.height || n > ((size_t)1 << 34))
         throw fail("image too large");
+    {
+        // uncompressed pixels must be in the file: a header that promises
+        // more is refused before the buffer is allocated
+        struct stat st;
+        const std::string comp = spec.get_string_attribute("compression", "none");
+        if ((comp == "none" || comp.empty()) && ::stat(path.c_str(), &st) == 0 &&
+            (unsigned long long)st.st_size < (unsigned long long)(n * fmt.size()))
+            throw fail("the header promises " + std::to_string(spec.width) + " x " + std::to_string(spec.height) +
+                       " uncompressed posts (" + std::to_string(n * fmt.size()) + " bytes) but the file has " +
+                       std::to_string((unsigned long long)st.st_size));
+    }
     std::vector<unsigned char> buf(n * fmt.size());
     // OIIO 2.4 can return true from read_image() although a strip failed to
     // decode (the error is only recorded), so check has_error() as well.
     const bool read_ok = in->read_image(0, 0, 0, 1, fmt, buf.data());
     if (!read_ok || in->has_error()) {
-        std::string e = one_line(in->geterror());
+        std::string e = clipped(one_line(in->geterror()));
         throw fail("cannot read pixels" + (e.empty() ? std::string() : ": " + e));
     }
     in->close();

@@ -727,6 +727,33 @@ struct BadCase {
     std::string rays;               // if set: written to rays.csv in the case directory
 };
 
+// A little-endian TIFF whose header promises w x h uncompressed int16 posts
+// in one strip but holds 64 bytes of pixels.
+static std::string lying_tiff(uint32_t w, uint32_t h)
+{
+    std::string b("II*\0", 4);
+    auto u16 = [&](uint32_t v) { b += (char)(v & 255); b += (char)((v >> 8) & 255); };
+    auto u32 = [&](uint32_t v) { u16(v & 0xffff); u16(v >> 16); };
+    u32(8 + 64);               // the IFD after the pixels
+    b += std::string(64, '\0');  // the pixels there are
+    const uint32_t tags[][3] = {{256, 4, w},  {257, 4, h}, {258, 3, 16},      {259, 3, 1},    {262, 3, 1},
+                                {273, 4, 8},  {277, 3, 1}, {278, 4, h},       {279, 4, w * h * 2}, {339, 3, 2}};
+    u16(10);
+    for (const auto &t : tags) {
+        u16(t[0]);
+        u16(t[1]);
+        u32(1);
+        if (t[1] == 3) {
+            u16(t[2]);
+            u16(0);
+        } else {
+            u32(t[2]);
+        }
+    }
+    u32(0);
+    return b;
+}
+
 static void test_bad_inputs(void)
 {
     std::string in = new_dir("inputs");
@@ -750,6 +777,7 @@ static void test_bad_inputs(void)
         TEST_FAIL_MSG("write_geotiff (1 x 1): %s", e.what());
     }
     spit(in + "/empty.csv", "");
+    spit(in + "/lie.tif", lying_tiff(30000, 30000));  // 1.8 GB promised, 64 bytes there
     const std::string pkg = fixture_package();
     TEST_ASSERT_MSG(!pkg.empty(), "no fixture package");
     std::string bytes = slurp(pkg);
@@ -770,6 +798,7 @@ static void test_bad_inputs(void)
         {"gif", {"build", "@gif.tif", "-o", "X.ctp"}, "gif.tif", "", false, ""},
         {"nonsquare", {"build", "@nonsq.tif", "-o", "X.ctp"}, "nonsq.tif", "non-square", false, ""},
         {"onepost", {"build", "@one.tif", "-o", "X.ctp"}, "one.tif", "", false, ""},
+        {"lie", {"build", "@lie.tif", "-o", "X.ctp", "--posting", "30"}, "lie.tif", "promises", false, ""},
         // output problems
         {"nodir", {"build", "@ok.tif", "-o", "nodir/X.ctp"}, "nodir/X.ctp", "", false, ""},
         {"outisdir", {"build", "@ok.tif", "-o", "adir"}, "adir", "", false, ""},
