@@ -811,29 +811,6 @@ static int cell_test(const ctx *c, int32_t i, int32_t j, rt tin, const cexit *e,
 }
 
 /* ------------------------------------------------------------------------ */
-/* The sign of f = z_ray - S at t0 > 0, a point on an entry face of cell
- * (i, j) (a tile set's seam): exact, as at a cell's exit. */
-static int entry_sign(const ctx *c, int32_t i, int32_t j, rt t0)
-{
-    cexit e;
-    posts4 q;
-    int onx, ony;
-    e.t = t0;
-    e.xf = i + (c->sx < 0 ? 1 : 0);
-    e.yf = j + (c->sy < 0 ? 1 : 0);
-    /* on the x entry face: (xf 2^16 - ox) sx d == n |dx| (< 2^57 each) */
-    onx = c->sx != 0 && ((int64_t)e.xf * ONE16 - c->r->ox) * c->sx * t0.d == t0.n * c->adx;
-    ony = c->sy != 0 && ((int64_t)e.yf * ONE16 - c->r->oy) * c->sy * t0.d == t0.n * c->ady;
-    e.face = onx ? (ony ? FACE_XY : FACE_X) : FACE_Y;
-    load_posts(c->p, i, j, &q);
-    if (c->lw != NULL) {
-        lposts L;
-        lower_posts(c, i, j, &q, &L);
-        return exit_sign_low(c, i, j, &e, &L);
-    }
-    return exit_sign(c, i, j, &e, &q);
-}
-
 /* Walkers.                                                                  */
 
 static void next_cell(const ctx *c, const cexit *e, int32_t *i, int32_t *j)
@@ -1706,6 +1683,29 @@ static ct_status check_prepared(const ct_package *p, const ct_prepared *r)
     return CT_OK;
 }
 
+/* The sign of f = z_ray - S at t0 > 0, a point on an entry face of cell
+ * (i, j) (a tile set's seam): exact, as at a cell's exit. */
+static int entry_sign(const ctx *c, int32_t i, int32_t j, rt t0)
+{
+    cexit e;
+    posts4 q;
+    int onx, ony;
+    e.t = t0;
+    e.xf = i + (c->sx < 0 ? 1 : 0);
+    e.yf = j + (c->sy < 0 ? 1 : 0);
+    /* on the x entry face: (xf 2^16 - ox) sx d == n |dx| (< 2^57 each) */
+    onx = c->sx != 0 && ((int64_t)e.xf * ONE16 - c->r->ox) * c->sx * t0.d == t0.n * c->adx;
+    ony = c->sy != 0 && ((int64_t)e.yf * ONE16 - c->r->oy) * c->sy * t0.d == t0.n * c->ady;
+    e.face = onx ? (ony ? FACE_XY : FACE_X) : FACE_Y;
+    load_posts(c->p, i, j, &q);
+    if (c->lw != NULL) {
+        lposts L;
+        lower_posts(c, i, j, &q, &L);
+        return exit_sign_low(c, i, j, &e, &L);
+    }
+    return exit_sign(c, i, j, &e, &q);
+}
+
 void ct_hit_clear(ct_hit *h)
 {
     h->steps = 0u;
@@ -1774,7 +1774,9 @@ static ct_status trace_impl(const ct_package *p, const ct_prepared *r, ct_method
          * previous tile's walk left the ray above its surface (a cell test
          * found f > 0 there, or a cone promised no point strictly below the
          * surface).  f = 0 -- the ray touching the surface on the seam
-         * after a cone jump -- is a hit there. */
+         * after a cone jump -- is a hit there.  The cone walks see f > 0
+         * from the cone above the seam point where there is one; the sign
+         * is tested from the posts otherwise. */
         int32_t i, j;
         if (r->start != CT_OK || (r->dx == 0 && r->dy == 0)) {
             return CT_ERR_RAY;
