@@ -3,7 +3,7 @@
 BUILD ?= build
 JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 
-.PHONY: all test demo bench tradeoff cross fuzz coverage clean deps
+.PHONY: all test demo bench tradeoff cross fuzz coverage soak clean deps
 FUZZ_SECONDS ?= 1800
 
 all: deps
@@ -44,6 +44,12 @@ cross: deps
 # the corpus is kept in $(BUILD)/fuzz_corpus between runs
 fuzz: all
 	sh tests/fuzz/fuzz.sh $(BUILD) 10000000 $(FUZZ_SECONDS) $(BUILD)/fuzz_corpus
+
+# many seeded rays (10^7, or SOAK_SECONDS) on generated terrain against the
+# long-double reference, the methods compared (tests/soak.cpp)
+SOAK_SECONDS ?= 1800
+soak: all
+	$(BUILD)/tests/ct_soak --rays 10000000 --seconds $(SOAK_SECONDS)
 
 # line and branch coverage of lib/ by the test suite (gcov, gcovr), in a
 # separate build directory

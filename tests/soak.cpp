@@ -1,0 +1,216 @@
+// soak.cpp -- `make soak`: many seeded rays on freshly generated terrain,
+// every result judged against the long-double reference (judge.hpp), the
+// four methods compared with each other and the iteration bounds checked.
+// Time-boxed; not part of `make test`.
+//
+// Each terrain is new: a smooth field, the same with isolated spikes, the
+// same cut into terraces (cliffs), or one of the adversarial DEMs, of a
+// random size (9..160 posts a side) and height range (1..60,000 codes),
+// built with a random N in {1, 3, 8, 24} and r in {1, 2, 3}; 4,000 rays of
+// every family per terrain.
+//
+// Usage: ct_soak [--rays N] [--seconds S] [--threads T] [--seed K]
+// (defaults: 10^7 rays, 1,800 s, all cores, seed 1).  Exit 1 when any
+// result is wrong, the methods differ, or a bound is exceeded.
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "conetrace.h"
+#include "dem_cases.hpp"
+#include "judge.hpp"
+#include "reference.hpp"
+
+namespace {
+
+struct Counts {
+    long terrains = 0, rays = 0, hits = 0, misses = 0, below = 0, tangent = 0, wrong = 0, differ = 0, bound = 0,
+         errors = 0;
+    long tangent_by[dem_cases::FAMILY_COUNT] = {};
+    long tangent_both_hit = 0; // both hit, positions apart by more than judge::POS_TOL_Q16
+    double worst_xy = 0, worst_z = 0; // the largest such distances (Q16)
+    void add(const Counts &o)
+    {
+        for (int f = 0; f < dem_cases::FAMILY_COUNT; ++f) tangent_by[f] += o.tangent_by[f];
+        tangent_both_hit += o.tangent_both_hit;
+        worst_xy = std::max(worst_xy, o.worst_xy);
+        worst_z = std::max(worst_z, o.worst_z);
+        terrains += o.terrains;
+        rays += o.rays;
+        hits += o.hits;
+        misses += o.misses;
+        below += o.below;
+        tangent += o.tangent;
+        wrong += o.wrong;
+        differ += o.differ;
+        bound += o.bound;
+        errors += o.errors;
+    }
+};
+
+std::mutex g_print;
+
+bool same(ct_status a, const ct_hit &x, ct_status b, const ct_hit &y)
+{
+    if (a != b) return false;
+    if (a != CT_HIT && a != CT_HIT_VOID) return true;
+    return x.x_q16 == y.x_q16 && x.y_q16 == y.y_q16 && x.z_q16 == y.z_q16 && x.t_q26 == y.t_q26 &&
+           x.cell_x == y.cell_x && x.cell_y == y.cell_y;
+}
+
+// Terrain number k of this seed: its codes, size and build options.
+dem_cases::Case make_terrain(uint64_t seed, const std::vector<dem_cases::Case> &adv)
+{
+    ct_rng r;
+    ct_rng_seed(&r, seed);
+    const int kind = (int)ct_rng_range(&r, 0, 3);
+    const int sectors[] = {1, 3, 8, 24};
+    const int N = sectors[ct_rng_range(&r, 0, 3)], R = (int)ct_rng_range(&r, 1, 3);
+    if (kind == 3 && !adv.empty()) {
+        const dem_cases::Case &c = adv[(size_t)ct_rng_range(&r, 0, (int64_t)adv.size() - 1)];
+        return dem_cases::make_case(c.name, c.t, N, R);
+    }
+    const int w = (int)ct_rng_range(&r, 9, 160), h = (int)ct_rng_range(&r, 9, 160);
+    const double lo = (double)ct_rng_range(&r, 0, 2000), span = (double)ct_rng_range(&r, 1, 60000);
+    std::vector<uint16_t> z = dem_cases::smooth(w, h, ct_rng_u64(&r), lo, std::min(65535.0, lo + span));
+    if (kind == 1) {  // isolated spikes
+        const int n = (int)ct_rng_range(&r, 1, 12);
+        for (int k = 0; k < n; ++k)
+            z[(size_t)ct_rng_range(&r, 0, (int64_t)z.size() - 1)] = (uint16_t)std::min(65535.0, lo + span);
+    } else if (kind == 2) {  // terraces: cliffs between flat steps
+        const uint16_t step = (uint16_t)std::max<int64_t>(1, ct_rng_range(&r, 1, (int64_t)span / 3 + 1));
+        for (auto &v : z) v = (uint16_t)(v / step * step);
+    }
+    const char *names[] = {"smooth", "spikes", "terraces"};
+    return dem_cases::make_case(names[kind], dem_cases::make_terrain(w, h, z, 0.5), N, R);
+}
+
+void soak_terrain(const dem_cases::Case &cs, uint64_t seed, long nrays, Counts *c)
+{
+    ct_package p;
+    if (ct_package_open(&p, cs.pkg.data(), cs.pkg.size()) != CT_OK) {
+        c->errors++;
+        return;
+    }
+    const ref::Dem d = dem_cases::ref_dem(cs.t);
+    const uint32_t bound_cells = CT_WCET_CELL_ITERS(p.cells_x, p.cells_y);
+    const uint32_t bound_hier = CT_WCET_HIER_ITERS(p.cells_x, p.cells_y, p.levels);
+    double lo, hi;
+    dem_cases::minmax(cs.t, &lo, &hi);
+    ct_rng rng;
+    ct_rng_seed(&rng, seed * 2654435761u + 17u);
+    c->terrains++;
+    for (long k = 0; k < nrays; ++k) {
+        const dem_cases::Family f = (dem_cases::Family)(k % dem_cases::FAMILY_COUNT);
+        const ct_ray ray = dem_cases::make_ray(cs.t, f, &rng, lo, hi);
+        ct_prepared pr;
+        const ct_status ps = ct_ray_prepare(&p, &ray, &pr);
+        c->rays++;
+        if (ps < 0) {
+            c->errors++;
+            continue;
+        }
+        if (ps == CT_MISS) {
+            c->misses++;
+            if (dem_cases::ray_crosses_box(cs.t, ray)) c->wrong++;
+            continue;
+        }
+        ct_hit h[4];
+        ct_status s[4];
+        for (int m = 0; m < 4; ++m) {
+            s[m] = ct_trace_prepared(&p, &pr, (ct_method)m, &h[m]);
+            if (s[m] < 0) c->errors++;
+            if (h[m].iters > (m == CT_METHOD_HIERARCHICAL ? bound_hier : bound_cells)) c->bound++;
+        }
+        for (int m = 1; m < 4; ++m) c->differ += !same(s[m], h[m], s[0], h[0]);
+        ref::Hit rh;
+        double err = 0;
+        const judge::Verdict v = judge::judge(d, pr, s[0], h[0], &rh, &err);
+        c->hits += s[0] == CT_HIT || s[0] == CT_HIT_VOID;
+        c->misses += s[0] == CT_MISS;
+        c->below += s[0] == CT_BELOW;
+        if (v == judge::TANGENT) {
+            c->tangent++;
+            c->tangent_by[f]++;
+            if ((s[0] == CT_HIT || s[0] == CT_HIT_VOID) && rh.status == ref::HIT) {
+                c->tangent_both_hit++;
+                c->worst_xy = std::max({c->worst_xy, std::fabs((double)(h[0].x_q16 - rh.x * 65536)),
+                                        std::fabs((double)(h[0].y_q16 - rh.y * 65536))});
+                c->worst_z = std::max(c->worst_z, std::fabs((double)(h[0].z_q16 - rh.z * 65536)));
+            }
+        }
+        if (v == judge::WRONG) {
+            c->wrong++;
+            std::lock_guard<std::mutex> g(g_print);
+            std::printf("  WRONG: terrain %s (seed %llu, %d x %d, N %d, r %d), family %s, ray (%lld, %lld, %lld) "
+                        "(%lld, %lld, %lld): status %d, reference %d\n",
+                        cs.name.c_str(), (unsigned long long)seed, cs.t.width, cs.t.height, cs.opt.sectors,
+                        cs.opt.reduce, dem_cases::family_name(f), (long long)ray.x_q16, (long long)ray.y_q16,
+                        (long long)ray.z_q16, (long long)ray.dx, (long long)ray.dy, (long long)ray.dz, s[0],
+                        (int)rh.status);
+        }
+    }
+}
+
+}  // namespace
+
+int main(int argc, char **argv)
+{
+    long total = 10000000;
+    double seconds = 1800;
+    unsigned threads = std::max(1u, std::thread::hardware_concurrency());
+    uint64_t seed = 1;
+    for (int a = 1; a + 1 < argc; a += 2) {
+        if (!std::strcmp(argv[a], "--rays")) total = std::atol(argv[a + 1]);
+        else if (!std::strcmp(argv[a], "--seconds")) seconds = std::atof(argv[a + 1]);
+        else if (!std::strcmp(argv[a], "--threads")) threads = (unsigned)std::max(1, std::atoi(argv[a + 1]));
+        else if (!std::strcmp(argv[a], "--seed")) seed = (uint64_t)std::atoll(argv[a + 1]);
+        else {
+            std::fprintf(stderr, "ct_soak: unknown option %s\n", argv[a]);
+            return 2;
+        }
+    }
+    std::setvbuf(stdout, nullptr, _IOLBF, 0);
+    const auto t0 = std::chrono::steady_clock::now();
+    auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
+    const std::vector<dem_cases::Case> adv = dem_cases::adversarial_cases();
+    const long per_terrain = 4000;
+    std::atomic<long> next{0}, done{0};
+    std::vector<Counts> counts(threads);
+    std::vector<std::thread> pool;
+    for (unsigned w = 0; w < threads; ++w)
+        pool.emplace_back([&, w] {
+            while (done.load() < total && elapsed() < seconds) {
+                const uint64_t k = (uint64_t)next++;
+                const dem_cases::Case cs = make_terrain(seed * 1000003u + k, adv);
+                soak_terrain(cs, seed * 1000003u + k, per_terrain, &counts[w]);
+                const long d = (done += per_terrain);
+                if (d / 200000 != (d - per_terrain) / 200000) {
+                    std::lock_guard<std::mutex> g(g_print);
+                    std::printf("  %ld rays, %.0f s\n", d, elapsed());
+                }
+            }
+        });
+    for (auto &t : pool) t.join();
+    Counts c;
+    for (const Counts &x : counts) c.add(x);
+    std::printf("soak: %ld rays x 4 methods on %ld generated terrains in %.0f s (%u threads, seed %llu): %ld hits, "
+                "%ld misses, %ld below; against the reference: %ld tangencies, %ld wrong; methods differing %ld, "
+                "bounds exceeded %ld, errors %ld\n",
+                c.rays, c.terrains, elapsed(), threads, (unsigned long long)seed, c.hits, c.misses, c.below,
+                c.tangent, c.wrong, c.differ, c.bound, c.errors);
+    std::printf("  tangencies by family (rays built to touch the surface: through posts, along grid lines, ...):");
+    for (int f = 0; f < dem_cases::FAMILY_COUNT; ++f)
+        std::printf(" %s %ld", dem_cases::family_name((dem_cases::Family)f), c.tangent_by[f]);
+    std::printf("\n  of them both hit %ld times, the positions at most %.1f Q16 apart in x or y, %.1f in z\n",
+                c.tangent_both_hit, c.worst_xy, c.worst_z);
+    return (c.wrong || c.differ || c.bound || c.errors) ? 1 : 0;
+}
