@@ -101,10 +101,9 @@ bool same_hit(ct_status sa, const ct_hit &a, ct_status sb, const ct_hit &b)
 // Rays built for the seams of grid g on terrain t: along a seam (exactly on
 // a seam line, descending slowly), through a tile corner post, grazing
 // across a seam at a random angle.
-ct_ray seam_ray(const ct_host::Terrain &t, const ct_host::TileGrid &g, int kind, ct_rng *r)
+// (lo, hi: the terrain's lowest and highest codes, dem_cases::minmax)
+ct_ray seam_ray(const ct_host::Terrain &t, const ct_host::TileGrid &g, int kind, ct_rng *r, double lo, double hi)
 {
-    double lo, hi;
-    dem_cases::minmax(t, &lo, &hi);
     const int sx = g.tiles_x > 1 ? (int)ct_rng_range(r, 1, g.tiles_x - 1) : 0;
     const int sy = g.tiles_y > 1 ? (int)ct_rng_range(r, 1, g.tiles_y - 1) : 0;
     const double seam_x = g.first_col(sx), seam_y = g.first_row(sy);
@@ -217,7 +216,7 @@ void check_seams(const char *name, const ct_host::Terrain &t, const ct_host::Bui
     for (long k = 0; k < n; ++k) {
         // two thirds from the ray families, a third built for the seams
         const ct_ray ray = (k % 3 == 2)
-                               ? seam_ray(t, tb.grid, (int)((k / 3) % 3), &rng)
+                               ? seam_ray(t, tb.grid, (int)((k / 3) % 3), &rng, lo, hi)
                                : dem_cases::make_ray(t, (dem_cases::Family)(k % dem_cases::FAMILY_COUNT), &rng, lo, hi);
         ct_hit hm[4], hs[4];
         ct_status sm[4], ss[4];
