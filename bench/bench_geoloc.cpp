@@ -96,12 +96,7 @@ int main(int argc, char **argv)
             std::printf("%s: %s\n", name, e.what());
             return 1;
         }
-        std::vector<int64_t> uv;
-        for (unsigned v = 0; v < w->s.height; v += (unsigned)stride)
-            for (unsigned u = 0; u < w->s.width; u += (unsigned)stride) {
-                uv.push_back((int64_t)u << 16);
-                uv.push_back((int64_t)v << 16);
-            }
+        std::vector<int64_t> uv = dem_cases::pixel_grid(w->s.width, w->s.height, (unsigned)stride);
         size_t n = uv.size() / 2;
         // unprojection + rotation alone
         auto unproject_ns = [&]() {

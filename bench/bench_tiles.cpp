@@ -210,28 +210,16 @@ int main(int argc, char **argv)
     // a 1024 x 768 pinhole image, 30 deg down from 3 km over the set's
     // north-west quarter, looking south-east across the seams
     {
-        ct_lens lens{};
-        lens.model = CT_LENS_PINHOLE;
-        lens.width = 1024;
-        lens.height = 768;
-        lens.fx_q32 = lens.fy_q32 = (int64_t)900 << 32;
-        lens.cx_q32 = (int64_t)1023 << 31;
-        lens.cy_q32 = (int64_t)767 << 31;
+        const ct_lens lens = dem_cases::centred_pinhole(1024, 768, 900);
         ct_camera cam;
         int32_t q[4];
         ct_pose pose;
-        const double deg = M_PI / 180 * 2305843009213693952.0;
         ct_camera_init(&cam, &lens);
-        ct_quat_from_ypr(std::llround(135 * deg), std::llround(-30 * deg), 0, q);
+        ct_quat_from_ypr(dem_cases::deg_q61(135), dem_cases::deg_q61(-30), 0, q);
         ct_pose_from_map(&pose, mp.origin_e_nm + 500 * mp.posting_e_nm, mp.origin_n_nm + 500 * mp.posting_n_nm,
                          (int64_t)3000 * 1000000000, q);
-        const int step = quick ? 4 : 1;
-        std::vector<int64_t> uv;
-        for (int v = 0; v < 768; v += step)
-            for (int u = 0; u < 1024; u += step) {
-                uv.push_back((int64_t)u << 16);
-                uv.push_back((int64_t)v << 16);
-            }
+        const unsigned step = quick ? 4 : 1;
+        const std::vector<int64_t> uv = dem_cases::pixel_grid(1024, 768, step);
         const size_t np = uv.size() / 2;
         std::vector<ct_geo> gm(np), gs(np);
         Cache all(16);

@@ -136,16 +136,7 @@ Cam camera_for(const scene::World &w, const Setting &s)
     return c;
 }
 
-std::vector<int64_t> pixel_grid(const scene::World &w)
-{
-    std::vector<int64_t> uv;
-    for (unsigned v = 0; v < w.s.height; v += 16)
-        for (unsigned u = 0; u < w.s.width; u += 16) {
-            uv.push_back((int64_t)u << 16);
-            uv.push_back((int64_t)v << 16);
-        }
-    return uv;
-}
+std::vector<int64_t> pixel_grid(const scene::World &w) { return dem_cases::pixel_grid(w.s.width, w.s.height, 16); }
 
 // Errors of geolocated samples against their truth (or against ref hits).
 void error_stats(const std::vector<scene::Sample> &smp, const std::vector<ct_geo> &g,

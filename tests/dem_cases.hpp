@@ -355,6 +355,37 @@ inline ct_ray make_ray(const ct_host::Terrain &t, Family f, ct_rng *r)
     return make_ray(t, f, r, lo, hi);
 }
 
+// ---- cameras --------------------------------------------------------------
+
+// A pinhole lens of w x h pixels, focal length f pixels, centred ((w - 1) / 2,
+// (h - 1) / 2).
+inline ct_lens centred_pinhole(uint32_t w, uint32_t h, int64_t f)
+{
+    ct_lens lens{};
+    lens.model = CT_LENS_PINHOLE;
+    lens.width = w;
+    lens.height = h;
+    lens.fx_q32 = lens.fy_q32 = f << 32;
+    lens.cx_q32 = (int64_t)(w - 1) << 31;
+    lens.cy_q32 = (int64_t)(h - 1) << 31;
+    return lens;
+}
+
+// Every step-th pixel of a w x h image, row by row, as (u, v) Q16 pairs.
+inline std::vector<int64_t> pixel_grid(unsigned w, unsigned h, unsigned step)
+{
+    std::vector<int64_t> uv;
+    for (unsigned v = 0; v < h; v += step)
+        for (unsigned u = 0; u < w; u += step) {
+            uv.push_back((int64_t)u << 16);
+            uv.push_back((int64_t)v << 16);
+        }
+    return uv;
+}
+
+// An angle in degrees as ct_quat_from_ypr takes it (radians, Q61).
+inline int64_t deg_q61(double deg) { return std::llround(deg * (M_PI / 180) * 2305843009213693952.0); }
+
 // Does the ray cross the interior of the tile's box (long double slab test)?
 inline bool ray_crosses_box(const ct_host::Terrain &t, const ct_ray &r)
 {

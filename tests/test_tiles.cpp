@@ -522,7 +522,7 @@ void test_geolocation()
     TEST_ASSERT_EQUAL_INT(CT_OK, ct_package_open(&mp, merged.data(), merged.size()));
     Set set;
     TEST_ASSERT_EQUAL_INT(CT_OK, set.open(tb, 4));
-    ct_lens lens{};
+    ct_lens lens{};  // principal point (159.5, 119.5): off centre
     lens.model = CT_LENS_PINHOLE;
     lens.width = 640;
     lens.height = 480;
@@ -533,18 +533,11 @@ void test_geolocation()
     TEST_ASSERT_EQUAL_INT(CT_OK, ct_camera_init(&cam, &lens));
     // over the set's centre, 2 km up, looking 20 deg down to the north-east
     int32_t q[4];
-    const double deg = M_PI / 180;
-    TEST_ASSERT_EQUAL_INT(CT_OK, ct_quat_from_ypr(std::llround(45 * deg * 2305843009213693952.0),
-                                                  std::llround(-20 * deg * 2305843009213693952.0), 0, q));
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_quat_from_ypr(dem_cases::deg_q61(45), dem_cases::deg_q61(-20), 0, q));
     ct_pose pose;
     const int64_t e = mp.origin_e_nm + 120 * mp.posting_e_nm, n = mp.origin_n_nm + 380 * mp.posting_n_nm;
     TEST_ASSERT_EQUAL_INT(CT_OK, ct_pose_from_map(&pose, e, n, (int64_t)2000 * 1000000000, q));
-    std::vector<int64_t> uv;
-    for (int v = 0; v < 480; v += 24)
-        for (int u = 0; u < 640; u += 24) {
-            uv.push_back((int64_t)u << 16);
-            uv.push_back((int64_t)v << 16);
-        }
+    const std::vector<int64_t> uv = dem_cases::pixel_grid(640, 480, 24);
     const size_t np = uv.size() / 2;
     ct_effects sphere = {CT_EFFECT_CURVATURE | CT_EFFECT_REFRACTION, CT_REFRACTION_K_STD_Q16,
                          (int64_t)6371000 * 1000000000, 0, NULL};
