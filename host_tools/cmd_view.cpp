@@ -18,12 +18,9 @@
 #include <string>
 #include <vector>
 
-#include <unistd.h>
-
-#include <OpenImageIO/imageio.h>
-
 #include "camera_host.hpp"
 #include "conetrace.h"
+#include "dem_io.hpp"
 #include "host_io.hpp"
 #include "picture.hpp"
 #include "terrain.hpp"
@@ -107,18 +104,8 @@ int cmd_view(int argc, char **argv)
     }
     write_png_atomic(opt["-o"], im, "conetrace view: " + cpath, "conetrace view");
     if (opt.count("--range")) {
-        const std::string out = opt["--range"];
-        const std::string tmp = out + ".tmp." + std::to_string((long)getpid()) + ".tif";
-        auto o = OIIO::ImageOutput::create("tiff");
-        if (!o) throw Error(out + ": cannot write TIFF");
-        OIIO::ImageSpec spec(W, H, 1, OIIO::TypeDesc::FLOAT);
-        spec.attribute("ImageDescription", "conetrace view: range from the camera centre, metres (NaN: no hit)");
-        bool ok = o->open(tmp, spec) && o->write_image(OIIO::TypeDesc::FLOAT, range.data());
-        ok = o->close() && ok;
-        if (!ok || std::rename(tmp.c_str(), out.c_str()) != 0) {
-            std::remove(tmp.c_str());
-            throw Error(out + ": cannot write (" + o->geterror() + ")");
-        }
+        write_float_tiff(opt["--range"], W, H, range,
+                         "conetrace view: range from the camera centre, metres (NaN: no hit)");
     }
     std::fprintf(stderr, "view: %dx%d pixels, %ld hit the terrain\n", W, H, hits);
     return 0;

@@ -33,6 +33,69 @@
 
 using namespace ct_host;
 
+namespace {
+
+// A proof that the line of sight to post (i, j) is blocked, from a point q
+// (grid x, y) where a neighbour's line of sight was: the segment from the
+// observer A to the target, at its point P closest (horizontally) to q, runs
+// at least kSafety below the surface there (bilinear between the four posts;
+// in the sphere model's lowered frame, terrain and target lowered by
+// c rho^2 / 2R as ct_los lowers them), and P lies far enough before the
+// target that ct_los's first hit -- at or before P, since A is above the
+// surface (else ct_los says CT_BELOW: hidden too) -- is more than the margin
+// before it.  kSafety (0.25 m) is far above this double arithmetic's error
+// and the library's prepared segment's distance from the exact one (within
+// a millimetre, docs/library.md), so a post proved hidden is one ct_los calls
+// hidden; test_cli checks every post of a viewshed against ct_los.
+class Shortcut {
+public:
+    static constexpr double kSafety = 0.25;  // metres
+
+    Shortcut(const ct_package &p, const Terrain &t, const int64_t A[3], const ct_effects &fx, double margin,
+             double target_height)
+        : t_(t), margin_(margin), th_(target_height)
+    {
+        int64_t x, y, z;
+        on_ = ct_map_to_grid(&p, A[0], A[1], A[2], &x, &y, &z) == CT_OK;
+        ax_ = x / 65536.0, ay_ = y / 65536.0, ha_ = A[2] * 1e-9;
+        pe_ = p.posting_e_nm * 1e-9;
+        double c = 0;
+        if (fx.flags & CT_EFFECT_CURVATURE) c = 1.0 - ((fx.flags & CT_EFFECT_REFRACTION) ? fx.refraction_k_q16 / 65536.0 : 0);
+        if (c < 0 || fx.earth_radius_nm <= 0) on_ = false;  // not the sphere model: ct_los decides every post
+        lower_ = on_ && c > 0 ? c * pe_ * pe_ / (2.0 * (fx.earth_radius_nm * 1e-9)) : 0.0;
+    }
+
+    bool hides(int i, int j, double qx, double qy) const
+    {
+        if (!on_) return false;
+        const double dx = i - ax_, dy = j - ay_, l2 = dx * dx + dy * dy;
+        const double tt = ((qx - ax_) * dx + (qy - ay_) * dy) / l2;
+        if (!(tt > 0 && tt < 1)) return false;
+        const double px = ax_ + tt * dx, py = ay_ + tt * dy;
+        const int ci = std::min(t_.width - 2, std::max(0, (int)std::floor(px)));
+        const int cj = std::min(t_.height - 2, std::max(0, (int)std::floor(py)));
+        const double fx = px - ci, fy = py - cj;
+        const double s = (1 - fy) * ((1 - fx) * post(ci, cj) + fx * post(ci + 1, cj)) +
+                         fy * ((1 - fx) * post(ci, cj + 1) + fx * post(ci + 1, cj + 1));
+        const double drop_b = lower_ * l2, hb = post(i, j) + th_;
+        const double seg = ha_ + tt * (hb - drop_b - ha_);
+        if (s - lower_ * tt * tt * l2 - seg < kSafety) return false;
+        // the first hit lies within tt |AB| + drop_b / 4 of A (the bent
+        // segment sags below the chord by at most a quarter of drop_b)
+        const double ab = std::sqrt(l2 * pe_ * pe_ + (hb - ha_) * (hb - ha_));
+        return tt * ab + drop_b / 4 + kSafety < ab - margin_;
+    }
+
+private:
+    double post(int i, int j) const { return t_.height_offset_m + t_.at(i, j) * t_.height_scale_m; }
+    const Terrain &t_;
+    double margin_, th_;
+    bool on_ = false;
+    double ax_ = 0, ay_ = 0, ha_ = 0, pe_ = 0, lower_ = 0;
+};
+
+}  // namespace
+
 int cmd_viewshed(int argc, char **argv)
 {
     CmdLine args;
@@ -89,44 +152,88 @@ int cmd_viewshed(int argc, char **argv)
     int64_t ge, gn, gh;
     (void)ct_grid_to_map(&p, ox, oy, gz, &ge, &gn, &gh);
     const int64_t A[3] = {oe, on, gh + std::llround(ob[2] * 1e9)};
-    // every post
+    // every post: hidden by a neighbour's blocking point when that proves it
+    // (Shortcut), else decided by ct_los
+    const Shortcut sc(p, t, A, fx, margin, th);
     const auto t0 = std::chrono::steady_clock::now();
     std::vector<uint8_t> vis((size_t)W * H, 255);
-    long seen = 0, hidden = 0, errors = 0;
-    std::vector<long> cnt((size_t)H * 3, 0);
+    long seen = 0, hidden = 0, errors = 0, proved = 0;
+    std::vector<long> cnt((size_t)H * 4, 0);
+    const double oi = ox / 65536.0, oj = oy / 65536.0;
+    const int orow = std::min(H - 1, std::max(0, (int)std::lround(oj)));
+    const int ocol = std::min(W - 1, std::max(0, (int)std::lround(oi)));
     parallel_chunks((size_t)H, threads, 8, [&](size_t b, size_t e) {
-        for (size_t j = b; j < e; ++j)
-            for (int i = 0; i < W; ++i) {
-                int64_t pt[3];
-                (void)ct_grid_to_map(&p, (int64_t)i << 16, (int64_t)j << 16, (int64_t)t.at(i, (int)j) << 16, &pt[0], &pt[1],
-                                     &pt[2]);
-                pt[2] += std::llround(th * 1e9);
-                if (radius > 0 && std::hypot((pt[0] - A[0]) * 1e-9, (pt[1] - A[1]) * 1e-9) > radius) continue;
-                if (pt[0] == A[0] && pt[1] == A[1]) {
-                    vis[j * W + i] = 1;
-                    cnt[3 * j]++;
-                    continue;
+        // rows from the observer's row outward, each row from its column
+        // outward: the neighbour toward the observer comes first, and its
+        // blocking point (grid x, y; NaN: none) is the candidate proof
+        std::vector<double> prev((size_t)W * 2, NAN), cur((size_t)W * 2, NAN);
+        const bool up = (int)e - 1 <= orow;  // the chunk lies at or north of the observer's row
+        for (size_t s = 0; s < e - b; ++s) {
+            const int j = up ? (int)(e - 1 - s) : (int)(b + s);
+            for (int half = 0; half < 2; ++half)
+                for (int i = half ? ocol - 1 : ocol; half ? i >= 0 : i < W; i += half ? -1 : 1) {
+                    double *blk = &cur[2 * (size_t)i];
+                    blk[0] = blk[1] = NAN;
+                    int64_t pt[3];
+                    (void)ct_grid_to_map(&p, (int64_t)i << 16, (int64_t)j << 16, (int64_t)t.at(i, j) << 16, &pt[0],
+                                         &pt[1], &pt[2]);
+                    pt[2] += std::llround(th * 1e9);
+                    if (radius > 0 && std::hypot((pt[0] - A[0]) * 1e-9, (pt[1] - A[1]) * 1e-9) > radius) continue;
+                    long *c = &cnt[4 * (size_t)j];
+                    if (pt[0] == A[0] && pt[1] == A[1]) {
+                        vis[(size_t)j * W + i] = 1;
+                        c[0]++;
+                        continue;
+                    }
+                    const int in = i + (i >= ocol ? -1 : 1);  // the row neighbour toward the observer
+                    const bool row_n = in >= 0 && in < W, col_n = s > 0 && j != orow;
+                    const double *cand[3] = {row_n ? &cur[2 * (size_t)in] : nullptr,
+                                             col_n ? &prev[2 * (size_t)i] : nullptr,
+                                             row_n && col_n ? &prev[2 * (size_t)in] : nullptr};
+                    bool done = false;
+                    for (const double *q : cand)
+                        if (q && !std::isnan(q[0]) && sc.hides(i, j, q[0], q[1])) {
+                            vis[(size_t)j * W + i] = 0;
+                            blk[0] = q[0], blk[1] = q[1];
+                            c[1]++, c[3]++;
+                            done = true;
+                            break;
+                        }
+                    if (done) continue;
+                    ct_hit h;
+                    const ct_status st = ct_los(&p, A, pt, &fx, std::llround(margin * 1e9), CT_METHOD_DIRECTIONAL, &h);
+                    if (st == CT_OK) {
+                        vis[(size_t)j * W + i] = 1;
+                        c[0]++;
+                    } else if (st == CT_HIT || st == CT_BELOW) {
+                        vis[(size_t)j * W + i] = 0;
+                        c[1]++;
+                        if (st == CT_HIT) {
+                            // the candidate for the next posts: a cell past the first
+                            // hit (at most half way to the target), where the segment
+                            // runs deeper under the surface than at the hit itself
+                            // (on the fixture 98 % of the hidden posts are proved
+                            // from there, 59 % from the hit itself)
+                            const double hx = h.x_q16 / 65536.0, hy = h.y_q16 / 65536.0;
+                            const double rx = i - hx, ry = j - hy, rl = std::hypot(rx, ry);
+                            const double step = std::min(1.0, 0.5 * rl) / std::max(rl, 1e-9);
+                            blk[0] = hx + step * rx, blk[1] = hy + step * ry;
+                        }
+                    } else {
+                        c[2]++;
+                    }
                 }
-                ct_hit h;
-                const ct_status s = ct_los(&p, A, pt, &fx, std::llround(margin * 1e9), CT_METHOD_DIRECTIONAL, &h);
-                if (s == CT_OK) {
-                    vis[j * W + i] = 1;
-                    cnt[3 * j]++;
-                } else if (s == CT_HIT || s == CT_BELOW) {
-                    vis[j * W + i] = 0;
-                    cnt[3 * j + 1]++;
-                } else {
-                    cnt[3 * j + 2]++;
-                }
-            }
+            std::swap(prev, cur);
+        }
     });
-    for (int j = 0; j < H; ++j) seen += cnt[3 * j], hidden += cnt[3 * j + 1], errors += cnt[3 * j + 2];
+    for (int j = 0; j < H; ++j)
+        seen += cnt[4 * j], hidden += cnt[4 * j + 1], errors += cnt[4 * j + 2], proved += cnt[4 * j + 3];
     const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (errors) throw Error("viewshed: " + std::to_string(errors) + " posts could not be decided");
     write_geotiff(opt["-o"], W, H, std::vector<double>(vis.begin(), vis.end()), SampleType::UInt16, t.geo, true, 255);
     std::fprintf(stderr, "viewshed: observer (%.3f, %.3f) %.3f m above the surface (h %.3f m); %ld posts seen, %ld "
-                         "hidden, %ld out of range; %.2f s\n",
-                 ob[0], ob[1], ob[2], A[2] * 1e-9, seen, hidden, (long)W * H - seen - hidden, secs);
+                         "hidden (%ld by a neighbour's blocking point), %ld out of range; %.2f s\n",
+                 ob[0], ob[1], ob[2], A[2] * 1e-9, seen, hidden, proved, (long)W * H - seen - hidden, secs);
     if (opt.count("--png")) {
         const int zoom = std::max(1, (int)std::lround(900.0 / std::max(W, H)));
         Image im(W * zoom, H * zoom);

@@ -1,6 +1,6 @@
-// dem_io.cpp -- DEM rasters: pixels through OpenImageIO (read in the file's
-// native sample type, never rescaled), georeference through libtiff +
-// libgeotiff, GeoTIFF writing through libtiff + libgeotiff.
+// dem_io.cpp -- DEM rasters: pixels through OpenImageIO (dem_pixels.cpp; read
+// in the file's native sample type, never rescaled), georeference through
+// libtiff + libgeotiff, GeoTIFF writing through libtiff + libgeotiff.
 //
 // Diagnostics: libtiff messages produced on our handles go to per-handle
 // handlers (libtiff >= 4.5, TIFFOpenOptions) and end up in the exception
@@ -11,8 +11,6 @@
 // before ours (OpenImageIO installs its own silent ones too).
 
 #include "dem_io.hpp"
-
-#include <OpenImageIO/imageio.h>
 
 #include <geotiffio.h>
 #include <geovalues.h>
@@ -59,25 +57,6 @@ std::string vformat(const char *fmt, va_list ap)
     va_end(ap2);
     big.resize((size_t)n);
     return big;
-}
-
-// Collapse a multi-line library message into one line.
-std::string one_line(std::string s)
-{
-    for (char &c : s)
-        if (c == '\n' || c == '\r') c = ' ';
-    while (!s.empty() && s.back() == ' ') s.pop_back();
-    size_t b = 0;
-    while (b < s.size() && s[b] == ' ') b++;
-    return s.substr(b);
-}
-
-// A library's error text cut to a readable length (OIIO records one message
-// per failed strip: megabytes for a file that lies about its size).
-std::string clipped(std::string s, size_t max = 300)
-{
-    if (s.size() > max) s = s.substr(0, max) + " ...";
-    return s;
 }
 
 struct MsgSink {
@@ -240,96 +219,6 @@ std::string num(double v)
 
 // ---------------------------------------------------------------------------
 // reading
-
-template <typename T>
-void convert_samples(const std::vector<unsigned char> &buf, size_t n, std::vector<double> &out)
-{
-    out.resize(n);
-    for (size_t k = 0; k < n; k++) {
-        T v;
-        std::memcpy(&v, buf.data() + k * sizeof(T), sizeof(T));
-        out[k] = (double)v;
-    }
-}
-
-void read_pixels(const std::string &path, DemRaster &r, bool &is_tiff)
-{
-    auto fail = [&](const std::string &why) { return Error(path + ": " + why); };
-
-    auto in = OIIO::ImageInput::open(path);
-    if (!in) {
-        std::string e = clipped(one_line(OIIO::geterror()));
-        throw fail("cannot read image" + (e.empty() ? std::string() : ": " + e));
-    }
-    const OIIO::ImageSpec spec = in->spec();
-    is_tiff = std::strcmp(in->format_name(), "tiff") == 0;
-
-    if (spec.nchannels != 1)
-        throw fail("has " + std::to_string(spec.nchannels) +
-                   " channels; a single-channel (single-band) raster is required");
-    if (spec.depth > 1) throw fail("volume images are not supported");
-    if (spec.width <= 0 || spec.height <= 0) throw fail("empty image");
-
-    const OIIO::TypeDesc fmt = spec.format;
-    const char *name = nullptr;
-    switch (fmt.basetype) {
-    case OIIO::TypeDesc::INT8: name = "int8"; break;
-    case OIIO::TypeDesc::UINT8: name = "uint8"; break;
-    case OIIO::TypeDesc::INT16: name = "int16"; break;
-    case OIIO::TypeDesc::UINT16: name = "uint16"; break;
-    case OIIO::TypeDesc::INT32: name = "int32"; break;
-    case OIIO::TypeDesc::UINT32: name = "uint32"; break;
-    case OIIO::TypeDesc::FLOAT: name = "float32"; break;
-    case OIIO::TypeDesc::DOUBLE: name = "float64"; break;
-    default: break;
-    }
-    if (!name || fmt.aggregate != OIIO::TypeDesc::SCALAR || fmt.arraylen != 0)
-        throw fail(std::string("unsupported sample format '") + fmt.c_str() + "'");
-    // Sub-byte or odd bit depths (1/2/4/10/12-bit) are widened *and rescaled*
-    // by OIIO, which would corrupt heights.
-    int bits = spec.get_int_attribute("oiio:BitsPerSample", 0);
-    if (bits != 0 && bits != (int)(fmt.size() * 8))
-        throw fail("unsupported bit depth " + std::to_string(bits) + " (stored as " +
-                   fmt.c_str() + ")");
-
-    const size_t n = (size_t)spec.width * (size_t)spec.height;
-    if (n / (size_t)spec.width != (size_t)spec.height || n > ((size_t)1 << 34))
-        throw fail("image too large");
-    {
-        // uncompressed pixels must be in the file: a header that promises
-        // more is refused before the buffer is allocated
-        struct stat st;
-        const std::string comp = spec.get_string_attribute("compression", "none");
-        if ((comp == "none" || comp.empty()) && ::stat(path.c_str(), &st) == 0 &&
-            (unsigned long long)st.st_size < (unsigned long long)(n * fmt.size()))
-            throw fail("the header promises " + std::to_string(spec.width) + " x " + std::to_string(spec.height) +
-                       " uncompressed posts (" + std::to_string(n * fmt.size()) + " bytes) but the file has " +
-                       std::to_string((unsigned long long)st.st_size));
-    }
-    std::vector<unsigned char> buf(n * fmt.size());
-    // OIIO 2.4 can return true from read_image() although a strip failed to
-    // decode (the error is only recorded), so check has_error() as well.
-    const bool read_ok = in->read_image(0, 0, 0, 1, fmt, buf.data());
-    if (!read_ok || in->has_error()) {
-        std::string e = clipped(one_line(in->geterror()));
-        throw fail("cannot read pixels" + (e.empty() ? std::string() : ": " + e));
-    }
-    in->close();
-
-    switch (fmt.basetype) {
-    case OIIO::TypeDesc::INT8: convert_samples<int8_t>(buf, n, r.h); break;
-    case OIIO::TypeDesc::UINT8: convert_samples<uint8_t>(buf, n, r.h); break;
-    case OIIO::TypeDesc::INT16: convert_samples<int16_t>(buf, n, r.h); break;
-    case OIIO::TypeDesc::UINT16: convert_samples<uint16_t>(buf, n, r.h); break;
-    case OIIO::TypeDesc::INT32: convert_samples<int32_t>(buf, n, r.h); break;
-    case OIIO::TypeDesc::UINT32: convert_samples<uint32_t>(buf, n, r.h); break;
-    case OIIO::TypeDesc::FLOAT: convert_samples<float>(buf, n, r.h); break;
-    default: convert_samples<double>(buf, n, r.h); break;
-    }
-    r.width = spec.width;
-    r.height = spec.height;
-    r.sample_type = name;
-}
 
 void read_georef(const std::string &path, DemRaster &r)
 {
@@ -519,6 +408,99 @@ void to_float32(const std::string &path, const std::vector<double> &values,
     }
 }
 
+// The samples `data` (bits, sample format and predictor as TIFF tags) as a
+// single-band TIFF at `path`, written to a temporary file next to it and
+// renamed; GeoTIFF tags when geo is given (and GDAL_NODATA when nodata_text
+// is), an ImageDescription when desc is not empty.
+void write_tiff(const std::string &path, int width, int height, const std::vector<unsigned char> &data,
+                uint16_t bits, uint16_t sfmt, uint16_t predictor, const Georef *geo, const std::string *nodata_text,
+                const std::string &desc)
+{
+    auto fail = [&](const std::string &why) { return Error(path + ": " + why); };
+    tiff_init_once();
+    MsgSink sink;  // must outlive the TIFF handle
+    SinkScope scope(&sink);
+    TempFile tmp;
+    int fd = -1;
+    for (int attempt = 0; attempt < 100 && fd < 0; attempt++) {
+        tmp.path = path + ".tmp-" + random_suffix();
+        fd = ::open(tmp.path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+        if (fd < 0 && errno != EEXIST)
+            throw fail("cannot create temporary file '" + tmp.path + "': " + std::strerror(errno));
+    }
+    if (fd < 0) throw fail("cannot create a temporary file next to the output");
+    tmp.armed = true;
+
+    const bool big = data.size() > 0xE0000000ull;
+    TiffPtr tif(open_tiff(tmp.path, big ? "w8" : "w", sink, fd));
+    if (!tif) {
+        ::close(fd);
+        throw fail("cannot open for writing: " + sink.text("unknown libtiff error"));
+    }
+    TIFF *t = tif.get();
+    auto check = [&](bool ok, const char *what) {
+        if (!ok || !sink.errors.empty())
+            throw fail(std::string(what) + " failed" +
+                       (sink.errors.empty() ? std::string() : ": " + sink.errors));
+    };
+
+    const uint16_t compression =
+        TIFFIsCODECConfigured(COMPRESSION_ADOBE_DEFLATE) ? COMPRESSION_ADOBE_DEFLATE : COMPRESSION_NONE;
+    const size_t row_bytes = (size_t)width * (bits / 8);
+    const uint32_t rows_per_strip =
+        (uint32_t)std::max<size_t>(1, std::min<size_t>((size_t)height, 65536 / std::max<size_t>(1, row_bytes)));
+    bool ok = TIFFSetField(t, TIFFTAG_IMAGEWIDTH, (uint32_t)width) &&
+              TIFFSetField(t, TIFFTAG_IMAGELENGTH, (uint32_t)height) &&
+              TIFFSetField(t, TIFFTAG_SAMPLESPERPIXEL, (uint16_t)1) &&
+              TIFFSetField(t, TIFFTAG_BITSPERSAMPLE, bits) &&
+              TIFFSetField(t, TIFFTAG_SAMPLEFORMAT, sfmt) &&
+              TIFFSetField(t, TIFFTAG_PHOTOMETRIC, (uint16_t)PHOTOMETRIC_MINISBLACK) &&
+              TIFFSetField(t, TIFFTAG_PLANARCONFIG, (uint16_t)PLANARCONFIG_CONTIG) &&
+              TIFFSetField(t, TIFFTAG_COMPRESSION, compression) &&
+              TIFFSetField(t, TIFFTAG_ROWSPERSTRIP, rows_per_strip);
+    if (ok && compression != COMPRESSION_NONE) ok = TIFFSetField(t, TIFFTAG_PREDICTOR, predictor);
+    check(ok, "setting TIFF tags");
+
+    if (!desc.empty()) check(TIFFSetField(t, TIFFTAG_IMAGEDESCRIPTION, desc.c_str()) == 1, "setting TIFF tags");
+    if (geo) {
+        // Georeference: PixelIsArea tiepoint at the corner of pixel (0,0).
+        double pixel_scale[3] = {std::fabs(geo->posting_e), std::fabs(geo->posting_n), 0.0};
+        double tiepoint[6] = {0.0, 0.0, 0.0, geo->origin_e, geo->origin_n, 0.0};
+        ok = TIFFSetField(t, TIFFTAG_GEOPIXELSCALE, (uint16_t)3, pixel_scale) &&
+             TIFFSetField(t, TIFFTAG_GEOTIEPOINTS, (uint16_t)6, tiepoint);
+        if (ok && nodata_text) ok = TIFFSetField(t, kTagGdalNodata, nodata_text->c_str());
+        check(ok, "setting GeoTIFF tags");
+        GtifPtr gt(GTIFNewEx(t, geotiff_message, &sink));
+        check(gt != nullptr, "creating GeoTIFF keys");
+        ok = GTIFKeySet(gt.get(), GTModelTypeGeoKey, TYPE_SHORT, 1, (int)ModelTypeProjected) &&
+             GTIFKeySet(gt.get(), GTRasterTypeGeoKey, TYPE_SHORT, 1, (int)RasterPixelIsArea);
+        if (ok && geo->epsg != 0)
+            ok = GTIFKeySet(gt.get(), ProjectedCSTypeGeoKey, TYPE_SHORT, 1, geo->epsg);
+        else if (ok)
+            ok = GTIFKeySet(gt.get(), ProjLinearUnitsGeoKey, TYPE_SHORT, 1, (int)Linear_Meter);
+        check(ok, "setting GeoTIFF keys");
+        check(GTIFWriteKeys(gt.get()) != 0, "writing GeoTIFF keys");
+    }
+
+    for (uint32_t row = 0, strip = 0; row < (uint32_t)height; row += rows_per_strip, strip++) {
+        const uint32_t nrows = std::min<uint32_t>(rows_per_strip, (uint32_t)height - row);
+        const tmsize_t bytes = (tmsize_t)(nrows * row_bytes);
+        // libtiff may modify the buffer in place (predictor), so hand it a copy
+        std::vector<unsigned char> chunk(data.begin() + (ptrdiff_t)(row * row_bytes),
+                                         data.begin() + (ptrdiff_t)(row * row_bytes + (size_t)bytes));
+        check(TIFFWriteEncodedStrip(t, strip, chunk.data(), bytes) == bytes, "writing pixel data");
+    }
+    check(TIFFFlush(t) == 1, "writing TIFF directory");
+    if (::fsync(TIFFFileno(t)) != 0 && errno != EINVAL && errno != EROFS)
+        throw fail(std::string("fsync failed: ") + std::strerror(errno));
+    tif.reset();  // closes fd
+    check(true, "closing TIFF");
+
+    if (::rename(tmp.path.c_str(), path.c_str()) != 0)
+        throw fail("cannot rename '" + tmp.path + "' to the output: " + std::strerror(errno));
+    tmp.armed = false;
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------------------
@@ -535,7 +517,7 @@ DemRaster read_dem(const std::string &path)
     DemRaster r;
     bool is_tiff = false;
     try {
-        read_pixels(path, r, is_tiff);
+        read_dem_pixels(path, r, is_tiff);
     } catch (const Error &) {
         throw;
     } catch (const std::exception &e) {
@@ -591,87 +573,20 @@ void write_geotiff(const std::string &path, int width, int height,
         nodata_text = b;
     }
 
-    tiff_init_once();
-    MsgSink sink;  // must outlive the TIFF handle
-    SinkScope scope(&sink);
-    TempFile tmp;
-    int fd = -1;
-    for (int attempt = 0; attempt < 100 && fd < 0; attempt++) {
-        tmp.path = path + ".tmp-" + random_suffix();
-        fd = ::open(tmp.path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-        if (fd < 0 && errno != EEXIST)
-            throw fail("cannot create temporary file '" + tmp.path + "': " + std::strerror(errno));
-    }
-    if (fd < 0) throw fail("cannot create a temporary file next to the output");
-    tmp.armed = true;
+    write_tiff(path, width, height, data, bits, sfmt, predictor, &geo, has_nodata ? &nodata_text : nullptr, "");
+}
 
-    const bool big = data.size() > 0xE0000000ull;
-    TiffPtr tif(open_tiff(tmp.path, big ? "w8" : "w", sink, fd));
-    if (!tif) {
-        ::close(fd);
-        throw fail("cannot open for writing: " + sink.text("unknown libtiff error"));
-    }
-    TIFF *t = tif.get();
-    auto check = [&](bool ok, const char *what) {
-        if (!ok || !sink.errors.empty())
-            throw fail(std::string(what) + " failed" +
-                       (sink.errors.empty() ? std::string() : ": " + sink.errors));
-    };
-
-    const uint16_t compression =
-        TIFFIsCODECConfigured(COMPRESSION_ADOBE_DEFLATE) ? COMPRESSION_ADOBE_DEFLATE : COMPRESSION_NONE;
-    const size_t row_bytes = (size_t)width * (bits / 8);
-    const uint32_t rows_per_strip =
-        (uint32_t)std::max<size_t>(1, std::min<size_t>((size_t)height, 65536 / std::max<size_t>(1, row_bytes)));
-    bool ok = TIFFSetField(t, TIFFTAG_IMAGEWIDTH, (uint32_t)width) &&
-              TIFFSetField(t, TIFFTAG_IMAGELENGTH, (uint32_t)height) &&
-              TIFFSetField(t, TIFFTAG_SAMPLESPERPIXEL, (uint16_t)1) &&
-              TIFFSetField(t, TIFFTAG_BITSPERSAMPLE, bits) &&
-              TIFFSetField(t, TIFFTAG_SAMPLEFORMAT, sfmt) &&
-              TIFFSetField(t, TIFFTAG_PHOTOMETRIC, (uint16_t)PHOTOMETRIC_MINISBLACK) &&
-              TIFFSetField(t, TIFFTAG_PLANARCONFIG, (uint16_t)PLANARCONFIG_CONTIG) &&
-              TIFFSetField(t, TIFFTAG_COMPRESSION, compression) &&
-              TIFFSetField(t, TIFFTAG_ROWSPERSTRIP, rows_per_strip);
-    if (ok && compression != COMPRESSION_NONE) ok = TIFFSetField(t, TIFFTAG_PREDICTOR, predictor);
-    check(ok, "setting TIFF tags");
-
-    // Georeference: PixelIsArea tiepoint at the corner of pixel (0,0).
-    double pixel_scale[3] = {std::fabs(geo.posting_e), std::fabs(geo.posting_n), 0.0};
-    double tiepoint[6] = {0.0, 0.0, 0.0, geo.origin_e, geo.origin_n, 0.0};
-    ok = TIFFSetField(t, TIFFTAG_GEOPIXELSCALE, (uint16_t)3, pixel_scale) &&
-         TIFFSetField(t, TIFFTAG_GEOTIEPOINTS, (uint16_t)6, tiepoint);
-    if (ok && has_nodata) ok = TIFFSetField(t, kTagGdalNodata, nodata_text.c_str());
-    check(ok, "setting GeoTIFF tags");
-    {
-        GtifPtr gt(GTIFNewEx(t, geotiff_message, &sink));
-        check(gt != nullptr, "creating GeoTIFF keys");
-        ok = GTIFKeySet(gt.get(), GTModelTypeGeoKey, TYPE_SHORT, 1, (int)ModelTypeProjected) &&
-             GTIFKeySet(gt.get(), GTRasterTypeGeoKey, TYPE_SHORT, 1, (int)RasterPixelIsArea);
-        if (ok && geo.epsg != 0)
-            ok = GTIFKeySet(gt.get(), ProjectedCSTypeGeoKey, TYPE_SHORT, 1, geo.epsg);
-        else if (ok)
-            ok = GTIFKeySet(gt.get(), ProjLinearUnitsGeoKey, TYPE_SHORT, 1, (int)Linear_Meter);
-        check(ok, "setting GeoTIFF keys");
-        check(GTIFWriteKeys(gt.get()) != 0, "writing GeoTIFF keys");
-    }
-
-    for (uint32_t row = 0, strip = 0; row < (uint32_t)height; row += rows_per_strip, strip++) {
-        const uint32_t nrows = std::min<uint32_t>(rows_per_strip, (uint32_t)height - row);
-        const tmsize_t bytes = (tmsize_t)(nrows * row_bytes);
-        // libtiff may modify the buffer in place (predictor), so hand it a copy
-        std::vector<unsigned char> chunk(data.begin() + (ptrdiff_t)(row * row_bytes),
-                                         data.begin() + (ptrdiff_t)(row * row_bytes + (size_t)bytes));
-        check(TIFFWriteEncodedStrip(t, strip, chunk.data(), bytes) == bytes, "writing pixel data");
-    }
-    check(TIFFFlush(t) == 1, "writing TIFF directory");
-    if (::fsync(TIFFFileno(t)) != 0 && errno != EINVAL && errno != EROFS)
-        throw fail(std::string("fsync failed: ") + std::strerror(errno));
-    tif.reset();  // closes fd
-    check(true, "closing TIFF");
-
-    if (::rename(tmp.path.c_str(), path.c_str()) != 0)
-        throw fail("cannot rename '" + tmp.path + "' to the output: " + std::strerror(errno));
-    tmp.armed = false;
+void write_float_tiff(const std::string &path, int width, int height, const std::vector<float> &values,
+                      const std::string &desc)
+{
+    if (width <= 0 || height <= 0)
+        throw Error(path + ": invalid raster size " + std::to_string(width) + " x " + std::to_string(height));
+    if (values.size() != (size_t)width * (size_t)height)
+        throw Error(path + ": expected " + std::to_string((size_t)width * (size_t)height) + " samples, got " +
+                    std::to_string(values.size()));
+    std::vector<unsigned char> data(values.size() * sizeof(float));
+    std::memcpy(data.data(), values.data(), data.size());
+    write_tiff(path, width, height, data, 32, SAMPLEFORMAT_IEEEFP, PREDICTOR_FLOATINGPOINT, nullptr, nullptr, desc);
 }
 
 }  // namespace ct_host

@@ -1,5 +1,6 @@
 // dem_io.hpp -- reading DEM rasters (pixels via OpenImageIO, georeference via
-// libgeotiff/libtiff) and writing GeoTIFFs (libtiff + libgeotiff).
+// libgeotiff/libtiff) and writing GeoTIFFs and plain float TIFFs (libtiff +
+// libgeotiff).
 #pragma once
 
 #include <cstdint>
@@ -34,5 +35,37 @@ enum class SampleType { Int16, UInt16, Float32 };
 void write_geotiff(const std::string &path, int width, int height,
                    const std::vector<double> &values, SampleType type,
                    const Georef &geo, bool has_nodata = false, double nodata = 0.0);
+
+// Write a single-band float32 TIFF without a georeference (an image's
+// samples, e.g. the range per pixel of `conetrace view`; NaN allowed), its
+// ImageDescription tag `desc`.  Atomic as write_geotiff.  Throws
+// ct_host::Error("<path>: <reason>").
+void write_float_tiff(const std::string &path, int width, int height, const std::vector<float> &values,
+                      const std::string &desc);
+
+// read_dem's first half: the pixels, sample type and size of `path` through
+// OpenImageIO (dem_pixels.cpp); is_tiff: OpenImageIO read it as a TIFF (so
+// read_dem looks for GeoTIFF tags).  The `conetrace` binary links a door to
+// the plugin in its place (heavy_door.hpp).
+void read_dem_pixels(const std::string &path, DemRaster &r, bool &is_tiff);
+
+// A library's message on one line (line breaks as spaces, ends trimmed).
+inline std::string one_line(std::string s)
+{
+    for (char &c : s)
+        if (c == '\n' || c == '\r') c = ' ';
+    while (!s.empty() && s.back() == ' ') s.pop_back();
+    size_t b = 0;
+    while (b < s.size() && s[b] == ' ') b++;
+    return s.substr(b);
+}
+
+// A library's error text cut to a readable length (OIIO records one message
+// per failed strip: megabytes for a file that lies about its size).
+inline std::string clipped(std::string s, size_t max = 300)
+{
+    if (s.size() > max) s = s.substr(0, max) + " ...";
+    return s;
+}
 
 }  // namespace ct_host

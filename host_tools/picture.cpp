@@ -10,7 +10,7 @@
 
 #include <unistd.h>
 
-#include <OpenImageIO/imageio.h>
+#include <png.h>
 
 #include "host_io.hpp"
 #include "le.hpp"
@@ -150,33 +150,85 @@ void paint_posts(Image &im, const Terrain &t, int i0, int j0, int i1, int j1, in
         }
 }
 
+namespace {
+
+struct PngError {
+    char text[200];
+};
+
+void png_fail(png_structp png, png_const_charp msg)
+{
+    PngError *e = static_cast<PngError *>(png_get_error_ptr(png));
+    std::snprintf(e->text, sizeof e->text, "%s", msg ? msg : "libpng error");
+    png_longjmp(png, 1);
+}
+
+void png_warn(png_structp, png_const_charp) {}
+
+// The RGB rows of an image as a PNG on f, with Description and Software text
+// chunks (the keys OpenImageIO reads as ImageDescription and Software).
+// libpng reports errors by longjmp to this frame, so it holds only plain C
+// objects; false with err->text set on failure.
+bool png_to_file(FILE *f, int w, int h, const uint8_t *px, const char *desc, const char *software, PngError *err)
+{
+    png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, err, png_fail, png_warn);
+    if (!png) {
+        std::snprintf(err->text, sizeof err->text, "out of memory");
+        return false;
+    }
+    png_infop info = png_create_info_struct(png);
+    if (!info || setjmp(png_jmpbuf(png))) {
+        if (!info) std::snprintf(err->text, sizeof err->text, "out of memory");
+        png_destroy_write_struct(&png, info ? &info : nullptr);
+        return false;
+    }
+    png_init_io(png, f);
+    png_set_IHDR(png, info, (png_uint_32)w, (png_uint_32)h, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
+                 PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+    png_text text[2];
+    std::memset(text, 0, sizeof text);
+    text[0].compression = PNG_TEXT_COMPRESSION_NONE;
+    text[0].key = const_cast<char *>("Description");
+    text[0].text = const_cast<char *>(desc);
+    text[1].compression = PNG_TEXT_COMPRESSION_NONE;
+    text[1].key = const_cast<char *>("Software");
+    text[1].text = const_cast<char *>(software);
+    png_set_text(png, info, text, 2);
+    png_write_info(png, info);
+    for (int y = 0; y < h; ++y) png_write_row(png, px + (size_t)y * (size_t)w * 3);
+    png_write_end(png, info);
+    png_destroy_write_struct(&png, &info);
+    return true;
+}
+
+}  // namespace
+
 void write_png_atomic(const std::string &path, const Image &im, const std::string &desc,
                       const std::string &software)
 {
     const std::string tmp = path + ".tmp." + std::to_string((long)getpid()) + ".png";
-    auto out = OIIO::ImageOutput::create("png");
-    if (!out) throw Error(path + ": cannot write PNG (" + OIIO::geterror() + ")");
-    OIIO::ImageSpec spec(im.w, im.h, 3, OIIO::TypeDesc::UINT8);
-    spec.attribute("ImageDescription", desc);
-    spec.attribute("Software", software);
+    FILE *f = std::fopen(tmp.c_str(), "wb");
+    if (!f) throw Error(path + ": cannot write (" + std::strerror(errno) + ")");
+    PngError err{};
+    bool ok = png_to_file(f, im.w, im.h, im.px.data(), desc.c_str(), software.c_str(), &err);
+    std::string why = ok ? "" : err.text;
     errno = 0;
-    bool opened = out->open(tmp, spec);
-    const int open_errno = errno;
-    bool ok = opened && out->write_image(OIIO::TypeDesc::UINT8, im.px.data());
-    std::string err = ok ? "" : out->geterror();
-    if (!opened && open_errno != 0) err = std::strerror(open_errno);  // OIIO's text names the temporary
-    ok = out->close() && ok;
-    if (ok && std::rename(tmp.c_str(), path.c_str()) != 0) {
+    if (std::fflush(f) != 0 || std::ferror(f)) {
+        if (ok) why = std::strerror(errno ? errno : EIO);
         ok = false;
-        err = std::strerror(errno);
+    }
+    if (std::fclose(f) != 0 && ok) {
+        why = std::strerror(errno ? errno : EIO);
+        ok = false;
+    }
+    if (ok && std::rename(tmp.c_str(), path.c_str()) != 0) {
+        why = std::strerror(errno);
+        ok = false;
     }
     if (!ok) {
         std::remove(tmp.c_str());
-        if (err.empty()) err = out->geterror();
-        // OIIO's messages often repeat the (temporary) file name; keep the reason
-        throw Error(path + ": cannot write (" + (err.empty() ? "unknown error" : err) + ")");
+        throw Error(path + ": cannot write (" + (why.empty() ? "unknown error" : why) + ")");
     }
 }
-
 
 }  // namespace ct_host

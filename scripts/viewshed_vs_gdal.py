@@ -2,8 +2,9 @@
 # viewshed_vs_gdal.py -- `make bench`: conetrace viewshed against GDAL's
 # gdal_viewshed on the bundled DEM, the same observer (a post centre, 10 m
 # above the ground) and targets on the ground, without curvature (-cc 0):
-# agreement in % of posts, the posts each one alone sees, both times (best of
-# three, one thread for ours; gdal_viewshed's whole process), and a picture
+# agreement in % of posts, the posts each one alone sees, both times (whole
+# processes, one thread for ours, in 7 alternating rounds: median and range,
+# and the ratio's range over the rounds), and a picture
 # of where they differ: BUILD/viewshed/viewshed_vs_gdal.png.  Then
 # conetrace shadows (sun at 135, 20 deg) on packages of N = 8, 24, 64
 # sectors: the same shadow map from each (exact rays), steps and time.
@@ -25,13 +26,10 @@ import matplotlib.pyplot as plt  # noqa: E402
 gdal.UseExceptions()
 
 
-def best_of(n, cmd):
-    best = 1e30
-    for _ in range(n):
-        t0 = time.perf_counter()
-        subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-        best = min(best, time.perf_counter() - t0)
-    return best
+def timed(cmd):
+    t0 = time.perf_counter()
+    subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    return time.perf_counter() - t0
 
 
 def main():
@@ -47,10 +45,17 @@ def main():
     e, n, h = 201045.0, 4065855.0, 10.0  # a post centre near the middle of the tile
     ours = os.path.join(out, "ours.tif")
     theirs = os.path.join(out, "gdal.tif")
-    t_ours = best_of(3, [cli, "viewshed", pkg, "--observer", "%.3f,%.3f,%.3f" % (e, n, h), "--threads", "1",
-                         "-o", ours])
-    t_gdal = best_of(3, ["gdal_viewshed", "-q", "-ox", str(e), "-oy", str(n), "-oz", str(h), "-tz", "0", "-cc", "0",
-                         "-vv", "1", "-iv", "0", dem, theirs])
+    cmd_ours = [cli, "viewshed", pkg, "--observer", "%.3f,%.3f,%.3f" % (e, n, h), "--threads", "1", "-o", ours]
+    cmd_gdal = ["gdal_viewshed", "-q", "-ox", str(e), "-oy", str(n), "-oz", str(h), "-tz", "0", "-cc", "0",
+                "-vv", "1", "-iv", "0", dem, theirs]
+    timed(cmd_ours), timed(cmd_gdal)  # warm the page cache
+    t_ours, t_gdal = [], []
+    for k in range(7):  # alternating rounds: ab ba ab ...
+        pair = (cmd_ours, cmd_gdal) if k % 2 == 0 else (cmd_gdal, cmd_ours)
+        t = [timed(c) for c in pair]
+        t_ours.append(t[0] if k % 2 == 0 else t[1])
+        t_gdal.append(t[1] if k % 2 == 0 else t[0])
+    ratios = sorted(a / b for a, b in zip(t_ours, t_gdal))
     a = gdal.Open(ours).ReadAsArray().astype(int)
     b = gdal.Open(theirs).ReadAsArray().astype(int)
     z = gdal.Open(dem).ReadAsArray().astype(float)
@@ -60,8 +65,11 @@ def main():
     only_gdal = int(((a == 0) & (b == 1)).sum())
     print("viewshed vs gdal_viewshed (fixture, observer (%.0f, %.0f) %.0f m above the ground, targets on the ground, "
           "no curvature): agreement %.2f %% of %d posts; seen by both %d, only by conetrace %d, only by GDAL %d; "
-          "time conetrace %.3f s (one thread, whole process), gdal_viewshed %.3f s"
-          % (e, n, h, agree, m.sum(), int(((a == 1) & (b == 1)).sum()), only_ours, only_gdal, t_ours, t_gdal))
+          "time (whole processes, 7 alternating rounds, median [range]) conetrace %.3f s [%.3f-%.3f] (one thread), "
+          "gdal_viewshed %.3f s [%.3f-%.3f]; conetrace / GDAL %.2f-%.2fx"
+          % (e, n, h, agree, m.sum(), int(((a == 1) & (b == 1)).sum()), only_ours, only_gdal,
+             sorted(t_ours)[3], min(t_ours), max(t_ours), sorted(t_gdal)[3], min(t_gdal), max(t_gdal),
+             ratios[0], ratios[-1]))
     # the picture: hillshade, both seen, only one of them
     gy, gx = np.gradient(z, 30.0)
     shade = np.clip((-gx * (-0.5) - gy * 0.5 + 1) / np.sqrt(gx * gx + gy * gy + 1) / 1.3, 0, 1)

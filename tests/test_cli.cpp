@@ -154,8 +154,7 @@ static Run run_cli(const std::string &dir, const std::vector<std::string> &args)
     return r;
 }
 
-// Independent jobs (each in its own directory) run a few at a time: every
-// start of the binary costs ~0.4 s of dynamic linking (OpenImageIO).
+// Independent jobs (each in its own directory) run a few at a time.
 static std::vector<Run> run_all(const std::vector<Job> &jobs)
 {
     std::vector<Run> runs(jobs.size());
@@ -278,6 +277,36 @@ static std::string fixture_package()
 // --help: the usage on stdout and exit 0 (for the program: every command's;
 // `CMD --help`, anywhere on the line: that command's alone); a missing or
 // unknown command: the usage on stderr and exit 2.
+// The binary starts light: OpenImageIO and GDAL (~200 shared libraries
+// between them) are loaded only from the plugin conetrace_heavy.so when a
+// DEM is read (host_tools/heavy_door.hpp), never by the dynamic linker at
+// start-up; a binary without its plugin says so when it needs it and runs
+// every other command.
+static void test_light_start(void)
+{
+    std::string d = new_dir("light");
+    Run r = run_job(Job{d, {}, "LD_TRACE_LOADED_OBJECTS=1 "}, 0);  // what ldd prints
+    TEST_ASSERT_MSG(r.code == 0 && contains(r.out, "libtiff") && contains(r.out, "libc.so"), "no listing: %s",
+                    r.out.c_str());
+    TEST_ASSERT_MSG(!contains(r.out, "OpenImageIO") && !contains(r.out, "libgdal") && !contains(r.out, "opencv"),
+                    "loaded at start-up:\n%s", r.out.c_str());
+    // alone, without the plugin beside it
+    fs::create_directories(d + "/bin");
+    fs::copy_file(CT_CLI, d + "/bin/conetrace");
+    fs::permissions(d + "/bin/conetrace", fs::perms::owner_all);
+    const std::string dem = std::string(CT_FIXTURES_DIR) + "/jacksboro_fault_dem.tif";
+    const std::string cmd = "cd " + quote(d) + " && ./bin/conetrace build " + quote(dem) + " -o p.ctp 2>err.txt";
+    const int st = std::system(cmd.c_str());
+    TEST_ASSERT(st != -1 && WIFEXITED(st) && WEXITSTATUS(st) == 1);
+    const std::string err = slurp(d + "/err.txt");
+    TEST_ASSERT_MSG(starts_with(err, "conetrace: cannot load the DEM reader ") && contains(err, "conetrace_heavy.so") &&
+                        lines_of(err).size() == 1,
+                    "stderr: %s", err.c_str());
+    TEST_ASSERT(!fs::exists(d + "/p.ctp"));
+    const int st2 = std::system(("cd " + quote(d) + " && ./bin/conetrace --help >/dev/null 2>&1").c_str());
+    TEST_ASSERT(st2 != -1 && WIFEXITED(st2) && WEXITSTATUS(st2) == 0);
+}
+
 static void test_help(void)
 {
     std::string d = new_dir("help");
@@ -1116,6 +1145,7 @@ int main(void)
         return 1;
     }
     load_fixture();
+    RUN_TEST(test_light_start);
     RUN_TEST(test_help);
     RUN_TEST(test_build_info_fixture);
     RUN_TEST(test_trace_methods);

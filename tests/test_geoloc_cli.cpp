@@ -767,6 +767,38 @@ void test_viewshed()
             TEST_ASSERT_EQUAL_INT(d.h, vs.height);
             TEST_ASSERT(std::fabs(vs.geo.origin_e - p.origin_e_nm * 1e-9) < 1e-6 && vs.geo.epsg == (int)p.epsg);
             TEST_ASSERT(fs::exists(g_dir + "/vs.png"));
+            // every post as ct_lib's ct_los decides it, bit for bit: the
+            // posts the command proved hidden from a neighbour's blocking
+            // point (Shortcut, cmd_viewshed.cpp) without calling it included
+            {
+                int64_t gx, gy, gz0, gz, ge, gn, gh;
+                TEST_ASSERT_EQUAL_INT(CT_OK, ct_map_to_grid(&p, e, n, 0, &gx, &gy, &gz0));
+                TEST_ASSERT_EQUAL_INT(CT_OK, ct_surface_height(&p, gx, gy, &gz));
+                TEST_ASSERT_EQUAL_INT(CT_OK, ct_grid_to_map(&p, gx, gy, gz, &ge, &gn, &gh));
+                const int64_t A[3] = {e, n, gh + 5000000000};
+                ct_effects fx = {bent ? CT_EFFECT_CURVATURE | CT_EFFECT_REFRACTION : 0u, CT_REFRACTION_K_STD_Q16,
+                                 CT_EARTH_RADIUS_NM, 0, nullptr};
+                long differ = 0;
+                for (int j = 0; j < d.h; ++j)
+                    for (int i = 0; i < d.w; ++i) {
+                        int64_t pt[3];
+                        TEST_ASSERT_EQUAL_INT(CT_OK, ct_grid_to_map(&p, (int64_t)i << 16, (int64_t)j << 16,
+                                                                    (int64_t)d.at(i, j) << 16, &pt[0], &pt[1], &pt[2]));
+                        pt[2] += 1750000000;
+                        if (pt[0] == A[0] && pt[1] == A[1]) continue;
+                        ct_hit hh;
+                        const ct_status st = ct_los(&p, A, pt, &fx, 10000000, CT_METHOD_DIRECTIONAL, &hh);
+                        TEST_ASSERT(st == CT_OK || st == CT_HIT || st == CT_BELOW);
+                        differ += (vs.h[(size_t)j * d.w + i] == 1) != (st == CT_OK);
+                    }
+                long proved = -1;
+                const size_t at = r.err.find(" hidden (");
+                TEST_ASSERT(at != std::string::npos && std::sscanf(r.err.c_str() + at, " hidden (%ld", &proved) == 1);
+                std::printf("  viewshed%s from post (%d, %d): %ld posts proved hidden without ct_los, %ld differ from "
+                            "ct_los\n", bent ? " (curvature, refraction)" : "", oi, oj, proved, differ);
+                TEST_ASSERT_EQUAL_INT(0, differ);
+                TEST_ASSERT(proved > 0);
+            }
             // the reference, post by post
             const ref::ld ox = oi, oy = oj, oz = d.at(oi, oj) + 5 / hs;
             const ref::ld c = bent ? 1 - (ref::ld)CT_REFRACTION_K_STD_Q16 / 65536 : 0, R = 6371000.0L;

@@ -1,0 +1,109 @@
+// dem_pixels.cpp -- the pixels of a DEM raster through OpenImageIO, in the
+// file's native sample type, never rescaled (read_dem's first half; the
+// georeference is dem_io.cpp's).  The only file of the DEM reader that needs
+// OpenImageIO: the `conetrace` binary reaches it through the plugin
+// (heavy_door.hpp), so commands that read no DEM do not load OpenImageIO.
+#include "dem_io.hpp"
+
+#include <OpenImageIO/imageio.h>
+
+#include <sys/stat.h>
+
+#include <cstring>
+
+namespace ct_host {
+namespace {
+
+template <typename T>
+void convert_samples(const std::vector<unsigned char> &buf, size_t n, std::vector<double> &out)
+{
+    out.resize(n);
+    for (size_t k = 0; k < n; k++) {
+        T v;
+        std::memcpy(&v, buf.data() + k * sizeof(T), sizeof(T));
+        out[k] = (double)v;
+    }
+}
+
+}  // namespace
+
+void read_dem_pixels(const std::string &path, DemRaster &r, bool &is_tiff)
+{
+    auto fail = [&](const std::string &why) { return Error(path + ": " + why); };
+
+    auto in = OIIO::ImageInput::open(path);
+    if (!in) {
+        std::string e = clipped(one_line(OIIO::geterror()));
+        throw fail("cannot read image" + (e.empty() ? std::string() : ": " + e));
+    }
+    const OIIO::ImageSpec spec = in->spec();
+    is_tiff = std::strcmp(in->format_name(), "tiff") == 0;
+
+    if (spec.nchannels != 1)
+        throw fail("has " + std::to_string(spec.nchannels) +
+                   " channels; a single-channel (single-band) raster is required");
+    if (spec.depth > 1) throw fail("volume images are not supported");
+    if (spec.width <= 0 || spec.height <= 0) throw fail("empty image");
+
+    const OIIO::TypeDesc fmt = spec.format;
+    const char *name = nullptr;
+    switch (fmt.basetype) {
+    case OIIO::TypeDesc::INT8: name = "int8"; break;
+    case OIIO::TypeDesc::UINT8: name = "uint8"; break;
+    case OIIO::TypeDesc::INT16: name = "int16"; break;
+    case OIIO::TypeDesc::UINT16: name = "uint16"; break;
+    case OIIO::TypeDesc::INT32: name = "int32"; break;
+    case OIIO::TypeDesc::UINT32: name = "uint32"; break;
+    case OIIO::TypeDesc::FLOAT: name = "float32"; break;
+    case OIIO::TypeDesc::DOUBLE: name = "float64"; break;
+    default: break;
+    }
+    if (!name || fmt.aggregate != OIIO::TypeDesc::SCALAR || fmt.arraylen != 0)
+        throw fail(std::string("unsupported sample format '") + fmt.c_str() + "'");
+    // Sub-byte or odd bit depths (1/2/4/10/12-bit) are widened *and rescaled*
+    // by OIIO, which would corrupt heights.
+    int bits = spec.get_int_attribute("oiio:BitsPerSample", 0);
+    if (bits != 0 && bits != (int)(fmt.size() * 8))
+        throw fail("unsupported bit depth " + std::to_string(bits) + " (stored as " +
+                   fmt.c_str() + ")");
+
+    const size_t n = (size_t)spec.width * (size_t)spec.height;
+    if (n / (size_t)spec.width != (size_t)spec.height || n > ((size_t)1 << 34))
+        throw fail("image too large");
+    {
+        // uncompressed pixels must be in the file: a header that promises
+        // more is refused before the buffer is allocated
+        struct stat st;
+        const std::string comp = spec.get_string_attribute("compression", "none");
+        if ((comp == "none" || comp.empty()) && ::stat(path.c_str(), &st) == 0 &&
+            (unsigned long long)st.st_size < (unsigned long long)(n * fmt.size()))
+            throw fail("the header promises " + std::to_string(spec.width) + " x " + std::to_string(spec.height) +
+                       " uncompressed posts (" + std::to_string(n * fmt.size()) + " bytes) but the file has " +
+                       std::to_string((unsigned long long)st.st_size));
+    }
+    std::vector<unsigned char> buf(n * fmt.size());
+    // OIIO 2.4 can return true from read_image() although a strip failed to
+    // decode (the error is only recorded), so check has_error() as well.
+    const bool read_ok = in->read_image(0, 0, 0, 1, fmt, buf.data());
+    if (!read_ok || in->has_error()) {
+        std::string e = clipped(one_line(in->geterror()));
+        throw fail("cannot read pixels" + (e.empty() ? std::string() : ": " + e));
+    }
+    in->close();
+
+    switch (fmt.basetype) {
+    case OIIO::TypeDesc::INT8: convert_samples<int8_t>(buf, n, r.h); break;
+    case OIIO::TypeDesc::UINT8: convert_samples<uint8_t>(buf, n, r.h); break;
+    case OIIO::TypeDesc::INT16: convert_samples<int16_t>(buf, n, r.h); break;
+    case OIIO::TypeDesc::UINT16: convert_samples<uint16_t>(buf, n, r.h); break;
+    case OIIO::TypeDesc::INT32: convert_samples<int32_t>(buf, n, r.h); break;
+    case OIIO::TypeDesc::UINT32: convert_samples<uint32_t>(buf, n, r.h); break;
+    case OIIO::TypeDesc::FLOAT: convert_samples<float>(buf, n, r.h); break;
+    default: convert_samples<double>(buf, n, r.h); break;
+    }
+    r.width = spec.width;
+    r.height = spec.height;
+    r.sample_type = name;
+}
+
+}  // namespace ct_host
