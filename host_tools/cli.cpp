@@ -79,7 +79,7 @@ const UsageBlock kUsage[] = {
      "                   [--margin M] [--threads T] -o vs.tif [--png vs.png]\n"
      "                   (H above the surface; every post by the library's exact line of sight)\n"},
     {"shadows",
-     "conetrace shadows PKG --sun AZ,EL [--lift M] [--threads T] -o shadow.tif [--png shadow.png]\n"
+     "conetrace shadows PKG --sun AZ,EL [--lift M] [--method M] [--threads T] -o shadow.tif [--png shadow.png]\n"
      "                  (a ray from every post towards the sun, AZ clockwise from grid north)\n"},
     {"view",
      "conetrace view PKG --camera C.cameramodel [--effects LIST] [--threads T] -o view.png\n"
@@ -149,11 +149,11 @@ double to_double(const Args &a, const std::string &k, double def)
 
 ct_method parse_method(const std::string &m)
 {
-    if (m == "incremental") return CT_METHOD_INCREMENTAL;
-    if (m == "hierarchical") return CT_METHOD_HIERARCHICAL;
-    if (m == "cone") return CT_METHOD_CONE;
-    if (m == "directional") return CT_METHOD_DIRECTIONAL;
-    usage("unknown method '" + m + "'");
+    try {
+        return method_named(m);
+    } catch (const Error &e) {
+        usage(e.what());
+    }
 }
 
 Terrain load_terrain(const std::string &path, double posting, double hscale, int vdatum = CT_VDATUM_UNKNOWN,

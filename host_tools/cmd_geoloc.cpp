@@ -116,15 +116,7 @@ int cmd_geoloc(int argc, char **argv)
         fx.earth_radius_nm = (int64_t)std::llround(
             number("--earth-radius", 1100, 1.8e7, "a radius in metres in [1100, 1.8e7]") * 1e9);
     }
-    ct_method m = CT_METHOD_DIRECTIONAL;
-    if (opt.count("--method")) {
-        const std::string &s = opt["--method"];
-        if (s == "incremental") m = CT_METHOD_INCREMENTAL;
-        else if (s == "hierarchical") m = CT_METHOD_HIERARCHICAL;
-        else if (s == "cone") m = CT_METHOD_CONE;
-        else if (s == "directional") m = CT_METHOD_DIRECTIONAL;
-        else throw Error("unknown method '" + s + "' (incremental, hierarchical, cone, directional)");
-    }
+    const ct_method m = opt.count("--method") ? method_named(opt["--method"]) : CT_METHOD_DIRECTIONAL;
 
     double grid_step = kDefaultGridStepPx;
     if (opt.count("--grid-step")) {

@@ -1,14 +1,20 @@
 // cmd_shadows.cpp -- `conetrace shadows`: which posts are in the sun's shadow.
 //
-//   conetrace shadows PKG --sun AZ,EL [--lift M] [--threads T] -o shadow.tif
-//                     [--png shadow.png]
+//   conetrace shadows PKG --sun AZ,EL [--lift M] [--method M] [--threads T]
+//                     -o shadow.tif [--png shadow.png]
 //
 // For the sun at azimuth AZ (degrees clockwise from grid north) and
 // elevation EL (degrees above the horizon, (0, 90]), every post casts a ray
 // from the surface there (lifted by --lift metres, default 0.01, so a post
 // on a slope facing the sun does not shadow itself) towards the sun; the
-// flight library's ct_trace (directional: the cones jump over the empty
-// space above the terrain) decides: a hit is shadow, a miss is sun.
+// flight library's ct_trace decides: a hit is shadow, a miss is sun.  With
+// the default --method directional this is the paper's horizon-angle view:
+// the walk's first step compares the sun with the cone of the post's coarse
+// cell in the sun's sector (a post at or above the cone's apex with the sun
+// above the cone is lit at once: "lit by its own cone" in the summary), then
+// jumps from cone to cone and tests cells exactly only where no cone
+// decides.  --method incremental is the exact ray cell by cell (the same
+// map, bit for bit; make bench compares the two per N).
 // shadow.tif: a GeoTIFF on the package's grid and CRS, 1 lit, 0 shadow.
 // --png: the picture over the hillshade (shadow darkened and blue; in the
 // top-left corner the sun's marker and a line the way shadows fall).  Errors print one line and exit non-zero; outputs are
@@ -34,7 +40,7 @@ int cmd_shadows(int argc, char **argv)
 {
     CmdLine args;
     const std::string err =
-        parse_cmdline(argc, argv, 2, {"--sun", "--lift", "--threads", "-o", "--png"}, {}, false, &args);
+        parse_cmdline(argc, argv, 2, {"--sun", "--lift", "--method", "--threads", "-o", "--png"}, {}, false, &args);
     if (!err.empty()) throw Error("shadows: " + err);
     std::map<std::string, std::string> &opt = args.opt;
     if (args.pos.size() != 1) throw Error("shadows needs exactly one package file");
@@ -61,6 +67,7 @@ int cmd_shadows(int argc, char **argv)
             throw Error("--lift needs a height in metres in [0, 1000], got '" + opt["--lift"] + "'");
     }
     const int threads = opt.count("--threads") ? threads_option(opt["--threads"], "shadows") : 0;
+    const ct_method method = opt.count("--method") ? method_named(opt["--method"]) : CT_METHOD_DIRECTIONAL;
     const std::string &path = args.pos[0];
     std::vector<uint8_t> bytes;
     ct_package p;
@@ -74,7 +81,7 @@ int cmd_shadows(int argc, char **argv)
                   dh = std::llround(std::sin(el) * s);
     const auto t0 = std::chrono::steady_clock::now();
     std::vector<uint8_t> lit((size_t)W * H, 0);
-    std::vector<long> bad((size_t)H, 0), steps((size_t)H, 0);
+    std::vector<long> bad((size_t)H, 0), steps((size_t)H, 0), at_once((size_t)H, 0);
     parallel_chunks((size_t)H, threads, 8, [&](size_t b, size_t e) {
         for (size_t j = b; j < e; ++j)
             for (int i = 0; i < W; ++i) {
@@ -83,21 +90,23 @@ int cmd_shadows(int argc, char **argv)
                 ct_ray r;
                 ct_hit h;
                 ct_status s2 = ct_ray_from_map(&p, pe, pn, ph + std::llround(lift * 1e9), de, dn, dh, &r);
-                if (s2 == CT_OK) s2 = ct_trace(&p, &r, CT_METHOD_DIRECTIONAL, &h);
-                if (s2 == CT_MISS) lit[j * W + i] = 1;
+                if (s2 == CT_OK) s2 = ct_trace(&p, &r, method, &h);
+                if (s2 == CT_MISS) lit[j * W + i] = 1, at_once[j] += h.steps == 1;
                 else if (s2 != CT_HIT && s2 != CT_HIT_VOID && s2 != CT_BELOW) bad[j]++;
                 if (s2 >= 0) steps[j] += h.steps;
             }
     });
-    long errors = 0, nlit = 0, nsteps = 0;
-    for (int j = 0; j < H; ++j) errors += bad[j], nsteps += steps[j];
+    long errors = 0, nlit = 0, nsteps = 0, nonce = 0;
+    for (int j = 0; j < H; ++j) errors += bad[j], nsteps += steps[j], nonce += at_once[j];
     for (uint8_t v : lit) nlit += v;
     const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (errors) throw Error("shadows: " + std::to_string(errors) + " posts could not be decided");
     write_geotiff(opt["-o"], W, H, std::vector<double>(lit.begin(), lit.end()), SampleType::UInt16, t.geo);
-    std::fprintf(stderr, "shadows: sun at azimuth %.2f, elevation %.2f deg: %ld posts lit, %ld in shadow; %.1f steps "
-                         "per post; %.2f s\n", sun[0], sun[1], nlit, (long)W * H - nlit, (double)nsteps / ((double)W * H),
-                 secs);
+    const bool cones = method == CT_METHOD_CONE || method == CT_METHOD_DIRECTIONAL;
+    std::fprintf(stderr, "shadows: sun at azimuth %.2f, elevation %.2f deg: %ld posts lit (%ld %s), %ld in shadow; "
+                         "%.1f steps per post; %.3f s\n",
+                 sun[0], sun[1], nlit, nonce, cones ? "by their own cone" : "in one cell step", (long)W * H - nlit,
+                 (double)nsteps / ((double)W * H), secs);
     if (opt.count("--png")) {
         const int zoom = std::max(1, (int)std::lround(900.0 / std::max(W, H)));
         Image im(W * zoom, H * zoom);

@@ -250,6 +250,15 @@ void parallel_chunks(size_t n, int threads, size_t chunk, const std::function<vo
     for (auto &th : pool) th.join();
 }
 
+ct_method method_named(const std::string &name)
+{
+    if (name == "incremental") return CT_METHOD_INCREMENTAL;
+    if (name == "hierarchical") return CT_METHOD_HIERARCHICAL;
+    if (name == "cone") return CT_METHOD_CONE;
+    if (name == "directional") return CT_METHOD_DIRECTIONAL;
+    throw Error("unknown method '" + name + "' (incremental, hierarchical, cone, directional)");
+}
+
 int threads_option(const std::string &text, const std::string &cmd)
 {
     char *end = nullptr;

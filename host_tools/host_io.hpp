@@ -59,6 +59,10 @@ std::string status_name(ct_status s);
 // the calling thread takes part.  Outputs indexed by item keep input order.
 void parallel_chunks(size_t n, int threads, size_t chunk, const std::function<void(size_t, size_t)> &work);
 
+// --method NAME: incremental, hierarchical, cone or directional.  Throws
+// Error("unknown method 'x' (incremental, hierarchical, cone, directional)").
+ct_method method_named(const std::string &name);
+
 // --threads T: a number of threads in [0, 256] (0 = all cores).
 int threads_option(const std::string &text, const std::string &cmd);
 

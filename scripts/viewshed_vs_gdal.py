@@ -7,7 +7,10 @@
 # and the ratio's range over the rounds), and a picture
 # of where they differ: BUILD/viewshed/viewshed_vs_gdal.png.  Then
 # conetrace shadows (sun at 135, 20 deg) on packages of N = 8, 24, 64
-# sectors: the same shadow map from each (exact rays), steps and time.
+# sectors: the cones (--method directional) against the exact ray cell by
+# cell (--method incremental), one thread, 5 alternating rounds (median and
+# range of the command's own timing), posts lit by their own cone, steps,
+# and the same shadow map from every N and both methods.
 #
 #   /usr/bin/python3 scripts/viewshed_vs_gdal.py [BUILD]
 import os
@@ -93,25 +96,33 @@ def main():
     ax.set_ylabel("row")
     fig.tight_layout()
     fig.savefig(os.path.join(out, "viewshed_vs_gdal.png"), dpi=100)
-    # shadows per N
+    # shadows per N: the cones (directional) against the exact ray cell by
+    # cell (incremental), alternating rounds, the same map from each
     first = None
     for nsec in (8, 24, 64):
         pk = os.path.join(out, "jacksboro_n%d.ctp" % nsec)
         subprocess.run([cli, "build", dem, "--sectors", str(nsec), "--reduce", "3", "-o", pk], check=True,
                        stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-        sh = os.path.join(out, "shadow_n%d.tif" % nsec)
-        best, line = 1e30, ""
-        for _ in range(3):
-            r = subprocess.run([cli, "shadows", pk, "--sun", "135,20", "--threads", "1", "-o", sh], check=True,
-                               capture_output=True, text=True)
-            t = float(r.stderr.strip().split()[-2])
-            if t < best:
-                best, line = t, r.stderr.strip()
-        m = gdal.Open(sh).ReadAsArray()
-        same = "reference" if first is None else ("identical" if (m == first).all() else "DIFFERENT")
+        times = {"directional": [], "incremental": []}
+        lines, maps = {}, {}
+        for k in range(5):
+            order = ("directional", "incremental") if k % 2 == 0 else ("incremental", "directional")
+            for meth in order:
+                sh = os.path.join(out, "shadow_n%d_%s.tif" % (nsec, meth))
+                r = subprocess.run([cli, "shadows", pk, "--sun", "135,20", "--method", meth, "--threads", "1",
+                                    "-o", sh], check=True, capture_output=True, text=True)
+                times[meth].append(float(r.stderr.strip().split()[-2]))
+                lines[meth] = r.stderr.strip()
+                maps[meth] = gdal.Open(sh).ReadAsArray()
+        same_methods = (maps["directional"] == maps["incremental"]).all()
         if first is None:
-            first = m
-        print("shadows N = %2d: %s -- %s map" % (nsec, line.split(": ", 1)[1], same))
+            first = maps["directional"]
+        same_n = (maps["directional"] == first).all()
+        td, ti = sorted(times["directional"]), sorted(times["incremental"])
+        print("shadows N = %2d: %s; directional %.3f s [%.3f-%.3f], incremental %.3f s [%.3f-%.3f] (%s, %s)"
+              % (nsec, lines["directional"].split(": ", 1)[1].rsplit(";", 1)[0], td[2], td[0], td[-1], ti[2], ti[0],
+                 ti[-1], "the same map from both" if same_methods else "MAPS DIFFER",
+                 "the same map as N = 8" if same_n else "A DIFFERENT MAP FROM N = 8"))
 
 
 if __name__ == "__main__":

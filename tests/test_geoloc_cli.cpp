@@ -852,8 +852,9 @@ void test_viewshed()
 // `conetrace shadows` against a ray to the sun per post by the independent
 // reference tracer (the same grid ray, from ct_ray_from_map, 0.1 m above
 // each post): lit exactly where the reference finds no hit, except ties
-// (the ray passing within 1 cm of the surface: counted); the sun below the
-// horizon is an error.
+// (the ray passing within 1 cm of the surface: counted); --method
+// incremental gives the same map; the sun below the horizon and an unknown
+// method are errors.
 void test_shadows()
 {
     Setup *s = setup();
@@ -902,7 +903,17 @@ void test_shadows()
                 if (got != ref_lit) bad++;
                 lit += ref_lit;
             }
-        std::printf("  shadows, sun %s: %ld posts lit by the reference, %ld ties, %ld disagree\n", sun, lit, ties, bad);
+        // the exact ray cell by cell gives the same map, bit for bit
+        Run inc = run({"shadows", "t.ctp", "--sun", sun, "--lift", "0.1", "--method", "incremental", "-o", "shi.tif"});
+        TEST_ASSERT_MSG(inc.code == 0, "shadows --method incremental: exit %d: %s", inc.code, inc.err.c_str());
+        const ct_host::DemRaster shi = ct_host::read_dem(g_dir + "/shi.tif");
+        TEST_ASSERT(shi.h == sh.h);
+        long own = -1;
+        const size_t at = r.err.find(" lit (");
+        TEST_ASSERT(at != std::string::npos && std::sscanf(r.err.c_str() + at, " lit (%ld by their own cone", &own) == 1);
+        std::printf("  shadows, sun %s: %ld posts lit by the reference (%ld of them by their own cone at the first "
+                    "step), %ld ties, %ld disagree; incremental: the same map\n",
+                    sun, lit, own, ties, bad);
         TEST_ASSERT_EQUAL_INT(0, bad);
         TEST_ASSERT(ties * 10 < d.w * d.h && lit > 0);
     }
@@ -910,7 +921,10 @@ void test_shadows()
     TEST_ASSERT(below.code != 0 && below.err.find("below the horizon") != std::string::npos);
     Run nosun = run({"shadows", "t.ctp", "-o", "sh.tif"});
     TEST_ASSERT(nosun.code != 0 && nosun.err.find("needs --sun") != std::string::npos);
+    Run meth = run({"shadows", "t.ctp", "--sun", "90,30", "--method", "fastest", "-o", "sh.tif"});
+    TEST_ASSERT(meth.code != 0 && meth.err.find("unknown method 'fastest'") != std::string::npos);
     fs::remove(g_dir + "/sh.tif");
+    fs::remove(g_dir + "/shi.tif");
     fs::remove(g_dir + "/sh.png");
 }
 
