@@ -76,7 +76,7 @@ const UsageBlock kUsage[] = {
      "                 chunk of pixels when there are 256 or more (auto); --earth-radius: a sphere)\n"},
     {"viewshed",
      "conetrace viewshed PKG --observer E,N,H [--target-height M] [--radius M] [--effects LIST]\n"
-     "                   [--margin M] [--threads T] -o vs.tif [--png vs.png]\n"
+     "                   [--earth-radius M] [--margin M] [--threads T] -o vs.tif [--png vs.png]\n"
      "                   (H above the surface; every post by the library's exact line of sight)\n"},
     {"shadows",
      "conetrace shadows PKG --sun AZ,EL [--lift M] [--method M] [--threads T] -o shadow.tif [--png shadow.png]\n"

@@ -1,16 +1,19 @@
 // cmd_viewshed.cpp -- `conetrace viewshed`: which posts an observer sees.
 //
 //   conetrace viewshed PKG --observer E,N,H [--target-height M] [--radius M]
-//                      [--effects LIST] [--margin M] [--threads T]
-//                      -o vs.tif [--png vs.png]
+//                      [--effects LIST] [--earth-radius M] [--margin M]
+//                      [--threads T] -o vs.tif [--png vs.png]
 //
 // The observer stands at map point (E, N), H metres above the surface there
 // (as gdal_viewshed's -oz); every post (i, j) within --radius metres
 // (horizontally; default: the whole tile) is a target at the post's height
 // plus --target-height (default 0, as -tz), and is visible when the flight
 // library's ct_los finds nothing of the surface more than --margin (default
-// 0.01 m) before it -- the exact line of sight on the bilinear surface, with
-// --effects curvature,refraction as the sphere model (R 6371 km, k 0.13).
+// 0.01 m) before it -- the exact line of sight on the bilinear surface.
+// --effects curvature,refraction bends it as geolocation does (k 0.13): on
+// a UTM package the true Earth (the line of sight straight in Earth-fixed
+// space; a ct_earth_map fitted once around the observer), elsewhere or with
+// --earth-radius M the sphere of that radius (default 6371 km).
 // vs.tif: a GeoTIFF on the package's grid and CRS, 1 visible, 0 hidden, 255
 // (nodata) beyond the radius.  --png: the picture over the hillshade (warm:
 // seen, blue: hidden, grey: out of range; the observer a white dot).
@@ -51,18 +54,28 @@ class Shortcut {
 public:
     static constexpr double kSafety = 0.25;  // metres
 
-    Shortcut(const ct_package &p, const Terrain &t, const int64_t A[3], const ct_effects &fx, double margin,
-             double target_height)
+    // true_earth: ct_los follows the true Earth; the proof then uses the
+    // sphere of 6371 km with room for the difference (below)
+    Shortcut(const ct_package &p, const Terrain &t, const int64_t A[3], const ct_effects &fx, bool true_earth,
+             double margin, double target_height)
         : t_(t), margin_(margin), th_(target_height)
     {
         int64_t x, y, z;
         on_ = ct_map_to_grid(&p, A[0], A[1], A[2], &x, &y, &z) == CT_OK;
         ax_ = x / 65536.0, ay_ = y / 65536.0, ha_ = A[2] * 1e-9;
         pe_ = p.posting_e_nm * 1e-9;
-        double c = 0;
-        if (fx.flags & CT_EFFECT_CURVATURE) c = 1.0 - ((fx.flags & CT_EFFECT_REFRACTION) ? fx.refraction_k_q16 / 65536.0 : 0);
-        if (c < 0 || fx.earth_radius_nm <= 0) on_ = false;  // not the sphere model: ct_los decides every post
-        lower_ = on_ && c > 0 ? c * pe_ * pe_ / (2.0 * (fx.earth_radius_nm * 1e-9)) : 0.0;
+        const double k = (fx.flags & CT_EFFECT_REFRACTION) ? fx.refraction_k_q16 / 65536.0 : 0.0;
+        const double c = ((fx.flags & CT_EFFECT_CURVATURE) ? 1.0 : 0.0) - k;
+        if (c < 0) on_ = false;  // ct_los refuses these effects: it decides (refuses) every post
+        const double R = true_earth ? CT_EARTH_RADIUS_NM * 1e-9 : (fx.earth_radius_nm ? fx.earth_radius_nm : CT_EARTH_RADIUS_NM) * 1e-9;
+        lower_ = c > 0 ? c * pe_ * pe_ / (2.0 * R) : 0.0;
+        // The true Earth against that sphere: the radii of curvature of
+        // WGS84 (6,335-6,400 km) within 0.6 % of 6,371 km, UTM's scale
+        // (0.9996-1.001 in a zone) within 0.2 % on rho^2, the terms of
+        // higher order within rho / R: 2 % + rho / R of the drop, twice
+        // over, is the room the proof leaves
+        rel_ = true_earth ? 0.02 : 0.0;
+        per_cell_ = true_earth ? pe_ / R : 0.0;
     }
 
     bool hides(int i, int j, double qx, double qy) const
@@ -78,12 +91,13 @@ public:
         const double s = (1 - fy) * ((1 - fx) * post(ci, cj) + fx * post(ci + 1, cj)) +
                          fy * ((1 - fx) * post(ci, cj + 1) + fx * post(ci + 1, cj + 1));
         const double drop_b = lower_ * l2, hb = post(i, j) + th_;
+        const double room = kSafety + 2 * drop_b * (rel_ + per_cell_ * std::sqrt(l2));
         const double seg = ha_ + tt * (hb - drop_b - ha_);
-        if (s - lower_ * tt * tt * l2 - seg < kSafety) return false;
+        if (s - lower_ * tt * tt * l2 - seg < room) return false;
         // the first hit lies within tt |AB| + drop_b / 4 of A (the bent
         // segment sags below the chord by at most a quarter of drop_b)
         const double ab = std::sqrt(l2 * pe_ * pe_ + (hb - ha_) * (hb - ha_));
-        return tt * ab + drop_b / 4 + kSafety < ab - margin_;
+        return tt * ab + drop_b / 4 + room < ab - margin_;
     }
 
 private:
@@ -91,7 +105,7 @@ private:
     const Terrain &t_;
     double margin_, th_;
     bool on_ = false;
-    double ax_ = 0, ay_ = 0, ha_ = 0, pe_ = 0, lower_ = 0;
+    double ax_ = 0, ay_ = 0, ha_ = 0, pe_ = 0, lower_ = 0, rel_ = 0, per_cell_ = 0;
 };
 
 }  // namespace
@@ -100,7 +114,7 @@ int cmd_viewshed(int argc, char **argv)
 {
     CmdLine args;
     const std::string err = parse_cmdline(argc, argv, 2,
-                                          {"--observer", "--target-height", "--radius", "--effects", "--margin",
+                                          {"--observer", "--target-height", "--radius", "--effects", "--earth-radius", "--margin",
                                            "--threads", "-o", "--png"},
                                           {}, false, &args);
     if (!err.empty()) throw Error("viewshed: " + err);
@@ -131,8 +145,14 @@ int cmd_viewshed(int argc, char **argv)
     const double margin = opt.count("--margin") ? number("--margin", opt["--margin"], 0, 1e4,
                                                          "a length in metres in [0, 1e4]")
                                                 : 0.01;
-    ct_effects fx = {0u, CT_REFRACTION_K_STD_Q16, CT_EARTH_RADIUS_NM, 0, nullptr};
+    // radius 0: the true Earth on UTM packages (the sphere of 6371 km on others)
+    ct_effects fx = {0u, CT_REFRACTION_K_STD_Q16, 0, 0, nullptr};
     if (opt.count("--effects")) fx.flags = effects_from_list(opt["--effects"]);
+    if (opt.count("--earth-radius")) {
+        if (!fx.flags) throw Error("--earth-radius needs --effects curvature and/or refraction");
+        fx.earth_radius_nm = std::llround(number("--earth-radius", opt["--earth-radius"], 1100, 1.8e7,
+                                                 "a radius in metres in [1100, 1.8e7]") * 1e9);
+    }
     const int threads = opt.count("--threads") ? threads_option(opt["--threads"], "viewshed") : 0;
 
     const std::string &path = args.pos[0];
@@ -154,7 +174,19 @@ int cmd_viewshed(int argc, char **argv)
     const int64_t A[3] = {oe, on, gh + std::llround(ob[2] * 1e9)};
     // every post: hidden by a neighbour's blocking point when that proves it
     // (Shortcut), else decided by ct_los
-    const Shortcut sc(p, t, A, fx, margin, th);
+    // the true Earth: its map fitted once around the observer, over the tile
+    ct_utm zone;
+    const bool true_earth = (fx.flags & CT_EFFECT_CURVATURE) && fx.earth_radius_nm == 0 &&
+                            ct_utm_zone_of_epsg((int32_t)p.epsg, &zone) == CT_OK;
+    ct_earth_map emap;
+    if (true_earth) {
+        double far = 0;
+        for (int c = 0; c < 4; ++c)
+            far = std::max(far, std::hypot(E0 + (c & 1 ? W : 0) * pe - oe * 1e-9, N0 + (c & 2 ? H : 0) * pn - on * 1e-9));
+        const double reach = far + (p.hmax - p.hmin) * p.height_scale_nm * 1e-9 + ob[2] + 1000;
+        if (ct_earth_map_init(&p, A[0], A[1], A[2], std::llround(reach * 1e9), &emap) == CT_OK) fx.earth_map = &emap;
+    }
+    const Shortcut sc(p, t, A, fx, true_earth, margin, th);
     const auto t0 = std::chrono::steady_clock::now();
     std::vector<uint8_t> vis((size_t)W * H, 255);
     long seen = 0, hidden = 0, errors = 0, proved = 0;
@@ -231,7 +263,12 @@ int cmd_viewshed(int argc, char **argv)
     const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (errors) throw Error("viewshed: " + std::to_string(errors) + " posts could not be decided");
     write_geotiff(opt["-o"], W, H, std::vector<double>(vis.begin(), vis.end()), SampleType::UInt16, t.geo, true, 255);
-    std::fprintf(stderr, "viewshed: observer (%.3f, %.3f) %.3f m above the surface (h %.3f m); %ld posts seen, %ld "
+    const double R_m = (fx.earth_radius_nm ? fx.earth_radius_nm : CT_EARTH_RADIUS_NM) * 1e-9;
+    const std::string model = !(fx.flags & CT_EFFECT_CURVATURE) && !(fx.flags & CT_EFFECT_REFRACTION) ? "straight"
+                              : true_earth ? std::string("the true Earth") + (fx.earth_map ? ", its map fitted once" : "")
+                                           : "the sphere of " + std::to_string((long)std::lround(R_m / 1000)) + " km";
+    std::fprintf(stderr, "viewshed: %s; ", model.c_str());
+    std::fprintf(stderr, "observer (%.3f, %.3f) %.3f m above the surface (h %.3f m); %ld posts seen, %ld "
                          "hidden (%ld by a neighbour's blocking point), %ld out of range; %.2f s\n",
                  ob[0], ob[1], ob[2], A[2] * 1e-9, seen, hidden, proved, (long)W * H - seen - hidden, secs);
     if (opt.count("--png")) {

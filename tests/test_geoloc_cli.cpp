@@ -738,24 +738,37 @@ void test_geoloc_tolerance()
 // (1 cm) before the post.  Identical except ties (the segment within 1 cm
 // of the surface before the margin, or the first hit within 1 cm of it:
 // counted); straight and with curvature and refraction (the sphere, as the
-// reference's bent segment); plus the GeoTIFF's georeference and the errors.
+// reference's bent segment; and on a UTM copy of the DEM the true Earth,
+// which differs from the sphere by far less than the ties over this 2 km
+// tile); every post also exactly as ct_los decides it (the posts the
+// command proves hidden from a neighbour's blocking point included); plus
+// the GeoTIFF's georeference and the errors.
 void test_viewshed()
 {
+    static const char *const kLabel[3] = {"", " (curvature, refraction: the sphere)",
+                                          " (curvature, refraction: the true Earth)"};
     Setup *s = setup();
     TEST_ASSERT(s != nullptr);
-    const ct_package &p = s->p;
     const ref::Dem d = dem_cases::ref_dem(s->c.t);
-    const ref::ld pe = std::fabs(p.posting_e_nm * 1e-9L), pn = std::fabs(p.posting_n_nm * 1e-9L),
-                  hs = p.height_scale_nm * 1e-9L;
-    for (int bent = 0; bent < 2; ++bent)
+    const ref::ld pe = std::fabs(s->p.posting_e_nm * 1e-9L), pn = std::fabs(s->p.posting_n_nm * 1e-9L),
+                  hs = s->p.height_scale_nm * 1e-9L;
+    // the same terrain on UTM zone 17N: --effects is the true Earth there
+    ct_host::Terrain tu = s->c.t;
+    tu.geo.epsg = 32617;
+    const dem_cases::Case cu = dem_cases::make_case("cli-utm", tu, 8, 1);
+    spit(g_dir + "/tu.ctp", std::string(cu.pkg.begin(), cu.pkg.end()));
+    ct_package pu;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_package_open(&pu, cu.pkg.data(), cu.pkg.size()));
+    for (int bent = 0; bent < 3; ++bent)  // straight, the sphere, the true Earth
         for (int oi : {20, 41}) {
+            const ct_package &p = bent == 2 ? pu : s->p;
             const int oj = oi == 20 ? 30 : 12;
             int64_t e, n, h;
             TEST_ASSERT_EQUAL_INT(CT_OK, ct_grid_to_map(&p, (int64_t)oi << 16, (int64_t)oj << 16, 0, &e, &n, &h));
             char obs[96];
             std::snprintf(obs, sizeof obs, "%.9f,%.9f,5", e * 1e-9, n * 1e-9);
-            std::vector<std::string> args = {"viewshed", "t.ctp", "--observer", obs, "--target-height", "1.75",
-                                             "-o", "vs.tif", "--png", "vs.png"};
+            std::vector<std::string> args = {"viewshed", bent == 2 ? "tu.ctp" : "t.ctp", "--observer", obs,
+                                             "--target-height", "1.75", "-o", "vs.tif", "--png", "vs.png"};
             if (bent) {
                 args.push_back("--effects");
                 args.push_back("curvature,refraction");
@@ -777,7 +790,22 @@ void test_viewshed()
                 TEST_ASSERT_EQUAL_INT(CT_OK, ct_grid_to_map(&p, gx, gy, gz, &ge, &gn, &gh));
                 const int64_t A[3] = {e, n, gh + 5000000000};
                 ct_effects fx = {bent ? CT_EFFECT_CURVATURE | CT_EFFECT_REFRACTION : 0u, CT_REFRACTION_K_STD_Q16,
-                                 CT_EARTH_RADIUS_NM, 0, nullptr};
+                                 bent == 2 ? 0 : CT_EARTH_RADIUS_NM, 0, nullptr};
+                ct_earth_map emap;
+                if (bent == 2) {
+                    // the command's map: fitted once around the observer, out to
+                    // the tile's farthest corner, its relief, the observer's
+                    // height and a kilometre
+                    const double qe = p.posting_e_nm * 1e-9, qn = p.posting_n_nm * 1e-9;
+                    double far = 0;
+                    for (int c = 0; c < 4; ++c)
+                        far = std::max(far, std::hypot(p.origin_e_nm * 1e-9 + (c & 1 ? d.w : 0) * qe - e * 1e-9,
+                                                       p.origin_n_nm * 1e-9 + (c & 2 ? d.h : 0) * qn - n * 1e-9));
+                    const double reach = far + (p.hmax - p.hmin) * p.height_scale_nm * 1e-9 + 5 + 1000;
+                    TEST_ASSERT_EQUAL_INT(CT_OK, ct_earth_map_init(&p, A[0], A[1], A[2], std::llround(reach * 1e9), &emap));
+                    fx.earth_map = &emap;
+                    TEST_ASSERT(r.err.find("viewshed: the true Earth, its map fitted once;") != std::string::npos);
+                }
                 long differ = 0;
                 for (int j = 0; j < d.h; ++j)
                     for (int i = 0; i < d.w; ++i) {
@@ -795,7 +823,7 @@ void test_viewshed()
                 const size_t at = r.err.find(" hidden (");
                 TEST_ASSERT(at != std::string::npos && std::sscanf(r.err.c_str() + at, " hidden (%ld", &proved) == 1);
                 std::printf("  viewshed%s from post (%d, %d): %ld posts proved hidden without ct_los, %ld differ from "
-                            "ct_los\n", bent ? " (curvature, refraction)" : "", oi, oj, proved, differ);
+                            "ct_los\n", kLabel[bent], oi, oj, proved, differ);
                 TEST_ASSERT_EQUAL_INT(0, differ);
                 TEST_ASSERT(proved > 0);
             }
@@ -834,7 +862,7 @@ void test_viewshed()
                     seen += ref_seen;
                 }
             std::printf("  viewshed%s from post (%d, %d), 5 m up, targets 1.75 m: %ld posts seen by the reference, %ld "
-                        "ties, %ld disagree\n", bent ? " (curvature, refraction)" : "", oi, oj, seen, ties, bad);
+                        "ties, %ld disagree\n", kLabel[bent], oi, oj, seen, ties, bad);
             TEST_ASSERT_EQUAL_INT(0, bad);
             TEST_ASSERT(ties * 10 < d.w * d.h && seen > 50);
         }
@@ -843,6 +871,8 @@ void test_viewshed()
     TEST_ASSERT(off.code != 0 && off.err.find("is not over the tile") != std::string::npos);
     Run rad = run({"viewshed", "t.ctp", "--observer", "500000,4000000,3", "--radius", "0", "-o", "vs.tif"});
     TEST_ASSERT(rad.code != 0 && rad.err.find("--radius needs") != std::string::npos);
+    Run radius = run({"viewshed", "t.ctp", "--observer", "500000,4000000,3", "--earth-radius", "6e6", "-o", "vs.tif"});
+    TEST_ASSERT(radius.code != 0 && radius.err.find("--earth-radius needs --effects") != std::string::npos);
     Run noobs = run({"viewshed", "t.ctp", "-o", "vs.tif"});
     TEST_ASSERT(noobs.code != 0 && noobs.err.find("needs --observer") != std::string::npos);
     fs::remove(g_dir + "/vs.tif");
