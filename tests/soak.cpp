@@ -1,4 +1,4 @@
-// soak.cpp -- `make soak`: many seeded rays on freshly generated terrain,
+// soak.cpp -- `make soak`: many seeded rays and pixels on freshly generated terrain,
 // every result judged against the long-double reference (judge.hpp), the
 // four methods compared with each other and the iteration bounds checked.
 // Time-boxed; not part of `make test`.
@@ -7,7 +7,8 @@
 // same cut into terraces (cliffs), or one of the adversarial DEMs, of a
 // random size (9..160 posts a side) and height range (1..60,000 codes),
 // built with a random N in {1, 3, 8, 24} and r in {1, 2, 3}; 4,000 rays of
-// every family per terrain.
+// every family per terrain, and 4,000 pixels of a camera posed over it
+// (soak_pixels).
 //
 // Usage: ct_soak [--rays N] [--seconds S] [--threads T] [--seed K]
 // (defaults: 10^7 rays, 1,800 s, all cores, seed 1).  Exit 1 when any
@@ -34,6 +35,9 @@ namespace {
 struct Counts {
     long terrains = 0, rays = 0, hits = 0, misses = 0, below = 0, tangent = 0, wrong = 0, differ = 0, bound = 0,
          errors = 0;
+    // pixels: geolocated with each method; their grid ray formed again from
+    // the pose and ct_geo (ct_ray_from_map) and traced must give the same hit
+    long pixels = 0, pixel_hits = 0, pixel_unprojected = 0, pixel_retrace_differ = 0;
     long tangent_by[dem_cases::FAMILY_COUNT] = {};
     long tangent_both_hit = 0; // both hit, positions apart by more than judge::POS_TOL_Q16
     double worst_xy = 0, worst_z = 0; // the largest such distances (Q16)
@@ -53,6 +57,10 @@ struct Counts {
         differ += o.differ;
         bound += o.bound;
         errors += o.errors;
+        pixels += o.pixels;
+        pixel_hits += o.pixel_hits;
+        pixel_unprojected += o.pixel_unprojected;
+        pixel_retrace_differ += o.pixel_retrace_differ;
     }
 };
 
@@ -93,6 +101,38 @@ dem_cases::Case make_terrain(uint64_t seed, const std::vector<dem_cases::Case> &
     return dem_cases::make_case(names[kind], dem_cases::make_terrain(w, h, z, 0.5), N, R);
 }
 
+// One traced result judged against the reference: counts, and a line for
+// a wrong one.  f == FAMILY_COUNT: a pixel's ray.
+void judge_one(const dem_cases::Case &cs, const ref::Dem &d, uint64_t seed, const char *what, int f, const ct_ray &ray,
+               const ct_prepared &pr, ct_status s0, const ct_hit &h0, Counts *c)
+{
+    ref::Hit rh;
+    double err = 0;
+    const judge::Verdict v = judge::judge(d, pr, s0, h0, &rh, &err);
+    c->hits += s0 == CT_HIT || s0 == CT_HIT_VOID;
+    c->misses += s0 == CT_MISS;
+    c->below += s0 == CT_BELOW;
+    if (v == judge::TANGENT) {
+        c->tangent++;
+        if (f < dem_cases::FAMILY_COUNT) c->tangent_by[f]++;
+        if ((s0 == CT_HIT || s0 == CT_HIT_VOID) && rh.status == ref::HIT) {
+            c->tangent_both_hit++;
+            c->worst_xy = std::max({c->worst_xy, std::fabs((double)(h0.x_q16 - rh.x * 65536)),
+                                    std::fabs((double)(h0.y_q16 - rh.y * 65536))});
+            c->worst_z = std::max(c->worst_z, std::fabs((double)(h0.z_q16 - rh.z * 65536)));
+        }
+    }
+    if (v == judge::WRONG) {
+        c->wrong++;
+        std::lock_guard<std::mutex> g(g_print);
+        std::printf("  WRONG: terrain %s (seed %llu, %d x %d, N %d, r %d), %s, ray (%lld, %lld, %lld) "
+                    "(%lld, %lld, %lld): status %d, reference %d\n",
+                    cs.name.c_str(), (unsigned long long)seed, cs.t.width, cs.t.height, cs.opt.sectors, cs.opt.reduce,
+                    what, (long long)ray.x_q16, (long long)ray.y_q16, (long long)ray.z_q16, (long long)ray.dx,
+                    (long long)ray.dy, (long long)ray.dz, s0, (int)rh.status);
+    }
+}
+
 void soak_terrain(const dem_cases::Case &cs, uint64_t seed, long nrays, Counts *c)
 {
     ct_package p;
@@ -131,32 +171,94 @@ void soak_terrain(const dem_cases::Case &cs, uint64_t seed, long nrays, Counts *
             if (h[m].iters > (m == CT_METHOD_HIERARCHICAL ? bound_hier : bound_cells)) c->bound++;
         }
         for (int m = 1; m < 4; ++m) c->differ += !same(s[m], h[m], s[0], h[0]);
-        ref::Hit rh;
-        double err = 0;
-        const judge::Verdict v = judge::judge(d, pr, s[0], h[0], &rh, &err);
-        c->hits += s[0] == CT_HIT || s[0] == CT_HIT_VOID;
-        c->misses += s[0] == CT_MISS;
-        c->below += s[0] == CT_BELOW;
-        if (v == judge::TANGENT) {
-            c->tangent++;
-            c->tangent_by[f]++;
-            if ((s[0] == CT_HIT || s[0] == CT_HIT_VOID) && rh.status == ref::HIT) {
-                c->tangent_both_hit++;
-                c->worst_xy = std::max({c->worst_xy, std::fabs((double)(h[0].x_q16 - rh.x * 65536)),
-                                        std::fabs((double)(h[0].y_q16 - rh.y * 65536))});
-                c->worst_z = std::max(c->worst_z, std::fabs((double)(h[0].z_q16 - rh.z * 65536)));
-            }
+        judge_one(cs, d, seed, dem_cases::family_name(f), f, ray, pr, s[0], h[0], c);
+    }
+}
+
+// Pixels: a pinhole camera (640 x 480, focal length 150..1500 px) at a
+// random point above or beside the terrain (up to 5 km above its top)
+// looking at a random point of its surface (roll -30..30 deg), npx random
+// pixels geolocated
+// (straight lines of sight) with each method: the four identical; the
+// pixel's grid ray formed again from the pose centre and ct_geo's map
+// direction by ct_ray_from_map and traced gives the same hit, bit for bit;
+// and that ray judged against the reference as the rays are.
+void soak_pixels(const dem_cases::Case &cs, uint64_t seed, long npx, Counts *c)
+{
+    ct_package p;
+    if (ct_package_open(&p, cs.pkg.data(), cs.pkg.size()) != CT_OK) {
+        c->errors++;
+        return;
+    }
+    const ref::Dem d = dem_cases::ref_dem(cs.t);
+    double lo, hi;
+    dem_cases::minmax(cs.t, &lo, &hi);
+    ct_rng rng;
+    ct_rng_seed(&rng, seed * 40503u + 99u);
+    const ct_lens lens = dem_cases::centred_pinhole(640, 480, ct_rng_range(&rng, 150, 1500));
+    ct_camera cam;
+    if (ct_camera_init(&cam, &lens) != CT_OK) {
+        c->errors++;
+        return;
+    }
+    // the centre: anywhere over the tile or up to half its size beside it,
+    // looking at a random point of the surface (so most pixels see terrain)
+    const double gx = (ct_rng_unit(&rng) * 2 - 0.5) * (cs.t.width - 1), gy = (ct_rng_unit(&rng) * 2 - 0.5) * (cs.t.height - 1);
+    const double tx = ct_rng_unit(&rng) * (cs.t.width - 1), ty = ct_rng_unit(&rng) * (cs.t.height - 1);
+    const double up_m = 1 + ct_rng_unit(&rng) * 5000;
+    int64_t e, n, h, te, tn, th;
+    if (ct_grid_to_map(&p, std::llround(gx * 65536), std::llround(gy * 65536), std::llround(hi * 65536), &e, &n, &h) !=
+            CT_OK ||
+        ct_grid_to_map(&p, std::llround(tx * 65536), std::llround(ty * 65536),
+                       std::llround(dem_cases::surf(cs.t, tx, ty) * 65536), &te, &tn, &th) != CT_OK) {
+        c->errors++;
+        return;
+    }
+    h += std::llround(up_m * 1e9);
+    const double de = (te - e) * 1e-9, dn = (tn - n) * 1e-9, dh = (th - h) * 1e-9;
+    const double yaw = std::atan2(de, dn) * 180 / M_PI, pitch = std::atan2(dh, std::hypot(de, dn)) * 180 / M_PI;
+    int32_t q[4];
+    ct_pose pose;
+    if (ct_quat_from_ypr(dem_cases::deg_q61(yaw), dem_cases::deg_q61(pitch), dem_cases::deg_q61(ct_rng_unit(&rng) * 60 - 30),
+                         q) != CT_OK ||
+        ct_pose_from_map(&pose, e, n, h, q) != CT_OK) {
+        c->errors++;
+        return;
+    }
+    for (long k = 0; k < npx; ++k) {
+        const int64_t u = ct_rng_range(&rng, 0, 639 << 16), v = ct_rng_range(&rng, 0, 479 << 16);
+        ct_geo g[4];
+        ct_status s[4];
+        for (int m = 0; m < 4; ++m) s[m] = ct_geolocate(&p, &cam, &pose, (ct_method)m, nullptr, u, v, &g[m]);
+        c->pixels++;
+        for (int m = 1; m < 4; ++m) c->differ += !same(s[m], g[m].hit, s[0], g[0].hit);
+        if (s[0] == CT_ERR_RAY || s[0] == CT_ERR_LENS) continue;  // outside the lens's field: nothing to trace
+        if (s[0] < 0) {
+            c->errors++;
+            continue;
         }
-        if (v == judge::WRONG) {
-            c->wrong++;
-            std::lock_guard<std::mutex> g(g_print);
-            std::printf("  WRONG: terrain %s (seed %llu, %d x %d, N %d, r %d), family %s, ray (%lld, %lld, %lld) "
-                        "(%lld, %lld, %lld): status %d, reference %d\n",
-                        cs.name.c_str(), (unsigned long long)seed, cs.t.width, cs.t.height, cs.opt.sectors,
-                        cs.opt.reduce, dem_cases::family_name(f), (long long)ray.x_q16, (long long)ray.y_q16,
-                        (long long)ray.z_q16, (long long)ray.dx, (long long)ray.dy, (long long)ray.dz, s[0],
-                        (int)rh.status);
+        c->pixel_unprojected++;
+        ct_ray ray;
+        if (ct_ray_from_map(&p, pose.e_nm, pose.n_nm, pose.h_nm, g[0].dir_map_q39[0], g[0].dir_map_q39[1],
+                            g[0].dir_map_q39[2], &ray) != CT_OK) {
+            c->errors++;
+            continue;
         }
+        ct_hit rh;
+        const ct_status rs = ct_trace(&p, &ray, CT_METHOD_DIRECTIONAL, &rh);
+        c->pixel_retrace_differ += !same(rs, rh, s[0], g[0].hit);
+        c->pixel_hits += s[0] == CT_HIT || s[0] == CT_HIT_VOID;
+        ct_prepared pr;
+        const ct_status ps = ct_ray_prepare(&p, &ray, &pr);
+        if (ps < 0) {
+            c->errors++;
+            continue;
+        }
+        if (ps == CT_MISS) {
+            if (dem_cases::ray_crosses_box(cs.t, ray)) c->wrong++;
+            continue;
+        }
+        judge_one(cs, d, seed, "pixel", dem_cases::FAMILY_COUNT, ray, pr, s[0], g[0].hit, c);
     }
 }
 
@@ -192,21 +294,25 @@ int main(int argc, char **argv)
                 const uint64_t k = (uint64_t)next++;
                 const dem_cases::Case cs = make_terrain(seed * 1000003u + k, adv);
                 soak_terrain(cs, seed * 1000003u + k, per_terrain, &counts[w]);
+                soak_pixels(cs, seed * 1000003u + k, per_terrain, &counts[w]);
                 const long d = (done += per_terrain);
                 if (d / 200000 != (d - per_terrain) / 200000) {
                     std::lock_guard<std::mutex> g(g_print);
-                    std::printf("  %ld rays, %.0f s\n", d, elapsed());
+                    std::printf("  %ld rays and as many pixels, %.0f s\n", d, elapsed());
                 }
             }
         });
     for (auto &t : pool) t.join();
     Counts c;
     for (const Counts &x : counts) c.add(x);
-    std::printf("soak: %ld rays x 4 methods on %ld generated terrains in %.0f s (%u threads, seed %llu): %ld hits, "
-                "%ld misses, %ld below; against the reference %ld wrong, methods differing %ld, bounds exceeded %ld, "
-                "errors %ld\n",
-                c.rays, c.terrains, elapsed(), threads, (unsigned long long)seed, c.hits, c.misses, c.below, c.wrong,
-                c.differ, c.bound, c.errors);
+    std::printf("soak: %ld rays and %ld pixels x 4 methods on %ld generated terrains in %.0f s (%u threads, seed "
+                "%llu): %ld hits, %ld misses, %ld below; against the reference %ld wrong, methods differing %ld, bounds "
+                "exceeded %ld, errors %ld\n",
+                c.rays, c.pixels, c.terrains, elapsed(), threads, (unsigned long long)seed, c.hits, c.misses, c.below,
+                c.wrong, c.differ, c.bound, c.errors);
+    std::printf("  pixels (one camera per terrain): %ld unprojected, %ld hit; the pixel's ray formed again from the "
+                "pose and ct_geo by ct_ray_from_map and traced: %ld differ from ct_geolocate's hit\n",
+                c.pixel_unprojected, c.pixel_hits, c.pixel_retrace_differ);
     std::printf("  disputes the judge settles as tangent (the reference's ray within 1e-6 LSB of the surface there): "
                 "%ld, of them %ld where both hit -- x and y at most %.1f Q16 apart (the stated bound: 2), z up to "
                 "%.1f (steep cells: 2 Q16 across a cliff is many codes up); by family:",
@@ -214,5 +320,5 @@ int main(int argc, char **argv)
     for (int f = 0; f < dem_cases::FAMILY_COUNT; ++f)
         std::printf(" %s %ld", dem_cases::family_name((dem_cases::Family)f), c.tangent_by[f]);
     std::printf("\n");
-    return (c.wrong || c.differ || c.bound || c.errors) ? 1 : 0;
+    return (c.wrong || c.differ || c.bound || c.errors || c.pixel_retrace_differ) ? 1 : 0;
 }

@@ -1,5 +1,6 @@
 /*
- * bend.h -- bent-ray helpers shared by bend.c and geoloc.c (private).
+ * bend.h -- tracer helpers shared by trace.c, bend.c and geoloc.c (private):
+ * bent rays, the lowered terrain, the grid direction of a map direction.
  */
 #ifndef CT_BEND_H
 #define CT_BEND_H
@@ -9,6 +10,11 @@
 #ifdef __cplusplus
 extern "C" {
 #endif
+
+/* The grid direction of a map direction (|.| <= 2^40, not all 0), as
+ * ct_ray_from_map forms it (trace.c); geolocation uses it so that a pixel's
+ * grid ray is ct_ray_from_map's of the pose centre and ct_geo.dir_map_q39. */
+void ct_grid_dir_from_map(const ct_package *p, int64_t de, int64_t dn, int64_t dh, int64_t d[3]);
 
 /* Check *bd's ranges (ct_bend) and compute the polyline's segment length
  * Delta = sqrt(8 chord R / |c|) in Q16 fine cells of pkg (0 when c = 0).

@@ -10,16 +10,12 @@
  * resulting segment length) are checked once per call (ct_bend_segment),
  * so a bad parameter is CT_ERR_EFFECTS for the call, never per pixel.
  *
- * Grid direction: as ct_ray_from_map, (dE s_e, dN s_n, dh |p_e|) with
- * s_e = sign(p_e) * scale, s_n = sign(p_n) * scale (scale = height_scale_nm,
- * p = posting_nm), i.e. (dE / p_e, dN / p_n, dh / scale) times
- * |p_e| * scale.  |d| < 2^40 (Q39 unit vector) and |s| < 2^b: the products
- * are formed in 128 bits and shifted right by one common `shift`, chosen
- * once per call so that 2^(40 + b) / 2^shift <= 2^62 (ct_ray's range), and
- * rounded half up: each component is within 1/2 of its exact value while
- * the largest is >= 2^60 min|s| / max|s| / sqrt(3), so the direction keeps
- * a relative precision of ~2^-58 max|s| / min|s| (far below the tracer's
- * own 2^-25 direction quantisation).
+ * Grid ray: ct_ray_from_map's from the pose centre along the pixel's map
+ * direction (ct_geo.dir_map_q39, a Q39 unit vector): the centre converted
+ * once per call, the direction per pixel by ct_grid_dir_from_map, so a
+ * pixel's ray can be formed again from the pose and ct_geo alone (the pixel
+ * soak does) and keeps ct_ray_from_map's precision (each component exact,
+ * or within 1/2 of its exact value with the largest above 2^61).
  */
 #include "bend.h"
 #include "fixed.h"
@@ -27,8 +23,6 @@
 
 typedef struct {
     int64_t ox, oy, oz;   /* camera centre, grid frame, Q16 */
-    int64_t sx, sy, sz;   /* direction scale factors        */
-    unsigned shift;       /* common right shift (0..63)     */
     ct_bend bend;         /* coeff_q16 == 0: straight rays  */
     ct_bent_setup bent;   /* the bend for this observer     */
     int earth;            /* 1: the true Earth (earth.c)    */
@@ -86,8 +80,6 @@ ct_status ct_effects_to_bend(const ct_package *p, const ct_effects *fx, ct_bend 
 static ct_status setup(const ct_package *p, const ct_camera *cam, const ct_pose *pose, ct_method m,
                        const ct_effects *effects, geo_setup *s)
 {
-    int64_t big;
-    unsigned b = 0u;
     if (p == NULL || cam == NULL || pose == NULL || cam->ready == 0u || pose->ready == 0u) {
         return CT_ERR_ARG;
     }
@@ -102,15 +94,6 @@ static ct_status setup(const ct_package *p, const ct_camera *cam, const ct_pose 
         ct_abs64(s->oz) > CT_MAX_ORIGIN_Q16) {
         return CT_ERR_RAY;
     }
-    s->sx = p->posting_e_nm < 0 ? -p->height_scale_nm : p->height_scale_nm;
-    s->sy = p->posting_n_nm < 0 ? -p->height_scale_nm : p->height_scale_nm;
-    s->sz = ct_abs64(p->posting_e_nm);
-    big = ct_max64(p->height_scale_nm, s->sz);
-    /* bound: 63 bits */
-    while (b < 63u && (big >> b) != 0) {
-        b++;
-    }
-    s->shift = b + 40u > 62u ? b + 40u - 62u : 0u;
     s->earth = 0;
     if (effects != NULL && (effects->flags & CT_EFFECT_CURVATURE) != 0u && effects->earth_radius_nm == 0) {
         /* the true Earth on a package on a UTM zone (CT_ERR_CRS: another
@@ -131,12 +114,6 @@ static ct_status setup(const ct_package *p, const ct_camera *cam, const ct_pose 
         return CT_ERR_EFFECTS; /* checked by ct_effects_to_bend already */
     }
     return CT_OK;
-}
-
-/* d * s / 2^shift, rounded: |d| < 2^40, |s| < 2^b, result <= 2^62. */
-static int64_t scale_dir(int64_t d, int64_t s, unsigned shift)
-{
-    return shift == 0u ? d * s : ct_mul_shr(d, s, shift);
 }
 
 /* ts != NULL: trace over the tile set (p is its frame). */
@@ -166,12 +143,16 @@ static ct_status one_pixel(const ct_package *p, ct_tileset *ts, const ct_camera 
         ct_pose_rotate_grid(pose, out->ray_cam_q30, dg);
         st = ct_trace_earth_set(p, ts, &s->es, dg, m, &out->hit);
     } else if (st == CT_OK) {
+        /* ct_ray_from_map's ray from the pose centre along dir_map_q39
+         * (|.| <= 2^39, a unit vector: never all 0) */
+        int64_t d[3];
+        ct_grid_dir_from_map(p, out->dir_map_q39[0], out->dir_map_q39[1], out->dir_map_q39[2], d);
         ray.x_q16 = s->ox;
         ray.y_q16 = s->oy;
         ray.z_q16 = s->oz;
-        ray.dx = scale_dir(out->dir_map_q39[0], s->sx, s->shift);
-        ray.dy = scale_dir(out->dir_map_q39[1], s->sy, s->shift);
-        ray.dz = scale_dir(out->dir_map_q39[2], s->sz, s->shift);
+        ray.dx = d[0];
+        ray.dy = d[1];
+        ray.dz = d[2];
         if (ts != NULL) {
             st = s->bend.coeff_q16 == 0 ? ct_tileset_trace(ts, &ray, m, &out->hit)
                                         : ct_trace_bent_set_ts(p, ts, &ray, &s->bent, m, &out->hit);

@@ -2019,12 +2019,51 @@ ct_status ct_map_to_grid(const ct_package *p, int64_t e, int64_t n, int64_t hh,
     return round_div(ct_i128_shl(ct_i128_from64(hh - p->height_offset_nm), 16), p->height_scale_nm, z);
 }
 
+/* The grid direction of a map direction (|.| <= 2^40), shared by
+ * ct_ray_from_map and geolocation (geoloc.c): (de, dn, dh) scaled by
+ * (scale sgn(pe), scale sgn(pn), |pe|) -- proportional to (de/pe, dn/pn,
+ * dh/scale), < 2^40 * 2^50 in 128 bits -- then divided by the least 2^s
+ * (s <= 60) that brings every component to |.| <= 2^62, rounded half away
+ * from zero. */
+void ct_grid_dir_from_map(const ct_package *p, int64_t de, int64_t dn, int64_t dh, int64_t d[3])
+{
+    ct_i128 v[3];
+    ct_i128 top = ct_i128_from64(0);
+    unsigned s = 0u, len;
+    int k;
+    v[0] = ct_i128_mul(de, p->posting_e_nm < 0 ? -p->height_scale_nm : p->height_scale_nm);
+    v[1] = ct_i128_mul(dn, p->posting_n_nm < 0 ? -p->height_scale_nm : p->height_scale_nm);
+    v[2] = ct_i128_mul(dh, ct_abs64(p->posting_e_nm));
+    for (k = 0; k < 3; ++k) { /* bound: 3 axes */
+        ct_i128 a = ct_i128_abs(v[k]);
+        if (ct_i128_cmp(a, top) > 0) {
+            top = a;
+        }
+    }
+    /* top < 2^len: s = len - 63 unless top exceeds 2^(62 + s), then one more */
+    len = ct_i128_bits(top);
+    if (len > 62u) {
+        s = len > 63u ? len - 63u : 0u;
+        if (ct_i128_cmp(top, ct_i128_shl(ct_i128_from64(INT64_C(1) << 62), s)) > 0) {
+            s++;
+        }
+        s = s > 60u ? 60u : s;
+    }
+    for (k = 0; k < 3; ++k) { /* bound: 3 axes */
+        if (s == 0u) {
+            d[k] = ct_i128_to64(v[k]);
+        } else {
+            ct_i128 a = ct_i128_abs(v[k]);
+            int64_t q = ct_i128_floor_div(ct_i128_add(a, ct_i128_shl(ct_i128_from64(1), s - 1u)), INT64_C(1) << s);
+            d[k] = ct_i128_sign(v[k]) < 0 ? -q : q;
+        }
+    }
+}
+
 ct_status ct_ray_from_map(const ct_package *p, int64_t e, int64_t n, int64_t hh,
                           int64_t de, int64_t dn, int64_t dh, ct_ray *out)
 {
-    ct_status st;
-    ct_i128 v[3];
-    int k, shift = 0;
+    int64_t d[3];
     CT_ASSERT(p != NULL && out != NULL);
     if (p == NULL || out == NULL) {
         return CT_ERR_ARG;
@@ -2033,49 +2072,12 @@ ct_status ct_ray_from_map(const ct_package *p, int64_t e, int64_t n, int64_t hh,
         ct_abs64(dh) > (INT64_C(1) << 40) || (de == 0 && dn == 0 && dh == 0)) {
         return CT_ERR_RAY;
     }
-    st = ct_map_to_grid(p, e, n, hh, &out->x_q16, &out->y_q16, &out->z_q16);
-    if (st != CT_OK) {
+    if (ct_map_to_grid(p, e, n, hh, &out->x_q16, &out->y_q16, &out->z_q16) != CT_OK) {
         return CT_ERR_RAY;
     }
-    /* grid direction ~ (de/pe, dn/pn, dh/scale) * |pe| * scale:
-     * (de*scale*sgn(pe), dn*scale*sgn(pn), dh*|pe|): < 2^40 * 2^50, 128-bit */
-    v[0] = ct_i128_mul(de, p->posting_e_nm < 0 ? -p->height_scale_nm : p->height_scale_nm);
-    v[1] = ct_i128_mul(dn, p->posting_n_nm < 0 ? -p->height_scale_nm : p->height_scale_nm);
-    v[2] = ct_i128_mul(dh, ct_abs64(p->posting_e_nm));
-    /* scale down to |.| <= 2^62. bound: < 40 halvings */
-    for (;;) {
-        int big = 0;
-        for (k = 0; k < 3; ++k) {
-            ct_i128 a = ct_i128_sign(v[k]) < 0 ? ct_i128_neg(v[k]) : v[k];
-            ct_i128 lim = ct_i128_shl(ct_i128_from64(INT64_C(1) << 61), 1 + (unsigned)shift);
-            if (ct_i128_cmp(a, lim) > 0) {
-                big = 1;
-            }
-        }
-        if (!big || shift >= 60) {
-            break;
-        }
-        shift++;
-    }
-    for (k = 0; k < 3; ++k) {
-        int64_t q;
-        if (shift == 0) {
-            q = ct_i128_to64(v[k]);
-        } else {
-            ct_i128 a = ct_i128_sign(v[k]) < 0 ? ct_i128_neg(v[k]) : v[k];
-            q = ct_i128_floor_div(ct_i128_add(a, ct_i128_shl(ct_i128_from64(1), (unsigned)shift - 1u)),
-                                  INT64_C(1) << shift);
-            if (ct_i128_sign(v[k]) < 0) {
-                q = -q;
-            }
-        }
-        if (k == 0) {
-            out->dx = q;
-        } else if (k == 1) {
-            out->dy = q;
-        } else {
-            out->dz = q;
-        }
-    }
+    ct_grid_dir_from_map(p, de, dn, dh, d);
+    out->dx = d[0];
+    out->dy = d[1];
+    out->dz = d[2];
     return CT_OK;
 }
