@@ -172,8 +172,6 @@ int cmd_viewshed(int argc, char **argv)
     int64_t ge, gn, gh;
     (void)ct_grid_to_map(&p, ox, oy, gz, &ge, &gn, &gh);
     const int64_t A[3] = {oe, on, gh + std::llround(ob[2] * 1e9)};
-    // every post: hidden by a neighbour's blocking point when that proves it
-    // (Shortcut), else decided by ct_los
     // the true Earth: its map fitted once around the observer, over the tile
     ct_utm zone;
     const bool true_earth = (fx.flags & CT_EFFECT_CURVATURE) && fx.earth_radius_nm == 0 &&
@@ -186,6 +184,8 @@ int cmd_viewshed(int argc, char **argv)
         const double reach = far + (p.hmax - p.hmin) * p.height_scale_nm * 1e-9 + ob[2] + 1000;
         if (ct_earth_map_init(&p, A[0], A[1], A[2], std::llround(reach * 1e9), &emap) == CT_OK) fx.earth_map = &emap;
     }
+    // every post: hidden by a neighbour's blocking point when that proves it
+    // (Shortcut), else decided by ct_los
     const Shortcut sc(p, t, A, fx, true_earth, margin, th);
     const auto t0 = std::chrono::steady_clock::now();
     std::vector<uint8_t> vis((size_t)W * H, 255);
@@ -199,6 +199,9 @@ int cmd_viewshed(int argc, char **argv)
         // outward: the neighbour toward the observer comes first, and its
         // blocking point (grid x, y; NaN: none) is the candidate proof
         std::vector<double> prev((size_t)W * 2, NAN), cur((size_t)W * 2, NAN);
+        // (a chunk holding the observer's row runs south from its first row;
+        // its rows north of the observer then see the wrong neighbour first:
+        // fewer proofs, never a wrong one)
         const bool up = (int)e - 1 <= orow;  // the chunk lies at or north of the observer's row
         for (size_t s = 0; s < e - b; ++s) {
             const int j = up ? (int)(e - 1 - s) : (int)(b + s);
