@@ -346,7 +346,8 @@ ct_status ct_package_layout(uint32_t width, uint32_t height, uint32_t reduce,
 ct_status ct_crc32(uint32_t crc, const uint8_t *data, size_t len,
                    uint32_t *out_crc);
 
-/* Sector boundary vector k (0..N) for N sectors; |b| ~ 2^30.                */
+/* Sector boundary vector k (0..N) for N sectors; |b| ~ 2^30.  CT_ERR_ARG
+ * (NULL), CT_ERR_SECTORS (N outside [1, CT_MAX_SECTORS] or k > N).         */
 ct_status ct_sector_boundary(uint32_t sectors, uint32_t k, int32_t *bx,
                              int32_t *by);
 
@@ -356,7 +357,9 @@ ct_status ct_sector_boundary(uint32_t sectors, uint32_t k, int32_t *bx,
 ct_status ct_sector_of(const ct_package *pkg, int64_t dx, int64_t dy,
                        uint32_t *out_sector);
 
-/* Same test for an explicit boundary set (used by the builder).             */
+/* Same test for an explicit boundary set (used by the builder): *out_inside
+ * 1 when d lies in the closed wedge s.  CT_ERR_ARG (NULL, |dx| or |dy|
+ * beyond 2^30), CT_ERR_SECTORS (N outside [1, CT_MAX_SECTORS], s >= N).    */
 ct_status ct_in_wedge(const int32_t *bound_x, const int32_t *bound_y,
                       uint32_t sectors, uint32_t s, int64_t dx, int64_t dy,
                       uint32_t *out_inside);

@@ -1,0 +1,471 @@
+// test_api_args.cpp -- every public entry point of the flight library with
+// each pointer argument NULL, an object never set up, or a value outside its
+// documented range: a table of named cases, each with the status conetrace.h
+// documents for it (littlefs's test_evil style).  The other arguments are
+// valid (a small UTM package, a pinhole camera, a pose over the tile), so
+// the case's status is the answer to its one fault.  CT_TEST_VERBOSE=1
+// prints every case.
+#include <cstdlib>
+#include <cstring>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "conetrace.h"
+#include "dem_cases.hpp"
+#include "harness.h"
+
+namespace {
+
+struct World {
+    dem_cases::Case c;
+    ct_package p{};
+    ct_camera cam{};
+    ct_pose pose{};
+    ct_ray ray{};
+    ct_prepared pr{};
+    int64_t a[3] = {0, 0, 0}, b[3] = {0, 0, 0};  // two map points over the tile
+};
+
+World *world()
+{
+    static World *w = nullptr;
+    if (w) return w;
+    w = new World;
+    ct_host::Terrain t = dem_cases::make_terrain(24, 20, dem_cases::smooth(24, 20, 3, 1000, 3000), 0.25);
+    t.geo.epsg = 32617;
+    w->c = dem_cases::make_case("args", t, 8, 2);
+    if (ct_package_open(&w->p, w->c.pkg.data(), w->c.pkg.size()) != CT_OK) return nullptr;
+    const ct_lens lens = dem_cases::centred_pinhole(64, 48, 60);
+    if (ct_camera_init(&w->cam, &lens) != CT_OK) return nullptr;
+    int64_t e, n, h;
+    (void)ct_grid_to_map(&w->p, 12 << 16, 10 << 16, (int64_t)w->p.hmax << 16, &e, &n, &h);
+    int32_t q[4];
+    if (ct_quat_from_ypr(0, dem_cases::deg_q61(-60), 0, q) != CT_OK ||
+        ct_pose_from_map(&w->pose, e, n, h + 500000000000, q) != CT_OK)
+        return nullptr;
+    w->a[0] = e, w->a[1] = n, w->a[2] = h + 100000000000;
+    (void)ct_grid_to_map(&w->p, 3 << 16, 4 << 16, (int64_t)w->p.hmin << 16, &w->b[0], &w->b[1], &w->b[2]);
+    if (ct_ray_from_map(&w->p, e, n, h + 100000000000, 1 << 20, 1 << 19, -(1 << 20), &w->ray) != CT_OK) return nullptr;
+    if (ct_ray_prepare(&w->p, &w->ray, &w->pr) != CT_OK) return nullptr;
+    return w;
+}
+
+struct Case {
+    const char *name;
+    ct_status want;
+    std::function<ct_status(World &)> call;
+};
+
+const ct_method kBadMethod = (ct_method)CT_METHOD_COUNT;
+
+std::vector<Case> cases()
+{
+    std::vector<Case> v;
+    auto add = [&](const char *name, ct_status want, std::function<ct_status(World &)> f) {
+        v.push_back(Case{name, want, std::move(f)});
+    };
+    // ---- packages
+    add("package_open: pkg NULL", CT_ERR_ARG, [](World &w) { return ct_package_open(nullptr, w.c.pkg.data(), w.c.pkg.size()); });
+    add("package_open: bytes NULL", CT_ERR_ARG, [](World &w) {
+        ct_package q;
+        return ct_package_open(&q, nullptr, w.c.pkg.size());
+    });
+    add("package_open: 0 bytes", CT_ERR_TRUNCATED, [](World &w) {
+        ct_package q;
+        return ct_package_open(&q, w.c.pkg.data(), 0);
+    });
+    add("package_verify: NULL", CT_ERR_ARG, [](World &) { return ct_package_verify(nullptr); });
+    add("package_size: out NULL", CT_ERR_ARG, [](World &) { return ct_package_size(16, 16, 1, 8, 0, nullptr); });
+    add("package_size: width 1", CT_ERR_DIMS, [](World &) {
+        uint32_t s;
+        return ct_package_size(1, 16, 1, 8, 0, &s);
+    });
+    add("package_size: 0 sectors", CT_ERR_SECTORS, [](World &) {
+        uint32_t s;
+        return ct_package_size(16, 16, 1, 0, 0, &s);
+    });
+    add("package_size: r 0", CT_ERR_REDUCE, [](World &) {
+        uint32_t s;
+        return ct_package_size(16, 16, 0, 8, 0, &s);
+    });
+    add("package_layout: levels NULL", CT_ERR_ARG, [](World &) {
+        uint32_t off[CT_SEC_COUNT], size[CT_SEC_COUNT], total;
+        return ct_package_layout(16, 16, 1, 8, 0, off, size, nullptr, &total);
+    });
+    add("package_layout: sec_off NULL", CT_ERR_ARG, [](World &) {
+        uint32_t size[CT_SEC_COUNT], levels, total;
+        return ct_package_layout(16, 16, 1, 8, 0, nullptr, size, &levels, &total);
+    });
+    add("crc32: out NULL", CT_ERR_ARG, [](World &w) { return ct_crc32(0, w.c.pkg.data(), 4, nullptr); });
+    add("crc32: data NULL, len 4", CT_ERR_ARG, [](World &) {
+        uint32_t c;
+        return ct_crc32(0, nullptr, 4, &c);
+    });
+    add("sector_boundary: bx NULL", CT_ERR_ARG, [](World &) {
+        int32_t y;
+        return ct_sector_boundary(8, 0, nullptr, &y);
+    });
+    add("sector_boundary: k > N", CT_ERR_SECTORS, [](World &) {
+        int32_t x, y;
+        return ct_sector_boundary(8, 9, &x, &y);
+    });
+    add("sector_boundary: N 0", CT_ERR_SECTORS, [](World &) {
+        int32_t x, y;
+        return ct_sector_boundary(0, 0, &x, &y);
+    });
+    add("sector_of: pkg NULL", CT_ERR_ARG, [](World &) {
+        uint32_t s;
+        return ct_sector_of(nullptr, 1, 0, &s);
+    });
+    add("sector_of: out NULL", CT_ERR_ARG, [](World &w) { return ct_sector_of(&w.p, 1, 0, nullptr); });
+    add("sector_of: direction 0", CT_ERR_ARG, [](World &w) {
+        uint32_t s;
+        return ct_sector_of(&w.p, 0, 0, &s);
+    });
+    add("in_wedge: bounds NULL", CT_ERR_ARG, [](World &w) {
+        uint32_t in;
+        return ct_in_wedge(nullptr, w.p.bound_y, 8, 0, 1, 0, &in);
+    });
+    add("in_wedge: s = N", CT_ERR_SECTORS, [](World &w) {
+        uint32_t in;
+        return ct_in_wedge(w.p.bound_x, w.p.bound_y, 8, 8, 1, 0, &in);
+    });
+    add("in_wedge: direction beyond 2^30", CT_ERR_ARG, [](World &w) {
+        uint32_t in;
+        return ct_in_wedge(w.p.bound_x, w.p.bound_y, 8, 0, (INT64_C(1) << 30) + 1, 0, &in);
+    });
+    add("cot_table: out NULL", CT_ERR_ARG, [](World &) {
+        uint8_t ok[256];
+        return ct_cot_table(30000000000, 62500000, nullptr, ok);
+    });
+    add("cot_table: posting 0", CT_ERR_GEOREF, [](World &) {
+        int64_t c[256];
+        uint8_t ok[256];
+        return ct_cot_table(0, 62500000, c, ok);
+    });
+    // ---- rays
+    add("ray_prepare: pkg NULL", CT_ERR_ARG, [](World &w) {
+        ct_prepared q;
+        return ct_ray_prepare(nullptr, &w.ray, &q);
+    });
+    add("ray_prepare: ray NULL", CT_ERR_ARG, [](World &w) {
+        ct_prepared q;
+        return ct_ray_prepare(&w.p, nullptr, &q);
+    });
+    add("ray_prepare: out NULL", CT_ERR_ARG, [](World &w) { return ct_ray_prepare(&w.p, &w.ray, nullptr); });
+    add("ray_prepare: zero direction", CT_ERR_RAY, [](World &w) {
+        ct_ray r = w.ray;
+        r.dx = r.dy = r.dz = 0;
+        ct_prepared q;
+        return ct_ray_prepare(&w.p, &r, &q);
+    });
+    add("ray_prepare: origin beyond CT_MAX_ORIGIN_Q16", CT_ERR_RAY, [](World &w) {
+        ct_ray r = w.ray;
+        r.x_q16 = CT_MAX_ORIGIN_Q16 + 1;
+        ct_prepared q;
+        return ct_ray_prepare(&w.p, &r, &q);
+    });
+    add("ray_prepare_segment: out NULL", CT_ERR_ARG, [](World &w) { return ct_ray_prepare_segment(&w.p, &w.ray, nullptr); });
+    add("trace_prepared: hit NULL", CT_ERR_ARG, [](World &w) {
+        return ct_trace_prepared(&w.p, &w.pr, CT_METHOD_DIRECTIONAL, nullptr);
+    });
+    add("trace_prepared: ray NULL", CT_ERR_ARG, [](World &w) {
+        ct_hit h;
+        return ct_trace_prepared(&w.p, nullptr, CT_METHOD_DIRECTIONAL, &h);
+    });
+    add("trace_prepared: unknown method", CT_ERR_METHOD, [](World &w) {
+        ct_hit h;
+        return ct_trace_prepared(&w.p, &w.pr, kBadMethod, &h);
+    });
+    add("trace: pkg NULL", CT_ERR_ARG, [](World &w) {
+        ct_hit h;
+        return ct_trace(nullptr, &w.ray, CT_METHOD_DIRECTIONAL, &h);
+    });
+    add("trace: unknown method", CT_ERR_METHOD, [](World &w) {
+        ct_hit h;
+        return ct_trace(&w.p, &w.ray, kBadMethod, &h);
+    });
+    add("trace_bent: bend NULL", CT_ERR_ARG, [](World &w) {
+        ct_hit h;
+        return ct_trace_bent(&w.p, &w.ray, nullptr, CT_METHOD_DIRECTIONAL, &h);
+    });
+    add("trace_bent: radius below 2^40", CT_ERR_ARG, [](World &w) {
+        const ct_bend bd = {57016, INT64_C(1) << 39, CT_EFFECTS_CHORD_NM, 0u};
+        ct_hit h;
+        return ct_trace_bent(&w.p, &w.ray, &bd, CT_METHOD_DIRECTIONAL, &h);
+    });
+    add("grid_to_map: e NULL", CT_ERR_ARG, [](World &w) {
+        int64_t n, h;
+        return ct_grid_to_map(&w.p, 0, 0, 0, nullptr, &n, &h);
+    });
+    add("map_to_grid: pkg NULL", CT_ERR_ARG, [](World &) {
+        int64_t x, y, z;
+        return ct_map_to_grid(nullptr, 0, 0, 0, &x, &y, &z);
+    });
+    add("ray_from_map: out NULL", CT_ERR_ARG, [](World &w) { return ct_ray_from_map(&w.p, w.a[0], w.a[1], w.a[2], 1, 0, 0, nullptr); });
+    add("ray_from_map: direction beyond 2^40", CT_ERR_RAY, [](World &w) {
+        ct_ray r;
+        return ct_ray_from_map(&w.p, w.a[0], w.a[1], w.a[2], (INT64_C(1) << 40) + 1, 0, 0, &r);
+    });
+    add("ray_from_map: zero direction", CT_ERR_RAY, [](World &w) {
+        ct_ray r;
+        return ct_ray_from_map(&w.p, w.a[0], w.a[1], w.a[2], 0, 0, 0, &r);
+    });
+    add("surface_height: out NULL", CT_ERR_ARG, [](World &w) { return ct_surface_height(&w.p, 0, 0, nullptr); });
+    add("surface_height: off the tile", CT_ERR_RANGE, [](World &w) {
+        int64_t z;
+        return ct_surface_height(&w.p, -1, 0, &z);
+    });
+    add("status_name: out NULL", CT_ERR_ARG, [](World &) { return ct_status_name(CT_OK, nullptr); });
+    add("status_name: unknown status", CT_ERR_ARG, [](World &) {
+        const char *s;
+        return ct_status_name((ct_status)-999, &s);
+    });
+    // ---- cameras and poses
+    add("camera_init: cam NULL", CT_ERR_ARG, [](World &) {
+        const ct_lens lens = dem_cases::centred_pinhole(64, 48, 60);
+        return ct_camera_init(nullptr, &lens);
+    });
+    add("camera_init: lens NULL", CT_ERR_ARG, [](World &) {
+        ct_camera c;
+        return ct_camera_init(&c, nullptr);
+    });
+    add("camera_init: focal length 0", CT_ERR_LENS, [](World &) {
+        ct_lens lens = dem_cases::centred_pinhole(64, 48, 60);
+        lens.fx_q32 = 0;
+        ct_camera c;
+        return ct_camera_init(&c, &lens);
+    });
+    add("camera_init_grid: grid NULL", CT_ERR_ARG, [](World &) {
+        ct_camera c;
+        return ct_camera_init_grid(&c, nullptr);
+    });
+    add("camera_unproject: ray NULL", CT_ERR_ARG, [](World &w) {
+        uint32_t it;
+        return ct_camera_unproject(&w.cam, 0, 0, nullptr, &it);
+    });
+    add("camera_unproject: camera never set up", CT_ERR_ARG, [](World &) {
+        ct_camera c;
+        std::memset(&c, 0, sizeof c);
+        int32_t r[3];
+        uint32_t it;
+        return ct_camera_unproject(&c, 0, 0, r, &it);
+    });
+    add("camera_project: u NULL", CT_ERR_ARG, [](World &w) {
+        const int32_t r[3] = {0, 0, 1 << 30};
+        int64_t vv;
+        return ct_camera_project(&w.cam, r, nullptr, &vv);
+    });
+    add("pose_init: R NULL", CT_ERR_ARG, [](World &) {
+        ct_pose q;
+        return ct_pose_init(&q, nullptr, 0, 0, 0);
+    });
+    add("pose_init: not a rotation", CT_ERR_POSE, [](World &) {
+        const int32_t R[9] = {1 << 30, 0, 0, 0, 1 << 30, 0, 0, 0, -(1 << 30)};  // det -1
+        ct_pose q;
+        return ct_pose_init(&q, R, 0, 0, 0);
+    });
+    add("pose_rotate: out NULL", CT_ERR_ARG, [](World &w) {
+        const int32_t r[3] = {0, 0, 1 << 30};
+        return ct_pose_rotate(&w.pose, r, nullptr);
+    });
+    add("pose_from_map: quaternion NULL", CT_ERR_ARG, [](World &) {
+        ct_pose q;
+        return ct_pose_from_map(&q, 0, 0, 0, nullptr);
+    });
+    add("pose_from_map: quaternion far from unit", CT_ERR_POSE, [](World &) {
+        const int32_t qq[4] = {1 << 29, 0, 0, 0};
+        ct_pose q;
+        return ct_pose_from_map(&q, 0, 0, 0, qq);
+    });
+    add("quat_from_ypr: out NULL", CT_ERR_ARG, [](World &) { return ct_quat_from_ypr(0, 0, 0, nullptr); });
+    add("quat_from_ypr: yaw beyond pi", CT_ERR_RANGE, [](World &) {
+        int32_t q[4];
+        return ct_quat_from_ypr(CT_PI_Q61 + 1, 0, 0, q);
+    });
+    // ---- geolocation
+    add("geolocate: out NULL", CT_ERR_ARG, [](World &w) {
+        return ct_geolocate(&w.p, &w.cam, &w.pose, CT_METHOD_DIRECTIONAL, nullptr, 32 << 16, 24 << 16, nullptr);
+    });
+    add("geolocate: camera NULL", CT_ERR_ARG, [](World &w) {
+        ct_geo g;
+        return ct_geolocate(&w.p, nullptr, &w.pose, CT_METHOD_DIRECTIONAL, nullptr, 32 << 16, 24 << 16, &g);
+    });
+    add("geolocate: pose never set up", CT_ERR_ARG, [](World &w) {
+        ct_pose q;
+        std::memset(&q, 0, sizeof q);
+        ct_geo g;
+        return ct_geolocate(&w.p, &w.cam, &q, CT_METHOD_DIRECTIONAL, nullptr, 32 << 16, 24 << 16, &g);
+    });
+    add("geolocate: unknown method", CT_ERR_METHOD, [](World &w) {
+        ct_geo g;
+        return ct_geolocate(&w.p, &w.cam, &w.pose, kBadMethod, nullptr, 32 << 16, 24 << 16, &g);
+    });
+    add("geolocate: unknown effect flag", CT_ERR_EFFECTS, [](World &w) {
+        const ct_effects fx = {0x80u, CT_REFRACTION_K_STD_Q16, 0, 0, nullptr};
+        ct_geo g;
+        return ct_geolocate(&w.p, &w.cam, &w.pose, CT_METHOD_DIRECTIONAL, &fx, 32 << 16, 24 << 16, &g);
+    });
+    add("geolocate: refraction k beyond 2", CT_ERR_EFFECTS, [](World &w) {
+        const ct_effects fx = {CT_EFFECT_REFRACTION | CT_EFFECT_CURVATURE, 3 * 65536, 0, 0, nullptr};
+        ct_geo g;
+        return ct_geolocate(&w.p, &w.cam, &w.pose, CT_METHOD_DIRECTIONAL, &fx, 32 << 16, 24 << 16, &g);
+    });
+    add("geolocate: an earth map never fitted", CT_ERR_EFFECTS, [](World &w) {
+        ct_earth_map m;
+        std::memset(&m, 0, sizeof m);
+        const ct_effects fx = {CT_EFFECT_CURVATURE, 0, 0, 0, &m};
+        ct_geo g;
+        return ct_geolocate(&w.p, &w.cam, &w.pose, CT_METHOD_DIRECTIONAL, &fx, 32 << 16, 24 << 16, &g);
+    });
+    add("geolocate_batch: pixels NULL, count 1", CT_ERR_ARG, [](World &w) {
+        ct_geo g;
+        return ct_geolocate_batch(&w.p, &w.cam, &w.pose, CT_METHOD_DIRECTIONAL, nullptr, nullptr, 1, &g, 1);
+    });
+    add("geolocate_batch: out shorter than count", CT_ERR_ARG, [](World &w) {
+        const int64_t uv[4] = {0, 0, 1 << 16, 1 << 16};
+        ct_geo g[2];
+        return ct_geolocate_batch(&w.p, &w.cam, &w.pose, CT_METHOD_DIRECTIONAL, nullptr, uv, 2, g, 1);
+    });
+    add("effects_for_tolerance: out NULL", CT_ERR_ARG, [](World &w) {
+        return ct_effects_for_tolerance(&w.p, &w.cam, &w.pose, CT_REFRACTION_K_STD_Q16, 0, 1000000, nullptr);
+    });
+    add("los: block NULL", CT_ERR_ARG, [](World &w) {
+        return ct_los(&w.p, w.a, w.b, nullptr, 0, CT_METHOD_DIRECTIONAL, nullptr);
+    });
+    add("los: negative margin", CT_ERR_ARG, [](World &w) {
+        ct_hit h;
+        return ct_los(&w.p, w.a, w.b, nullptr, -1, CT_METHOD_DIRECTIONAL, &h);
+    });
+    add("los: unknown method", CT_ERR_METHOD, [](World &w) {
+        ct_hit h;
+        return ct_los(&w.p, w.a, w.b, nullptr, 0, kBadMethod, &h);
+    });
+    add("los: A = B", CT_ERR_RAY, [](World &w) {
+        ct_hit h;
+        return ct_los(&w.p, w.a, w.a, nullptr, 0, CT_METHOD_DIRECTIONAL, &h);
+    });
+    add("los: a point beyond 2^61 nm", CT_ERR_RAY, [](World &w) {
+        int64_t far[3] = {w.b[0], w.b[1], (INT64_C(1) << 61) + 1};
+        ct_hit h;
+        return ct_los(&w.p, w.a, far, nullptr, 0, CT_METHOD_DIRECTIONAL, &h);
+    });
+    add("locate_inverse: u NULL", CT_ERR_ARG, [](World &w) {
+        int64_t vv;
+        uint32_t vis;
+        ct_hit h;
+        return ct_locate_inverse(&w.p, &w.cam, &w.pose, nullptr, w.b, 0, nullptr, &vv, &vis, &h);
+    });
+    add("earth_map_init: map NULL", CT_ERR_ARG, [](World &w) {
+        return ct_earth_map_init(&w.p, w.a[0], w.a[1], w.a[2], 10000000000000, nullptr);
+    });
+    add("earth_map_init: radius 0", CT_ERR_RANGE, [](World &w) {
+        static ct_earth_map m;
+        return ct_earth_map_init(&w.p, w.a[0], w.a[1], w.a[2], 0, &m);
+    });
+    // ---- geodesy
+    add("utm_zone_of_epsg: zone NULL", CT_ERR_ARG, [](World &) { return ct_utm_zone_of_epsg(32617, nullptr); });
+    add("utm_zone_of_epsg: not UTM", CT_ERR_CRS, [](World &) {
+        ct_utm z;
+        return ct_utm_zone_of_epsg(4326, &z);
+    });
+    add("utm_forward: e NULL", CT_ERR_ARG, [](World &) {
+        const ct_utm z = {17, 0};
+        int64_t n;
+        return ct_utm_forward(&z, 0, 0, nullptr, &n);
+    });
+    add("utm_forward: zone 61", CT_ERR_ARG, [](World &) {
+        const ct_utm z = {61, 0};
+        int64_t e, n;
+        return ct_utm_forward(&z, 0, 0, &e, &n);
+    });
+    add("utm_factors: gamma NULL", CT_ERR_ARG, [](World &) {
+        const ct_utm z = {17, 0};
+        int64_t k;
+        return ct_utm_factors(&z, 0, 0, nullptr, &k);
+    });
+    add("utm_inverse: lat NULL", CT_ERR_ARG, [](World &) {
+        const ct_utm z = {17, 0};
+        int64_t lon;
+        return ct_utm_inverse(&z, 500000000000000, 0, nullptr, &lon);
+    });
+    add("pose_from_wgs84: zone NULL", CT_ERR_ARG, [](World &) {
+        const int32_t q[4] = {1 << 30, 0, 0, 0};
+        ct_pose p;
+        return ct_pose_from_wgs84(&p, nullptr, 0, 0, 0, q);
+    });
+    add("geoid_at: out NULL", CT_ERR_ARG, [](World &) {
+        const ct_geoid_grid g = {0, 0, 0, 0, 0, nullptr};
+        return ct_geoid_at(&g, 0, 0, nullptr);
+    });
+    add("package_geoid: out NULL", CT_ERR_ARG, [](World &w) { return ct_package_geoid(&w.p, w.a[0], w.a[1], nullptr); });
+    add("ecef_from_wgs84: out NULL", CT_ERR_ARG, [](World &) { return ct_ecef_from_wgs84(0, 0, 0, nullptr); });
+    add("ecef_from_wgs84: latitude beyond pi/2", CT_ERR_RANGE, [](World &) {
+        int64_t x[3];
+        return ct_ecef_from_wgs84(CT_PI_Q61 / 2 + 1, 0, 0, x);
+    });
+    add("wgs84_from_ecef: point NULL", CT_ERR_ARG, [](World &) {
+        int64_t lat, lon, h;
+        return ct_wgs84_from_ecef(nullptr, &lat, &lon, &h);
+    });
+    add("wgs84_from_ecef: the Earth's centre", CT_ERR_RANGE, [](World &) {
+        const int64_t x[3] = {0, 0, 0};
+        int64_t lat, lon, h;
+        return ct_wgs84_from_ecef(x, &lat, &lon, &h);
+    });
+    // ---- tile sets
+    add("tileset_open: ts NULL", CT_ERR_ARG, [](World &w) {
+        ct_tile_slot s[1];
+        return ct_tileset_open(nullptr, w.c.pkg.data(), w.c.pkg.size(), s, 1, nullptr, nullptr);
+    });
+    add("tileset_trace: ts NULL", CT_ERR_ARG, [](World &w) {
+        ct_hit h;
+        return ct_tileset_trace(nullptr, &w.ray, CT_METHOD_DIRECTIONAL, &h);
+    });
+    add("geolocate_tiles: ts NULL", CT_ERR_ARG, [](World &w) {
+        ct_geo g;
+        return ct_geolocate_tiles(nullptr, &w.cam, &w.pose, CT_METHOD_DIRECTIONAL, nullptr, 0, 0, &g);
+    });
+    add("geolocate_batch_tiles: ts NULL", CT_ERR_ARG, [](World &w) {
+        ct_geo g;
+        const int64_t uv[2] = {0, 0};
+        return ct_geolocate_batch_tiles(nullptr, &w.cam, &w.pose, CT_METHOD_DIRECTIONAL, nullptr, uv, 1, &g, 1);
+    });
+    add("los_tiles: ts NULL", CT_ERR_ARG, [](World &w) {
+        ct_hit h;
+        return ct_los_tiles(nullptr, w.a, w.b, nullptr, 0, CT_METHOD_DIRECTIONAL, &h);
+    });
+    return v;
+}
+
+void test_table()
+{
+    World *w = world();
+    TEST_ASSERT(w != nullptr);
+    int bad = 0;
+    const std::vector<Case> cs = cases();
+    for (const Case &c : cs) {
+        const ct_status got = c.call(*w);
+        const char *gn = "?", *wn = "?";
+        (void)ct_status_name(got, &gn);
+        (void)ct_status_name(c.want, &wn);
+        if (got != c.want) {
+            std::printf("  %-48s got %s (%d), want %s (%d)\n", c.name, gn, (int)got, wn, (int)c.want);
+            bad++;
+        } else if (std::getenv("CT_TEST_VERBOSE")) {
+            std::printf("  %-48s %s\n", c.name, gn);
+        }
+    }
+    std::printf("  %zu named cases, %d with another status\n", cs.size(), bad);
+    TEST_ASSERT_EQUAL_INT(0, bad);
+}
+
+}  // namespace
+
+int main()
+{
+    TEST_BEGIN("test_api_args");
+    RUN_TEST(test_table);
+    return TEST_END();
+}
