@@ -108,89 +108,26 @@ private:
     double ax_ = 0, ay_ = 0, ha_ = 0, pe_ = 0, lower_ = 0, rel_ = 0, per_cell_ = 0;
 };
 
-}  // namespace
+// What a sweep found: posts seen, hidden (proved so without ct_los), and
+// not decided (ct_los's error statuses).
+struct Tally {
+    long seen = 0, hidden = 0, proved = 0, errors = 0;
+};
 
-int cmd_viewshed(int argc, char **argv)
+// Every post of t within `radius` metres (0: all) of the observer A as a
+// target th metres above it: (*out)[j W + i] = 1 seen, 0 hidden, 255
+// beyond the radius.  A hidden post is proved so by sc from a neighbour's
+// blocking point where it can be, else decided by ct_los; rows in chunks
+// over `threads` threads.
+Tally sweep_posts(const ct_package &p, const Terrain &t, const int64_t A[3], const ct_effects &fx, const Shortcut &sc,
+                  double th, double radius, double margin, int threads, std::vector<uint8_t> *out)
 {
-    CmdLine args;
-    const std::string err = parse_cmdline(argc, argv, 2,
-                                          {"--observer", "--target-height", "--radius", "--effects", "--earth-radius", "--margin",
-                                           "--threads", "-o", "--png"},
-                                          {}, false, &args);
-    if (!err.empty()) throw Error("viewshed: " + err);
-    std::map<std::string, std::string> &opt = args.opt;
-    if (args.pos.size() != 1) throw Error("viewshed needs exactly one package file");
-    if (!opt.count("--observer")) throw Error("viewshed needs --observer E,N,H");
-    if (!opt.count("-o")) throw Error("viewshed needs -o vs.tif");
-    auto number = [&](const std::string &name, const std::string &text, double lo, double hi, const char *what) {
-        char *end = nullptr;
-        const double v = std::strtod(text.c_str(), &end);
-        if (text.empty() || !end || *end || !(v >= lo && v <= hi))
-            throw Error(name + " needs " + what + ", got '" + text + "'");
-        return v;
-    };
-    std::vector<double> ob;
-    {
-        std::stringstream ss(opt["--observer"]);
-        std::string tok;
-        while (std::getline(ss, tok, ',')) ob.push_back(number("--observer", tok, -1e9, 1e9, "three numbers E,N,H"));
-        if (ob.size() != 3) throw Error("--observer needs three numbers E,N,H (metres; H above the surface)");
-    }
-    const double th = opt.count("--target-height") ? number("--target-height", opt["--target-height"], 0, 1e5,
-                                                            "a height in metres in [0, 1e5]")
-                                                     : 0.0;
-    const double radius = opt.count("--radius") ? number("--radius", opt["--radius"], 1e-3, 1e7,
-                                                         "a radius in metres in (0, 1e7]")
-                                                : 0.0;
-    const double margin = opt.count("--margin") ? number("--margin", opt["--margin"], 0, 1e4,
-                                                         "a length in metres in [0, 1e4]")
-                                                : 0.01;
-    // radius 0: the true Earth on UTM packages (the sphere of 6371 km on others)
-    ct_effects fx = {0u, CT_REFRACTION_K_STD_Q16, 0, 0, nullptr};
-    if (opt.count("--effects")) fx.flags = effects_from_list(opt["--effects"]);
-    if (opt.count("--earth-radius")) {
-        if (!fx.flags) throw Error("--earth-radius needs --effects curvature and/or refraction");
-        fx.earth_radius_nm = std::llround(number("--earth-radius", opt["--earth-radius"], 1100, 1.8e7,
-                                                 "a radius in metres in [1100, 1.8e7]") * 1e9);
-    }
-    const int threads = opt.count("--threads") ? threads_option(opt["--threads"], "viewshed") : 0;
-
-    const std::string &path = args.pos[0];
-    std::vector<uint8_t> bytes;
-    ct_package p;
-    open_package_file(path, &bytes, &p);
-    const Terrain t = terrain_from_package(p);
     const int W = t.width, H = t.height;
-    const double pe = p.posting_e_nm * 1e-9, pn = p.posting_n_nm * 1e-9;
-    const double E0 = p.origin_e_nm * 1e-9, N0 = p.origin_n_nm * 1e-9;
-    // the observer: on the tile, H above the surface
-    int64_t ox, oy, oz, gz;
-    const int64_t oe = std::llround(ob[0] * 1e9), on = std::llround(ob[1] * 1e9);
-    if (ct_map_to_grid(&p, oe, on, 0, &ox, &oy, &oz) != CT_OK || ox < 0 || oy < 0 ||
-        ox > (int64_t)(W - 1) << 16 || oy > (int64_t)(H - 1) << 16 || ct_surface_height(&p, ox, oy, &gz) != CT_OK)
-        throw Error("--observer: (" + opt["--observer"] + ") is not over the tile");
-    int64_t ge, gn, gh;
-    (void)ct_grid_to_map(&p, ox, oy, gz, &ge, &gn, &gh);
-    const int64_t A[3] = {oe, on, gh + std::llround(ob[2] * 1e9)};
-    // the true Earth: its map fitted once around the observer, over the tile
-    ct_utm zone;
-    const bool true_earth = (fx.flags & CT_EFFECT_CURVATURE) && fx.earth_radius_nm == 0 &&
-                            ct_utm_zone_of_epsg((int32_t)p.epsg, &zone) == CT_OK;
-    ct_earth_map emap;
-    if (true_earth) {
-        double far = 0;
-        for (int c = 0; c < 4; ++c)
-            far = std::max(far, std::hypot(E0 + (c & 1 ? W : 0) * pe - oe * 1e-9, N0 + (c & 2 ? H : 0) * pn - on * 1e-9));
-        const double reach = far + (p.hmax - p.hmin) * p.height_scale_nm * 1e-9 + ob[2] + 1000;
-        if (ct_earth_map_init(&p, A[0], A[1], A[2], std::llround(reach * 1e9), &emap) == CT_OK) fx.earth_map = &emap;
-    }
-    // every post: hidden by a neighbour's blocking point when that proves it
-    // (Shortcut), else decided by ct_los
-    const Shortcut sc(p, t, A, fx, true_earth, margin, th);
-    const auto t0 = std::chrono::steady_clock::now();
-    std::vector<uint8_t> vis((size_t)W * H, 255);
-    long seen = 0, hidden = 0, errors = 0, proved = 0;
+    std::vector<uint8_t> &vis = *out;
+    vis.assign((size_t)W * H, 255);
     std::vector<long> cnt((size_t)H * 4, 0);
+    int64_t ox, oy, oz;
+    (void)ct_map_to_grid(&p, A[0], A[1], A[2], &ox, &oy, &oz);
     const double oi = ox / 65536.0, oj = oy / 65536.0;
     const int orow = std::min(H - 1, std::max(0, (int)std::lround(oj)));
     const int ocol = std::min(W - 1, std::max(0, (int)std::lround(oi)));
@@ -261,11 +198,142 @@ int cmd_viewshed(int argc, char **argv)
             std::swap(prev, cur);
         }
     });
+    Tally n;
     for (int j = 0; j < H; ++j)
-        seen += cnt[4 * j], hidden += cnt[4 * j + 1], errors += cnt[4 * j + 2], proved += cnt[4 * j + 3];
+        n.seen += cnt[4 * j], n.hidden += cnt[4 * j + 1], n.errors += cnt[4 * j + 2], n.proved += cnt[4 * j + 3];
+    return n;
+}
+
+// The command line, checked.
+struct Options {
+    std::string package, out, png, observer_text;
+    double ob[3] = {0, 0, 0};  // E, N (map metres), H (metres above the surface)
+    double th = 0, radius = 0, margin = 0.01;
+    ct_effects fx = {0u, CT_REFRACTION_K_STD_Q16, 0, 0, nullptr};  // radius 0: the true Earth on UTM packages
+    int threads = 0;
+};
+
+Options parse_options(int argc, char **argv)
+{
+    CmdLine args;
+    const std::string err = parse_cmdline(argc, argv, 2,
+                                          {"--observer", "--target-height", "--radius", "--effects", "--earth-radius",
+                                           "--margin", "--threads", "-o", "--png"},
+                                          {}, false, &args);
+    if (!err.empty()) throw Error("viewshed: " + err);
+    std::map<std::string, std::string> &opt = args.opt;
+    if (args.pos.size() != 1) throw Error("viewshed needs exactly one package file");
+    if (!opt.count("--observer")) throw Error("viewshed needs --observer E,N,H");
+    if (!opt.count("-o")) throw Error("viewshed needs -o vs.tif");
+    auto number = [&](const std::string &name, const std::string &text, double lo, double hi, const char *what) {
+        char *end = nullptr;
+        const double v = std::strtod(text.c_str(), &end);
+        if (text.empty() || !end || *end || !(v >= lo && v <= hi))
+            throw Error(name + " needs " + what + ", got '" + text + "'");
+        return v;
+    };
+    Options o;
+    o.package = args.pos[0];
+    o.out = opt["-o"];
+    if (opt.count("--png")) o.png = opt["--png"];
+    o.observer_text = opt["--observer"];
+    {
+        std::stringstream ss(o.observer_text);
+        std::string tok;
+        int k = 0;
+        while (std::getline(ss, tok, ',')) {
+            const double v = number("--observer", tok, -1e9, 1e9, "three numbers E,N,H");
+            if (k < 3) o.ob[k] = v;
+            k++;
+        }
+        if (k != 3) throw Error("--observer needs three numbers E,N,H (metres; H above the surface)");
+    }
+    if (opt.count("--target-height"))
+        o.th = number("--target-height", opt["--target-height"], 0, 1e5, "a height in metres in [0, 1e5]");
+    if (opt.count("--radius")) o.radius = number("--radius", opt["--radius"], 1e-3, 1e7, "a radius in metres in (0, 1e7]");
+    if (opt.count("--margin")) o.margin = number("--margin", opt["--margin"], 0, 1e4, "a length in metres in [0, 1e4]");
+    if (opt.count("--effects")) o.fx.flags = effects_from_list(opt["--effects"]);
+    if (opt.count("--earth-radius")) {
+        if (!o.fx.flags) throw Error("--earth-radius needs --effects curvature and/or refraction");
+        o.fx.earth_radius_nm = std::llround(number("--earth-radius", opt["--earth-radius"], 1100, 1.8e7,
+                                                   "a radius in metres in [1100, 1.8e7]") * 1e9);
+    }
+    if (opt.count("--threads")) o.threads = threads_option(opt["--threads"], "viewshed");
+    return o;
+}
+
+// The observer A (map nm): H above the surface at (E, N), which must be
+// over the tile.
+void place_observer(const ct_package &p, const Options &o, int64_t A[3])
+{
+    int64_t ox, oy, oz, gz, ge, gn, gh;
+    const int64_t oe = std::llround(o.ob[0] * 1e9), on = std::llround(o.ob[1] * 1e9);
+    if (ct_map_to_grid(&p, oe, on, 0, &ox, &oy, &oz) != CT_OK || ox < 0 || oy < 0 ||
+        ox > (int64_t)p.cells_x << 16 || oy > (int64_t)p.cells_y << 16 || ct_surface_height(&p, ox, oy, &gz) != CT_OK)
+        throw Error("--observer: (" + o.observer_text + ") is not over the tile");
+    (void)ct_grid_to_map(&p, ox, oy, gz, &ge, &gn, &gh);
+    A[0] = oe, A[1] = on, A[2] = gh + std::llround(o.ob[2] * 1e9);
+}
+
+// The picture over the hillshade: warm seen, blue hidden, the observer white.
+void write_picture(const std::string &path, const ct_package &p, const Terrain &t, const std::vector<uint8_t> &vis,
+                   const int64_t A[3])
+{
+    const int W = t.width, H = t.height;
+    const int zoom = std::max(1, (int)std::lround(900.0 / std::max(W, H)));
+    Image im(W * zoom, H * zoom);
+    paint_posts(im, t, 0, 0, W - 1, H - 1, zoom, [&](int i, int j, double s) {
+        const uint8_t gg = (uint8_t)std::lround(255 * (0.25 + 0.7 * s));
+        Rgb c{gg, gg, gg};
+        const uint8_t v = vis[(size_t)j * W + i];
+        if (v == 1) c = mix(c, Rgb{255, 214, 120}, 0.45);
+        if (v == 0) c = mix(c, Rgb{20, 40, 140}, 0.55);
+        return c;
+    });
+    const double cx = (double)(A[0] - p.origin_e_nm) / (double)p.posting_e_nm * zoom,
+                 cy = (double)(A[1] - p.origin_n_nm) / (double)p.posting_n_nm * zoom;
+    im.disc((int)cx, (int)cy, 6, kInk);
+    im.disc((int)cx, (int)cy, 4, kWhite);
+    write_png_atomic(path, im, "conetrace viewshed: warm seen, blue hidden", "conetrace viewshed");
+}
+
+}  // namespace
+
+int cmd_viewshed(int argc, char **argv)
+{
+    Options o = parse_options(argc, argv);
+    std::vector<uint8_t> bytes;
+    ct_package p;
+    open_package_file(o.package, &bytes, &p);
+    const Terrain t = terrain_from_package(p);
+    const int W = t.width, H = t.height;
+    int64_t A[3];
+    place_observer(p, o, A);
+    // the true Earth: its map fitted once around the observer, out to the
+    // tile's farthest corner, its relief, the observer's height and a km
+    ct_effects &fx = o.fx;
+    ct_utm zone;
+    const bool true_earth = (fx.flags & CT_EFFECT_CURVATURE) && fx.earth_radius_nm == 0 &&
+                            ct_utm_zone_of_epsg((int32_t)p.epsg, &zone) == CT_OK;
+    ct_earth_map emap;
+    if (true_earth) {
+        const double pe = p.posting_e_nm * 1e-9, pn = p.posting_n_nm * 1e-9;
+        double far = 0;
+        for (int c = 0; c < 4; ++c)
+            far = std::max(far, std::hypot((p.origin_e_nm - A[0]) * 1e-9 + (c & 1 ? W : 0) * pe,
+                                           (p.origin_n_nm - A[1]) * 1e-9 + (c & 2 ? H : 0) * pn));
+        const double reach = far + (p.hmax - p.hmin) * p.height_scale_nm * 1e-9 + o.ob[2] + 1000;
+        if (ct_earth_map_init(&p, A[0], A[1], A[2], std::llround(reach * 1e9), &emap) == CT_OK) fx.earth_map = &emap;
+    }
+    // every post: hidden by a neighbour's blocking point when that proves it
+    // (Shortcut), else decided by ct_los
+    const Shortcut sc(p, t, A, fx, true_earth, o.margin, o.th);
+    const auto t0 = std::chrono::steady_clock::now();
+    std::vector<uint8_t> vis;
+    const Tally n = sweep_posts(p, t, A, fx, sc, o.th, o.radius, o.margin, o.threads, &vis);
     const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    if (errors) throw Error("viewshed: " + std::to_string(errors) + " posts could not be decided");
-    write_geotiff(opt["-o"], W, H, std::vector<double>(vis.begin(), vis.end()), SampleType::UInt16, t.geo, true, 255);
+    if (n.errors) throw Error("viewshed: " + std::to_string(n.errors) + " posts could not be decided");
+    write_geotiff(o.out, W, H, std::vector<double>(vis.begin(), vis.end()), SampleType::UInt16, t.geo, true, 255);
     const double R_m = (fx.earth_radius_nm ? fx.earth_radius_nm : CT_EARTH_RADIUS_NM) * 1e-9;
     const std::string model = !(fx.flags & CT_EFFECT_CURVATURE) && !(fx.flags & CT_EFFECT_REFRACTION) ? "straight"
                               : true_earth ? std::string("the true Earth") + (fx.earth_map ? ", its map fitted once" : "")
@@ -273,22 +341,8 @@ int cmd_viewshed(int argc, char **argv)
     std::fprintf(stderr, "viewshed: %s; ", model.c_str());
     std::fprintf(stderr, "observer (%.3f, %.3f) %.3f m above the surface (h %.3f m); %ld posts seen, %ld "
                          "hidden (%ld by a neighbour's blocking point), %ld out of range; %.2f s\n",
-                 ob[0], ob[1], ob[2], A[2] * 1e-9, seen, hidden, proved, (long)W * H - seen - hidden, secs);
-    if (opt.count("--png")) {
-        const int zoom = std::max(1, (int)std::lround(900.0 / std::max(W, H)));
-        Image im(W * zoom, H * zoom);
-        paint_posts(im, t, 0, 0, W - 1, H - 1, zoom, [&](int i, int j, double s) {
-            const uint8_t gg = (uint8_t)std::lround(255 * (0.25 + 0.7 * s));
-            Rgb c{gg, gg, gg};
-            const uint8_t v = vis[(size_t)j * W + i];
-            if (v == 1) c = mix(c, Rgb{255, 214, 120}, 0.45);
-            if (v == 0) c = mix(c, Rgb{20, 40, 140}, 0.55);
-            return c;
-        });
-        const double cx = (ob[0] - E0) / pe * zoom, cy = (ob[1] - N0) / pn * zoom;
-        im.disc((int)cx, (int)cy, 6, kInk);
-        im.disc((int)cx, (int)cy, 4, kWhite);
-        write_png_atomic(opt["--png"], im, "conetrace viewshed: warm seen, blue hidden", "conetrace viewshed");
-    }
+                 o.ob[0], o.ob[1], o.ob[2], A[2] * 1e-9, n.seen, n.hidden, n.proved, (long)W * H - n.seen - n.hidden,
+                 secs);
+    if (!o.png.empty()) write_picture(o.png, p, t, vis, A);
     return 0;
 }
