@@ -73,100 +73,100 @@
 
 using namespace ct_host;
 
-int cmd_geoloc(int argc, char **argv)
+namespace {
+
+using Opts = std::map<std::string, std::string>;
+
+// The value of option `name`, a number in [lo, hi].
+double option_number(Opts &opt, const char *name, double lo, double hi, const char *what)
 {
-    CmdLine args;
-    const std::string err = parse_cmdline(argc, argv, 2,
-                                          {"--camera", "--pixels", "--method", "--effects", "--grid-step",
-                                           "--refraction-k", "--earth-radius", "--threads", "--pose-wgs84",
-                                           "--pose-map", "--earth-map", "--tolerance", "--chord", "--cache-tiles", "-o"},
-                                          {}, false, &args);
-    if (!err.empty()) throw Error("geoloc: " + err);
-    const std::vector<std::string> &pos = args.pos;
-    std::map<std::string, std::string> &opt = args.opt;
-    if (pos.size() != 1) throw Error("geoloc needs exactly one package file or tile set");
-    if (!opt.count("--camera")) throw Error("geoloc needs --camera C.cameramodel");
-    if (!opt.count("--pixels")) throw Error("geoloc needs --pixels pixels.csv");
-    if (!opt.count("-o")) throw Error("geoloc needs -o out.csv");
+    const std::string &g = opt[name];
+    char *end = nullptr;
+    double v = std::strtod(g.c_str(), &end);
+    if (g.empty() || !end || *end || !(v >= lo && v <= hi))
+        throw Error(std::string(name) + " needs " + what + ", got '" + g + "'");
+    return v;
+}
+
+// --effects, --refraction-k, --chord, --earth-radius (with --tolerance the
+// flags and the chord are chosen later).
+ct_effects parse_effects(Opts &opt, bool by_tolerance)
+{
     // radius 0: the true Earth on UTM packages (the sphere of 6371 km on others)
     ct_effects fx = {0u, CT_REFRACTION_K_STD_Q16, 0, 0, nullptr};
     if (opt.count("--effects")) fx.flags = effects_from_list(opt["--effects"]);
-    const bool by_tolerance = opt.count("--tolerance") > 0;
     if (by_tolerance && opt.count("--effects")) throw Error("geoloc: give --effects or --tolerance, not both");
-    auto number = [&](const char *name, double lo, double hi, const char *what) {
-        const std::string &g = opt[name];
-        char *end = nullptr;
-        double v = std::strtod(g.c_str(), &end);
-        if (g.empty() || !end || *end || !(v >= lo && v <= hi))
-            throw Error(std::string(name) + " needs " + what + ", got '" + g + "'");
-        return v;
-    };
     if (opt.count("--refraction-k")) {
         if (!(fx.flags & CT_EFFECT_REFRACTION) && !by_tolerance)
             throw Error("--refraction-k needs --effects refraction (or --tolerance)");
-        fx.refraction_k_q16 = (int32_t)std::lround(number("--refraction-k", -2, 2, "a coefficient in [-2, 2]") * 65536);
+        fx.refraction_k_q16 =
+            (int32_t)std::lround(option_number(opt, "--refraction-k", -2, 2, "a coefficient in [-2, 2]") * 65536);
     }
     if (opt.count("--chord")) {
         if (by_tolerance) throw Error("geoloc: --tolerance chooses the chord; give one or the other");
-        fx.chord_nm = (int64_t)std::llround(number("--chord", 1.024e-6, 1.1e6, "a length in metres in [1.024e-6, 1.1e6]") * 1e9);
+        fx.chord_nm = (int64_t)std::llround(
+            option_number(opt, "--chord", 1.024e-6, 1.1e6, "a length in metres in [1.024e-6, 1.1e6]") * 1e9);
     }
     if (opt.count("--earth-radius")) {
         if (!fx.flags && !by_tolerance)
             throw Error("--earth-radius needs --effects curvature and/or refraction (or --tolerance)");
         fx.earth_radius_nm = (int64_t)std::llround(
-            number("--earth-radius", 1100, 1.8e7, "a radius in metres in [1100, 1.8e7]") * 1e9);
+            option_number(opt, "--earth-radius", 1100, 1.8e7, "a radius in metres in [1100, 1.8e7]") * 1e9);
     }
-    const ct_method m = opt.count("--method") ? method_named(opt["--method"]) : CT_METHOD_DIRECTIONAL;
+    return fx;
+}
 
-    double grid_step = kDefaultGridStepPx;
-    if (opt.count("--grid-step")) {
-        const std::string &g = opt["--grid-step"];
-        char *end = nullptr;
-        grid_step = std::strtod(g.c_str(), &end);
-        if (g.empty() || !end || *end || !(grid_step >= 1 && grid_step <= 4096))
-            throw Error("--grid-step needs a number of pixels in [1, 4096], got '" + g + "'");
-    }
-
-    const int threads = opt.count("--threads") ? threads_option(opt["--threads"], "geoloc") : 0;
-
-    // a package, or a tile set read through per-chunk caches of K tiles
-    // (then p is the set's frame, and gp a tile for the geoid)
+// What the pixels are geolocated over: a package, or a tile set read through
+// per-chunk caches of cache_tiles tiles (then p is the set's frame, and gp a
+// tile for the geoid).
+struct Target {
     std::vector<uint8_t> bytes, gbytes;
     ct_package p, gp;
-    ct_status st;
     std::unique_ptr<TileSetFiles> tiles;
     int cache_tiles = 16;
+};
+
+void open_target(const std::string &path, Opts &opt, Target *t)
+{
+    ct_package &p = t->p, &gp = t->gp;
     if (opt.count("--cache-tiles")) {
         char *end = nullptr;
         const long k = std::strtol(opt["--cache-tiles"].c_str(), &end, 10);
         if (opt["--cache-tiles"].empty() || *end || k < 1 || k > 4096)
             throw Error("--cache-tiles needs a number of tiles in [1, 4096], got '" + opt["--cache-tiles"] + "'");
-        cache_tiles = (int)k;
+        t->cache_tiles = (int)k;
     }
-    if (is_tileset_path(pos[0])) {
-        tiles = std::make_unique<TileSetFiles>(pos[0]);
-        TileCache probe(*tiles, 1);
+    if (is_tileset_path(path)) {
+        t->tiles = std::make_unique<TileSetFiles>(path);
+        TileSetFiles &tiles = *t->tiles;
+        TileCache probe(tiles, 1);
         p = probe.set()->frame;
         gp = p;
-        for (uint32_t k = 0; k < tiles->tiles_x() * tiles->tiles_y() && p.vdatum == CT_VDATUM_EGM96; ++k) {
-            const std::string tp = tiles->dir() + "/" + tile_file_name((int)(k % tiles->tiles_x()), (int)(k / tiles->tiles_x()));
+        for (uint32_t k = 0; k < tiles.tiles_x() * tiles.tiles_y() && p.vdatum == CT_VDATUM_EGM96; ++k) {
+            const std::string tp = tiles.dir() + "/" + tile_file_name((int)(k % tiles.tiles_x()), (int)(k / tiles.tiles_x()));
             try {
-                gbytes = read_file(tp);
+                t->gbytes = read_file(tp);
             } catch (const Error &) {
                 continue;
             }
-            if (ct_package_open(&gp, gbytes.data(), gbytes.size()) == CT_OK) break;
+            if (ct_package_open(&gp, t->gbytes.data(), t->gbytes.size()) == CT_OK) break;
             gp = p;
         }
     } else {
         if (opt.count("--cache-tiles")) throw Error("--cache-tiles needs a tile set");
-        open_package_file(pos[0], &bytes, &p);
+        open_package_file(path, &t->bytes, &p);
         gp = p;
     }
-    const std::string &cpath = opt["--camera"];
-    LibCamera cam = lib_camera(read_cameramodel(cpath), cpath, grid_step);
+}
+
+// --pose-wgs84 / --pose-map into cam->pose (else the camera model's
+// extrinsics stay).
+void parse_pose(Opts &opt, const ct_package &p, const std::string &path, LibCamera *camp)
+{
+    LibCamera &cam = *camp;
     ct_utm zone = {0, 0};
     const bool utm = ct_utm_zone_of_epsg((int32_t)p.epsg, &zone) == CT_OK;
+    ct_status st = CT_OK;
     if (opt.count("--pose-wgs84") && opt.count("--pose-map"))
         throw Error("geoloc: give --pose-wgs84 or --pose-map, not both");
     for (const char *flag : {"--pose-wgs84", "--pose-map"}) {
@@ -194,7 +194,7 @@ int cmd_geoloc(int argc, char **argv)
         const int64_t h_nm = std::llround(v[2] * 1e9);
         if (flag[7] == 'w') {
             if (!utm)
-                throw Error(pos[0] + ": --pose-wgs84 needs a UTM package (EPSG 326zz/327zz); this one is EPSG:" +
+                throw Error(path + ": --pose-wgs84 needs a UTM package (EPSG 326zz/327zz); this one is EPSG:" +
                             std::to_string(p.epsg));
             if (std::fabs(v[0]) > 90 || std::fabs(v[1]) > 180)
                 throw Error("--pose-wgs84: latitude must be in [-90, 90] and longitude in [-180, 180] degrees");
@@ -208,74 +208,45 @@ int cmd_geoloc(int argc, char **argv)
         }
         if (st != CT_OK) throw Error(std::string(flag) + ": not a valid pose (" + status_name(st) + ")");
     }
-    if (by_tolerance) {
-        const double tol = number("--tolerance", 0, 1e6, "a tolerance in metres in [0, 1e6]");
-        ct_effects_choice ch;
-        st = ct_effects_for_tolerance(&p, &cam.cam, &cam.pose, fx.refraction_k_q16, fx.earth_radius_nm,
-                                      std::llround(tol * 1e9), &ch);
-        if (st != CT_OK) throw Error("--tolerance: cannot bound the effects for this camera (" + status_name(st) + ")");
-        fx.flags = ch.flags;
-        fx.chord_nm = ch.chord_nm;
-        auto metres = [](int64_t nm) {
-            char b[32];
-            if (nm >= (INT64_C(1) << 62)) return std::string("unbounded");
-            std::snprintf(b, sizeof b, "%.4g m", nm * 1e-9);
-            return std::string(b);
-        };
-        const char *names[4] = {"none", "curvature", "refraction", "curvature, refraction"};
-        std::fprintf(stderr,
-                     "geoloc --tolerance %g m: horizontal error bounds over the image on flat ground (rays to %.1f "
-                     "km, depression down to %.2f deg; k %.3g, R %.0f km): simulating nothing %s, curvature only %s, "
-                     "refraction only %s, both 0 -> chord %.6g m, effects: %s\n",
-                     tol, ch.range_nm * 1e-12,
-                     ch.tan_min_q30 >= (INT64_C(1) << 62) ? 90.0 : std::atan(ch.tan_min_q30 / 1073741824.0) * 180 / M_PI,
-                     fx.refraction_k_q16 / 65536.0, (fx.earth_radius_nm ? fx.earth_radius_nm : CT_EARTH_RADIUS_NM) * 1e-12,
-                     metres(ch.bound_nm[0]).c_str(), metres(ch.bound_nm[1]).c_str(), metres(ch.bound_nm[2]).c_str(),
-                     ch.chord_nm * 1e-9, names[ch.flags & 3u]);
-    }
-    std::vector<PixelRow> px = read_pixels_csv(opt["--pixels"]);
+}
 
-    std::vector<int64_t> uv(2 * px.size());
-    std::vector<uint8_t> in_range(px.size());
-    for (size_t k = 0; k < px.size(); ++k) {
-        in_range[k] = pixel_to_q16(px[k].u, px[k].v, &uv[2 * k], &uv[2 * k + 1]);
-        if (!in_range[k]) uv[2 * k] = uv[2 * k + 1] = 0;
-    }
-    std::string earth_map = opt.count("--earth-map") ? opt["--earth-map"] : "auto";
-    if (earth_map != "auto" && earth_map != "fitted" && earth_map != "exact")
-        throw Error("--earth-map needs auto, fitted or exact, got '" + earth_map + "'");
-    if (earth_map == "fitted" || (earth_map == "auto" && px.size() >= 256)) fx.flags |= CT_EFFECT_EARTH_FIT;
-    // a fitted map is set up once per chunk: few large chunks then
-    const size_t chunk =
-        (fx.flags & CT_EFFECT_EARTH_FIT) != 0u ? std::max<size_t>(1024, px.size() / 8 + 1) : (size_t)1024;
-    std::vector<ct_geo> g(px.size());
-    // the set-up's status (the same for every chunk; an empty input still
-    // checks the camera and the effects)
-    std::atomic<uint64_t> loads{0}, nodata{0};
-    std::atomic<size_t> caches{0};
-    if (tiles) {
-        TileCache probe(*tiles, 1);
-        st = ct_geolocate_batch_tiles(probe.set(), &cam.cam, &cam.pose, m, &fx, uv.data(), 0, g.data(), 0);
-    } else {
-        st = ct_geolocate_batch(&p, &cam.cam, &cam.pose, m, &fx, uv.data(), 0, g.data(), 0);
-    }
-    if (st == CT_OK)
-        parallel_chunks(px.size(), threads, chunk, [&](size_t b, size_t e) {
-            if (!tiles) {
-                (void)ct_geolocate_batch(&p, &cam.cam, &cam.pose, m, &fx, uv.data() + 2 * b, e - b, g.data() + b, e - b);
-                return;
-            }
-            TileCache cache(*tiles, cache_tiles);
-            caches++;
-            (void)ct_geolocate_batch_tiles(cache.set(), &cam.cam, &cam.pose, m, &fx, uv.data() + 2 * b, e - b,
-                                           g.data() + b, e - b);
-            loads += cache.set()->loads;
-            for (size_t k = b; k < e; ++k) nodata += g[k].status == CT_NO_DATA;
-        });
-    if (st == CT_ERR_EFFECTS)
-        throw Error("--effects: the effect parameters are out of range for this package (" + status_name(st) + ")");
-    if (st != CT_OK) throw Error(cpath + ": cannot geolocate from this camera (" + status_name(st) + ")");
+// --tolerance: the least effects (and the largest chord) within it, with
+// the bounds on stderr.
+void choose_effects(Opts &opt, const ct_package &p, const LibCamera &cam, ct_effects *fxp)
+{
+    ct_effects &fx = *fxp;
+    const double tol = option_number(opt, "--tolerance", 0, 1e6, "a tolerance in metres in [0, 1e6]");
+    ct_effects_choice ch;
+    const ct_status st = ct_effects_for_tolerance(&p, &cam.cam, &cam.pose, fx.refraction_k_q16, fx.earth_radius_nm,
+                                                  std::llround(tol * 1e9), &ch);
+    if (st != CT_OK) throw Error("--tolerance: cannot bound the effects for this camera (" + status_name(st) + ")");
+    fx.flags = ch.flags;
+    fx.chord_nm = ch.chord_nm;
+    auto metres = [](int64_t nm) {
+        char b[32];
+        if (nm >= (INT64_C(1) << 62)) return std::string("unbounded");
+        std::snprintf(b, sizeof b, "%.4g m", nm * 1e-9);
+        return std::string(b);
+    };
+    const char *names[4] = {"none", "curvature", "refraction", "curvature, refraction"};
+    std::fprintf(stderr,
+                 "geoloc --tolerance %g m: horizontal error bounds over the image on flat ground (rays to %.1f "
+                 "km, depression down to %.2f deg; k %.3g, R %.0f km): simulating nothing %s, curvature only %s, "
+                 "refraction only %s, both 0 -> chord %.6g m, effects: %s\n",
+                 tol, ch.range_nm * 1e-12,
+                 ch.tan_min_q30 >= (INT64_C(1) << 62) ? 90.0 : std::atan(ch.tan_min_q30 / 1073741824.0) * 180 / M_PI,
+                 fx.refraction_k_q16 / 65536.0, (fx.earth_radius_nm ? fx.earth_radius_nm : CT_EARTH_RADIUS_NM) * 1e-12,
+                 metres(ch.bound_nm[0]).c_str(), metres(ch.bound_nm[1]).c_str(), metres(ch.bound_nm[2]).c_str(),
+                 ch.chord_nm * 1e-9, names[ch.flags & 3u]);
+}
 
+// The output rows (header first), formatted in chunks on `threads` threads
+// and joined in input order.
+std::string format_rows(const std::vector<PixelRow> &px, const std::vector<uint8_t> &in_range,
+                        const std::vector<ct_geo> &g, const ct_package &p, const ct_package &gp, int threads)
+{
+    ct_utm zone = {0, 0};
+    const bool utm = ct_utm_zone_of_epsg((int32_t)p.epsg, &zone) == CT_OK;
     // rows formatted in chunks on the same threads, joined in input order
     const size_t CH = 1024;
     std::vector<std::string> parts((px.size() + CH - 1) / CH);
@@ -330,6 +301,95 @@ int cmd_geoloc(int argc, char **argv)
     });
     std::string txt = "u,v,status,E,N,h,steps,lat,lon,h_ell\n";
     for (const std::string &part : parts) txt += part;
+    return txt;
+}
+
+}  // namespace
+
+int cmd_geoloc(int argc, char **argv)
+{
+    CmdLine args;
+    const std::string err = parse_cmdline(argc, argv, 2,
+                                          {"--camera", "--pixels", "--method", "--effects", "--grid-step",
+                                           "--refraction-k", "--earth-radius", "--threads", "--pose-wgs84",
+                                           "--pose-map", "--earth-map", "--tolerance", "--chord", "--cache-tiles", "-o"},
+                                          {}, false, &args);
+    if (!err.empty()) throw Error("geoloc: " + err);
+    const std::vector<std::string> &pos = args.pos;
+    std::map<std::string, std::string> &opt = args.opt;
+    if (pos.size() != 1) throw Error("geoloc needs exactly one package file or tile set");
+    if (!opt.count("--camera")) throw Error("geoloc needs --camera C.cameramodel");
+    if (!opt.count("--pixels")) throw Error("geoloc needs --pixels pixels.csv");
+    if (!opt.count("-o")) throw Error("geoloc needs -o out.csv");
+    const bool by_tolerance = opt.count("--tolerance") > 0;
+    ct_effects fx = parse_effects(opt, by_tolerance);
+    const ct_method m = opt.count("--method") ? method_named(opt["--method"]) : CT_METHOD_DIRECTIONAL;
+
+    double grid_step = kDefaultGridStepPx;
+    if (opt.count("--grid-step")) {
+        const std::string &g = opt["--grid-step"];
+        char *end = nullptr;
+        grid_step = std::strtod(g.c_str(), &end);
+        if (g.empty() || !end || *end || !(grid_step >= 1 && grid_step <= 4096))
+            throw Error("--grid-step needs a number of pixels in [1, 4096], got '" + g + "'");
+    }
+
+    const int threads = opt.count("--threads") ? threads_option(opt["--threads"], "geoloc") : 0;
+
+    Target tg;
+    open_target(pos[0], opt, &tg);
+    const ct_package &p = tg.p;
+    const std::unique_ptr<TileSetFiles> &tiles = tg.tiles;
+    const int cache_tiles = tg.cache_tiles;
+    const std::string &cpath = opt["--camera"];
+    LibCamera cam = lib_camera(read_cameramodel(cpath), cpath, grid_step);
+    parse_pose(opt, p, pos[0], &cam);
+    if (by_tolerance) choose_effects(opt, p, cam, &fx);
+    std::vector<PixelRow> px = read_pixels_csv(opt["--pixels"]);
+
+    std::vector<int64_t> uv(2 * px.size());
+    std::vector<uint8_t> in_range(px.size());
+    for (size_t k = 0; k < px.size(); ++k) {
+        in_range[k] = pixel_to_q16(px[k].u, px[k].v, &uv[2 * k], &uv[2 * k + 1]);
+        if (!in_range[k]) uv[2 * k] = uv[2 * k + 1] = 0;
+    }
+    std::string earth_map = opt.count("--earth-map") ? opt["--earth-map"] : "auto";
+    if (earth_map != "auto" && earth_map != "fitted" && earth_map != "exact")
+        throw Error("--earth-map needs auto, fitted or exact, got '" + earth_map + "'");
+    if (earth_map == "fitted" || (earth_map == "auto" && px.size() >= 256)) fx.flags |= CT_EFFECT_EARTH_FIT;
+    // a fitted map is set up once per chunk: few large chunks then
+    const size_t chunk =
+        (fx.flags & CT_EFFECT_EARTH_FIT) != 0u ? std::max<size_t>(1024, px.size() / 8 + 1) : (size_t)1024;
+    std::vector<ct_geo> g(px.size());
+    // the set-up's status (the same for every chunk; an empty input still
+    // checks the camera and the effects)
+    std::atomic<uint64_t> loads{0}, nodata{0};
+    std::atomic<size_t> caches{0};
+    ct_status st;
+    if (tiles) {
+        TileCache probe(*tiles, 1);
+        st = ct_geolocate_batch_tiles(probe.set(), &cam.cam, &cam.pose, m, &fx, uv.data(), 0, g.data(), 0);
+    } else {
+        st = ct_geolocate_batch(&p, &cam.cam, &cam.pose, m, &fx, uv.data(), 0, g.data(), 0);
+    }
+    if (st == CT_OK)
+        parallel_chunks(px.size(), threads, chunk, [&](size_t b, size_t e) {
+            if (!tiles) {
+                (void)ct_geolocate_batch(&p, &cam.cam, &cam.pose, m, &fx, uv.data() + 2 * b, e - b, g.data() + b, e - b);
+                return;
+            }
+            TileCache cache(*tiles, cache_tiles);
+            caches++;
+            (void)ct_geolocate_batch_tiles(cache.set(), &cam.cam, &cam.pose, m, &fx, uv.data() + 2 * b, e - b,
+                                           g.data() + b, e - b);
+            loads += cache.set()->loads;
+            for (size_t k = b; k < e; ++k) nodata += g[k].status == CT_NO_DATA;
+        });
+    if (st == CT_ERR_EFFECTS)
+        throw Error("--effects: the effect parameters are out of range for this package (" + status_name(st) + ")");
+    if (st != CT_OK) throw Error(cpath + ": cannot geolocate from this camera (" + status_name(st) + ")");
+
+    const std::string txt = format_rows(px, in_range, g, p, tg.gp, threads);
     write_file_atomic(opt["-o"], std::vector<uint8_t>(txt.begin(), txt.end()));
     if (tiles)
         std::fprintf(stderr,
