@@ -436,6 +436,330 @@ std::vector<Case> cases()
         ct_hit h;
         return ct_los_tiles(nullptr, w.a, w.b, nullptr, 0, CT_METHOD_DIRECTIONAL, &h);
     });
+    // ---- every other pointer argument NULL: CT_ERR_ARG, the rule of the header
+    auto null_arg = [&](const char *name, std::function<ct_status(World &)> f) { add(name, CT_ERR_ARG, std::move(f)); };
+    null_arg("package_layout: sec_size NULL", [](World &) {
+        uint32_t off[CT_SEC_COUNT], levels, total;
+        return ct_package_layout(16, 16, 1, 8, 0, off, nullptr, &levels, &total);
+    });
+    null_arg("package_layout: total NULL", [](World &) {
+        uint32_t off[CT_SEC_COUNT], size[CT_SEC_COUNT], levels;
+        return ct_package_layout(16, 16, 1, 8, 0, off, size, &levels, nullptr);
+    });
+    null_arg("sector_boundary: by NULL", [](World &) {
+        int32_t x;
+        return ct_sector_boundary(8, 0, &x, nullptr);
+    });
+    null_arg("in_wedge: bound_y NULL", [](World &w) {
+        uint32_t in;
+        return ct_in_wedge(w.p.bound_x, nullptr, 8, 0, 1, 0, &in);
+    });
+    null_arg("in_wedge: out NULL", [](World &w) { return ct_in_wedge(w.p.bound_x, w.p.bound_y, 8, 0, 1, 0, nullptr); });
+    null_arg("cot_table: ok NULL", [](World &) {
+        int64_t c[256];
+        return ct_cot_table(30000000000, 62500000, c, nullptr);
+    });
+    null_arg("ray_prepare_segment: pkg NULL", [](World &w) {
+        ct_prepared q;
+        return ct_ray_prepare_segment(nullptr, &w.ray, &q);
+    });
+    null_arg("ray_prepare_segment: ray NULL", [](World &w) {
+        ct_prepared q;
+        return ct_ray_prepare_segment(&w.p, nullptr, &q);
+    });
+    null_arg("trace_prepared: pkg NULL", [](World &w) {
+        ct_hit h;
+        return ct_trace_prepared(nullptr, &w.pr, CT_METHOD_DIRECTIONAL, &h);
+    });
+    null_arg("trace: ray NULL", [](World &w) {
+        ct_hit h;
+        return ct_trace(&w.p, nullptr, CT_METHOD_DIRECTIONAL, &h);
+    });
+    null_arg("trace: hit NULL", [](World &w) { return ct_trace(&w.p, &w.ray, CT_METHOD_DIRECTIONAL, nullptr); });
+    null_arg("trace_bent: pkg NULL", [](World &w) {
+        const ct_bend bd = {57016, CT_EARTH_RADIUS_NM, CT_EFFECTS_CHORD_NM, 0u};
+        ct_hit h;
+        return ct_trace_bent(nullptr, &w.ray, &bd, CT_METHOD_DIRECTIONAL, &h);
+    });
+    null_arg("trace_bent: ray NULL", [](World &w) {
+        const ct_bend bd = {57016, CT_EARTH_RADIUS_NM, CT_EFFECTS_CHORD_NM, 0u};
+        ct_hit h;
+        return ct_trace_bent(&w.p, nullptr, &bd, CT_METHOD_DIRECTIONAL, &h);
+    });
+    null_arg("trace_bent: hit NULL", [](World &w) {
+        const ct_bend bd = {57016, CT_EARTH_RADIUS_NM, CT_EFFECTS_CHORD_NM, 0u};
+        return ct_trace_bent(&w.p, &w.ray, &bd, CT_METHOD_DIRECTIONAL, nullptr);
+    });
+    add("trace_bent: unknown method", CT_ERR_METHOD, [](World &w) {
+        const ct_bend bd = {57016, CT_EARTH_RADIUS_NM, CT_EFFECTS_CHORD_NM, 0u};
+        ct_hit h;
+        return ct_trace_bent(&w.p, &w.ray, &bd, kBadMethod, &h);
+    });
+    null_arg("grid_to_map: pkg NULL", [](World &) {
+        int64_t e, n, h;
+        return ct_grid_to_map(nullptr, 0, 0, 0, &e, &n, &h);
+    });
+    null_arg("grid_to_map: n NULL", [](World &w) {
+        int64_t e, h;
+        return ct_grid_to_map(&w.p, 0, 0, 0, &e, nullptr, &h);
+    });
+    null_arg("grid_to_map: h NULL", [](World &w) {
+        int64_t e, n;
+        return ct_grid_to_map(&w.p, 0, 0, 0, &e, &n, nullptr);
+    });
+    null_arg("map_to_grid: x NULL", [](World &w) {
+        int64_t y, z;
+        return ct_map_to_grid(&w.p, w.a[0], w.a[1], w.a[2], nullptr, &y, &z);
+    });
+    null_arg("map_to_grid: y NULL", [](World &w) {
+        int64_t x, z;
+        return ct_map_to_grid(&w.p, w.a[0], w.a[1], w.a[2], &x, nullptr, &z);
+    });
+    null_arg("map_to_grid: z NULL", [](World &w) {
+        int64_t x, y;
+        return ct_map_to_grid(&w.p, w.a[0], w.a[1], w.a[2], &x, &y, nullptr);
+    });
+    null_arg("ray_from_map: pkg NULL", [](World &w) {
+        ct_ray r;
+        return ct_ray_from_map(nullptr, w.a[0], w.a[1], w.a[2], 1, 0, 0, &r);
+    });
+    null_arg("surface_height: pkg NULL", [](World &) {
+        int64_t z;
+        return ct_surface_height(nullptr, 0, 0, &z);
+    });
+    null_arg("camera_init_grid: cam NULL", [](World &) {
+        ct_unproject_grid g{};
+        return ct_camera_init_grid(nullptr, &g);
+    });
+    null_arg("camera_unproject: cam NULL", [](World &) {
+        int32_t r[3];
+        uint32_t it;
+        return ct_camera_unproject(nullptr, 0, 0, r, &it);
+    });
+    null_arg("camera_project: cam NULL", [](World &) {
+        const int32_t r[3] = {0, 0, 1 << 30};
+        int64_t u, vv;
+        return ct_camera_project(nullptr, r, &u, &vv);
+    });
+    null_arg("camera_project: ray NULL", [](World &w) {
+        int64_t u, vv;
+        return ct_camera_project(&w.cam, nullptr, &u, &vv);
+    });
+    null_arg("camera_project: v NULL", [](World &w) {
+        const int32_t r[3] = {0, 0, 1 << 30};
+        int64_t u;
+        return ct_camera_project(&w.cam, r, &u, nullptr);
+    });
+    null_arg("camera_project: camera never set up", [](World &) {
+        ct_camera c;
+        std::memset(&c, 0, sizeof c);
+        const int32_t r[3] = {0, 0, 1 << 30};
+        int64_t u, vv;
+        return ct_camera_project(&c, r, &u, &vv);
+    });
+    null_arg("pose_init: pose NULL", [](World &) {
+        const int32_t R[9] = {1 << 30, 0, 0, 0, 1 << 30, 0, 0, 0, 1 << 30};
+        return ct_pose_init(nullptr, R, 0, 0, 0);
+    });
+    null_arg("pose_rotate: pose NULL", [](World &) {
+        const int32_t r[3] = {0, 0, 1 << 30};
+        int64_t d[3];
+        return ct_pose_rotate(nullptr, r, d);
+    });
+    null_arg("pose_rotate: ray NULL", [](World &w) {
+        int64_t d[3];
+        return ct_pose_rotate(&w.pose, nullptr, d);
+    });
+    null_arg("pose_rotate: pose never set up", [](World &) {
+        ct_pose q;
+        std::memset(&q, 0, sizeof q);
+        const int32_t r[3] = {0, 0, 1 << 30};
+        int64_t d[3];
+        return ct_pose_rotate(&q, r, d);
+    });
+    null_arg("pose_from_map: pose NULL", [](World &) {
+        const int32_t q[4] = {1 << 30, 0, 0, 0};
+        return ct_pose_from_map(nullptr, 0, 0, 0, q);
+    });
+    null_arg("pose_from_wgs84: pose NULL", [](World &) {
+        const ct_utm z = {17, 0};
+        const int32_t q[4] = {1 << 30, 0, 0, 0};
+        return ct_pose_from_wgs84(nullptr, &z, 0, 0, 0, q);
+    });
+    null_arg("pose_from_wgs84: quaternion NULL", [](World &) {
+        const ct_utm z = {17, 0};
+        ct_pose p;
+        return ct_pose_from_wgs84(&p, &z, 0, 0, 0, nullptr);
+    });
+    null_arg("geolocate: pkg NULL", [](World &w) {
+        ct_geo g;
+        return ct_geolocate(nullptr, &w.cam, &w.pose, CT_METHOD_DIRECTIONAL, nullptr, 0, 0, &g);
+    });
+    null_arg("geolocate: pose NULL", [](World &w) {
+        ct_geo g;
+        return ct_geolocate(&w.p, &w.cam, nullptr, CT_METHOD_DIRECTIONAL, nullptr, 0, 0, &g);
+    });
+    null_arg("geolocate: camera never set up", [](World &w) {
+        ct_camera c;
+        std::memset(&c, 0, sizeof c);
+        ct_geo g;
+        return ct_geolocate(&w.p, &c, &w.pose, CT_METHOD_DIRECTIONAL, nullptr, 0, 0, &g);
+    });
+    null_arg("geolocate_batch: pkg NULL", [](World &w) {
+        const int64_t uv[2] = {0, 0};
+        ct_geo g;
+        return ct_geolocate_batch(nullptr, &w.cam, &w.pose, CT_METHOD_DIRECTIONAL, nullptr, uv, 1, &g, 1);
+    });
+    null_arg("geolocate_batch: out NULL, count 1", [](World &w) {
+        const int64_t uv[2] = {0, 0};
+        return ct_geolocate_batch(&w.p, &w.cam, &w.pose, CT_METHOD_DIRECTIONAL, nullptr, uv, 1, nullptr, 1);
+    });
+    null_arg("effects_for_tolerance: pkg NULL", [](World &w) {
+        ct_effects_choice ch;
+        return ct_effects_for_tolerance(nullptr, &w.cam, &w.pose, CT_REFRACTION_K_STD_Q16, 0, 1000000, &ch);
+    });
+    null_arg("effects_for_tolerance: camera NULL", [](World &w) {
+        ct_effects_choice ch;
+        return ct_effects_for_tolerance(&w.p, nullptr, &w.pose, CT_REFRACTION_K_STD_Q16, 0, 1000000, &ch);
+    });
+    null_arg("effects_for_tolerance: pose NULL", [](World &w) {
+        ct_effects_choice ch;
+        return ct_effects_for_tolerance(&w.p, &w.cam, nullptr, CT_REFRACTION_K_STD_Q16, 0, 1000000, &ch);
+    });
+    null_arg("los: pkg NULL", [](World &w) {
+        ct_hit h;
+        return ct_los(nullptr, w.a, w.b, nullptr, 0, CT_METHOD_DIRECTIONAL, &h);
+    });
+    null_arg("los: A NULL", [](World &w) {
+        ct_hit h;
+        return ct_los(&w.p, nullptr, w.b, nullptr, 0, CT_METHOD_DIRECTIONAL, &h);
+    });
+    null_arg("los: B NULL", [](World &w) {
+        ct_hit h;
+        return ct_los(&w.p, w.a, nullptr, nullptr, 0, CT_METHOD_DIRECTIONAL, &h);
+    });
+    null_arg("locate_inverse: pkg NULL", [](World &w) {
+        int64_t u, vv;
+        uint32_t vis;
+        ct_hit h;
+        return ct_locate_inverse(nullptr, &w.cam, &w.pose, nullptr, w.b, 0, &u, &vv, &vis, &h);
+    });
+    null_arg("locate_inverse: camera NULL", [](World &w) {
+        int64_t u, vv;
+        uint32_t vis;
+        ct_hit h;
+        return ct_locate_inverse(&w.p, nullptr, &w.pose, nullptr, w.b, 0, &u, &vv, &vis, &h);
+    });
+    null_arg("locate_inverse: pose NULL", [](World &w) {
+        int64_t u, vv;
+        uint32_t vis;
+        ct_hit h;
+        return ct_locate_inverse(&w.p, &w.cam, nullptr, nullptr, w.b, 0, &u, &vv, &vis, &h);
+    });
+    null_arg("locate_inverse: point NULL", [](World &w) {
+        int64_t u, vv;
+        uint32_t vis;
+        ct_hit h;
+        return ct_locate_inverse(&w.p, &w.cam, &w.pose, nullptr, nullptr, 0, &u, &vv, &vis, &h);
+    });
+    null_arg("locate_inverse: v NULL", [](World &w) {
+        int64_t u;
+        uint32_t vis;
+        ct_hit h;
+        return ct_locate_inverse(&w.p, &w.cam, &w.pose, nullptr, w.b, 0, &u, nullptr, &vis, &h);
+    });
+    null_arg("locate_inverse: visible NULL", [](World &w) {
+        int64_t u, vv;
+        ct_hit h;
+        return ct_locate_inverse(&w.p, &w.cam, &w.pose, nullptr, w.b, 0, &u, &vv, nullptr, &h);
+    });
+    null_arg("locate_inverse: block NULL", [](World &w) {
+        int64_t u, vv;
+        uint32_t vis;
+        return ct_locate_inverse(&w.p, &w.cam, &w.pose, nullptr, w.b, 0, &u, &vv, &vis, nullptr);
+    });
+    null_arg("locate_inverse: camera never set up", [](World &w) {
+        ct_camera c;
+        std::memset(&c, 0, sizeof c);
+        int64_t u, vv;
+        uint32_t vis;
+        ct_hit h;
+        return ct_locate_inverse(&w.p, &c, &w.pose, nullptr, w.b, 0, &u, &vv, &vis, &h);
+    });
+    null_arg("locate_inverse: pose never set up", [](World &w) {
+        ct_pose q;
+        std::memset(&q, 0, sizeof q);
+        int64_t u, vv;
+        uint32_t vis;
+        ct_hit h;
+        return ct_locate_inverse(&w.p, &w.cam, &q, nullptr, w.b, 0, &u, &vv, &vis, &h);
+    });
+    add("locate_inverse: a point beyond 2^61 nm", CT_ERR_RAY, [](World &w) {
+        const int64_t far[3] = {w.b[0], (INT64_C(1) << 61) + 1, w.b[2]};
+        int64_t u, vv;
+        uint32_t vis;
+        ct_hit h;
+        return ct_locate_inverse(&w.p, &w.cam, &w.pose, nullptr, far, 0, &u, &vv, &vis, &h);
+    });
+    null_arg("earth_map_init: pkg NULL", [](World &w) {
+        static ct_earth_map m;
+        return ct_earth_map_init(nullptr, w.a[0], w.a[1], w.a[2], 10000000000000, &m);
+    });
+    null_arg("utm_forward: zone NULL", [](World &) {
+        int64_t e, n;
+        return ct_utm_forward(nullptr, 0, 0, &e, &n);
+    });
+    null_arg("utm_forward: n NULL", [](World &) {
+        const ct_utm z = {17, 0};
+        int64_t e;
+        return ct_utm_forward(&z, 0, 0, &e, nullptr);
+    });
+    null_arg("utm_factors: zone NULL", [](World &) {
+        int64_t g, k;
+        return ct_utm_factors(nullptr, 0, 0, &g, &k);
+    });
+    null_arg("utm_factors: k NULL", [](World &) {
+        const ct_utm z = {17, 0};
+        int64_t g;
+        return ct_utm_factors(&z, 0, 0, &g, nullptr);
+    });
+    null_arg("utm_inverse: zone NULL", [](World &) {
+        int64_t lat, lon;
+        return ct_utm_inverse(nullptr, 500000000000000, 0, &lat, &lon);
+    });
+    null_arg("utm_inverse: lon NULL", [](World &) {
+        const ct_utm z = {17, 0};
+        int64_t lat;
+        return ct_utm_inverse(&z, 500000000000000, 0, &lat, nullptr);
+    });
+    null_arg("geoid_at: grid NULL", [](World &) {
+        int64_t n;
+        return ct_geoid_at(nullptr, 0, 0, &n);
+    });
+    null_arg("package_geoid: pkg NULL", [](World &w) {
+        int64_t n;
+        return ct_package_geoid(nullptr, w.a[0], w.a[1], &n);
+    });
+    null_arg("wgs84_from_ecef: lat NULL", [](World &) {
+        const int64_t x[3] = {INT64_C(6378137000000000), 0, 0};
+        int64_t lon, h;
+        return ct_wgs84_from_ecef(x, nullptr, &lon, &h);
+    });
+    null_arg("wgs84_from_ecef: lon NULL", [](World &) {
+        const int64_t x[3] = {INT64_C(6378137000000000), 0, 0};
+        int64_t lat, h;
+        return ct_wgs84_from_ecef(x, &lat, nullptr, &h);
+    });
+    null_arg("wgs84_from_ecef: h NULL", [](World &) {
+        const int64_t x[3] = {INT64_C(6378137000000000), 0, 0};
+        int64_t lat, lon;
+        return ct_wgs84_from_ecef(x, &lat, &lon, nullptr);
+    });
+    null_arg("tileset_open: manifest NULL", [](World &) {
+        ct_tileset ts;
+        ct_tile_slot s[1];
+        return ct_tileset_open(&ts, nullptr, 64, s, 1, nullptr, nullptr);
+    });
     return v;
 }
 
