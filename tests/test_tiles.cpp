@@ -494,6 +494,61 @@ void test_manifest_checks()
         {"entry range", CT_ERR_RANGE,
          [](std::vector<uint8_t> &m) { ct_host::put16(m, CT_SET_HEADER_SIZE + 10, 60000); }, true},
         {"posting", CT_ERR_GEOREF, [](std::vector<uint8_t> &m) { ct_host::put64(m, CT_SET_HDR_GEOREF + 16, 0); }, true},
+        // each of the grid's checks alone (40 x 33 posts, tiles of 12: 4 x 3)
+        {"header size", CT_ERR_HEADER, [](std::vector<uint8_t> &m) { ct_host::put16(m, CT_HDR_HEADER_SIZE, 64); }, true},
+        {"total beyond the bytes", CT_ERR_TRUNCATED,
+         [](std::vector<uint8_t> &m) { ct_host::put32(m, CT_HDR_TOTAL, (uint32_t)m.size() + 1); }, true},
+        {"width 1", CT_ERR_DIMS, [](std::vector<uint8_t> &m) { ct_host::put16(m, CT_SET_HDR_WIDTH, 1); }, true},
+        {"height 1", CT_ERR_DIMS, [](std::vector<uint8_t> &m) { ct_host::put16(m, CT_SET_HDR_HEIGHT, 1); }, true},
+        {"width beyond CT_MAX_POSTS", CT_ERR_DIMS,
+         [](std::vector<uint8_t> &m) { ct_host::put16(m, CT_SET_HDR_WIDTH, CT_MAX_POSTS + 1); }, true},
+        {"height beyond CT_MAX_POSTS", CT_ERR_DIMS,
+         [](std::vector<uint8_t> &m) { ct_host::put16(m, CT_SET_HDR_HEIGHT, CT_MAX_POSTS + 1); }, true},
+        {"tile posts 1", CT_ERR_DIMS, [](std::vector<uint8_t> &m) { ct_host::put16(m, CT_SET_HDR_TILE_POSTS, 1); }, true},
+        {"tile posts beyond CT_MAX_POSTS", CT_ERR_DIMS,
+         [](std::vector<uint8_t> &m) { ct_host::put16(m, CT_SET_HDR_TILE_POSTS, CT_MAX_POSTS + 1); }, true},
+        {"tiles_x 0", CT_ERR_DIMS, [](std::vector<uint8_t> &m) { ct_host::put16(m, CT_SET_HDR_TILES_X, 0); }, true},
+        {"tiles_y 0", CT_ERR_DIMS, [](std::vector<uint8_t> &m) { ct_host::put16(m, CT_SET_HDR_TILES_Y, 0); }, true},
+        {"more tiles than CT_SET_MAX_TILES", CT_ERR_DIMS,
+         [](std::vector<uint8_t> &m) {
+             ct_host::put16(m, CT_SET_HDR_TILES_X, 60000);
+             ct_host::put16(m, CT_SET_HDR_TILES_Y, 60000);
+         },
+         true},
+        {"tiles_x too few", CT_ERR_DIMS, [](std::vector<uint8_t> &m) { ct_host::put16(m, CT_SET_HDR_TILES_X, 3); }, true},
+        {"tiles_y too many", CT_ERR_DIMS, [](std::vector<uint8_t> &m) { ct_host::put16(m, CT_SET_HDR_TILES_Y, 4); }, true},
+        {"tiles_y too few", CT_ERR_DIMS, [](std::vector<uint8_t> &m) { ct_host::put16(m, CT_SET_HDR_TILES_Y, 2); }, true},
+        {"an entry too many", CT_ERR_SIZE,
+         [](std::vector<uint8_t> &m) {
+             m.resize(m.size() + CT_SET_ENTRY_SIZE, 0);
+             ct_host::put32(m, CT_HDR_TOTAL, (uint32_t)m.size());
+         },
+         true},
+        {"sectors 0", CT_ERR_SECTORS, [](std::vector<uint8_t> &m) { m[CT_SET_HDR_SECTORS] = 0; }, true},
+        {"reduce 0", CT_ERR_REDUCE, [](std::vector<uint8_t> &m) { m[CT_SET_HDR_REDUCE] = 0; }, true},
+        {"vertical datum unknown to the library", CT_ERR_FLAGS,
+         [](std::vector<uint8_t> &m) { ct_host::put16(m, CT_SET_HDR_VDATUM, CT_VDATUM_COUNT); }, true},
+        {"entry flag 2", CT_ERR_FLAGS, [](std::vector<uint8_t> &m) { m[CT_SET_HEADER_SIZE + 12] = 2; }, true},
+        {"entry hmin above its hmax", CT_ERR_RANGE,
+         [](std::vector<uint8_t> &m) {
+             m[CT_SET_HEADER_SIZE + 12] = 1;
+             ct_host::put16(m, CT_SET_HEADER_SIZE + 8, 5);
+             ct_host::put16(m, CT_SET_HEADER_SIZE + 10, 4);
+         },
+         true},
+        {"entry hmin below the set's", CT_ERR_RANGE,
+         [](std::vector<uint8_t> &m) {
+             m[CT_SET_HEADER_SIZE + 12] = 1;
+             ct_host::put16(m, CT_SET_HDR_HMIN, 3);
+             ct_host::put16(m, CT_SET_HDR_HMAX, 60000);
+             ct_host::put16(m, CT_SET_HEADER_SIZE + 8, 2);
+             ct_host::put16(m, CT_SET_HEADER_SIZE + 10, 4);
+         },
+         true},
+        {"a corner beyond 2^61 nm east", CT_ERR_GEOREF,
+         [](std::vector<uint8_t> &m) { ct_host::put64(m, CT_SET_HDR_GEOREF, (INT64_C(1) << 61) - 1000); }, true},
+        {"a corner beyond 2^61 nm north", CT_ERR_GEOREF,
+         [](std::vector<uint8_t> &m) { ct_host::put64(m, CT_SET_HDR_GEOREF + 8, (INT64_C(1) << 61) - 1000); }, true},
     };
     for (const Bad &b : bads) {
         std::vector<uint8_t> m = tb.manifest;
@@ -506,6 +561,12 @@ void test_manifest_checks()
     ct_tileset ts;
     TEST_ASSERT_EQUAL_INT(CT_ERR_ARG, ct_tileset_open(&ts, tb.manifest.data(), tb.manifest.size(), set.slots.data(), 0,
                                                       mem_loader, &set.mem));
+    TEST_ASSERT_EQUAL_INT(CT_ERR_ARG, ct_tileset_open(&ts, tb.manifest.data(), tb.manifest.size(), set.slots.data(),
+                                                      CT_SET_MAX_SLOTS + 1, mem_loader, &set.mem));
+    TEST_ASSERT_EQUAL_INT(CT_ERR_ARG, ct_tileset_open(&ts, tb.manifest.data(), tb.manifest.size(), nullptr, 1,
+                                                      mem_loader, &set.mem));
+    TEST_ASSERT_EQUAL_INT(CT_ERR_ARG, ct_tileset_open(&ts, tb.manifest.data(), tb.manifest.size(), set.slots.data(), 1,
+                                                      nullptr, &set.mem));
 }
 
 // Geolocation over a set: the merged package's results, straight and on a
