@@ -760,6 +760,51 @@ std::vector<Case> cases()
         ct_tile_slot s[1];
         return ct_tileset_open(&ts, nullptr, 64, s, 1, nullptr, nullptr);
     });
+    // ---- ranges of geolocation's inputs
+    add("geolocate: refraction k below -2", CT_ERR_EFFECTS, [](World &w) {
+        const ct_effects fx = {CT_EFFECT_REFRACTION | CT_EFFECT_CURVATURE, -3 * 65536, 0, 0, nullptr};
+        ct_geo g;
+        return ct_geolocate(&w.p, &w.cam, &w.pose, CT_METHOD_DIRECTIONAL, &fx, 32 << 16, 24 << 16, &g);
+    });
+    // (east and north cannot leave the grid's range on a 30 m grid: 2^61 nm
+    // is 2^42 Q16 cells there, inside CT_MAX_ORIGIN_Q16; such a camera's
+    // rays miss)
+    add("geolocate: camera 2^61 nm up", CT_ERR_RAY, [](World &w) -> ct_status {
+        int32_t q[4];
+        ct_pose far;
+        if (ct_quat_from_ypr(0, dem_cases::deg_q61(-60), 0, q) != CT_OK ||
+            ct_pose_from_map(&far, w.pose.e_nm, w.pose.n_nm, INT64_C(1) << 61, q) != CT_OK)
+            return CT_ERR_INTERNAL;  // not the case under test: fails it
+        ct_geo g;
+        return ct_geolocate(&w.p, &w.cam, &far, CT_METHOD_DIRECTIONAL, nullptr, 32 << 16, 24 << 16, &g);
+    });
+    struct Tol {
+        const char *name;
+        int32_t k;
+        int64_t radius, tol;
+    };
+    for (const Tol &t : {Tol{"effects_for_tolerance: k beyond 2", 3 * 65536, 0, 1000000},
+                         Tol{"effects_for_tolerance: k below -2", -3 * 65536, 0, 1000000},
+                         Tol{"effects_for_tolerance: radius below 2^40 nm", CT_REFRACTION_K_STD_Q16, 1000, 1000000},
+                         Tol{"effects_for_tolerance: radius beyond 2^54 nm", CT_REFRACTION_K_STD_Q16,
+                             (INT64_C(1) << 54) + 1, 1000000},
+                         Tol{"effects_for_tolerance: negative tolerance", CT_REFRACTION_K_STD_Q16, 0, -1}})
+        add(t.name, CT_ERR_EFFECTS, [t](World &w) {
+            ct_effects_choice ch;
+            return ct_effects_for_tolerance(&w.p, &w.cam, &w.pose, t.k, t.radius, t.tol, &ch);
+        });
+    add("effects_for_tolerance: camera never set up", CT_ERR_ARG, [](World &w) {
+        ct_camera c;
+        std::memset(&c, 0, sizeof c);
+        ct_effects_choice ch;
+        return ct_effects_for_tolerance(&w.p, &c, &w.pose, CT_REFRACTION_K_STD_Q16, 0, 1000000, &ch);
+    });
+    add("effects_for_tolerance: pose never set up", CT_ERR_ARG, [](World &w) {
+        ct_pose q;
+        std::memset(&q, 0, sizeof q);
+        ct_effects_choice ch;
+        return ct_effects_for_tolerance(&w.p, &w.cam, &q, CT_REFRACTION_K_STD_Q16, 0, 1000000, &ch);
+    });
     return v;
 }
 
