@@ -805,6 +805,28 @@ std::vector<Case> cases()
         ct_effects_choice ch;
         return ct_effects_for_tolerance(&w.p, &w.cam, &q, CT_REFRACTION_K_STD_Q16, 0, 1000000, &ch);
     });
+    // ---- a bend's ranges (ct_bend): each alone
+    struct Bend {
+        const char *name;
+        ct_bend bd;
+    };
+    for (const Bend &b : {Bend{"trace_bent: coefficient below -4", {-4 * 65536 - 1, CT_EARTH_RADIUS_NM, CT_EFFECTS_CHORD_NM, 0u}},
+                          Bend{"trace_bent: coefficient beyond 4", {4 * 65536 + 1, CT_EARTH_RADIUS_NM, CT_EFFECTS_CHORD_NM, 0u}},
+                          Bend{"trace_bent: radius beyond 2^54", {57016, (INT64_C(1) << 54) + 1, CT_EFFECTS_CHORD_NM, 0u}},
+                          Bend{"trace_bent: chord below 2^10", {57016, CT_EARTH_RADIUS_NM, (INT64_C(1) << 10) - 1, 0u}},
+                          Bend{"trace_bent: chord beyond 2^50", {57016, CT_EARTH_RADIUS_NM, (INT64_C(1) << 50) + 1, 0u}},
+                          Bend{"trace_bent: unknown flag", {57016, CT_EARTH_RADIUS_NM, CT_EFFECTS_CHORD_NM, 2u}}})
+        add(b.name, CT_ERR_ARG, [b](World &w) {
+            ct_hit h;
+            return ct_trace_bent(&w.p, &w.ray, &b.bd, CT_METHOD_DIRECTIONAL, &h);
+        });
+    add("trace_bent: origin beyond CT_MAX_ORIGIN_Q16", CT_ERR_RAY, [](World &w) {
+        const ct_bend bd = {57016, CT_EARTH_RADIUS_NM, CT_EFFECTS_CHORD_NM, 0u};
+        ct_ray r = w.ray;
+        r.z_q16 = CT_MAX_ORIGIN_Q16 + 1;
+        ct_hit h;
+        return ct_trace_bent(&w.p, &r, &bd, CT_METHOD_DIRECTIONAL, &h);
+    });
     return v;
 }
 
