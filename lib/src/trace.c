@@ -37,15 +37,9 @@
 #include "conetrace.h"
 #include "fixed.h"
 #include "tiles.h"
-
-#define ONE16 INT64_C(65536)
-#define T_ONE (INT64_C(1) << CT_T_FRAC_BITS)
+#include "trace_core.h"
 
 enum { FACE_X = 1, FACE_Y = 2, FACE_XY = 3 };
-
-typedef struct {
-    int64_t n, d; /* t = n / d, d > 0 */
-} rt;
 
 static const rt T_ZERO = {0, 1};
 
@@ -145,40 +139,6 @@ static int64_t lower_ahead(const ctx *c, int32_t i, int32_t j)
     return ct_min64((r * r * c->lw->kc) >> 16, c->lw->dmax) >> c->zs;
 }
 
-/* floor(a / 2^n) without relying on the implementation-defined right shift
- * of negative values. */
-static int64_t floor_shr(int64_t a, unsigned n)
-{
-    return a >= 0 ? a >> n : -(int64_t)(((uint64_t)(-a) + (((uint64_t)1 << n) - 1u)) >> n);
-}
-
-/* a < b for rationals: n <= 2^34, d <= 2^26 -> products < 2^60 */
-static int rt_lt(rt a, rt b) { return a.n * b.d < b.n * a.d; }
-
-/* Fine-cell index along one axis at o + t*d (Q16), with the tie rule: a
- * point exactly on a grid line belongs to the cell the ray moves into; with
- * no motion along the axis, to the cell on its + side, clamped to the tile.
- * num = o*den + n*d: o < 2^31 (or 2^47 at prep) ... callers bound it.      */
-static int32_t axis_cell(int64_t num, int64_t den16, int32_t s, int32_t ncell)
-{
-    /* den16 = 2^16 (a Q16 coordinate itself, t = 0 / 1): a shift */
-    int64_t k = den16 == ONE16 ? floor_shr(num, 16u) : ct_floor_div(num, den16);
-    if (k * den16 == num) {
-        if (s < 0) {
-            k -= 1;
-        } else if (s == 0 && k == ncell) {
-            k -= 1;
-        }
-    }
-    if (k < -1) {
-        k = -1;
-    }
-    if (k > ncell) {
-        k = ncell;
-    }
-    return (int32_t)k;
-}
-
 /* Cell index for a Q26 t (den 2^42): shifts instead of divisions. */
 static int32_t axis_cell_q26(int64_t num, int32_t s, int32_t ncell)
 {
@@ -275,24 +235,6 @@ static rt cell_entry(const ctx *c, int32_t i, int32_t j)
         }
     }
     return t;
-}
-
-typedef struct {
-    int32_t h00, h10, h01, h11, hmax;
-} posts4;
-
-static void load_posts(const ct_package *p, int32_t i, int32_t j, posts4 *q)
-{
-    const uint8_t *r0 = p->heights + 2u * ((size_t)(uint32_t)j * p->width + (uint32_t)i);
-    const uint8_t *r1 = r0 + 2u * p->width;
-    int32_t m;
-    q->h00 = (int32_t)ct_ld16(r0);
-    q->h10 = (int32_t)ct_ld16(r0 + 2);
-    q->h01 = (int32_t)ct_ld16(r1);
-    q->h11 = (int32_t)ct_ld16(r1 + 2);
-    m = q->h00 > q->h10 ? q->h00 : q->h10;
-    m = m > q->h01 ? m : q->h01;
-    q->hmax = m > q->h11 ? m : q->h11;
 }
 
 /* Sign of f = z_ray - S at the exit point, exact.  With d = e->t.d and
@@ -1111,33 +1053,11 @@ static int above_apex(const ctx *c, uint32_t plane, int32_t i, int32_t j)
 
 /* ------------------------------------------------------------------------ */
 
-/* Surface height at a Q16 point of cell (i, j), times 2^32 (exact):
- * h00*2^32 + a*U*2^16 + b*V*2^16 + c*U*V with U, V in [0, 2^16]: < 2^50. */
-/* The tallest post of cell (i, j). */
-static int32_t cell_hmax(const ct_package *p, int32_t i, int32_t j)
-{
-    posts4 q;
-    load_posts(p, i, j, &q);
-    return q.hmax;
-}
-
-static int64_t surface_q32(const ct_package *p, int32_t i, int32_t j, int64_t x, int64_t y)
-{
-    posts4 q;
-    int64_t U = x - (int64_t)i * ONE16, V = y - (int64_t)j * ONE16;
-    int64_t a, b, cc;
-    load_posts(p, i, j, &q);
-    a = (int64_t)q.h10 - q.h00;
-    b = (int64_t)q.h01 - q.h00;
-    cc = (int64_t)q.h11 - q.h10 - q.h01 + q.h00;
-    return (int64_t)q.h00 * (ONE16 * ONE16) + a * U * ONE16 + b * V * ONE16 + cc * U * V;
-}
-
 /* The lowered surface (bent rays) at a Q16 point of cell (i, j), in Q16
  * LSB times 2^32, exact: posts G < 2^33 in Q16 LSB, a, b < 2^34, c < 2^35,
  * U, V in [0, 2^16]: G00 2^32 + (a U + b V) 2^16 + c U V < 2^68 (128-bit). */
-CT_NOINLINE static ct_i128 surface_low_q48(const ct_package *p, const ct_lower *lw, int32_t i, int32_t j, int64_t x,
-                                               int64_t y)
+CT_NOINLINE ct_i128 ct_surface_low_q48(const ct_package *p, const ct_lower *lw, int32_t i, int32_t j, int64_t x,
+                                       int64_t y)
 {
     posts4 q;
     int64_t U = x - (int64_t)i * ONE16, V = y - (int64_t)j * ONE16, x0 = (int64_t)i * ONE16,
@@ -1172,466 +1092,6 @@ ct_status ct_surface_height(const ct_package *p, int64_t x, int64_t y, int64_t *
 }
 
 /* ------------------------------------------------------------------------ */
-/* Ray preparation.                                                          */
-
-typedef struct {
-    ct_i128 n;
-    int64_t d; /* > 0 */
-} bigrt;
-
-/* a < b for 128-bit rationals: |n| < 2^48, d <= 2^62: products < 2^110 */
-static int bigrt_lt(const bigrt *a, const bigrt *b)
-{
-    return ct_i128_cmp(ct_i128_mul128_64(a->n, b->d), ct_i128_mul128_64(b->n, a->d)) < 0;
-}
-
-/* Round o + t*D to nearest on one axis: (o*d + n*D) / d, 128-bit:
- * |o| d < 2^46 2^62, |n D| < 2^48 2^62; quotient < 2^48. */
-static int64_t round_axis(int64_t o, int64_t D, const bigrt *t)
-{
-    ct_i128 num = ct_i128_add(ct_i128_mul(o, t->d), ct_i128_mul128_64(t->n, D));
-    int64_t q = ct_i128_floor_div(num, t->d);
-    ct_i128 rem = ct_i128_sub(num, ct_i128_mul(q, t->d)); /* 0 <= rem < d */
-    if (ct_i128_cmp(ct_i128_shl(rem, 1), ct_i128_from64(t->d)) >= 0) {
-        q += 1;
-    }
-    return q;
-}
-
-/* a * 2^e for a <= 2^62 and a result known to be <= 2^32, rounded to
- * nearest (halves away from zero) when e < 0. */
-static uint64_t scale_pow2(uint64_t a, int e)
-{
-    if (e >= 0) {
-        return a << (unsigned)e;
-    }
-    if (e <= -64) {
-        return 0u;
-    }
-    /* a + 2^(-e-1) <= 2^62 + 2^62: fits uint64 */
-    return (a + ((uint64_t)1 << (unsigned)(-e - 1))) >> (unsigned)(-e);
-}
-
-/* A direction's magnitudes: the larger horizontal component h = max(|Ux|,
- * |Uy|), az = |Uz|, and their bit lengths. */
-typedef struct {
-    uint64_t h, az;
-    unsigned bh, bz;
-} dir_mag;
-
-static dir_mag dir_magnitudes(const int64_t U[3])
-{
-    dir_mag g;
-    g.h = (uint64_t)ct_max64(ct_abs64(U[0]), ct_abs64(U[1]));
-    g.az = (uint64_t)ct_abs64(U[2]);
-    g.bh = ct_bitlen64(g.h);
-    g.bz = ct_bitlen64(g.az);
-    return g;
-}
-
-/* z shift of a direction: the smallest k <= kmax with |Uz| / 2^k <= h (so
- * that z, in units of 2^k Q16, no longer dominates a steep ray); 0 for a
- * vertical ray.  With k0 = bitlen(|Uz|) - bitlen(h), |Uz| >> k0 <
- * 2^bitlen(h) <= 2h, so k is k0 or k0 + 1. */
-static unsigned dir_zshift(const dir_mag *g, uint32_t kmax)
-{
-    uint64_t h = g->h, az = g->az;
-    unsigned bh = g->bh, bz = g->bz, k;
-    if (h == 0u || bz < bh) {
-        return 0u;
-    }
-    k = bz - bh;
-    k += (az >> k) > h ? 1u : 0u;
-    return k < kmax ? k : kmax;
-}
-
-/* The direction (Ux, Uy, Uz / 2^zs) scaled so that its largest component is
- * 2^26 - 1 or 2^26.  |U| <= 2^62.  V = (Ux 2^zs, Uy 2^zs, Uz) is first
- * brought by a common power of two to a largest component m' in
- * [2^31, 2^32] (rounding error <= 1/2 in 2^31: relative 2^-32), then
- * multiplied by f / 2^32 with f = floor(2^58 / m') in [2^26, 2^27] and
- * rounded: each component is within 1/2 + 2^-5 of the exact (common)
- * scaling, whose largest component is in (2^26 - 1, 2^26].  Products
- * V' f <= 2^32 2^27 = 2^59.                                               */
-static void normalize_dir(const int64_t U[3], const dir_mag *g, unsigned zs, int32_t out[3])
-{
-    uint64_t a[3], v[3], m = 0u, f;
-    int e[3], top, k;
-    /* bound: 3 components */
-    for (k = 0; k < 3; ++k) {
-        a[k] = (uint64_t)ct_abs64(U[k]);
-    }
-    top = (int)(g->bh + zs) > (int)g->bz ? (int)(g->bh + zs) : (int)g->bz;
-    for (k = 0; k < 3; ++k) { /* bound: 3 components */
-        /* V_k / 2^(top - 32), V_k = a_k 2^(zs for x, y) */
-        e[k] = (k < 2 ? (int)zs : 0) - (top - 32);
-        v[k] = scale_pow2(a[k], e[k]);
-        m = v[k] > m ? v[k] : m;
-    }
-    f = ((uint64_t)1 << 58) / m; /* m >= 2^31 */
-    for (k = 0; k < 3; ++k) { /* bound: 3 components */
-        int64_t q = (int64_t)((v[k] * f + ((uint64_t)1 << 31)) >> 32);
-        out[k] = (int32_t)(U[k] < 0 ? -q : q);
-    }
-}
-
-/* Where the ray o + t D (o in the box: x, y Q16, z in units of 2^16/zone
- * Q16) leaves the tile's box: horizontally, through the top (rising) or
- * below hmin - 1 (descending; never reached without a hit), the floor
- * lowered by zlow (a bent ray's largest lowering in its z units, < 2^32;
- * 0 for a straight ray): |zbot| < 2^33.  Candidates
- * have n < 2^34 and d <= 2^26, so rt_lt cannot overflow; with no candidate
- * (cannot happen: some axis moves) te stays 2^34. */
-static rt box_exit(const ct_package *p, const int64_t O[3], const int32_t D[3], int64_t zone, int64_t zlow)
-{
-    rt te = {INT64_C(1) << 34, 1}, c;
-    int64_t ztop = ((int64_t)p->hmax + 1) * zone, zbot = ((int64_t)p->hmin - 1) * zone - zlow;
-    int have = 0, k;
-    /* bound: 3 axes */
-    for (k = 0; k < 3; ++k) {
-        if (D[k] == 0) {
-            continue;
-        }
-        c.d = ct_abs64(D[k]);
-        if (k < 2) {
-            c.n = D[k] > 0 ? (int64_t)(k == 0 ? p->cells_x : p->cells_y) * ONE16 - O[k] : O[k];
-        } else if (D[k] > 0) {
-            c.n = ct_max64(ztop - O[2], 0);
-        } else {
-            if (O[2] <= zbot) {
-                continue;
-            }
-            c.n = O[2] - zbot;
-        }
-        if (!have || rt_lt(c, te)) {
-            te = c;
-            have = 1;
-        }
-    }
-    return te;
-}
-
-/* Preparation in two parts.  prep_geom clips the ray to p's box and
- * quantises it (origin, direction, zshift, length, sector): geometry only,
- * no heights read, so a tile set prepares against its whole extent (a
- * header-only package).  prep_finish decides the first point against the
- * surface of sp -- the package holding it; in a tile set the tile, whose
- * grid is p's shifted by (offx, offy) Q16, whole cells -- and forms tend
- * in p's box.  seg != 0: the ray ends at origin + direction (t <= 1 in the
- * caller's parameter) as well as at the box.  prep_geom returns CT_OK
- * (then out->start is not yet set), or CT_MISS / CT_BELOW (out->start set)
- * or an error. */
-static ct_status prep_geom(const ct_package *p, const ct_ray *ray, int seg, ct_prepared *out)
-{
-    int32_t D[3];
-    int64_t O[3], U[3], lo[3], hi[3];
-    bigrt tin, tout;
-    int k, has_out = 0, kin = -1;
-    unsigned zs;
-    dir_mag mag;
-    int64_t kin_at = 0; /* the entry face's coordinate on axis kin */
-    CT_ASSERT(p != NULL && ray != NULL && out != NULL);
-    if (p == NULL || ray == NULL || out == NULL) {
-        return CT_ERR_ARG;
-    }
-    O[0] = ray->x_q16;
-    O[1] = ray->y_q16;
-    O[2] = ray->z_q16;
-    U[0] = ray->dx;
-    U[1] = ray->dy;
-    U[2] = ray->dz;
-    /* bound: 3 axes */
-    for (k = 0; k < 3; ++k) {
-        if (ct_abs64(O[k]) > CT_MAX_ORIGIN_Q16 || ct_abs64(U[k]) > (INT64_C(1) << 62)) {
-            return CT_ERR_RAY;
-        }
-    }
-    if (U[0] == 0 && U[1] == 0 && U[2] == 0) {
-        return CT_ERR_RAY;
-    }
-    lo[0] = 0;
-    hi[0] = (int64_t)p->cells_x * ONE16;
-    lo[1] = 0;
-    hi[1] = (int64_t)p->cells_y * ONE16;
-    lo[2] = 0; /* unused: the box has no floor (a ray entering below the
-                  surface is BELOW) */
-    hi[2] = ((int64_t)p->hmax + 1) * ONE16;
-    tin.n = ct_i128_from64(0);
-    tin.d = 1;
-    tout = tin;
-    /* A segment that starts and ends inside the box (the bent walk's usual
-     * case) needs no clipping: tin = 0, and every box exit is at t >= 1.
-     * |O| <= 2^46, |U| <= 2^62: O + U fits in int64. */
-    if (seg) {
-        int in = 1;
-        for (k = 0; k < 3; ++k) { /* bound: 3 axes */
-            int64_t e = O[k] + U[k];
-            if ((k < 2 && (O[k] < lo[k] || e < lo[k])) || O[k] > hi[k] || e > hi[k]) {
-                in = 0;
-            }
-        }
-        if (in) {
-            has_out = 1;
-            tout.n = ct_i128_from64(1);
-            k = 3; /* skip the clip below */
-        } else {
-            k = 0;
-        }
-    } else {
-        k = 0;
-    }
-    /* Clip the caller's ray (unnormalised direction, exact 128-bit
-     * rationals) to the box.  bound: 3 axes */
-    for (; k < 3; ++k) {
-        bigrt a, b;
-        int floorless = (k == 2);
-        if (U[k] == 0) {
-            if ((!floorless && O[k] < lo[k]) || O[k] > hi[k]) {
-                out->start = CT_MISS;
-                return CT_MISS;
-            }
-            continue;
-        }
-        a.d = b.d = ct_abs64(U[k]);
-        /* |bound - o| < 2^47 */
-        if (U[k] > 0) {
-            a.n = ct_i128_from64(lo[k] - O[k]);
-            b.n = ct_i128_from64(hi[k] - O[k]);
-            if (!floorless && bigrt_lt(&tin, &a)) {
-                tin = a;
-                kin = k;
-                kin_at = lo[k];
-            }
-            if (!has_out || bigrt_lt(&b, &tout)) {
-                tout = b;
-                has_out = 1;
-            }
-        } else {
-            a.n = ct_i128_from64(O[k] - hi[k]);
-            b.n = ct_i128_from64(O[k] - lo[k]);
-            if (bigrt_lt(&tin, &a)) {
-                tin = a;
-                kin = k;
-                kin_at = hi[k];
-            }
-            if (!floorless && (!has_out || bigrt_lt(&b, &tout))) {
-                tout = b;
-                has_out = 1;
-            }
-        }
-    }
-    if (seg) {
-        bigrt one;
-        one.n = ct_i128_from64(1);
-        one.d = 1;
-        if (!has_out || bigrt_lt(&one, &tout)) {
-            tout = one;
-            has_out = 1;
-        }
-    }
-    if (has_out && bigrt_lt(&tout, &tin)) {
-        out->start = CT_MISS;
-        return CT_MISS;
-    }
-    if (ct_i128_sign(tin.n) > 0) {
-        /* The box has no floor: a ray may enter through a side face far
-         * below the terrain (z unbounded below).  Below -2^46 it is BELOW
-         * (every surface is >= 0) and its z would not fit the rounding:
-         * (oz + 2^46) * d + n * U_z < 0, with |oz + 2^46| <= 2^47,
-         * d <= 2^62, n < 2^48: 128-bit.                                    */
-        ct_i128 zq = ct_i128_add(ct_i128_mul(O[2] + CT_MAX_ORIGIN_Q16, tin.d),
-                                 ct_i128_mul128_64(tin.n, U[2]));
-        if (ct_i128_sign(zq) < 0) {
-            out->start = CT_BELOW;
-            return CT_BELOW;
-        }
-        /* the entry point, rounded to Q16 and kept in the box */
-        for (k = 0; k < 3; ++k) {
-            /* on the entry face's axis the point is the face itself, exactly
-             * (o + (bound - o)/U U): no division */
-            O[k] = k == kin ? kin_at : round_axis(O[k], U[k], &tin);
-        }
-        for (k = 0; k < 3; ++k) {
-            if (O[k] > hi[k]) {
-                O[k] = hi[k];
-            }
-            if (k < 2 && O[k] < lo[k]) {
-                O[k] = lo[k];
-            }
-        }
-    }
-    /* per-axis scaling: z in units of 2^zs Q16 (see ct_prepared); the
-     * origin's z rounded to them (O[2] <= hi[2], a multiple of 2^16, stays
-     * in the box; |O[2]| <= 2^46 here) */
-    mag = dir_magnitudes(U);
-    zs = dir_zshift(&mag, p->zshift_max);
-    normalize_dir(U, &mag, zs, D);
-    if (zs > 0u && D[0] == 0 && D[1] == 0) {
-        /* horizontal components too small to survive: a vertical ray,
-         * which the tracer handles in Q16 */
-        zs = 0u;
-        normalize_dir(U, &mag, zs, D);
-    }
-    if (zs > 0u) {
-        O[2] = floor_shr(O[2] + (INT64_C(1) << (zs - 1u)), zs);
-    }
-    out->ox = O[0];
-    out->oy = O[1];
-    out->oz = O[2];
-    out->dx = D[0];
-    out->dy = D[1];
-    out->dz = D[2];
-    out->zshift = (int32_t)zs;
-    {
-        /* dx^2 + dy^2 <= 2^53 */
-        uint64_t l2 = (uint64_t)((int64_t)D[0] * D[0] + (int64_t)D[1] * D[1]);
-        uint64_t l = ct_isqrt64(l2);
-        out->len_lo = (int64_t)l;
-        out->len_hi = (int64_t)l + (l * l != l2 ? 1 : 0);
-    }
-    if (D[0] != 0 || D[1] != 0) {
-        uint32_t s;
-        ct_status st = ct_sector_of(p, D[0], D[1], &s);
-        if (st != CT_OK) {
-            return st;
-        }
-        out->sector = (int32_t)s;
-    } else {
-        out->sector = -1;
-    }
-    return CT_OK;
-}
-
-void ct_prepared_first_cell(const ct_package *p, const ct_prepared *r, int32_t *i, int32_t *j)
-{
-    /* the cell holding the first point (as the walk's locate at t = 0:
-     * -1 .. cells on an axis) */
-    *i = axis_cell(r->ox, ONE16, r->dx > 0 ? 1 : (r->dx < 0 ? -1 : 0), (int32_t)p->cells_x);
-    *j = axis_cell(r->oy, ONE16, r->dy > 0 ? 1 : (r->dy < 0 ? -1 : 0), (int32_t)p->cells_y);
-}
-
-/* (fi, fj): the first point's cell of p (ct_prepared_first_cell). */
-static ct_status prep_finish(const ct_package *p, const ct_package *sp, int64_t offx, int64_t offy, int32_t fi,
-                             int32_t fj, const ct_ray *ray, int seg, const ct_lower *lw, ct_prepared *out)
-{
-    int64_t O[3];
-    int32_t D[3];
-    unsigned zs = (unsigned)out->zshift;
-    int64_t zone = ONE16 >> zs;
-    ct_status start;
-    int k;
-    O[0] = out->ox;
-    O[1] = out->oy;
-    O[2] = out->oz;
-    D[0] = out->dx;
-    D[1] = out->dy;
-    D[2] = out->dz;
-    /* the first point: below, on, or above the surface (exact); decided
-     * first, so that tend below is formed only for a point at or above the
-     * surface (z >= 0: every candidate < 2^34) */
-    {
-        /* in sp's grid (a tile set's tile: shifted by whole cells) */
-        int32_t i = fi - (int32_t)(offx >> 16), j = fj - (int32_t)(offy >> 16);
-        int64_t s, f, lx = O[0] - offx, ly = O[1] - offy;
-        if (O[2] < -(INT64_C(1) << (46u - zs))) {
-            start = CT_BELOW;
-        } else if (sp == NULL) {
-            start = CT_OK; /* a tile set's caller: above every post of the tile */
-        } else if (lw != NULL && O[2] * (INT64_C(1) << zs) > (int64_t)cell_hmax(sp, i, j) * ONE16) {
-            start = CT_OK; /* above the cell's tallest post (|O[2] 2^zs| <= 2^46) */
-        } else if (lw != NULL) {
-            /* the lowered surface, Q16 2^32: z_q16 2^32 < 2^78 */
-            int sg = ct_i128_cmp(ct_i128_shl(ct_i128_from64(O[2] * (INT64_C(1) << zs)), 32),
-                                 surface_low_q48(sp, lw, i, j, lx, ly));
-            start = sg < 0 ? CT_BELOW : (sg == 0 ? CT_HIT : CT_OK);
-        } else {
-            s = surface_q32(sp, i, j, lx, ly);
-            f = O[2] * (INT64_C(1) << zs) * ONE16 - s; /* |oz 2^zs| <= 2^46: < 2^62 */
-            start = f < 0 ? CT_BELOW : (f == 0 ? CT_HIT : CT_OK);
-        }
-    }
-    if (start == CT_BELOW) {
-        /* decided before tend: below the surface, z may be far under the
-         * box, where tend's rationals would not fit */
-        out->tend_n = 0;
-        out->tend_d = 1;
-        out->start = CT_BELOW;
-        return CT_BELOW;
-    }
-    /* tend: leaving the box horizontally, through the top (rising) or
-     * below hmin - 1 (descending; never reached without a hit).          */
-    {
-        rt te = box_exit(p, O, D, zone, lw != NULL ? lw->dmax >> zs : 0), c;
-        if (seg) {
-            /* the segment's end: where the prepared ray reaches the end
-             * point's coordinate on its dominant axis m.  The end is
-             * origin + U: |origin| <= 2^46, |U| <= 2^62, so the sum fits;
-             * the entry |O[m]| <= 2^47, so the difference fits.  Beyond
-             * 2^34 the box exit above is nearer anyway (box < 2^34).    */
-            int m = 0;
-            int64_t e, num;
-            for (k = 1; k < 3; ++k) { /* bound: 2 axes */
-                if (ct_abs64(D[k]) > ct_abs64(D[m])) {
-                    m = k;
-                }
-            }
-            e = m == 0 ? ray->x_q16 + ray->dx : (m == 1 ? ray->y_q16 + ray->dy : ray->z_q16 + ray->dz);
-            num = (e - (m == 2 ? O[2] * (INT64_C(1) << zs) : O[m])) * (D[m] > 0 ? 1 : -1);
-            if (num < 0) {
-                num = 0;
-            }
-            if (m == 2) {
-                /* in prepared z units, rounded up */
-                num = (num >> zs) + ((num & ((INT64_C(1) << zs) - 1)) != 0 ? 1 : 0);
-            }
-            if (num < (INT64_C(1) << 34)) {
-                c.n = num;
-                c.d = ct_abs64(D[m]);
-                if (rt_lt(c, te)) {
-                    te = c;
-                }
-            }
-        }
-        out->tend_n = te.n;
-        out->tend_d = te.d;
-    }
-    out->start = start;
-    return start;
-}
-
-ct_status ct_tile_prep_geom(const ct_package *frame, const ct_ray *ray, int seg, ct_prepared *out)
-{
-    return prep_geom(frame, ray, seg, out);
-}
-
-ct_status ct_tile_prep_finish(const ct_package *frame, const ct_package *tile, int64_t offx, int64_t offy, int32_t fi,
-                              int32_t fj, const ct_ray *ray, int seg, const ct_lower *lw, ct_prepared *out)
-{
-    return prep_finish(frame, tile, offx, offy, fi, fj, ray, seg, lw, out);
-}
-
-static ct_status prepare_impl(const ct_package *p, const ct_ray *ray, int seg, const ct_lower *lw, ct_prepared *out)
-{
-    int32_t i, j;
-    ct_status st = prep_geom(p, ray, seg, out);
-    if (st != CT_OK) {
-        return st;
-    }
-    /* the first point is on the tile: the cell it is in, clamped */
-    ct_prepared_first_cell(p, out, &i, &j);
-    return prep_finish(p, p, 0, 0, ct_clamp_cell(i, p->cells_x), ct_clamp_cell(j, p->cells_y), ray, seg, lw, out);
-}
-
-ct_status ct_ray_prepare(const ct_package *p, const ct_ray *ray, ct_prepared *out)
-{
-    return prepare_impl(p, ray, 0, NULL, out);
-}
-
-ct_status ct_ray_prepare_segment(const ct_package *p, const ct_ray *ray, ct_prepared *out)
-{
-    return prepare_impl(p, ray, 1, NULL, out);
-}
-
 /* ------------------------------------------------------------------------ */
 
 static ct_status check_prepared(const ct_package *p, const ct_prepared *r)
@@ -1825,7 +1285,7 @@ static ct_status trace_impl(const ct_package *p, const ct_prepared *r, ct_method
         if (lw != NULL) {
             /* the lowered surface rounded up to Q16 2^16 (a hit at or
              * above it); |s| < 2^50 as below */
-            ct_i128 sl = surface_low_q48(p, lw, i, j, r->ox, r->oy);
+            ct_i128 sl = ct_surface_low_q48(p, lw, i, j, r->ox, r->oy);
             s = -ct_i128_floor_div(ct_i128_neg(sl), ONE16);
         } else {
             s = surface_q32(p, i, j, r->ox, r->oy);
@@ -1907,11 +1367,6 @@ ct_status ct_trace_prepared_own(const ct_package *p, const ct_prepared *r, ct_me
     return trace_impl(p, r, m, 1, NULL, NULL, h);
 }
 
-ct_status ct_prepare_lowered_segment(const ct_package *p, const ct_ray *ray, const ct_lower *lw, ct_prepared *out)
-{
-    return prepare_impl(p, ray, 1, lw, out);
-}
-
 ct_status ct_trace_prepared_lowered(const ct_package *p, const ct_prepared *r, const ct_lower *lw, ct_method m,
                                     ct_hit *h)
 {
@@ -1921,7 +1376,7 @@ ct_status ct_trace_prepared_lowered(const ct_package *p, const ct_prepared *r, c
 ct_status ct_trace_lowered(const ct_package *p, const ct_ray *ray, const ct_lower *lw, ct_method m, ct_hit *h)
 {
     ct_prepared r;
-    ct_status st = prepare_impl(p, ray, 0, lw, &r);
+    ct_status st = ct_prepare_lowered(p, ray, 0, lw, &r);
     if (st < 0) {
         return st;
     }
