@@ -131,8 +131,9 @@ void ct_grid_dir_from_map(const ct_package *p, int64_t de, int64_t dn, int64_t d
         if (s == 0u) {
             d[k] = ct_i128_to64(v[k]);
         } else {
+            /* |v| + 2^(s-1) >= 0: floor division by 2^s is a shift */
             ct_i128 a = ct_i128_abs(v[k]);
-            int64_t q = ct_i128_floor_div(ct_i128_add(a, ct_i128_shl(ct_i128_from64(1), s - 1u)), INT64_C(1) << s);
+            int64_t q = ct_i128_to64(ct_i128_sar(ct_i128_add(a, ct_i128_shl(ct_i128_from64(1), s - 1u)), s));
             d[k] = ct_i128_sign(v[k]) < 0 ? -q : q;
         }
     }
