@@ -142,21 +142,8 @@ static int64_t lower_ahead(const ctx *c, int32_t i, int32_t j)
 /* Cell index for a Q26 t (den 2^42): shifts instead of divisions. */
 static int32_t axis_cell_q26(int64_t num, int32_t s, int32_t ncell)
 {
-    int64_t k = floor_shr(num, 16u + CT_T_FRAC_BITS);
-    if ((num & ((INT64_C(1) << (16 + CT_T_FRAC_BITS)) - 1)) == 0) {
-        if (s < 0) {
-            k -= 1;
-        } else if (s == 0 && k == ncell) {
-            k -= 1;
-        }
-    }
-    if (k < -1) {
-        k = -1;
-    }
-    if (k > ncell) {
-        k = ncell;
-    }
-    return (int32_t)k;
+    return cell_rule(floor_shr(num, 16u + CT_T_FRAC_BITS), (num & ((INT64_C(1) << (16 + CT_T_FRAC_BITS)) - 1)) == 0, s,
+                     ncell);
 }
 
 /* The cell index on one axis (origin o, direction d of sign s, n cells)

@@ -31,15 +31,12 @@ static inline int64_t floor_shr(int64_t a, unsigned n)
 static inline int rt_lt(rt a, rt b) { return a.n * b.d < b.n * a.d; }
 
 
-/* Fine-cell index along one axis at o + t*d (Q16), with the tie rule: a
- * point exactly on a grid line belongs to the cell the ray moves into; with
- * no motion along the axis, to the cell on its + side, clamped to the tile.
- * num = o*den + n*d: o < 2^31 (or 2^47 at prep) ... callers bound it.      */
-static inline int32_t axis_cell(int64_t num, int64_t den16, int32_t s, int32_t ncell)
+/* The tie rule and the clamp of a cell index k = floor(coordinate): on a
+ * grid line (exact) the cell the ray moves into, with no motion along the
+ * axis the cell on its + side; clamped to -1 .. ncell. */
+static inline int32_t cell_rule(int64_t k, int exact, int32_t s, int32_t ncell)
 {
-    /* den16 = 2^16 (a Q16 coordinate itself, t = 0 / 1): a shift */
-    int64_t k = den16 == ONE16 ? floor_shr(num, 16u) : ct_floor_div(num, den16);
-    if (k * den16 == num) {
+    if (exact) {
         if (s < 0) {
             k -= 1;
         } else if (s == 0 && k == ncell) {
@@ -53,6 +50,17 @@ static inline int32_t axis_cell(int64_t num, int64_t den16, int32_t s, int32_t n
         k = ncell;
     }
     return (int32_t)k;
+}
+
+/* Fine-cell index along one axis at o + t*d (Q16), with the tie rule: a
+ * point exactly on a grid line belongs to the cell the ray moves into; with
+ * no motion along the axis, to the cell on its + side, clamped to the tile.
+ * num = o*den + n*d: o < 2^31 (or 2^47 at prep) ... callers bound it.      */
+static inline int32_t axis_cell(int64_t num, int64_t den16, int32_t s, int32_t ncell)
+{
+    /* den16 = 2^16 (a Q16 coordinate itself, t = 0 / 1): a shift */
+    int64_t k = den16 == ONE16 ? floor_shr(num, 16u) : ct_floor_div(num, den16);
+    return cell_rule(k, k * den16 == num, s, ncell);
 }
 
 typedef struct {
