@@ -827,6 +827,40 @@ std::vector<Case> cases()
         ct_hit h;
         return ct_trace_bent(&w.p, &r, &bd, CT_METHOD_DIRECTIONAL, &h);
     });
+    // ---- the frames' ranges, one axis at a time
+    struct Pt {
+        const char *name;
+        ct_status want;
+        int64_t v[3];
+        bool to_map;
+    };
+    const int64_t big60 = (INT64_C(1) << 60) + 1, at60 = INT64_C(1) << 60, big61 = (INT64_C(1) << 61) + 1;
+    for (const Pt &q : {Pt{"grid_to_map: x beyond 2^60", CT_ERR_RANGE, {big60, 0, 0}, true},
+                        Pt{"grid_to_map: y beyond 2^60", CT_ERR_RANGE, {0, big60, 0}, true},
+                        Pt{"grid_to_map: z beyond 2^60", CT_ERR_RANGE, {0, 0, big60}, true},
+                        Pt{"grid_to_map: x 2^60, e beyond 2^62 nm", CT_ERR_RANGE, {at60, 0, 0}, true},
+                        Pt{"grid_to_map: y 2^60, n beyond 2^62 nm", CT_ERR_RANGE, {0, at60, 0}, true},
+                        Pt{"grid_to_map: z 2^60, h beyond 2^62 nm", CT_ERR_RANGE, {0, 0, at60}, true},
+                        Pt{"map_to_grid: e beyond 2^61", CT_ERR_RANGE, {big61, 0, 0}, false},
+                        Pt{"map_to_grid: n beyond 2^61", CT_ERR_RANGE, {0, big61, 0}, false},
+                        Pt{"map_to_grid: h beyond 2^61", CT_ERR_RANGE, {0, 0, big61}, false}})
+        add(q.name, q.want, [q](World &w) {
+            int64_t o[3];
+            return q.to_map ? ct_grid_to_map(&w.p, q.v[0], q.v[1], q.v[2], &o[0], &o[1], &o[2])
+                            : ct_map_to_grid(&w.p, q.v[0], q.v[1], q.v[2], &o[0], &o[1], &o[2]);
+        });
+    add("ray_from_map: dn beyond 2^40", CT_ERR_RAY, [](World &w) {
+        ct_ray r;
+        return ct_ray_from_map(&w.p, w.a[0], w.a[1], w.a[2], 0, (INT64_C(1) << 40) + 1, 0, &r);
+    });
+    add("ray_from_map: dh beyond 2^40", CT_ERR_RAY, [](World &w) {
+        ct_ray r;
+        return ct_ray_from_map(&w.p, w.a[0], w.a[1], w.a[2], 0, 0, (INT64_C(1) << 40) + 1, &r);
+    });
+    add("ray_from_map: origin beyond 2^61 nm", CT_ERR_RAY, [](World &w) {
+        ct_ray r;
+        return ct_ray_from_map(&w.p, (INT64_C(1) << 61) + 1, w.a[1], w.a[2], 1, 0, 0, &r);
+    });
     return v;
 }
 
