@@ -11,7 +11,8 @@
 // the default --method directional this is the paper's horizon-angle view:
 // the walk's first step compares the sun with the cone of the post's coarse
 // cell in the sun's sector (a post at or above the cone's apex with the sun
-// above the cone is lit at once: "lit by its own cone" in the summary), then
+// above the cone is lit at once: "lit in one step" in the summary, which
+// also counts a first cell step that leaves the tile), then
 // jumps from cone to cone and tests cells exactly only where no cone
 // decides.  --method incremental is the exact ray cell by cell (the same
 // map, bit for bit; make bench compares the two per N).
@@ -102,11 +103,9 @@ int cmd_shadows(int argc, char **argv)
     const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (errors) throw Error("shadows: " + std::to_string(errors) + " posts could not be decided");
     write_geotiff(opt["-o"], W, H, std::vector<double>(lit.begin(), lit.end()), SampleType::UInt16, t.geo);
-    const bool cones = method == CT_METHOD_CONE || method == CT_METHOD_DIRECTIONAL;
-    std::fprintf(stderr, "shadows: sun at azimuth %.2f, elevation %.2f deg: %ld posts lit (%ld %s), %ld in shadow; "
-                         "%.1f steps per post; %.3f s\n",
-                 sun[0], sun[1], nlit, nonce, cones ? "by their own cone" : "in one cell step", (long)W * H - nlit,
-                 (double)nsteps / ((double)W * H), secs);
+    std::fprintf(stderr, "shadows: sun at azimuth %.2f, elevation %.2f deg: %ld posts lit (%ld in one step), %ld in "
+                         "shadow; %.1f steps per post; %.3f s\n",
+                 sun[0], sun[1], nlit, nonce, (long)W * H - nlit, (double)nsteps / ((double)W * H), secs);
     if (opt.count("--png")) {
         const int zoom = std::max(1, (int)std::lround(900.0 / std::max(W, H)));
         Image im(W * zoom, H * zoom);

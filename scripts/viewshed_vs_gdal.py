@@ -9,7 +9,7 @@
 # conetrace shadows (sun at 135, 20 deg) on packages of N = 8, 24, 64
 # sectors: the cones (--method directional) against the exact ray cell by
 # cell (--method incremental), one thread, 5 alternating rounds (median and
-# range of the command's own timing), posts lit by their own cone, steps,
+# range of the command's own timing), posts lit in one step (the post's own cone), steps,
 # and the same shadow map from every N and both methods.
 #
 #   /usr/bin/python3 scripts/viewshed_vs_gdal.py [BUILD]

@@ -940,9 +940,9 @@ void test_shadows()
         TEST_ASSERT(shi.h == sh.h);
         long own = -1;
         const size_t at = r.err.find(" lit (");
-        TEST_ASSERT(at != std::string::npos && std::sscanf(r.err.c_str() + at, " lit (%ld by their own cone", &own) == 1);
-        std::printf("  shadows, sun %s: %ld posts lit by the reference (%ld of them by their own cone at the first "
-                    "step), %ld ties, %ld disagree; incremental: the same map\n",
+        TEST_ASSERT(at != std::string::npos && std::sscanf(r.err.c_str() + at, " lit (%ld in one step", &own) == 1);
+        std::printf("  shadows, sun %s: %ld posts lit by the reference (%ld of them in one step), "
+                    "%ld ties, %ld disagree; incremental: the same map\n",
                     sun, lit, own, ties, bad);
         TEST_ASSERT_EQUAL_INT(0, bad);
         TEST_ASSERT(ties * 10 < d.w * d.h && lit > 0);
