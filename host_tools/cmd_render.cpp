@@ -223,6 +223,156 @@ void draw_wedge_glyph(Image &im, int cx, int cy, int rad, int n, int s)
         }
 }
 
+// The panels of a picture and what its legend and description say.
+struct Picture {
+    std::vector<Panel> panels;
+    int reduce = 1, nsec = 0;
+    bool grey = false, distances = false;  // grey scale (apexes); distances from 0
+    std::ostringstream desc;
+    std::string unit;
+    int wc = 0, hc = 0;  // cells per panel
+    double level_m = 0.0;
+};
+
+// --what bitmap|dt|ddt: the cross-section at the level the options give and
+// its DTs.
+void cross_section_panels(Opts &o, const Input &in, const std::string &what, int threads, Picture *pic)
+{
+    const Terrain &t = in.t;
+    int &reduce = pic->reduce, &nsec = pic->nsec, &wc = pic->wc, &hc = pic->hc;
+    std::vector<Panel> &panels = pic->panels;
+    std::ostringstream &desc = pic->desc;
+    reduce = (int)get_int(o, "--reduce", 1, 1, 8);
+    uint16_t hmin = 65535, hmax = 0;
+    for (uint16_t c : t.codes) hmin = std::min(hmin, c), hmax = std::max(hmax, c);
+    // level in code units (double): feature iff cell top >= level
+    double level;
+    if (o.val.count("--slice") && o.val.count("--level")) fail("give --slice H or --level k, not both");
+    if (o.val.count("--slice")) {
+        if (o.val.count("--slices")) fail("--slices goes with --level, not --slice");
+        double hm = parse_real("--slice", o.val["--slice"]);
+        level = (hm - t.height_offset_m) / t.height_scale_m;
+    } else if (o.val.count("--level")) {
+        long kdef = in.is_pkg && in.pkg.slices > 0 ? (long)in.pkg.slices : 0;
+        long k = get_int(o, "--slices", kdef, 1, 65535);
+        if (k == 0) fail("--level needs --slices K (the number of evenly spaced levels)");
+        long l = get_int(o, "--level", 0, 0, k);
+        level = slice_level(hmin, hmax, (int)k, (int)l);  // the builder's level, rounded up
+    } else {
+        fail("--what " + what + " needs a level: --slice H (metres) or --level k --slices K");
+    }
+    std::vector<uint16_t> top = cell_tops(t, reduce, wc, hc);
+    std::vector<uint8_t> bits(top.size());
+    size_t nfeat = 0;
+    for (size_t k = 0; k < top.size(); ++k) nfeat += bits[k] = top[k] >= level - 1e-9;
+    pic->level_m = t.height_offset_m + level * t.height_scale_m;
+    desc << "cross-section at " << pic->level_m << " m (cells with top >= level: " << nfeat << " of " << top.size()
+         << "), r=" << reduce;
+    if (what == "bitmap") {
+        Panel p;
+        p.w = wc, p.h = hc;
+        p.fg = bits;
+        p.v.assign(bits.size(), 0.0);
+        panels.push_back(std::move(p));
+    } else {
+        pic->distances = true;
+        pic->unit = "cells";
+        ddt::Prepared bm(wc, hc, bits.data());
+        ddt::Options dopt;
+        dopt.threads = threads;
+        std::vector<int64_t> dt;
+        std::vector<ddt::Point> ft;
+        auto to_panel = [&](int sector) {
+            Panel p;
+            p.w = wc, p.h = hc, p.sector = sector;
+            p.v.resize(dt.size());
+            for (size_t k = 0; k < dt.size(); ++k)
+                p.v[k] = dt[k] == ddt::Inf<int64_t>::value ? NAN : std::sqrt((double)dt[k]);
+            panels.push_back(std::move(p));
+        };
+        if (what == "dt") {
+            ddt::unconstrained(bm, ddt::EuclideanSq(), dt, ft, dopt);
+            to_panel(-1);
+            desc << "; unconstrained Euclidean DT";
+        } else {
+            nsec = (int)get_int(o, "--sectors", 8, 1, CT_MAX_SECTORS);
+            std::vector<int> secs = parse_sectors(o.val.count("--sector") ? o.val["--sector"] : "all", nsec, false);
+            for (int s : secs) {
+                ddt::directional(bm, (uint32_t)nsec, (uint32_t)s, ddt::EuclideanSq(), dt, ft, dopt);
+                to_panel(s);
+            }
+            desc << "; directional Euclidean DT, " << nsec << " sectors, sectors";
+            for (int s : secs) desc << " " << s;
+        }
+    }
+}
+
+// --what angles|apex: a package's planes.
+void package_panels(Opts &o, const Input &in, const std::string &what, Picture *pic)
+{
+    const Terrain &t = in.t;
+    int &reduce = pic->reduce, &nsec = pic->nsec, &wc = pic->wc, &hc = pic->hc;
+    std::vector<Panel> &panels = pic->panels;
+    std::ostringstream &desc = pic->desc;
+    const ct_package &p = in.pkg;
+    wc = (int)p.coarse_x, hc = (int)p.coarse_y;
+    reduce = (int)p.reduce;
+    const size_t plane = (size_t)wc * hc;
+    if (what == "apex") {
+        pic->grey = true;
+        pic->unit = "m";
+        Panel pn;
+        pn.w = wc, pn.h = hc;
+        pn.v.resize(plane);
+        for (size_t k = 0; k < plane; ++k) pn.v[k] = t.height_offset_m + get16(p.apex + 2 * k) * t.height_scale_m;
+        panels.push_back(std::move(pn));
+        desc << "apex heights (m), " << wc << "x" << hc << " coarse cells, r=" << reduce;
+    } else {
+        pic->unit = "deg";
+        nsec = (int)p.sectors;
+        std::vector<int> secs =
+            parse_sectors(o.val.count("--sector") ? o.val["--sector"] : "all", nsec, p.planes > p.sectors);
+        for (int s : secs) {
+            Panel pn;
+            pn.w = wc, pn.h = hc, pn.sector = s;
+            pn.v.resize(plane);
+            const uint8_t *a = p.angles + (size_t)s * plane;
+            for (size_t k = 0; k < plane; ++k) pn.v[k] = a[k] == 0 ? NAN : a[k] * 180.0 / 256.0;
+            panels.push_back(std::move(pn));
+        }
+        desc << "opening angles (deg from the upward vertical; no cone = grey), " << nsec << " sectors, r="
+             << reduce << ", planes";
+        for (int s : secs) desc << " " << (s == nsec ? std::string("omni") : std::to_string(s));
+    }
+}
+
+// The legend below the panels: the level's swatch (bitmaps), else the colour
+// bar from lo to hi and the "none" swatch.
+void draw_legend(Image &im, const std::string &what, const Picture &pic, double lo, double hi)
+{
+    const bool grey = pic.grey;
+    const int y0 = im.h - LEGEND + 8;  // 8 px gap above the bar
+    if (what == "bitmap") {
+        for (int a = 0; a < 12; ++a)
+            for (int b = 0; b < 12; ++b) im.set(2 + b, y0 + a, kFeature);
+        draw_text(im, 18, y0 + 1, fmt_num(pic.level_m), 2);  // the level, metres
+    } else {
+        const int bw = std::min(256, im.w - 120);
+        std::string ls = fmt_num(lo), hs = fmt_num(hi);
+        int x = 2;
+        draw_text(im, x, y0 + 1, ls, 2);
+        x += (int)ls.size() * 8 + 4;
+        for (int b = 0; b < bw; ++b)
+            for (int a = 0; a < 12; ++a) im.set(x + b, y0 + a, palette(grey, (int)std::lround(b * 255.0 / (bw - 1))));
+        x += bw + 4;
+        draw_text(im, x, y0 + 1, hs, 2);
+        x += (int)hs.size() * 8 + 12;
+        if (!grey)  // the "none" swatch: infinity / no cone
+            for (int a = 0; a < 12; ++a)
+                for (int b = 0; b < 12; ++b) im.set(x + b, y0 + a, kNone);
+    }
+}
+
 }  // namespace
 
 int cmd_render(int argc, char **argv)
@@ -256,116 +406,22 @@ int cmd_render(int argc, char **argv)
     if (!sliced && !in.is_pkg)
         fail(inpath + ": --what " + what + " needs a package (.ctp; make one with conetrace build)");
 
-    std::vector<Panel> panels;
-    int reduce = 1, nsec = 0;
-    bool grey = false, distances = false;
-    std::ostringstream desc;
-    std::string unit;
-    int wc = 0, hc = 0;
-    double level_m = 0.0;
-    if (sliced) {
-        reduce = (int)get_int(o, "--reduce", 1, 1, 8);
-        uint16_t hmin = 65535, hmax = 0;
-        for (uint16_t c : t.codes) hmin = std::min(hmin, c), hmax = std::max(hmax, c);
-        // level in code units (double): feature iff cell top >= level
-        double level;
-        if (o.val.count("--slice") && o.val.count("--level")) fail("give --slice H or --level k, not both");
-        if (o.val.count("--slice")) {
-            if (o.val.count("--slices")) fail("--slices goes with --level, not --slice");
-            double hm = parse_real("--slice", o.val["--slice"]);
-            level = (hm - t.height_offset_m) / t.height_scale_m;
-        } else if (o.val.count("--level")) {
-            long kdef = in.is_pkg && in.pkg.slices > 0 ? (long)in.pkg.slices : 0;
-            long k = get_int(o, "--slices", kdef, 1, 65535);
-            if (k == 0) fail("--level needs --slices K (the number of evenly spaced levels)");
-            long l = get_int(o, "--level", 0, 0, k);
-            level = slice_level(hmin, hmax, (int)k, (int)l);  // the builder's level, rounded up
-        } else {
-            fail("--what " + what + " needs a level: --slice H (metres) or --level k --slices K");
-        }
-        std::vector<uint16_t> top = cell_tops(t, reduce, wc, hc);
-        std::vector<uint8_t> bits(top.size());
-        size_t nfeat = 0;
-        for (size_t k = 0; k < top.size(); ++k) nfeat += bits[k] = top[k] >= level - 1e-9;
-        level_m = t.height_offset_m + level * t.height_scale_m;
-        desc << "cross-section at " << level_m << " m (cells with top >= level: " << nfeat << " of " << top.size()
-             << "), r=" << reduce;
-        if (what == "bitmap") {
-            Panel p;
-            p.w = wc, p.h = hc;
-            p.fg = bits;
-            p.v.assign(bits.size(), 0.0);
-            panels.push_back(std::move(p));
-        } else {
-            distances = true;
-            unit = "cells";
-            ddt::Prepared bm(wc, hc, bits.data());
-            ddt::Options dopt;
-            dopt.threads = threads;
-            std::vector<int64_t> dt;
-            std::vector<ddt::Point> ft;
-            auto to_panel = [&](int sector) {
-                Panel p;
-                p.w = wc, p.h = hc, p.sector = sector;
-                p.v.resize(dt.size());
-                for (size_t k = 0; k < dt.size(); ++k)
-                    p.v[k] = dt[k] == ddt::Inf<int64_t>::value ? NAN : std::sqrt((double)dt[k]);
-                panels.push_back(std::move(p));
-            };
-            if (what == "dt") {
-                ddt::unconstrained(bm, ddt::EuclideanSq(), dt, ft, dopt);
-                to_panel(-1);
-                desc << "; unconstrained Euclidean DT";
-            } else {
-                nsec = (int)get_int(o, "--sectors", 8, 1, CT_MAX_SECTORS);
-                std::vector<int> secs = parse_sectors(o.val.count("--sector") ? o.val["--sector"] : "all", nsec, false);
-                for (int s : secs) {
-                    ddt::directional(bm, (uint32_t)nsec, (uint32_t)s, ddt::EuclideanSq(), dt, ft, dopt);
-                    to_panel(s);
-                }
-                desc << "; directional Euclidean DT, " << nsec << " sectors, sectors";
-                for (int s : secs) desc << " " << s;
-            }
-        }
-    } else {
-        const ct_package &p = in.pkg;
-        wc = (int)p.coarse_x, hc = (int)p.coarse_y;
-        reduce = (int)p.reduce;
-        const size_t plane = (size_t)wc * hc;
-        if (what == "apex") {
-            grey = true;
-            unit = "m";
-            Panel pn;
-            pn.w = wc, pn.h = hc;
-            pn.v.resize(plane);
-            for (size_t k = 0; k < plane; ++k) pn.v[k] = t.height_offset_m + get16(p.apex + 2 * k) * t.height_scale_m;
-            panels.push_back(std::move(pn));
-            desc << "apex heights (m), " << wc << "x" << hc << " coarse cells, r=" << reduce;
-        } else {
-            unit = "deg";
-            nsec = (int)p.sectors;
-            std::vector<int> secs =
-                parse_sectors(o.val.count("--sector") ? o.val["--sector"] : "all", nsec, p.planes > p.sectors);
-            for (int s : secs) {
-                Panel pn;
-                pn.w = wc, pn.h = hc, pn.sector = s;
-                pn.v.resize(plane);
-                const uint8_t *a = p.angles + (size_t)s * plane;
-                for (size_t k = 0; k < plane; ++k) pn.v[k] = a[k] == 0 ? NAN : a[k] * 180.0 / 256.0;
-                panels.push_back(std::move(pn));
-            }
-            desc << "opening angles (deg from the upward vertical; no cone = grey), " << nsec << " sectors, r="
-                 << reduce << ", planes";
-            for (int s : secs) desc << " " << (s == nsec ? std::string("omni") : std::to_string(s));
-        }
-    }
+    Picture pic;
+    if (sliced)
+        cross_section_panels(o, in, what, threads, &pic);
+    else
+        package_panels(o, in, what, &pic);
+    const std::vector<Panel> &panels = pic.panels;
+    const int reduce = pic.reduce, nsec = pic.nsec, wc = pic.wc, hc = pic.hc;
+    const bool grey = pic.grey;
+    std::ostringstream &desc = pic.desc;
 
     // colour scale
     double lo = INFINITY, hi = -INFINITY;
     for (const Panel &p : panels)
         for (double v : p.v)
             if (!std::isnan(v)) lo = std::min(lo, v), hi = std::max(hi, v);
-    if (distances) lo = 0.0;
+    if (pic.distances) lo = 0.0;
     if (o.val.count("--range")) {
         const std::string &r = o.val["--range"];
         size_t c = r.find(',');
@@ -417,29 +473,8 @@ int cmd_render(int argc, char **argv)
                     for (int b = 0; b < zoom; ++b) im.set(x0 + x * zoom + b, y0 + y * zoom + a, col);
             }
     }
-    if (o.legend) {
-        const int y0 = im.h - LEGEND + 8;  // 8 px gap above the bar
-        if (what == "bitmap") {
-            for (int a = 0; a < 12; ++a)
-                for (int b = 0; b < 12; ++b) im.set(2 + b, y0 + a, kFeature);
-            draw_text(im, 18, y0 + 1, fmt_num(level_m), 2);  // the level, metres
-        } else {
-            const int bw = std::min(256, im.w - 120);
-            std::string ls = fmt_num(lo), hs = fmt_num(hi);
-            int x = 2;
-            draw_text(im, x, y0 + 1, ls, 2);
-            x += (int)ls.size() * 8 + 4;
-            for (int b = 0; b < bw; ++b)
-                for (int a = 0; a < 12; ++a) im.set(x + b, y0 + a, palette(grey, (int)std::lround(b * 255.0 / (bw - 1))));
-            x += bw + 4;
-            draw_text(im, x, y0 + 1, hs, 2);
-            x += (int)hs.size() * 8 + 12;
-            if (!grey)  // the "none" swatch: infinity / no cone
-                for (int a = 0; a < 12; ++a)
-                    for (int b = 0; b < 12; ++b) im.set(x + b, y0 + a, kNone);
-        }
-    }
-    if (what != "bitmap") desc << "; scale " << lo << ".." << hi << " " << unit;
+    if (o.legend) draw_legend(im, what, pic, lo, hi);
+    if (what != "bitmap") desc << "; scale " << lo << ".." << hi << " " << pic.unit;
     write_png_atomic(out, im, desc.str(), "conetrace render");
     std::printf("%s: %dx%d px, %d panel%s of %dx%d cells; %s\n", out.c_str(), im.w, im.h, n, n == 1 ? "" : "s", wc, hc,
                 desc.str().c_str());
