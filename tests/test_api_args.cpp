@@ -861,6 +861,46 @@ std::vector<Case> cases()
         ct_ray r;
         return ct_ray_from_map(&w.p, (INT64_C(1) << 61) + 1, w.a[1], w.a[2], 1, 0, 0, &r);
     });
+    // ---- lines of sight: effects and ranges
+    add("los: refraction alone (c < 0: not offered)", CT_ERR_EFFECTS, [](World &w) {
+        const ct_effects fx = {CT_EFFECT_REFRACTION, CT_REFRACTION_K_STD_Q16, CT_EARTH_RADIUS_NM, 0, nullptr};
+        ct_hit h;
+        return ct_los(&w.p, w.a, w.b, &fx, 0, CT_METHOD_DIRECTIONAL, &h);
+    });
+    add("los: unknown effect flag", CT_ERR_EFFECTS, [](World &w) {
+        const ct_effects fx = {0x80u, CT_REFRACTION_K_STD_Q16, 0, 0, nullptr};
+        ct_hit h;
+        return ct_los(&w.p, w.a, w.b, &fx, 0, CT_METHOD_DIRECTIONAL, &h);
+    });
+    add("los: B beyond the grid's height range", CT_ERR_RAY, [](World &w) {
+        const int64_t hb[3] = {w.b[0], w.b[1], (INT64_C(1) << 61) - 1};
+        ct_hit h;
+        return ct_los(&w.p, w.a, hb, nullptr, 0, CT_METHOD_DIRECTIONAL, &h);
+    });
+    add("los: A beyond the grid's height range", CT_ERR_RAY, [](World &w) {
+        const int64_t ha[3] = {w.a[0], w.a[1], (INT64_C(1) << 61) - 1};
+        ct_hit h;
+        return ct_los(&w.p, ha, w.b, nullptr, 0, CT_METHOD_DIRECTIONAL, &h);
+    });
+    add("los: the sphere from 2,000 km beside the tile (no lowered model)", CT_ERR_EFFECTS, [](World &w) {
+        const ct_effects fx = {CT_EFFECT_CURVATURE, 0, CT_EARTH_RADIUS_NM, 0, nullptr};
+        const int64_t far[3] = {w.a[0] + INT64_C(2000000000000000), w.a[1], w.a[2]};
+        ct_hit h;
+        return ct_los(&w.p, far, w.b, &fx, 0, CT_METHOD_DIRECTIONAL, &h);
+    });
+    add("los: the true Earth from beyond the zone", CT_ERR_EFFECTS, [](World &w) {
+        const ct_effects fx = {CT_EFFECT_CURVATURE, 0, 0, 0, nullptr};
+        const int64_t far[3] = {w.a[0] + INT64_C(3000000000000000), w.a[1], w.a[2]};
+        ct_hit h;
+        return ct_los(&w.p, far, w.b, &fx, 0, CT_METHOD_DIRECTIONAL, &h);
+    });
+    add("locate_inverse: unknown effect flag", CT_ERR_EFFECTS, [](World &w) {
+        const ct_effects fx = {CT_EFFECT_CURVATURE | 0x80u, 0, 0, 0, nullptr};
+        int64_t u, vv;
+        uint32_t vis;
+        ct_hit h;
+        return ct_locate_inverse(&w.p, &w.cam, &w.pose, &fx, w.b, 0, &u, &vv, &vis, &h);
+    });
     return v;
 }
 

@@ -740,7 +740,8 @@ ct_status ct_effects_for_tolerance(const ct_package *pkg, const ct_camera *cam, 
  * CT_MAX_ORIGIN_Q16 of the tile, or A = B), CT_ERR_EFFECTS (effects that
  * ct_geolocate refuses -- unknown flags, |k| > 2, R or chord out of range,
  * another package's earth_map -- or, on the sphere, c < 0 or a bend the
- * lowered walk cannot take from A).                                       */
+ * lowered walk cannot take from A; for the true Earth, A where the zone's
+ * projection cannot take it, e.g. far off the zone).                      */
 ct_status ct_los(const ct_package *pkg, const int64_t a_nm[3], const int64_t b_nm[3], const ct_effects *effects,
                  int64_t margin_nm, ct_method method, ct_hit *block);
 
