@@ -62,19 +62,13 @@ double range_m(const ct_pose &pose, const ct_geo &g)
 
 bool is_hit(ct_status s) { return s == CT_HIT || s == CT_HIT_VOID; }
 
-}  // namespace
-
-int demo_main_job(const std::vector<uint8_t> &bytes, const Terrain &t, const std::map<std::string, std::string> &opt)
+// The demo's effects: --effects as given, else those a --tolerance (default
+// 0.1 m) calls for (ct_effects_for_tolerance); *why says which and why.
+ct_effects demo_effects(const ct_package &p, const LibCamera &cam, const std::map<std::string, std::string> &opt,
+                        const std::string &cpath, std::string *whyp)
 {
-    ct_package p;
-    if (ct_package_open(&p, bytes.data(), bytes.size()) != CT_OK) throw Error("demo: the package did not open");
-    const std::string cpath = opt.at("--camera");
-    const CameraModel cm = read_cameramodel(cpath);
-    LibCamera cam = lib_camera(cm, cpath);
-    const unsigned W = cm.width, H = cm.height;
-    if (W == 0 || H == 0) throw Error(cpath + ": no image size");
+    std::string &why = *whyp;
     ct_effects fx = {0u, CT_REFRACTION_K_STD_Q16, 0, 0, nullptr};
-    std::string why;
     if (opt.count("--effects")) {
         if (opt.count("--tolerance")) throw Error("demo: give --effects or --tolerance, not both");
         fx.flags = effects_from_list(opt.at("--effects"));
@@ -104,6 +98,53 @@ int demo_main_job(const std::vector<uint8_t> &bytes, const Terrain &t, const std
                       ch.range_nm * 1e-12, ch.chord_nm * 1e-9);
         why = b;
     }
+    return fx;
+}
+
+// The posts inside the camera's image: each post's centre projected (double
+// rotation, the library's lens), as pixels (*seen) and post indices.
+void posts_in_view(const ct_package &p, const Terrain &t, const LibCamera &cam, unsigned W, unsigned H,
+                   std::vector<Px> *seenp, std::vector<size_t> *postp)
+{
+    std::vector<Px> &seen = *seenp;
+    std::vector<size_t> &seen_post = *postp;
+    const double pe = p.posting_e_nm * 1e-9, pn = p.posting_n_nm * 1e-9;
+    const double E0 = p.origin_e_nm * 1e-9, N0 = p.origin_n_nm * 1e-9;
+    const double C[3] = {cam.pose.e_nm * 1e-9, cam.pose.n_nm * 1e-9, cam.pose.h_nm * 1e-9};
+    double R[9];
+    for (int k = 0; k < 9; ++k) R[k] = cam.pose.R_map_cam_q30[k] / 1073741824.0;
+    for (int j = 0; j < t.height; ++j)
+        for (int i = 0; i < t.width; ++i) {
+            const double P[3] = {E0 + (i + 0.5) * pe - C[0], N0 + (j + 0.5) * pn - C[1],
+                                 t.height_offset_m + t.at(i, j) * t.height_scale_m - C[2]};
+            double d[3];
+            for (int r = 0; r < 3; ++r) d[r] = R[r] * P[0] + R[3 + r] * P[1] + R[6 + r] * P[2];  // R^T P
+            if (d[2] <= 0) continue;
+            const double m = std::max(std::fabs(d[0]), std::max(std::fabs(d[1]), d[2]));
+            const int32_t ray[3] = {(int32_t)std::lround(d[0] / m * 1e9), (int32_t)std::lround(d[1] / m * 1e9),
+                                    (int32_t)std::lround(d[2] / m * 1e9)};
+            int64_t uq, vq;
+            if (ct_camera_project(&cam.cam, ray, &uq, &vq) != CT_OK) continue;
+            const double u = uq / 65536.0, v = vq / 65536.0;
+            if (u < -0.5 || v < -0.5 || u > W - 0.5 || v > H - 0.5) continue;
+            seen.push_back(Px{u, v, uq, vq});
+            seen_post.push_back((size_t)j * t.width + i);
+        }
+}
+
+}  // namespace
+
+int demo_main_job(const std::vector<uint8_t> &bytes, const Terrain &t, const std::map<std::string, std::string> &opt)
+{
+    ct_package p;
+    if (ct_package_open(&p, bytes.data(), bytes.size()) != CT_OK) throw Error("demo: the package did not open");
+    const std::string cpath = opt.at("--camera");
+    const CameraModel cm = read_cameramodel(cpath);
+    LibCamera cam = lib_camera(cm, cpath);
+    const unsigned W = cm.width, H = cm.height;
+    if (W == 0 || H == 0) throw Error(cpath + ": no image size");
+    std::string why;
+    ct_effects fx = demo_effects(p, cam, opt, cpath, &why);
     fx.flags |= CT_EFFECT_EARTH_FIT;  // batches only; ignored without the true Earth
     ct_utm zone;
     const bool utm = ct_utm_zone_of_epsg((int32_t)p.epsg, &zone) == CT_OK;
@@ -201,28 +242,11 @@ int demo_main_job(const std::vector<uint8_t> &bytes, const Terrain &t, const std
     const clk::time_point tv = clk::now();
     const double pe = p.posting_e_nm * 1e-9, pn = p.posting_n_nm * 1e-9;
     const double E0 = p.origin_e_nm * 1e-9, N0 = p.origin_n_nm * 1e-9;
-    const double C[3] = {cam.pose.e_nm * 1e-9, cam.pose.n_nm * 1e-9, cam.pose.h_nm * 1e-9};
-    double R[9];
-    for (int k = 0; k < 9; ++k) R[k] = cam.pose.R_map_cam_q30[k] / 1073741824.0;
     std::vector<Px> seen;
     std::vector<size_t> seen_post;
-    for (int j = 0; j < t.height; ++j)
-        for (int i = 0; i < t.width; ++i) {
-            const double P[3] = {E0 + (i + 0.5) * pe - C[0], N0 + (j + 0.5) * pn - C[1],
-                                 t.height_offset_m + t.at(i, j) * t.height_scale_m - C[2]};
-            double d[3];
-            for (int r = 0; r < 3; ++r) d[r] = R[r] * P[0] + R[3 + r] * P[1] + R[6 + r] * P[2];  // R^T P
-            if (d[2] <= 0) continue;
-            const double m = std::max(std::fabs(d[0]), std::max(std::fabs(d[1]), d[2]));
-            const int32_t ray[3] = {(int32_t)std::lround(d[0] / m * 1e9), (int32_t)std::lround(d[1] / m * 1e9),
-                                    (int32_t)std::lround(d[2] / m * 1e9)};
-            int64_t uq, vq;
-            if (ct_camera_project(&cam.cam, ray, &uq, &vq) != CT_OK) continue;
-            const double u = uq / 65536.0, v = vq / 65536.0;
-            if (u < -0.5 || v < -0.5 || u > W - 0.5 || v > H - 0.5) continue;
-            seen.push_back(Px{u, v, uq, vq});
-            seen_post.push_back((size_t)j * t.width + i);
-        }
+    posts_in_view(p, t, cam, W, H, &seen, &seen_post);
+    double R[9];  // R_map_cam, for the heading in the picture
+    for (int k = 0; k < 9; ++k) R[k] = cam.pose.R_map_cam_q30[k] / 1073741824.0;
     std::vector<ct_geo> gs;
     batch(seen, CT_METHOD_DIRECTIONAL, &gs);
     std::vector<uint8_t> state((size_t)t.width * t.height, 0);  // 1 visible, 2 hidden
