@@ -1,5 +1,6 @@
 /*
- * bend.h -- tracer helpers shared by trace.c, bend.c and geoloc.c (private):
+ * bend.h -- tracer helpers shared by trace.c, prepare.c, frames.c, bend.c
+ * and geoloc.c (private):
  * bent rays, the lowered terrain, the grid direction of a map direction.
  */
 #ifndef CT_BEND_H
@@ -12,7 +13,7 @@ extern "C" {
 #endif
 
 /* The grid direction of a map direction (|.| <= 2^40, not all 0), as
- * ct_ray_from_map forms it (trace.c); geolocation uses it so that a pixel's
+ * ct_ray_from_map forms it (frames.c); geolocation uses it so that a pixel's
  * grid ray is ct_ray_from_map's of the pose centre and ct_geo.dir_map_q39. */
 void ct_grid_dir_from_map(const ct_package *p, int64_t de, int64_t dn, int64_t dh, int64_t d[3]);
 

@@ -1,5 +1,6 @@
 /*
- * tiles.h -- what tiles.c needs from the tracer (private; trace.c).
+ * tiles.h -- what tiles.c needs from the tracer (private; trace.c and
+ * prepare.c).
  *
  * A tile set traces a ray prepared against the whole set (a header-only
  * package, the "frame": the merged grid's extent, heights and
