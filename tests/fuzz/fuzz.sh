@@ -25,6 +25,7 @@ if [ -z "$CORPUS" ]; then
     trap 'rm -rf "$CORPUS"' EXIT
 fi
 mkdir -p "$CORPUS"
+CORPUS=$(cd "$CORPUS" && pwd)  # absolute: the fuzzer runs in $OUT
 # the seed corpus: inputs worth keeping (earlier findings among them)
 cp "$ROOT"/tests/fuzz/corpus/* "$CORPUS"/ 2>/dev/null || true
 FLAGS="-g -O1 -std=c99 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all"
