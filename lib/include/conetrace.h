@@ -317,7 +317,16 @@ typedef struct {
  * outlive pkg).  Checks, in order: header, magic, version, header size,
  * total size, CRC, dimensions, sectors, reduction, levels, flags, ranges,
  * georeference, every section's offset, size and alignment.  A package that
- * opens can never make any function read outside bytes[0..total).          */
+ * opens can never make any function read outside bytes[0..total).
+ *   [out] pkg    the opened package: a view of bytes plus derived tables
+ *                (cot table, sector boundaries, section pointers).
+ *   [in]  bytes  the package as built (little-endian, package-format.md).
+ *   [in]  len    bytes available, >= the header's total size.
+ * Returns CT_OK, or the status of the first check that fails: CT_ERR_ARG
+ * for NULL, one of CT_ERR_TRUNCATED .. CT_ERR_FLAGS (-2 .. -15) else.
+ * Scaling and overflow: sizes are 32-bit and every offset + size is summed
+ * in 64 bits before it is compared with total; postings, offsets and scales
+ * are checked against the ranges the conversions below rely on.            */
 ct_status ct_package_open(ct_package *pkg, const uint8_t *bytes, size_t len);
 
 /* Deep content check, O(cells): mipmap levels are the max of their children,
@@ -370,7 +379,20 @@ ct_status ct_cot_table(int64_t posting_nm, int64_t height_scale_nm,
                        int64_t out_q16[256], uint8_t ok[256]);
 
 /* Clip and quantise a ray.  Returns CT_OK (traceable), CT_MISS (never enters
- * the tile), CT_BELOW / CT_HIT (decided at its first point), or an error.   */
+ * the tile), CT_BELOW / CT_HIT (decided at its first point), or an error.
+ *   [in]  pkg  an opened package.
+ *   [in]  ray  grid frame: origin Q16 (x, y cells; z height LSB), |.| <=
+ *              CT_MAX_ORIGIN_Q16; direction in any common scale, |.| <=
+ *              2^62, not all zero.
+ *   [out] out  the prepared ray (ct_prepared: the object the tracer is exact
+ *              for), filled for every non-error status.
+ * Errors: CT_ERR_ARG (NULL), CT_ERR_RAY (origin or direction out of range,
+ * zero direction).
+ * Scaling and overflow: the clip is done in 128-bit rationals (origin <
+ * 2^47, direction < 2^63: products < 2^110); the direction is rounded to
+ * int32 with its largest component in [2^25, 2^26] and z in units of
+ * 2^zshift Q16, which keeps the prepared ray within 1 mm of the caller's on
+ * a tile up to 2,048 cells across (docs/library.md, "Exactness").          */
 ct_status ct_ray_prepare(const ct_package *pkg, const ct_ray *ray,
                          ct_prepared *out);
 
@@ -378,16 +400,40 @@ ct_status ct_ray_prepare(const ct_package *pkg, const ct_ray *ray,
  * error; *hit is filled for every non-error result (steps, iters).  A ray
  * that ct_ray_prepare could not have made is CT_ERR_RAY: direction scale,
  * zshift, sector, length, an origin outside the box (or, for start CT_OK,
- * at or below its floor hmin - 1), a tend beyond where it leaves the box.  */
+ * at or below its floor hmin - 1), a tend beyond where it leaves the box.
+ *   [in]  pkg     the package the ray was prepared for.
+ *   [in]  ray     from ct_ray_prepare (or an equal one: it is re-validated).
+ *   [in]  method  CT_METHOD_*; all four give bit-identical hits.
+ *   [out] hit     the first hit: grid (Q16) and map (nm) position, t_q26,
+ *                 cell, steps and iterations (<= CT_WCET_* for the method).
+ * Errors: CT_ERR_ARG (NULL), CT_ERR_METHOD, CT_ERR_RAY (above),
+ * CT_ERR_INTERNAL (a loop bound reached: a library bug).
+ * Scaling and overflow: positions inside the box are < 2^31 Q16 (x, y) and
+ * < 2^33 (z); t is a rational with denominator <= 2^26 and numerator < 2^34;
+ * every product is bounded beside the code (trace.c), 64-bit except the
+ * interior minimum's discriminant and the root (128-bit).                  */
 ct_status ct_trace_prepared(const ct_package *pkg, const ct_prepared *ray,
                             ct_method method, ct_hit *hit);
 
-/* ct_ray_prepare + ct_trace_prepared.                                       */
+/* ct_ray_prepare + ct_trace_prepared: [in] pkg, [in] ray (ct_ray_prepare's
+ * ranges), [in] method, [out] hit.  The statuses of both (CT_MISS and
+ * CT_BELOW decided at preparation come back with *hit's steps 0).          */
 ct_status ct_trace(const ct_package *pkg, const ct_ray *ray, ct_method method,
                    ct_hit *hit);
 
 /* Grid (Q16) to map (nm) and back, exact integer scaling, rounded to
- * nearest.  Map coordinates of the tile must stay within +-2^62 nm.         */
+ * nearest.  Map coordinates of the tile must stay within +-2^62 nm.
+ *   grid frame: x = column, y = row (Q16 fine cells, post (i, j) at
+ *   (i 2^16, j 2^16)); z = height code (Q16 LSB).  Map frame: E, N at the
+ *   post's pixel centre (GDAL's pixel-is-area), h = offset + code * scale;
+ *   all in nm.
+ * ct_grid_to_map: [in] x_q16, y_q16, z_q16 (|.| <= 2^60), [out] e_nm, n_nm,
+ * h_nm.  ct_map_to_grid: [in] e_nm, n_nm, h_nm (|.| <= 2^61), [out] x_q16,
+ * y_q16, z_q16.  Errors: CT_ERR_ARG (NULL), CT_ERR_RANGE (an input beyond
+ * its bound, or a result beyond 2^62).
+ * Scaling and overflow: each axis is one 128-bit product or quotient
+ * ((x + 2^15) posting / 2^16; (e - e0) 2^16 / posting - 2^15) rounded half
+ * up, its result checked against 2^62 before it is stored.                 */
 ct_status ct_grid_to_map(const ct_package *pkg, int64_t x_q16, int64_t y_q16,
                          int64_t z_q16, int64_t *e_nm, int64_t *n_nm,
                          int64_t *h_nm);
@@ -396,13 +442,28 @@ ct_status ct_map_to_grid(const ct_package *pkg, int64_t e_nm, int64_t n_nm,
                          int64_t *z_q16);
 
 /* A map-frame ray (origin in nm, direction in any common unit with
- * |.| <= 2^40) as a grid-frame ct_ray.                                      */
+ * |.| <= 2^40) as a grid-frame ct_ray.
+ *   [in]  e_nm, n_nm, h_nm  origin, map frame, nm (|.| <= 2^61).
+ *   [in]  de, dn, dh        direction, any common unit, |.| <= 2^40, not
+ *                           all zero.
+ *   [out] out               the grid ray: origin as ct_map_to_grid rounds
+ *                           it; direction (de/posting_e, dn/posting_n,
+ *                           dh/scale) times |posting_e| scale, divided by
+ *                           the least power of two that brings it within
+ *                           2^62 (rounded half away from zero).
+ * Errors: CT_ERR_ARG (NULL), CT_ERR_RAY (direction out of range or zero,
+ * an origin ct_map_to_grid refuses).
+ * Scaling and overflow: direction products < 2^40 2^50 in 128 bits.        */
 ct_status ct_ray_from_map(const ct_package *pkg, int64_t e_nm, int64_t n_nm,
                           int64_t h_nm, int64_t de, int64_t dn, int64_t dh,
                           ct_ray *out);
 
 /* Height of the bilinear surface at a grid point inside the tile, Q16,
- * rounded up.                                                               */
+ * rounded up.
+ *   [in]  x_q16, y_q16  grid point, 0 <= . <= cells 2^16.
+ *   [out] z_q16         the surface's height code there, Q16 LSB.
+ * Errors: CT_ERR_ARG (NULL), CT_ERR_RANGE (off the tile).
+ * Scaling and overflow: the patch times 2^32 is exact in 64 bits (< 2^50).  */
 ct_status ct_surface_height(const ct_package *pkg, int64_t x_q16,
                             int64_t y_q16, int64_t *z_q16);
 
