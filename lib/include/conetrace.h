@@ -854,7 +854,15 @@ ct_status ct_camera_init(ct_camera *cam, const ct_lens *lens);
 ct_status ct_camera_init_grid(ct_camera *cam, const ct_unproject_grid *grid);
 
 /* Pixel (u, v) (Q16) to the unit ray in the camera frame (Q30).  CT_OK or
- * CT_ERR_UNPROJECT.  *iters (may be NULL) receives the Newton iterations.  */
+ * CT_ERR_UNPROJECT.  *iters (may be NULL) receives the Newton iterations.
+ *   [in]  cam          from ct_camera_init / ct_camera_init_grid.
+ *   [in]  u_q16, v_q16 pixel, Q16 px, mrcal's convention (the centre of the
+ *                      top-left pixel is (0, 0)), |.| <= 2^20 px.
+ *   [out] ray_cam_q30  unit vector, camera frame (x right, y down, z
+ *                      forward), Q30, z > 0.
+ *   [out] iters        Newton iterations used (<= CT_UNPROJECT_MAX_ITERS).
+ * Scaling and overflow: normalised coordinates in Q32 (x^2 + y^2 <= 64),
+ * the distortion's Horner sums in Q44/Q38 (camera.c beside each product).  */
 ct_status ct_camera_unproject(const ct_camera *cam, int64_t u_q16,
                               int64_t v_q16, int32_t ray_cam_q30[3],
                               uint32_t *iters);
@@ -872,13 +880,31 @@ ct_status ct_camera_project(const ct_camera *cam, const int32_t ray_cam[3],
 ct_status ct_pose_init(ct_pose *pose, const int32_t R_map_cam_q30[9],
                        int64_t e_nm, int64_t n_nm, int64_t h_nm);
 
-/* dir_map = R_map_cam * ray_cam, Q39 (rounded).                             */
+/* dir_map = R_map_cam * ray_cam, Q39 (rounded).
+ *   [in]  pose         from ct_pose_init / ct_pose_from_map / _wgs84.
+ *   [in]  ray_cam_q30  camera-frame vector, Q30 (|.| <= 2^30 per axis).
+ *   [out] dir_map_q39  map-frame (E, N, h) direction, Q39 (|.| < 2^40); for
+ *                      a geodetic pose the horizontal components scaled by
+ *                      the map's point scale (pose->hscale_q30).
+ * CT_ERR_ARG for NULL or a pose not set up.  Scaling and overflow: R (Q30)
+ * times the ray (Q30), three products summed and rounded to Q39; the point
+ * scale applied in 128 bits (< 2^70), the results < 2^40.                  */
 ct_status ct_pose_rotate(const ct_pose *pose, const int32_t ray_cam_q30[3],
                          int64_t dir_map_q39[3]);
 
 /* Geolocate pixel (u, v): unproject, rotate into the map frame, trace from
  * the camera centre with `method`, bent by `effects` (NULL or flags 0: a
- * straight ray; see ct_effects).  Returns (and stores in out->status)
+ * straight ray; see ct_effects).
+ *   [in]  pkg           an opened package (the camera may be off the tile).
+ *   [in]  cam, pose     the lens and the camera centre (map nm) and
+ *                       attitude.
+ *   [in]  method        CT_METHOD_*.
+ *   [in]  effects       NULL, or the scene effects.
+ *   [in]  u_q16, v_q16  the pixel, Q16 px.
+ *   [out] out           status, camera-frame ray (Q30), map-frame direction
+ *                       (Q39) and the trace's hit (grid Q16 and map nm).
+ * The straight grid ray is ct_ray_from_map's from the pose centre along
+ * out->dir_map_q39, so it can be formed again from the pose and *out.  Returns (and stores in out->status)
  * CT_HIT or CT_HIT_VOID (out->hit.e_nm, n_nm, h_nm valid), CT_MISS,
  * CT_BELOW, or an error: CT_ERR_UNPROJECT for the pixel; CT_ERR_ARG /
  * CT_ERR_METHOD / CT_ERR_EFFECTS for the arguments; CT_ERR_RAY when the
@@ -896,7 +922,7 @@ ct_status ct_geolocate(const ct_package *pkg, const ct_camera *cam,
 /* Many pixels: uv_q16[2k], uv_q16[2k + 1] for k < count, results in
  * out[0..count) (out_len >= count), each bit-identical to ct_geolocate's.
  * The per-call setup (argument checks, the camera centre in the grid frame,
- * the direction scaling) is done once.  Returns CT_OK when every pixel was
+ * the bend's or the true Earth's set-up) is done once.  Returns CT_OK when every pixel was
  * processed (each with its own out[k].status), or the setup's error
  * (nothing written).                                                        */
 ct_status ct_geolocate_batch(const ct_package *pkg, const ct_camera *cam,
