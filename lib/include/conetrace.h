@@ -520,7 +520,18 @@ typedef struct {
 /* Trace ray (its origin is the observer) bent by *bend.  Returns as
  * ct_trace; hit->t_q26 is the parameter on the prepared straight ray (the
  * lowered walk) or on the segment holding the hit (the polyline), whose
- * steps and iters are summed over segments.                                */
+ * steps and iters are summed over segments.
+ *   [in]  pkg     an opened package.
+ *   [in]  ray     the tangent at the observer, grid frame (ct_ray's ranges).
+ *   [in]  bend    c (Q16), R and chord (nm), flags: the ranges above.
+ *   [in]  method  CT_METHOD_*.
+ *   [out] hit     as ct_trace's; its map position on the curve.
+ * Errors: CT_ERR_ARG (NULL, a bend out of range), CT_ERR_METHOD, CT_ERR_RAY
+ * (the ray's ranges), CT_ERR_RANGE (more than CT_BEND_MAX_SEGMENTS
+ * segments, or the observer beyond 2^52 nm of the tile).
+ * Scaling and overflow: the lowered terrain D = Q kf / 2^kshift with Q <
+ * 2^63 and kf < 2^32 (128-bit, bend.h); the polyline's vertices in 128-bit
+ * rationals, each segment prepared with ct_ray_prepare_segment's bounds.  */
 ct_status ct_trace_bent(const ct_package *pkg, const ct_ray *ray,
                         const ct_bend *bend, ct_method method, ct_hit *hit);
 
