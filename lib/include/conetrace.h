@@ -915,7 +915,8 @@ ct_status ct_pose_rotate(const ct_pose *pose, const int32_t ray_cam_q30[3],
  *   [out] out           status, camera-frame ray (Q30), map-frame direction
  *                       (Q39) and the trace's hit (grid Q16 and map nm).
  * The straight grid ray is ct_ray_from_map's from the pose centre along
- * out->dir_map_q39, so it can be formed again from the pose and *out.  Returns (and stores in out->status)
+ * out->dir_map_q39, so it can be formed again from the pose and *out.
+ * Returns (and stores in out->status)
  * CT_HIT or CT_HIT_VOID (out->hit.e_nm, n_nm, h_nm valid), CT_MISS,
  * CT_BELOW, or an error: CT_ERR_UNPROJECT for the pixel; CT_ERR_ARG /
  * CT_ERR_METHOD / CT_ERR_EFFECTS for the arguments; CT_ERR_RAY when the
@@ -933,9 +934,9 @@ ct_status ct_geolocate(const ct_package *pkg, const ct_camera *cam,
 /* Many pixels: uv_q16[2k], uv_q16[2k + 1] for k < count, results in
  * out[0..count) (out_len >= count), each bit-identical to ct_geolocate's.
  * The per-call setup (argument checks, the camera centre in the grid frame,
- * the bend's or the true Earth's set-up) is done once.  Returns CT_OK when every pixel was
- * processed (each with its own out[k].status), or the setup's error
- * (nothing written).                                                        */
+ * the bend's or the true Earth's set-up) is done once.  Returns CT_OK when
+ * every pixel was processed (each with its own out[k].status), or the
+ * setup's error (nothing written).                                         */
 ct_status ct_geolocate_batch(const ct_package *pkg, const ct_camera *cam,
                              const ct_pose *pose, ct_method method,
                              const ct_effects *effects,
@@ -965,7 +966,14 @@ typedef struct {
  * CT_ERR_CRS.                                                              */
 ct_status ct_utm_zone_of_epsg(int32_t epsg, ct_utm *zone);
 
-/* Geodetic (lat, lon: Q61 radians) to UTM (E, N: nm, rounded).            */
+/* Geodetic (lat, lon: Q61 radians) to UTM (E, N: nm, rounded).
+ *   [in]  zone              the zone (and hemisphere).
+ *   [in]  lat_q61, lon_q61  WGS84 latitude and longitude, Q61 radians.
+ *   [out] e_nm, n_nm        UTM easting and northing, nm, false easting
+ *                           and (south) northing included.
+ * Errors: CT_ERR_ARG (NULL, zone outside 1..60), CT_ERR_RANGE (outside the
+ * domain above).  Scaling: Q59 internals (|value| < 16) with 128-bit
+ * products and quotients (geodesy.c); within 7 nm of PROJ's result.       */
 ct_status ct_utm_forward(const ct_utm *zone, int64_t lat_q61, int64_t lon_q61,
                          int64_t *e_nm, int64_t *n_nm);
 
