@@ -76,10 +76,7 @@ ct_effects demo_effects(const ct_package &p, const LibCamera &cam, const std::ma
     } else {
         // the effects (and chord) the camera needs for a tolerance
         const std::string ts = opt.count("--tolerance") ? opt.at("--tolerance") : "0.1";
-        char *end = nullptr;
-        const double tol = std::strtod(ts.c_str(), &end);
-        if (ts.empty() || *end || !(tol >= 0 && tol <= 1e6))
-            throw Error("--tolerance needs a tolerance in metres in [0, 1e6], got '" + ts + "'");
+        const double tol = number_in("--tolerance", ts, 0, 1e6, "a tolerance in metres in [0, 1e6]");
         ct_effects_choice ch;
         if (ct_effects_for_tolerance(&p, &cam.cam, &cam.pose, fx.refraction_k_q16, 0, std::llround(tol * 1e9), &ch) !=
             CT_OK)

@@ -80,12 +80,7 @@ using Opts = std::map<std::string, std::string>;
 // The value of option `name`, a number in [lo, hi].
 double option_number(Opts &opt, const char *name, double lo, double hi, const char *what)
 {
-    const std::string &g = opt[name];
-    char *end = nullptr;
-    double v = std::strtod(g.c_str(), &end);
-    if (g.empty() || !end || *end || !(v >= lo && v <= hi))
-        throw Error(std::string(name) + " needs " + what + ", got '" + g + "'");
-    return v;
+    return number_in(name, opt[name], lo, hi, what);
 }
 
 // --effects, --refraction-k, --chord, --earth-radius (with --tolerance the
@@ -325,14 +320,9 @@ int cmd_geoloc(int argc, char **argv)
     ct_effects fx = parse_effects(opt, by_tolerance);
     const ct_method m = opt.count("--method") ? method_named(opt["--method"]) : CT_METHOD_DIRECTIONAL;
 
-    double grid_step = kDefaultGridStepPx;
-    if (opt.count("--grid-step")) {
-        const std::string &g = opt["--grid-step"];
-        char *end = nullptr;
-        grid_step = std::strtod(g.c_str(), &end);
-        if (g.empty() || !end || *end || !(grid_step >= 1 && grid_step <= 4096))
-            throw Error("--grid-step needs a number of pixels in [1, 4096], got '" + g + "'");
-    }
+    const double grid_step = opt.count("--grid-step") ? option_number(opt, "--grid-step", 1, 4096,
+                                                                      "a number of pixels in [1, 4096]")
+                                                        : kDefaultGridStepPx;
 
     const int threads = opt.count("--threads") ? threads_option(opt["--threads"], "geoloc") : 0;
 

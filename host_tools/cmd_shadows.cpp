@@ -60,13 +60,8 @@ int cmd_shadows(int argc, char **argv)
     }
     if (sun.size() != 2) throw Error("--sun needs two numbers AZ,EL (degrees)");
     if (!(sun[1] > 0 && sun[1] <= 90)) throw Error("--sun: the sun is below the horizon (elevation must be in (0, 90] degrees)");
-    double lift = 0.01;
-    if (opt.count("--lift")) {
-        char *end = nullptr;
-        lift = std::strtod(opt["--lift"].c_str(), &end);
-        if (opt["--lift"].empty() || *end || !(lift >= 0 && lift <= 1000))
-            throw Error("--lift needs a height in metres in [0, 1000], got '" + opt["--lift"] + "'");
-    }
+    const double lift =
+        opt.count("--lift") ? number_in("--lift", opt["--lift"], 0, 1000, "a height in metres in [0, 1000]") : 0.01;
     const int threads = opt.count("--threads") ? threads_option(opt["--threads"], "shadows") : 0;
     const ct_method method = opt.count("--method") ? method_named(opt["--method"]) : CT_METHOD_DIRECTIONAL;
     const std::string &path = args.pos[0];

@@ -225,13 +225,6 @@ Options parse_options(int argc, char **argv)
     if (args.pos.size() != 1) throw Error("viewshed needs exactly one package file");
     if (!opt.count("--observer")) throw Error("viewshed needs --observer E,N,H");
     if (!opt.count("-o")) throw Error("viewshed needs -o vs.tif");
-    auto number = [&](const std::string &name, const std::string &text, double lo, double hi, const char *what) {
-        char *end = nullptr;
-        const double v = std::strtod(text.c_str(), &end);
-        if (text.empty() || !end || *end || !(v >= lo && v <= hi))
-            throw Error(name + " needs " + what + ", got '" + text + "'");
-        return v;
-    };
     Options o;
     o.package = args.pos[0];
     o.out = opt["-o"];
@@ -242,20 +235,20 @@ Options parse_options(int argc, char **argv)
         std::string tok;
         int k = 0;
         while (std::getline(ss, tok, ',')) {
-            const double v = number("--observer", tok, -1e9, 1e9, "three numbers E,N,H");
+            const double v = number_in("--observer", tok, -1e9, 1e9, "three numbers E,N,H");
             if (k < 3) o.ob[k] = v;
             k++;
         }
         if (k != 3) throw Error("--observer needs three numbers E,N,H (metres; H above the surface)");
     }
     if (opt.count("--target-height"))
-        o.th = number("--target-height", opt["--target-height"], 0, 1e5, "a height in metres in [0, 1e5]");
-    if (opt.count("--radius")) o.radius = number("--radius", opt["--radius"], 1e-3, 1e7, "a radius in metres in (0, 1e7]");
-    if (opt.count("--margin")) o.margin = number("--margin", opt["--margin"], 0, 1e4, "a length in metres in [0, 1e4]");
+        o.th = number_in("--target-height", opt["--target-height"], 0, 1e5, "a height in metres in [0, 1e5]");
+    if (opt.count("--radius")) o.radius = number_in("--radius", opt["--radius"], 1e-3, 1e7, "a radius in metres in (0, 1e7]");
+    if (opt.count("--margin")) o.margin = number_in("--margin", opt["--margin"], 0, 1e4, "a length in metres in [0, 1e4]");
     if (opt.count("--effects")) o.fx.flags = effects_from_list(opt["--effects"]);
     if (opt.count("--earth-radius")) {
         if (!o.fx.flags) throw Error("--earth-radius needs --effects curvature and/or refraction");
-        o.fx.earth_radius_nm = std::llround(number("--earth-radius", opt["--earth-radius"], 1100, 1.8e7,
+        o.fx.earth_radius_nm = std::llround(number_in("--earth-radius", opt["--earth-radius"], 1100, 1.8e7,
                                                    "a radius in metres in [1100, 1.8e7]") * 1e9);
     }
     if (opt.count("--threads")) o.threads = threads_option(opt["--threads"], "viewshed");

@@ -250,6 +250,15 @@ void parallel_chunks(size_t n, int threads, size_t chunk, const std::function<vo
     for (auto &th : pool) th.join();
 }
 
+double number_in(const std::string &name, const std::string &text, double lo, double hi, const char *what)
+{
+    char *end = nullptr;
+    const double v = std::strtod(text.c_str(), &end);
+    if (text.empty() || !end || *end || !(v >= lo && v <= hi))
+        throw Error(name + " needs " + what + ", got '" + text + "'");
+    return v;
+}
+
 ct_method method_named(const std::string &name)
 {
     if (name == "incremental") return CT_METHOD_INCREMENTAL;

@@ -59,6 +59,10 @@ std::string status_name(ct_status s);
 // the calling thread takes part.  Outputs indexed by item keep input order.
 void parallel_chunks(size_t n, int threads, size_t chunk, const std::function<void(size_t, size_t)> &work);
 
+// An option's number: text parsed whole (strtod) and within [lo, hi]
+// (NaN never is).  Throws Error("<name> needs <what>, got '<text>'").
+double number_in(const std::string &name, const std::string &text, double lo, double hi, const char *what);
+
 // --method NAME: incremental, hierarchical, cone or directional.  Throws
 // Error("unknown method 'x' (incremental, hierarchical, cone, directional)").
 ct_method method_named(const std::string &name);

@@ -2,13 +2,10 @@
 #include "picture.hpp"
 
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-
-#include <unistd.h>
 
 #include <png.h>
 
@@ -165,11 +162,27 @@ void png_fail(png_structp png, png_const_charp msg)
 
 void png_warn(png_structp, png_const_charp) {}
 
-// The RGB rows of an image as a PNG on f, with Description and Software text
-// chunks (the keys OpenImageIO reads as ImageDescription and Software).
-// libpng reports errors by longjmp to this frame, so it holds only plain C
-// objects; false with err->text set on failure.
-bool png_to_file(FILE *f, int w, int h, const uint8_t *px, const char *desc, const char *software, PngError *err)
+// libpng's output callback: append to the std::vector<uint8_t> behind the
+// io pointer (an allocation failure becomes a libpng error, never an
+// exception through libpng's C frames).
+void png_append(png_structp png, png_bytep data, size_t n)
+{
+    auto *out = static_cast<std::vector<uint8_t> *>(png_get_io_ptr(png));
+    try {
+        out->insert(out->end(), data, data + n);
+    } catch (...) {
+        png_error(png, "out of memory");
+    }
+}
+
+void png_flush_none(png_structp) {}
+
+// The RGB rows of an image as PNG bytes appended to *out, with Description
+// and Software text chunks (the keys OpenImageIO reads as ImageDescription
+// and Software).  libpng reports errors by longjmp to this frame, so it
+// holds only plain C objects; false with err->text set on failure.
+bool png_to_bytes(std::vector<uint8_t> *out, int w, int h, const uint8_t *px, const char *desc, const char *software,
+                  PngError *err)
 {
     png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, err, png_fail, png_warn);
     if (!png) {
@@ -182,7 +195,7 @@ bool png_to_file(FILE *f, int w, int h, const uint8_t *px, const char *desc, con
         png_destroy_write_struct(&png, info ? &info : nullptr);
         return false;
     }
-    png_init_io(png, f);
+    png_set_write_fn(png, out, png_append, png_flush_none);
     png_set_IHDR(png, info, (png_uint_32)w, (png_uint_32)h, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
                  PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
     png_text text[2];
@@ -206,29 +219,11 @@ bool png_to_file(FILE *f, int w, int h, const uint8_t *px, const char *desc, con
 void write_png_atomic(const std::string &path, const Image &im, const std::string &desc,
                       const std::string &software)
 {
-    const std::string tmp = path + ".tmp." + std::to_string((long)getpid()) + ".png";
-    FILE *f = std::fopen(tmp.c_str(), "wb");
-    if (!f) throw Error(path + ": cannot write (" + std::strerror(errno) + ")");
+    std::vector<uint8_t> bytes;
     PngError err{};
-    bool ok = png_to_file(f, im.w, im.h, im.px.data(), desc.c_str(), software.c_str(), &err);
-    std::string why = ok ? "" : err.text;
-    errno = 0;
-    if (std::fflush(f) != 0 || std::ferror(f)) {
-        if (ok) why = std::strerror(errno ? errno : EIO);
-        ok = false;
-    }
-    if (std::fclose(f) != 0 && ok) {
-        why = std::strerror(errno ? errno : EIO);
-        ok = false;
-    }
-    if (ok && std::rename(tmp.c_str(), path.c_str()) != 0) {
-        why = std::strerror(errno);
-        ok = false;
-    }
-    if (!ok) {
-        std::remove(tmp.c_str());
-        throw Error(path + ": cannot write (" + (why.empty() ? "unknown error" : why) + ")");
-    }
+    if (!png_to_bytes(&bytes, im.w, im.h, im.px.data(), desc.c_str(), software.c_str(), &err))
+        throw Error(path + ": cannot write (" + std::string(err.text) + ")");
+    write_file_atomic(path, bytes);  // temporary file, renamed: "<path>: cannot write (<reason>)"
 }
 
 }  // namespace ct_host

@@ -1,7 +1,7 @@
 // picture.hpp -- small RGB pictures for `conetrace render`, `demo`, `view`,
 // `viewshed` and `shadows`: a package's terrain, an image buffer with points,
 // lines and 3x5-pixel digits, the viridis colour map, a hillshade of a
-// terrain painted post by post, and an atomic PNG writer (OpenImageIO).
+// terrain painted post by post, and an atomic PNG writer (libpng).
 #pragma once
 
 #include <cstdint>

@@ -133,18 +133,24 @@ void judge_one(const dem_cases::Case &cs, const ref::Dem &d, uint64_t seed, cons
     }
 }
 
-void soak_terrain(const dem_cases::Case &cs, uint64_t seed, long nrays, Counts *c)
-{
+// A generated terrain opened once for its rays and its pixels: the package,
+// the reference's DEM and the height range.
+struct Soaked {
+    const dem_cases::Case &cs;
     ct_package p;
-    if (ct_package_open(&p, cs.pkg.data(), cs.pkg.size()) != CT_OK) {
-        c->errors++;
-        return;
-    }
-    const ref::Dem d = dem_cases::ref_dem(cs.t);
+    ref::Dem d;
+    double lo = 0, hi = 0;
+    explicit Soaked(const dem_cases::Case &c) : cs(c), d(dem_cases::ref_dem(c.t)) { dem_cases::minmax(c.t, &lo, &hi); }
+};
+
+void soak_terrain(const Soaked &sk, uint64_t seed, long nrays, Counts *c)
+{
+    const dem_cases::Case &cs = sk.cs;
+    const ct_package &p = sk.p;
+    const ref::Dem &d = sk.d;
+    const double lo = sk.lo, hi = sk.hi;
     const uint32_t bound_cells = CT_WCET_CELL_ITERS(p.cells_x, p.cells_y);
     const uint32_t bound_hier = CT_WCET_HIER_ITERS(p.cells_x, p.cells_y, p.levels);
-    double lo, hi;
-    dem_cases::minmax(cs.t, &lo, &hi);
     ct_rng rng;
     ct_rng_seed(&rng, seed * 2654435761u + 17u);
     c->terrains++;
@@ -178,21 +184,16 @@ void soak_terrain(const dem_cases::Case &cs, uint64_t seed, long nrays, Counts *
 // Pixels: a pinhole camera (640 x 480, focal length 150..1500 px) at a
 // random point above or beside the terrain (up to 5 km above its top)
 // looking at a random point of its surface (roll -30..30 deg), npx random
-// pixels geolocated
-// (straight lines of sight) with each method: the four identical; the
-// pixel's grid ray formed again from the pose centre and ct_geo's map
-// direction by ct_ray_from_map and traced gives the same hit, bit for bit;
-// and that ray judged against the reference as the rays are.
-void soak_pixels(const dem_cases::Case &cs, uint64_t seed, long npx, Counts *c)
+// pixels geolocated (straight lines of sight) with each method: the four
+// identical; the pixel's grid ray formed again from the pose centre and
+// ct_geo's map direction by ct_ray_from_map and traced gives the same hit,
+// bit for bit; and that ray judged against the reference as the rays are.
+void soak_pixels(const Soaked &sk, uint64_t seed, long npx, Counts *c)
 {
-    ct_package p;
-    if (ct_package_open(&p, cs.pkg.data(), cs.pkg.size()) != CT_OK) {
-        c->errors++;
-        return;
-    }
-    const ref::Dem d = dem_cases::ref_dem(cs.t);
-    double lo, hi;
-    dem_cases::minmax(cs.t, &lo, &hi);
+    const dem_cases::Case &cs = sk.cs;
+    const ct_package &p = sk.p;
+    const ref::Dem &d = sk.d;
+    const double hi = sk.hi;
     ct_rng rng;
     ct_rng_seed(&rng, seed * 40503u + 99u);
     const ct_lens lens = dem_cases::centred_pinhole(640, 480, ct_rng_range(&rng, 150, 1500));
@@ -293,8 +294,13 @@ int main(int argc, char **argv)
             while (done.load() < total && elapsed() < seconds) {
                 const uint64_t k = (uint64_t)next++;
                 const dem_cases::Case cs = make_terrain(seed * 1000003u + k, adv);
-                soak_terrain(cs, seed * 1000003u + k, per_terrain, &counts[w]);
-                soak_pixels(cs, seed * 1000003u + k, per_terrain, &counts[w]);
+                Soaked sk(cs);
+                if (ct_package_open(&sk.p, cs.pkg.data(), cs.pkg.size()) != CT_OK) {
+                    counts[w].errors++;
+                } else {
+                    soak_terrain(sk, seed * 1000003u + k, per_terrain, &counts[w]);
+                    soak_pixels(sk, seed * 1000003u + k, per_terrain, &counts[w]);
+                }
                 const long d = (done += per_terrain);
                 if (d / 200000 != (d - per_terrain) / 200000) {
                     std::lock_guard<std::mutex> g(g_print);
