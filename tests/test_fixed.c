@@ -120,12 +120,17 @@ static void test_bitlen(void)
         TEST_ASSERT_EQUAL_INT((int)bitlen_ref(p), (int)ct_bitlen64(p));
         TEST_ASSERT_EQUAL_INT((int)bitlen_ref(p - 1u), (int)ct_bitlen64(p - 1u));
         TEST_ASSERT_EQUAL_INT((int)bitlen_ref(p + 1u), (int)ct_bitlen64(p + 1u));
+        TEST_ASSERT_EQUAL_INT((int)bitlen_ref(p), (int)ct_bitlen64_portable(p));
+        TEST_ASSERT_EQUAL_INT((int)bitlen_ref(p - 1u), (int)ct_bitlen64_portable(p - 1u));
+        TEST_ASSERT_EQUAL_INT((int)bitlen_ref(p + 1u), (int)ct_bitlen64_portable(p + 1u));
     }
+    TEST_ASSERT_EQUAL_INT(0, (int)ct_bitlen64_portable(0u));
     TEST_ASSERT_EQUAL_INT(64, (int)ct_bitlen64(~(uint64_t)0));
     ct_rng_seed(&r, ct_test_seed() + 41u);
     for (i = 0; i < 100000; ++i) {
         uint64_t v = ct_rng_u64(&r) >> ct_rng_range(&r, 0, 63);
         TEST_ASSERT_EQUAL_INT((int)bitlen_ref(v), (int)ct_bitlen64(v));
+        TEST_ASSERT_EQUAL_INT((int)bitlen_ref(v), (int)ct_bitlen64_portable(v));
     }
 }
 

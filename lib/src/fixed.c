@@ -36,7 +36,23 @@ static uint64_t knuth_digit(uint64_t un, uint64_t un_next, uint64_t vn1, uint64_
  * the remainder are < vn. */
 static uint64_t udiv128(uint64_t hi, uint64_t lo, uint64_t d, uint64_t *rem)
 {
-#ifdef CT_NATIVE_INT128
+#if defined(CT_NATIVE_INT128) && defined(__x86_64__) && defined(__GNUC__)
+    /* x86-64's DIV divides hi:lo by d in one instruction (hi < d: the
+     * quotient fits); the compiler's 128-bit division would call a general
+     * library routine instead */
+    uint64_t q, r;
+    if (hi < d) { /* else DIV would trap; the C division below wraps as the
+                     portable path does (callers keep hi < d) */
+        __asm__("divq %4" : "=a"(q), "=d"(r) : "a"(lo), "d"(hi), "rm"(d) : "cc");
+        *rem = r;
+        return q;
+    }
+    {
+        ct_nu128 n = ((ct_nu128)hi << 64) | (ct_nu128)lo;
+        *rem = (uint64_t)(n % d);
+        return (uint64_t)(n / d);
+    }
+#elif defined(CT_NATIVE_INT128)
     ct_nu128 n = ((ct_nu128)hi << 64) | (ct_nu128)lo;
     *rem = (uint64_t)(n % d);
     return (uint64_t)(n / d);

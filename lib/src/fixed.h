@@ -57,9 +57,24 @@ static inline int64_t ct_abs64(int64_t a) { return a < 0 ? (a == INT64_MIN ? INT
 static inline int64_t ct_max64(int64_t a, int64_t b) { return a > b ? a : b; }
 static inline int64_t ct_min64(int64_t a, int64_t b) { return a < b ? a : b; }
 
-/* Number of significant bits of v (0 for 0), by halving: six tests, no
- * loop (compilers turn them into conditional moves).                       */
+/* Number of significant bits of v (0 for 0): the count-leading-zeros
+ * instruction where there is one (GCC and clang on x86-64, AArch64 and
+ * Cortex-M3/M4/M7: LZCNT/BSR, CLZ), else ct_bitlen64_portable (Cortex-M0).
+ * test_fixed checks both.                                                  */
+static inline unsigned ct_bitlen64_portable(uint64_t v);
 static inline unsigned ct_bitlen64(uint64_t v)
+{
+#if defined(__GNUC__) && (defined(__x86_64__) || defined(__aarch64__) || defined(__ARM_FEATURE_CLZ)) && \
+    !defined(CT_PORTABLE_BITLEN)
+    return v == 0u ? 0u : 64u - (unsigned)__builtin_clzll(v);
+#else
+    return ct_bitlen64_portable(v);
+#endif
+}
+
+/* The same by halving: six tests, no loop (compilers turn them into
+ * conditional moves).                                                      */
+static inline unsigned ct_bitlen64_portable(uint64_t v)
 {
     unsigned n = 0u;
     if ((v >> 32) != 0u) { n += 32u; v >>= 32; }
