@@ -331,50 +331,106 @@ ct_status ct_package_open(ct_package *pkg, const uint8_t *bytes, size_t len);
 
 /* Deep content check, O(cells): mipmap levels are the max of their children,
  * every apex is at least its coarse cell's tallest corner, hmin/hmax match
- * the samples.  Returns CT_OK or CT_ERR_VERIFY.  The cones' opening angles
- * are not checked (only the builder's whole computation could confirm them):
- * the CRC guards them, and a package whose angle codes were altered with the
- * CRC re-stamped may make the cone methods pass terrain (never read out of
- * bounds).                                                                 */
+ * the samples.  The cones' opening angles are not checked (only the
+ * builder's whole computation could confirm them): the CRC guards them, and
+ * a package whose angle codes were altered with the CRC re-stamped may make
+ * the cone methods pass terrain (never read out of bounds).
+ *   [in]  pkg  a package ct_package_open accepted.
+ * Returns CT_OK, CT_ERR_VERIFY (a mismatch), CT_ERR_ARG (NULL, or no bytes
+ * behind pkg).
+ * Scaling and overflow: heights and maxima are 16-bit codes compared as
+ * uint32; indices are size_t products of dimensions <= CT_MAX_POSTS.      */
 ct_status ct_package_verify(const ct_package *pkg);
 
-/* Size in bytes of a package with these parameters (0 if out of limits).    */
+/* Size in bytes of a package with these parameters (the builder's and a
+ * loader's buffer size).
+ *   [in]  width, height  posts, [2, CT_MAX_POSTS].
+ *   [in]  reduce         r, [1, CT_MAX_REDUCE].
+ *   [in]  sectors        N, [1, CT_MAX_SECTORS].
+ *   [in]  with_voids     nonzero: the package carries a void mask.
+ *   [out] out_size       the total size; 0 on any error.
+ * Errors: CT_ERR_ARG (NULL), CT_ERR_DIMS, CT_ERR_REDUCE, CT_ERR_SECTORS,
+ * CT_ERR_SIZE (the total would not fit 32 bits).
+ * Scaling and overflow: section sizes are summed in 64 bits, each start
+ * aligned to 8 bytes, and the total compared with 2^32 - 1.               */
 ct_status ct_package_size(uint32_t width, uint32_t height, uint32_t reduce,
                           uint32_t sectors, uint32_t with_voids,
                           uint32_t *out_size);
 
 /* Section layout (offset, size in bytes) for a package with these
- * parameters; the writer and the reader share it.                          */
+ * parameters; the writer and the reader share it (package-format.md).
+ *   [in]  width .. with_voids  as ct_package_size.
+ *   [out] sec_off, sec_size    per section CT_SEC_*: byte offset (a multiple
+ *                              of 8) and size; an absent section has size 0.
+ *   [out] levels               mipmap levels above the fine cells.
+ *   [out] total                the package's size in bytes.
+ * Errors and scaling: as ct_package_size.                                  */
 ct_status ct_package_layout(uint32_t width, uint32_t height, uint32_t reduce,
                             uint32_t sectors, uint32_t with_voids,
                             uint32_t sec_off[CT_SEC_COUNT],
                             uint32_t sec_size[CT_SEC_COUNT],
                             uint32_t *levels, uint32_t *total);
 
-/* CRC-32 (IEEE 802.3, reflected 0xEDB88320), continuing from crc (start 0). */
+/* CRC-32 (IEEE 802.3, reflected 0xEDB88320) of data[0..len), continuing
+ * from crc: start with 0, pass the previous result to go on across pieces.
+ *   [in]  crc      0, or the CRC of the bytes before data.
+ *   [in]  data     len bytes (may be NULL when len is 0).
+ *   [out] out_crc  the CRC of everything so far.
+ * Errors: CT_ERR_ARG (out_crc NULL, or data NULL with len > 0).           */
 ct_status ct_crc32(uint32_t crc, const uint8_t *data, size_t len,
                    uint32_t *out_crc);
 
-/* Sector boundary vector k (0..N) for N sectors; |b| ~ 2^30.  CT_ERR_ARG
- * (NULL), CT_ERR_SECTORS (N outside [1, CT_MAX_SECTORS] or k > N).         */
+/* Sector boundary vector k of N sectors: the direction k 360/N degrees
+ * from +x (grid frame), as integers computed the same way on every platform
+ * and shared by the builder and the tracer (b_0 = b_N = +x).
+ *   [in]  sectors  N, [1, CT_MAX_SECTORS].
+ *   [in]  k        0 .. N.
+ *   [out] bx, by   the vector, |.| about 2^30 (an integer approximation of
+ *                  2^30 (cos, sin): multiples of 45 degrees from
+ *                  constants, the rest from a Q30 Taylor series).
+ * Errors: CT_ERR_ARG (NULL), CT_ERR_SECTORS (N outside [1, CT_MAX_SECTORS]
+ * or k > N).                                                               */
 ct_status ct_sector_boundary(uint32_t sectors, uint32_t k, int32_t *bx,
                              int32_t *by);
 
-/* Sector holding grid direction (dx, dy) (|.| <= 2^30, not both zero): the
- * s with angle(b_s) <= angle(d) < angle(b_{s+1}) by an exact integer order,
- * confirmed with the closed-wedge test ct_in_wedge (the builder's test).  */
+/* Sector holding a grid direction: the s with angle(b_s) <= angle(d) <
+ * angle(b_{s+1}) by an exact integer order, confirmed with the closed-wedge
+ * test ct_in_wedge (the builder's test).
+ *   [in]  pkg         an opened package (its N and boundaries).
+ *   [in]  dx, dy      the direction, |.| <= 2^30, not both zero.
+ *   [out] out_sector  s in [0, N); 0 when N = 1.
+ * Errors: CT_ERR_ARG (NULL, a zero or too long direction), CT_ERR_INTERNAL
+ * (the wedge test disagrees with the order: cannot happen).
+ * Scaling and overflow: cross products of 2^30-bounded vectors, < 2^61.  */
 ct_status ct_sector_of(const ct_package *pkg, int64_t dx, int64_t dy,
                        uint32_t *out_sector);
 
-/* Same test for an explicit boundary set (used by the builder): *out_inside
- * 1 when d lies in the closed wedge s.  CT_ERR_ARG (NULL, |dx| or |dy|
- * beyond 2^30), CT_ERR_SECTORS (N outside [1, CT_MAX_SECTORS], s >= N).    */
+/* Whether a direction lies in the closed wedge of sector s of an explicit
+ * boundary set (the builder's test; ct_sector_of confirms with it).
+ *   [in]  bound_x, bound_y  N + 1 boundary vectors (ct_sector_boundary).
+ *   [in]  sectors, s        N in [1, CT_MAX_SECTORS], s in [0, N).
+ *   [in]  dx, dy            the direction, |.| <= 2^30.
+ *   [out] out_inside        1 when b_s x d >= 0 and d x b_{s+1} >= 0 (both
+ *                           boundaries included), else 0; 1 when N = 1.
+ * Errors: CT_ERR_ARG (NULL, |dx| or |dy| beyond 2^30), CT_ERR_SECTORS.
+ * Scaling and overflow: |b|, |d| <= 2^30: each cross product < 2^61.      */
 ct_status ct_in_wedge(const int32_t *bound_x, const int32_t *bound_y,
                       uint32_t sectors, uint32_t s, int64_t dx, int64_t dy,
                       uint32_t *out_inside);
 
-/* cot table for angle codes given the georeference: out[code] in Q16 LSB per
- * fine cell, rounded up; ok[code] = 0 where degenerate.                     */
+/* The cones' slopes in the grid frame: for each angle code (half-angle
+ * omega = code 180/256 degrees from the upward vertical, in metres), the
+ * cone's rise cot(omega) in height LSB per fine cell, Q16, rounded up (so
+ * a cone is never wider than the builder's).
+ *   [in]  posting_nm       the cell size, nm (its sign is ignored), <= 2^50.
+ *   [in]  height_scale_nm  one height LSB, nm, (0, 2^46].
+ *   [out] out_q16          per code, Q16 LSB per cell; capped at
+ *                          +-CT_COT_MAX_Q16.
+ *   [out] ok               per code, 0 where the cone is too narrow to step
+ *                          with (code 0, or cot beyond the cap), else 1.
+ * Errors: CT_ERR_ARG (NULL), CT_ERR_GEOREF (posting or scale out of range).
+ * Scaling and overflow: cot_q32 (< 2^39) times posting (<= 2^50) in 128
+ * bits over scale 2^16 (<= 2^62), capped before the quotient is formed.   */
 ct_status ct_cot_table(int64_t posting_nm, int64_t height_scale_nm,
                        int64_t out_q16[256], uint8_t ok[256]);
 
@@ -470,7 +526,12 @@ ct_status ct_surface_height(const ct_package *pkg, int64_t x_q16,
 /* Like ct_ray_prepare, but the ray is the segment from its origin to
  * origin + direction (t <= 1 in the caller's parameter): the prepared ray's
  * tend is also at most the segment's end.  A walk may still report a hit in
- * the segment's last cell beyond tend; ct_trace_bent discards those.       */
+ * the segment's last cell beyond tend; ct_trace_bent discards those.
+ *   [in]  pkg, ray  as ct_ray_prepare (origin + direction must fit int64:
+ *                   it does within the documented ranges).
+ *   [out] out       the prepared segment.
+ * Statuses, errors and scaling: as ct_ray_prepare; a segment inside the box
+ * at both ends is not clipped.                                             */
 ct_status ct_ray_prepare_segment(const ct_package *pkg, const ct_ray *ray,
                                  ct_prepared *out);
 
@@ -535,6 +596,10 @@ typedef struct {
 ct_status ct_trace_bent(const ct_package *pkg, const ct_ray *ray,
                         const ct_bend *bend, ct_method method, ct_hit *hit);
 
+/* A status's short name ("hit", "err_crc", ...), for logs and the CLI.
+ *   [in]  s    any ct_status.
+ *   [out] out  a static string; "unknown" for a value that is not one.
+ * Errors: CT_ERR_ARG (out NULL, or s not a status: *out is then "unknown"). */
 ct_status ct_status_name(ct_status s, const char **out);
 
 /* ======================================================================== */
@@ -852,16 +917,23 @@ typedef struct {
     ct_hit hit;                /* the trace: hit.e_nm, n_nm, h_nm, steps    */
 } ct_geo;
 
-/* Validate *lens and find its valid field.  CT_OK or CT_ERR_LENS (unknown
- * model, fx or fy outside [1, 2^20] px, |cx|, |cy| > 2^20 px, a distortion
- * coefficient beyond 2^10 or set but unused by the model, or no valid field
- * at all).                                                                 */
+/* Validate *lens and find its valid field.
+ *   [out] cam   the camera: the lens in the library's fixed-point form and
+ *               its valid field (where the distortion is invertible).
+ *   [in]  lens  model, focal lengths and centre (px), distortion
+ *               coefficients (mrcal's / OpenCV's order and meaning).
+ * Errors: CT_ERR_ARG (NULL), CT_ERR_LENS (unknown model, fx or fy outside
+ * [1, 2^20] px, |cx|, |cy| > 2^20 px, a distortion coefficient beyond 2^10
+ * or set but unused by the model, or no valid field at all).              */
 ct_status ct_camera_init(ct_camera *cam, const ct_lens *lens);
 
-/* A camera from an unprojection grid (the table stays in caller memory).
- * Checks the geometry and every node (unit within 2^-20, or (0, 0, 0)):
- * CT_OK or CT_ERR_LENS.  ct_camera_project is not available for it
- * (CT_ERR_LENS).                                                           */
+/* A camera from an unprojection grid (the table stays in caller memory:
+ * it must outlive cam).  ct_camera_project is not available for it
+ * (CT_ERR_LENS).
+ *   [out] cam   the camera.
+ *   [in]  grid  the grid's geometry and nodes (ct_unproject_grid).
+ * Errors: CT_ERR_ARG (NULL), CT_ERR_LENS (geometry out of range, or a node
+ * that is neither a unit vector within 2^-20 nor (0, 0, 0)).              */
 ct_status ct_camera_init_grid(ct_camera *cam, const ct_unproject_grid *grid);
 
 /* Pixel (u, v) (Q16) to the unit ray in the camera frame (Q30).  CT_OK or
@@ -878,16 +950,24 @@ ct_status ct_camera_unproject(const ct_camera *cam, int64_t u_q16,
                               int64_t v_q16, int32_t ray_cam_q30[3],
                               uint32_t *iters);
 
-/* Camera-frame direction (any int32 vector with z > 0, not necessarily
- * unit) to the pixel (Q16, rounded).  CT_ERR_UNPROJECT when the direction
- * is behind the camera or outside the valid field; CT_ERR_LENS for a grid
- * camera.                                                                  */
+/* Camera-frame direction to the pixel that sees it (the lens model forward).
+ *   [in]  cam          from ct_camera_init.
+ *   [in]  ray_cam      any int32 vector with z > 0 (not necessarily unit),
+ *                      camera frame.
+ *   [out] u_q16, v_q16 the pixel, Q16, rounded.
+ * Errors: CT_ERR_ARG (NULL), CT_ERR_UNPROJECT (behind the camera or outside
+ * the valid field), CT_ERR_LENS (a grid camera).                          */
 ct_status ct_camera_project(const ct_camera *cam, const int32_t ray_cam[3],
                             int64_t *u_q16, int64_t *v_q16);
 
-/* Validate and store a pose: R_map_cam (Q30) must be orthonormal within
- * 2^-20 per entry of R^T R - I, with det > 0; |e|, |n|, |h| <= 2^61 nm.
- * CT_OK or CT_ERR_POSE.                                                    */
+/* Validate and store a pose.
+ *   [out] pose            the pose.
+ *   [in]  R_map_cam_q30   camera-to-map rotation, row-major, Q30:
+ *                         orthonormal within 2^-20 per entry of R^T R - I,
+ *                         det > 0 (map frame: east, north, up).
+ *   [in]  e_nm, n_nm, h_nm  the camera centre in the map frame, |.| <= 2^61.
+ * Errors: CT_ERR_ARG (NULL), CT_ERR_POSE (R not a rotation, a position out
+ * of range).                                                               */
 ct_status ct_pose_init(ct_pose *pose, const int32_t R_map_cam_q30[9],
                        int64_t e_nm, int64_t n_nm, int64_t h_nm);
 
