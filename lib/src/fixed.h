@@ -34,6 +34,7 @@ typedef struct {
 
 extern const int64_t ct_cot_q32[256];
 extern const uint32_t ct_crc32_table[256];
+extern const uint32_t ct_isqrt_top8[192];
 
 /* floor(a / b) for b > 0. */
 static inline int64_t ct_floor_div(int64_t a, int64_t b)
