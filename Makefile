@@ -4,7 +4,7 @@ BUILD ?= build
 JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 
 .PHONY: all test demo bench tradeoff cross fuzz coverage soak clean deps
-FUZZ_SECONDS ?= 1800
+FUZZ_SECONDS ?= 2700
 
 all: deps
 	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release
@@ -40,7 +40,8 @@ tradeoff: all
 cross: deps
 	scripts/cross.sh $(BUILD)/cross
 
-# long fuzzing of lib/ (10^7 inputs or FUZZ_SECONDS, whichever comes first);
+# long fuzzing of lib/ (10^7 inputs or FUZZ_SECONDS, whichever comes first,
+# one worker per core);
 # the corpus is kept in $(BUILD)/fuzz_corpus between runs
 fuzz: all
 	sh tests/fuzz/fuzz.sh $(BUILD) 10000000 $(FUZZ_SECONDS) $(BUILD)/fuzz_corpus

@@ -4,8 +4,15 @@
 #   tests/fuzz/fuzz.sh <build-dir> <runs> [max-seconds] [corpus-dir]
 # The packages come from the MCU vectors the host build generates
 # (<build-dir>/tests/mcu/ct_vectors.c).  `make test` runs 100,000 inputs from
-# an empty corpus with a fixed seed (reproducible); `make fuzz` runs long
-# (FUZZ_SECONDS, default 1800) and keeps its corpus in <build-dir>/fuzz_corpus.
+# an empty corpus with a fixed seed (reproducible), one process; `make fuzz`
+# runs long (10^7 inputs or FUZZ_SECONDS, default 2700) in libFuzzer's fork
+# mode, one worker per core (FUZZ_JOBS), and keeps its corpus in
+# <build-dir>/fuzz_corpus.
+# Comparison tracing (-fsanitize-coverage=trace-cmp, part of
+# -fsanitize=fuzzer) is left out: it took 2/3 of the time (30,000 inputs in
+# 21 s against 7 s) and reached no more coverage (3,276 against 3,292
+# edges after them; the harness builds valid packages itself, so there are
+# no magic values to guess).
 # Exit 0: no finding; 1: a finding (the crashing input is saved in
 # <build-dir>/fuzz/ and printed); 77: clang's libFuzzer is not available.
 set -u
@@ -28,7 +35,7 @@ mkdir -p "$CORPUS"
 CORPUS=$(cd "$CORPUS" && pwd)  # absolute: the fuzzer runs in $OUT
 # the seed corpus: inputs worth keeping (earlier findings among them)
 cp "$ROOT"/tests/fuzz/corpus/* "$CORPUS"/ 2>/dev/null || true
-FLAGS="-g -O1 -std=c99 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all"
+FLAGS="-g -O1 -std=c99 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all -fno-sanitize-coverage=trace-cmp"
 if ! "$CC" $FLAGS -I"$ROOT/lib/include" -I"$ROOT/lib/src" -I"$ROOT/tests/mcu" \
         "$ROOT/tests/fuzz/fuzz_lib.c" "$VEC" "$ROOT"/lib/src/*.c -o "$OUT/fuzz_lib" 2>"$OUT/build.log"; then
     if grep -q "fuzzer" "$OUT/build.log" && ! grep -q "error:" "$OUT/build.log"; then
@@ -39,9 +46,15 @@ fi
 cd "$OUT" || exit 1
 LIMIT=""
 [ "$SECS" -gt 0 ] && LIMIT="-max_total_time=$SECS"
-./fuzz_lib -runs="$RUNS" $LIMIT -seed=1 -max_len=512 -len_control=0 -print_final_stats=1 "$CORPUS" >"$OUT/run.log" 2>&1
+FORK=""
+if [ "$RUNS" -gt 100000 ]; then
+    # a long run: one worker per core; the parent counts every worker's inputs
+    FORK="-fork=${FUZZ_JOBS:-$(nproc 2>/dev/null || echo 1)}"
+fi
+./fuzz_lib $FORK -runs="$RUNS" $LIMIT -seed=1 -max_len=512 -len_control=0 -print_final_stats=1 "$CORPUS" >"$OUT/run.log" 2>&1
 rc=$?
-grep -E "^(stat::number_of_executed_units|stat::new_units_added)|^#[0-9]+.*DONE|Done [0-9]+ runs" "$OUT/run.log"
+grep -E "^(stat::number_of_executed_units|stat::new_units_added)|^#[0-9]+.*DONE|Done [0-9]+ runs|fuzzed for [0-9]+ iterations" "$OUT/run.log"
+grep -E "oom/timeout/crash" "$OUT/run.log" | tail -n 1
 if [ $rc -ne 0 ]; then
     tail -40 "$OUT/run.log"
     echo "fuzz: FINDING (input saved in $OUT, see run.log)"
