@@ -1011,12 +1011,18 @@ ct_status ct_geolocate(const ct_package *pkg, const ct_camera *cam,
                        const ct_effects *effects, int64_t u_q16,
                        int64_t v_q16, ct_geo *out);
 
-/* Many pixels: uv_q16[2k], uv_q16[2k + 1] for k < count, results in
- * out[0..count) (out_len >= count), each bit-identical to ct_geolocate's.
- * The per-call setup (argument checks, the camera centre in the grid frame,
- * the bend's or the true Earth's set-up) is done once.  Returns CT_OK when
- * every pixel was processed (each with its own out[k].status), or the
- * setup's error (nothing written).                                         */
+/* Many pixels, each result bit-identical to ct_geolocate's; the per-call
+ * set-up (argument checks, the camera centre in the grid frame, the bend's
+ * or the true Earth's set-up) is done once.
+ *   [in]  pkg .. effects  as ct_geolocate.
+ *   [in]  uv_q16          pixel k at uv_q16[2k], uv_q16[2k + 1], Q16 px.
+ *   [in]  count           pixels.
+ *   [out] out             out[0..count): each pixel's ct_geo, its own
+ *                         status in out[k].status.
+ *   [in]  out_len         entries available in out, >= count.
+ * Returns CT_OK when every pixel was processed, or the set-up's error
+ * (ct_geolocate's argument, camera, pose and effects errors; CT_ERR_ARG
+ * for NULL arrays or out_len < count), with nothing written.              */
 ct_status ct_geolocate_batch(const ct_package *pkg, const ct_camera *cam,
                              const ct_pose *pose, ct_method method,
                              const ct_effects *effects,
@@ -1042,8 +1048,10 @@ typedef struct {
 #define CT_UTM_MAX_LAT_Q61 INT64_C(3400664690041760445) /* 84.5 deg, Q61 */
 #define CT_UTM_MAX_DLON_DEG 9
 
-/* The UTM zone of an EPSG code (32601..32660, 32701..32760), else
- * CT_ERR_CRS.                                                              */
+/* The UTM zone of an EPSG code.
+ *   [in]  epsg  32601..32660 (north) or 32701..32760 (south).
+ *   [out] zone  the zone number and hemisphere.
+ * Errors: CT_ERR_ARG (NULL), CT_ERR_CRS (any other code).                 */
 ct_status ct_utm_zone_of_epsg(int32_t epsg, ct_utm *zone);
 
 /* Geodetic (lat, lon: Q61 radians) to UTM (E, N: nm, rounded).
@@ -1057,10 +1065,17 @@ ct_status ct_utm_zone_of_epsg(int32_t epsg, ct_utm *zone);
 ct_status ct_utm_forward(const ct_utm *zone, int64_t lat_q61, int64_t lon_q61,
                          int64_t *e_nm, int64_t *n_nm);
 
-/* The meridian convergence gamma (Q61 radians: the angle from true north
- * to grid north, clockwise positive as in PROJ) and the point scale k (Q61)
- * at a geodetic point: what turns a north-east-down attitude into the map
- * frame, and ground distances into map distances.                         */
+/* The meridian convergence and the point scale at a geodetic point: what
+ * turns a north-east-down attitude into the map frame, and ground distances
+ * into map distances.
+ *   [in]  zone              the zone (and hemisphere).
+ *   [in]  lat_q61, lon_q61  WGS84 latitude and longitude, Q61 radians.
+ *   [out] gamma_q61         the angle from true north to grid north, Q61
+ *                           radians, clockwise positive (as PROJ's).
+ *   [out] k_q61             the point scale, Q61 (0.9996 on the central
+ *                           meridian).
+ * Errors and scaling: as ct_utm_forward (the same series and its
+ * derivative, Karney 2011 eqs. 27-28).                                     */
 ct_status ct_utm_factors(const ct_utm *zone, int64_t lat_q61, int64_t lon_q61,
                          int64_t *gamma_q61, int64_t *k_q61);
 
@@ -1072,28 +1087,50 @@ ct_status ct_utm_factors(const ct_utm *zone, int64_t lat_q61, int64_t lon_q61,
  * camera are grid east, grid north and up: NED turned by the meridian
  * convergence, and horizontal lengths scaled by k R / (R + h) (the point
  * scale and the elevation factor, R the Gaussian mean radius there) into
- * pose->hscale_q30.  CT_ERR_POSE for a quaternion off unit length by more
- * than 2^-20, CT_ERR_RANGE / CT_ERR_ARG as ct_utm_forward.               */
+ * pose->hscale_q30.
+ *   [out] pose            the pose (ct_pose_init's checks applied).
+ *   [in]  zone            the package's UTM zone.
+ *   [in]  lat_q61, lon_q61, h_nm  the camera centre (Q61 radians, nm).
+ *   [in]  q_ned_cam_q30   (w, x, y, z), Q30, |q| = 1 within 2^-20.
+ * Errors: CT_ERR_ARG (NULL, a zone outside 1..60), CT_ERR_RANGE (outside
+ * the zone's domain), CT_ERR_POSE (q off unit length, a position beyond
+ * ct_pose_init's range).                                                   */
 ct_status ct_pose_from_wgs84(ct_pose *pose, const ct_utm *zone, int64_t lat_q61,
                              int64_t lon_q61, int64_t h_nm, const int32_t q_ned_cam_q30[4]);
 
-/* A pose in the map frame with an attitude quaternion (Q30) w.r.t. grid
- * north, grid east and down (no convergence, no scale: hscale 2^30).      */
+/* A pose in the map frame with an attitude quaternion w.r.t. grid north,
+ * grid east and down (no convergence, no scale: hscale 2^30).
+ *   [out] pose            the pose.
+ *   [in]  e_nm, n_nm, h_nm  the camera centre, map frame, |.| <= 2^61.
+ *   [in]  q_ned_cam_q30   (w, x, y, z), Q30, |q| = 1 within 2^-20,
+ *                         rotating camera-frame vectors into (grid north,
+ *                         grid east, down).
+ * Errors: CT_ERR_ARG (NULL), CT_ERR_POSE (q off unit length, a position
+ * out of range).                                                           */
 ct_status ct_pose_from_map(ct_pose *pose, int64_t e_nm, int64_t n_nm, int64_t h_nm,
                            const int32_t q_ned_cam_q30[4]);
 
-/* The attitude quaternion (Q30) of aerospace yaw, pitch, roll (Z-Y-X, Q61
- * radians, |.| <= pi) for a camera whose mrcal axes x right, y down, z
- * forward point east, down, north at zero; yaw turns it clockwise seen
- * from above, pitch raises its forward axis, roll turns it about that
- * axis.                                                                    */
+/* The attitude quaternion of aerospace yaw, pitch, roll (Z-Y-X) for a
+ * camera whose mrcal axes x right, y down, z forward point east, down,
+ * north at zero; yaw turns it clockwise seen from above, pitch raises its
+ * forward axis, roll turns it about that axis.
+ *   [in]  yaw_q61, pitch_q61, roll_q61  Q61 radians, |.| <= pi.
+ *   [out] q_ned_cam_q30  (w, x, y, z), Q30, rotating camera-frame vectors
+ *                        into north-east-down (ct_pose_from_wgs84's input).
+ * Errors: CT_ERR_ARG (NULL), CT_ERR_RANGE (an angle beyond pi).
+ * Scaling: Q59 sines and cosines; products of Q30 values < 2^60, sums of
+ * four < 2^62, rounded to Q30.                                             */
 ct_status ct_quat_from_ypr(int64_t yaw_q61, int64_t pitch_q61, int64_t roll_q61,
                            int32_t q_ned_cam_q30[4]);
 
-/* The geoid undulation N (nm; h_ellipsoid = h_geoid + N) at a geodetic
- * point (Q61 radians), bilinear in latitude and longitude between the
- * grid's nodes (longitude wraps at +-pi).  CT_ERR_RANGE outside the grid
- * (its last row and column included) or with no grid.
+/* The geoid undulation N (h_ellipsoid = h_geoid + N) at a geodetic point,
+ * bilinear in latitude and longitude between the grid's nodes (longitude
+ * wraps at +-pi).
+ *   [in]  grid              the geoid grid (a package's pkg->geoid).
+ *   [in]  lat_q61, lon_q61  Q61 radians.
+ *   [out] n_geoid_nm        N, nm.
+ * Errors: CT_ERR_ARG (NULL), CT_ERR_RANGE (outside the grid, its last row
+ * and column included, or no grid).
  * Scaling: the position within a cell is a Q19 fraction of the step (at
  * EGM96's 15', < 0.06 m on the ground; times the geoid's slope < 1e-3:
  * < 0.06 mm); the first interpolation is rounded to nm (|N| < 2^31 um:
@@ -1104,8 +1141,11 @@ ct_status ct_geoid_at(const ct_geoid_grid *grid, int64_t lat_q61, int64_t lon_q6
 /* The same at a map point of a package (ct_utm_inverse, then
  * ct_geoid_at on pkg->geoid): what turns the ellipsoidal heights of a
  * package with a known source datum into orthometric ones (h - N).
- * CT_ERR_CRS when the package is not on a UTM zone, CT_ERR_RANGE as
- * ct_utm_inverse and ct_geoid_at.                                          */
+ *   [in]  pkg         an opened package.
+ *   [in]  e_nm, n_nm  the map point, nm.
+ *   [out] n_geoid_nm  N there, nm.
+ * Errors: CT_ERR_ARG (NULL), CT_ERR_CRS (not on a UTM zone), CT_ERR_RANGE
+ * (as ct_utm_inverse and ct_geoid_at).                                     */
 ct_status ct_package_geoid(const ct_package *pkg, int64_t e_nm, int64_t n_nm,
                            int64_t *n_geoid_nm);
 
