@@ -1149,18 +1149,31 @@ ct_status ct_geoid_at(const ct_geoid_grid *grid, int64_t lat_q61, int64_t lon_q6
 ct_status ct_package_geoid(const ct_package *pkg, int64_t e_nm, int64_t n_nm,
                            int64_t *n_geoid_nm);
 
-/* WGS84 geodetic (lat, lon: Q61 radians; h: ellipsoidal height, nm) to
- * Earth-centred, Earth-fixed Cartesian coordinates (EPSG:4978; nm, rounded).
- * Domain: |lat| <= pi/2, |lon| <= pi, h in [-2^52, 2^54] nm (-4,500 km ..
- * 18,000 km); outside, CT_ERR_RANGE.                                       */
+/* WGS84 geodetic to Earth-centred, Earth-fixed Cartesian coordinates
+ * (EPSG:4978).
+ *   [in]  lat_q61, lon_q61  Q61 radians, |lat| <= pi/2, |lon| <= pi.
+ *   [in]  h_nm              ellipsoidal height, [-2^52, 2^54] nm (-4,500 km
+ *                           .. 18,000 km).
+ *   [out] xyz_nm            x, y, z, nm, rounded.
+ * Errors: CT_ERR_ARG (NULL), CT_ERR_RANGE (outside the domain).            */
 ct_status ct_ecef_from_wgs84(int64_t lat_q61, int64_t lon_q61, int64_t h_nm, int64_t xyz_nm[3]);
 
-/* Earth-fixed (nm) to WGS84 geodetic (lat, lon: Q61 radians; h: nm).
- * Domain: |x|, |y|, |z| <= 2^55 nm and at least 2^50 nm (1,100 km) from
- * the Earth's centre; outside, CT_ERR_RANGE.  On the polar axis lon = 0.  */
+/* Earth-fixed to WGS84 geodetic.  On the polar axis lon = 0.
+ *   [in]  xyz_nm            x, y, z, nm: |.| <= 2^55 and at least 2^50 nm
+ *                           (1,100 km) from the Earth's centre.
+ *   [out] lat_q61, lon_q61  Q61 radians.
+ *   [out] h_nm              ellipsoidal height, nm.
+ * Errors: CT_ERR_ARG (NULL), CT_ERR_RANGE (outside the domain).            */
 ct_status ct_wgs84_from_ecef(const int64_t xyz_nm[3], int64_t *lat_q61, int64_t *lon_q61, int64_t *h_nm);
 
-/* UTM (nm) to geodetic (Q61 radians).                                      */
+/* UTM to geodetic: the inverse of ct_utm_forward (Krueger's series).
+ *   [in]  zone              the zone (and hemisphere).
+ *   [in]  e_nm, n_nm        easting and northing, nm (false easting and,
+ *                           south, northing included).
+ *   [out] lat_q61, lon_q61  WGS84 latitude and longitude, Q61 radians.
+ * Errors: CT_ERR_ARG (NULL, zone outside 1..60), CT_ERR_RANGE (more than
+ * 1,100 km east or west of the central meridian or 9,500 km north or south
+ * of the equator, a pole, or a point outside the zone's domain above).  */
 ct_status ct_utm_inverse(const ct_utm *zone, int64_t e_nm, int64_t n_nm,
                          int64_t *lat_q61, int64_t *lon_q61);
 
