@@ -852,10 +852,15 @@ typedef struct {
     uint32_t samples;          /* pixels that unprojected                   */
 } ct_effects_choice;
 
-/* refraction_k_q16 in [-2, 2] (Q16), radius_nm 0 (6371 km) or [2^40, 2^54],
- * tol_nm >= 0.  CT_OK; CT_ERR_ARG (NULL, a camera or pose not set up),
- * CT_ERR_EFFECTS (k or R out of range), CT_ERR_UNPROJECT (no pixel
- * unprojects).                                                            */
+/* The least set of effects a camera's pixels need for a tolerance (see
+ * ct_effects_choice above): the camera's rays sampled over the image.
+ *   [in]  pkg, cam, pose     an opened package, a camera, its pose.
+ *   [in]  refraction_k_q16   k, Q16, in [-2, 2].
+ *   [in]  radius_nm          R, nm: 0 (6371 km) or [2^40, 2^54].
+ *   [in]  tol_nm             the ground error allowed, nm, >= 0.
+ *   [out] out                the choice, its bounds and the samples.
+ * Errors: CT_ERR_ARG (NULL, a camera or pose not set up), CT_ERR_EFFECTS
+ * (k or R out of range), CT_ERR_UNPROJECT (no pixel unprojects).          */
 ct_status ct_effects_for_tolerance(const ct_package *pkg, const ct_camera *cam, const ct_pose *pose,
                                    int32_t refraction_k_q16, int64_t radius_nm, int64_t tol_nm,
                                    ct_effects_choice *out);
@@ -878,7 +883,15 @@ ct_status ct_effects_for_tolerance(const ct_package *pkg, const ct_camera *cam, 
  * ct_geolocate refuses -- unknown flags, |k| > 2, R or chord out of range,
  * another package's earth_map -- or, on the sphere, c < 0 or a bend the
  * lowered walk cannot take from A; for the true Earth, A where the zone's
- * projection cannot take it, e.g. far off the zone).                      */
+ * projection cannot take it, e.g. far off the zone).
+ *   [in]  pkg        an opened package.
+ *   [in]  a_nm, b_nm the two map points (E, N, h), nm.
+ *   [in]  effects    NULL or as ct_geolocate's.
+ *   [in]  margin_nm  >= 0: how far before B a blocking point still counts
+ *                    as B itself.
+ *   [in]  method     CT_METHOD_*.
+ *   [out] block      for CT_HIT, the first point where the surface meets
+ *                    the line of sight (as ct_trace's hit).               */
 ct_status ct_los(const ct_package *pkg, const int64_t a_nm[3], const int64_t b_nm[3], const ct_effects *effects,
                  int64_t margin_nm, ct_method method, ct_hit *block);
 
@@ -892,7 +905,12 @@ ct_status ct_los(const ct_package *pkg, const int64_t a_nm[3], const int64_t b_n
  * camera under the surface; pixel set, *visible 0); CT_ERR_UNPROJECT
  * (behind the camera or outside the valid field: no pixel), CT_ERR_LENS
  * (a grid camera), or ct_los's errors.  A pixel outside the image is still
- * given: the caller compares it with the imager size.                   */
+ * given: the caller compares it with the imager size.
+ *   [in]  pkg, cam, pose, effects, margin_nm  as ct_geolocate and ct_los.
+ *   [in]  g_nm          the map point (E, N, h), nm.
+ *   [out] u_q16, v_q16  the pixel, Q16.
+ *   [out] visible       1 when nothing blocks the line of sight, else 0.
+ *   [out] block         the blocking point when hidden (as ct_los).      */
 ct_status ct_locate_inverse(const ct_package *pkg, const ct_camera *cam, const ct_pose *pose, const ct_effects *effects,
                             const int64_t g_nm[3], int64_t margin_nm, int64_t *u_q16, int64_t *v_q16,
                             uint32_t *visible, ct_hit *block);
@@ -903,7 +921,11 @@ ct_status ct_locate_inverse(const ct_package *pkg, const ct_camera *cam, const c
  * (125 .. 343; 9.4M instructions at q = 44 on Cortex-M4).  CT_OK;
  * CT_ERR_ARG (NULL), CT_ERR_CRS (not UTM), CT_ERR_RANGE (radius beyond
  * 2^47 nm or not positive, the point off the zone or the grid's range, or
- * a cube point the projection cannot take).                              */
+ * a cube point the projection cannot take).
+ *   [in]  pkg               an opened package on a UTM zone.
+ *   [in]  e_nm, n_nm, h_nm  the cube's centre, map frame, nm.
+ *   [in]  radius_nm         the half-width needed, (0, 2^47] nm.
+ *   [out] map               the fitted map, for ct_effects.earth_map.   */
 ct_status ct_earth_map_init(const ct_package *pkg, int64_t e_nm, int64_t n_nm, int64_t h_nm, int64_t radius_nm,
                             ct_earth_map *map);
 
@@ -1298,26 +1320,41 @@ typedef struct {
     uint32_t refused;          /* loads that failed or were refused         */
 } ct_tileset;
 
-/* Validate the manifest (as ct_package_open a package: CT_ERR_TRUNCATED,
- * _MAGIC, _VERSION, _HEADER, _CRC; CT_ERR_DIMS for a tile grid that does
- * not fit W x H or more than CT_SET_MAX_TILES tiles; _SECTORS, _REDUCE,
- * _RANGE (hmin > hmax, a tile's range outside the set's), _GEOREF, _FLAGS)
- * and set up *ts over slots[0..nslots) (1 <= nslots <= CT_SET_MAX_SLOTS;
- * else CT_ERR_ARG).                                                        */
+/* Validate a tile set's manifest and set up *ts over the caller's slots.
+ *   [out] ts        the set (kept by reference: manifest, slots, user).
+ *   [in]  manifest  the manifest's bytes (package-format.md), len of them;
+ *                   they must outlive ts.
+ *   [in]  slots     nslots cache slots, 1 <= nslots <= CT_SET_MAX_SLOTS,
+ *                   each with its buf and cap set (or NULL, 0).
+ *   [in]  load      the caller's loader; user is passed to it.
+ * Errors: as ct_package_open's for a package (CT_ERR_TRUNCATED, _MAGIC,
+ * _VERSION, _HEADER, _CRC; _SECTORS, _REDUCE, _GEOREF, _FLAGS), CT_ERR_DIMS
+ * (a tile grid that does not fit W x H, or more than CT_SET_MAX_TILES
+ * tiles), CT_ERR_RANGE (hmin > hmax, a tile's range outside the set's),
+ * CT_ERR_ARG (NULL, nslots out of range).                                  */
 ct_status ct_tileset_open(ct_tileset *ts, const uint8_t *manifest, size_t len, ct_tile_slot *slots, uint32_t nslots,
                           ct_tile_loader load, void *user);
 
-/* ct_trace over the set: ray in the set's grid frame (ts->frame).  Returns
- * as ct_trace (the hit in the set's grid and map frames, bit-identical to
- * the merged package's), or CT_NO_DATA.  hit->steps and iters add up over
- * the tiles walked.                                                        */
+/* ct_trace over the set.
+ *   [in,out] ts      the set (its cache is updated: one set per thread).
+ *   [in]  ray        grid frame of the set (ts->frame), ct_trace's ranges.
+ *   [in]  method     CT_METHOD_*.
+ *   [out] hit        as ct_trace's, in the set's grid and map frames,
+ *                    bit-identical to the merged package's; steps and iters
+ *                    add up over the tiles walked.
+ * Returns as ct_trace, or CT_NO_DATA (the ray reached a tile the set does
+ * not have, the loader could not give, or whose bytes failed their checks;
+ * hit: where it entered that tile).                                        */
 ct_status ct_tileset_trace(ct_tileset *ts, const ct_ray *ray, ct_method method, ct_hit *hit);
 
 /* ct_geolocate / ct_geolocate_batch over a tile set (ts->frame is the
  * package for every georeference question, e.g. ct_earth_map_init).
  * Every effect ct_geolocate takes -- straight, the sphere's lowered walk
  * or polyline, the true Earth -- with the same results bit for bit, and
- * CT_NO_DATA where the line of sight reaches a tile the set does not hold. */
+ * CT_NO_DATA where the line of sight reaches a tile the set does not hold.
+ *   [in,out] ts  the set (its cache is updated).
+ *   [in]  cam .. out_len  as ct_geolocate and ct_geolocate_batch.
+ * Errors: theirs.                                                          */
 ct_status ct_geolocate_tiles(ct_tileset *ts, const ct_camera *cam, const ct_pose *pose, ct_method method,
                              const ct_effects *effects, int64_t u_q16, int64_t v_q16, ct_geo *out);
 ct_status ct_geolocate_batch_tiles(ct_tileset *ts, const ct_camera *cam, const ct_pose *pose, ct_method method,
