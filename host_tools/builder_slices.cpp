@@ -153,6 +153,358 @@ std::vector<ddt::Wedge> widened_pieces(const Ctx &c, int s, double delta)
     return out;
 }
 
+// ---- the near and window terms ------------------------------------------
+
+// The per-sector offset lists merged: each offset is visited once per cell
+// (one height load and compare), then credited to its sectors.
+struct Merged {
+    int dx, dy;
+    size_t first, count;  // into secs / rhos
+};
+struct MergedList {
+    std::vector<Merged> offs;
+    std::vector<int> secs;
+    std::vector<double> rhos;
+};
+
+MergedList merge_offsets(const Ctx &c, const std::vector<std::vector<WinOffset>> &per)
+{
+    std::map<std::pair<int, int>, std::vector<std::pair<int, double>>> m;
+    for (int s = 0; s < c.n; ++s)
+        for (const WinOffset &o : per[(size_t)s]) m[{o.dy, o.dx}].push_back({s, o.rho});
+    MergedList out;
+    for (const auto &kv : m) {
+        out.offs.push_back(Merged{kv.first.second, kv.first.first, out.secs.size(), kv.second.size()});
+        for (const auto &e : kv.second) {
+            out.secs.push_back(e.first);
+            out.rhos.push_back(e.second);
+        }
+    }
+    return out;
+}
+
+// The fine window's three largest terms of a sector (value, fine cell), and
+// the largest of the rest, for the sub-square refinement.
+struct Top {
+    double v[3];
+    int qi[3], qj[3];
+    double rest;
+    void reset() { v[0] = v[1] = v[2] = rest = -INF; }
+    void add(double x, int i, int j)
+    {
+        if (x <= v[2]) {
+            rest = std::max(rest, x);
+            return;
+        }
+        rest = std::max(rest, v[2]);
+        int k = 2;
+        while (k > 0 && x > v[k - 1]) {
+            v[k] = v[k - 1], qi[k] = qi[k - 1], qj[k] = qj[k - 1];
+            --k;
+        }
+        v[k] = x, qi[k] = i, qj[k] = j;
+    }
+};
+
+// A coarse-window offset of one sector with 1 / rho: a product instead of a
+// division per term (within an ulp of the quotient, far inside code_for's
+// margin).
+struct SecOffset {
+    int dx, dy;
+    double inv_rho;
+};
+
+constexpr int RING_SIDE = 2 * FINE_RING + 1, RING_GROUPS = RING_SIDE * RING_SIDE;
+
+// What the near and window terms read, shared by the workers.
+struct LocalTables {
+    MergedList mnear, mfine, mcoarse;
+    std::vector<uint8_t> fine_group;                // each fine-ring offset's coarse cell, an index into alive[]
+    std::vector<std::vector<SecOffset>> by_sector;  // the coarse window per sector, by increasing rho
+};
+
+LocalTables local_tables(const Ctx &c, int rw)
+{
+    std::vector<std::vector<WinOffset>> win, wfine, wnear;
+    window_offsets(c, std::max(rw, FINE_RING), &wfine, &win, &wnear);
+    LocalTables t;
+    t.mnear = merge_offsets(c, wnear);
+    t.mfine = merge_offsets(c, wfine);
+    t.mcoarse = merge_offsets(c, win);
+    const int r = c.r;
+    t.fine_group.resize(t.mfine.offs.size());
+    for (size_t m = 0; m < t.mfine.offs.size(); ++m) {
+        auto fdiv = [r](int v) { return v >= 0 ? v / r : -((-v + r - 1) / r); };
+        int gx = fdiv(t.mfine.offs[m].dx) + FINE_RING, gy = fdiv(t.mfine.offs[m].dy) + FINE_RING;
+        if (gx < 0 || gy < 0 || gx >= RING_SIDE || gy >= RING_SIDE) throw Error("slice builder: fine ring offset");
+        t.fine_group[m] = (uint8_t)(gy * RING_SIDE + gx);
+    }
+    t.by_sector.assign((size_t)c.n, {});
+    for (const Merged &o : t.mcoarse.offs)
+        for (size_t e = o.first; e < o.first + o.count; ++e)
+            t.by_sector[(size_t)t.mcoarse.secs[e]].push_back(SecOffset{o.dx, o.dy, 1.0 / t.mcoarse.rhos[e]});
+    for (auto &l : t.by_sector)
+        std::stable_sort(l.begin(), l.end(), [](const SecOffset &x, const SecOffset &y) { return x.inv_rho > y.inv_rho; });
+    return t;
+}
+
+struct Sub {
+    int k;
+    int64_t i, j;
+};
+
+// The cot sector s of a cell needs from its near and window terms: the
+// largest fine-window terms refined to 1/8-cell sub-squares (the column
+// bound at the cell's tallest corner and nearest point over-estimates most
+// next to F) while one of them is the maximum, at most 3; `other` is the
+// largest of the rest.  Best-first over the quadtree of sub-squares: a
+// sub-square's bound covers its children, so only those above every other
+// term are split; the result is exact where it matters (above `other`).
+double refined_need(const Ctx &c, int s, double a, Top &tp, double other, int fx0, int fx1, int fy0, int fy1,
+                    std::vector<Sub> &stack)
+{
+    bool done[3] = {false, false, false};
+    for (int it = 0; it < 3; ++it) {
+        int m = 0;
+        for (int q = 1; q < 3; ++q)
+            if (tp.v[q] > tp.v[m]) m = q;
+        if (tp.v[m] <= other || done[m]) break;
+        const double floor = other;
+        double vr = -INF;
+        stack.clear();
+        stack.push_back(Sub{0, tp.qi[m], tp.qj[m]});
+        while (!stack.empty()) {
+            Sub sq = stack.back();
+            stack.pop_back();
+            for (int d = 0; d < 4; ++d) {
+                int64_t ci2 = sq.i * 2 + (d & 1), cj2 = sq.j * 2 + (d >> 1);
+                double b = sub_term(c, s, a, sq.k + 1, ci2, cj2, fx0, fx1, fy0, fy1);
+                if (b <= std::max(floor, vr)) continue;
+                if (sq.k + 1 == SUB_DEPTH)
+                    vr = b;
+                else
+                    stack.push_back(Sub{sq.k + 1, ci2, cj2});
+            }
+        }
+        // vr = -INF: nothing of the cell rises above floor
+        tp.v[m] = std::min(tp.v[m], std::max(vr, floor));
+        done[m] = true;
+    }
+    return std::max(other, std::max(tp.v[0], std::max(tp.v[1], tp.v[2])));
+}
+
+// One worker's scratch for the near and window terms.
+struct LocalScratch {
+    std::vector<uint16_t> colmax, winmax;  // per coarse column of the row: the window's max height
+    bool alive[RING_GROUPS];               // the fine ring's coarse cells that rise above the apex
+    std::vector<double> need;              // per sector
+    std::vector<Top> top;                  // per sector
+    std::vector<Sub> stack;
+};
+
+// What a row of the near and window terms reads.
+struct LocalInput {
+    const Ctx *c;
+    const LocalTables *t;
+    const std::vector<uint16_t> *hcm;  // coarse heights
+    const std::vector<double> *lvd;    // levels
+    const std::vector<uint16_t> *k0;   // apex level per coarse cell
+    int rw, wc, hc;
+    size_t plane;
+};
+
+// The codes of every cell of coarse row cj from its near and window terms.
+void local_row(const LocalInput &L, int cj, LocalScratch &sc, uint8_t *codes)
+{
+    const Ctx &c = *L.c;
+    const LocalTables &T = *L.t;
+    const std::vector<uint16_t> &hcm = *L.hcm;
+    const int r = c.r, wc = L.wc, hc = L.hc;
+    if (r > 1) {  // the window's max height around each cell of the row
+        const int rww = std::max(L.rw, FINE_RING);
+        std::fill(sc.colmax.begin(), sc.colmax.end(), (uint16_t)0);
+        for (int gj = std::max(0, cj - rww); gj <= std::min(hc - 1, cj + rww); ++gj)
+            for (int gi = 0; gi < wc; ++gi)
+                sc.colmax[(size_t)gi] = std::max(sc.colmax[(size_t)gi], hcm[(size_t)gj * wc + gi]);
+        for (int ci = 0; ci < wc; ++ci) {
+            uint16_t m = 0;
+            for (int gi = std::max(0, ci - rww); gi <= std::min(wc - 1, ci + rww); ++gi)
+                m = std::max(m, sc.colmax[(size_t)gi]);
+            sc.winmax[(size_t)ci] = m;
+        }
+    }
+    for (int ci = 0; ci < wc; ++ci) {
+        size_t f = (size_t)cj * wc + ci;
+        double a = (*L.lvd)[(*L.k0)[f]];  // the cell's apex: its level
+        int fx0 = ci * r, fy0 = cj * r;
+        // the coarse cells of the fine ring that rise above a
+        for (int g = 0; g < RING_GROUPS; ++g) {
+            int gi = ci + g % RING_SIDE - FINE_RING, gj = cj + g / RING_SIDE - FINE_RING;
+            sc.alive[g] = gi >= 0 && gj >= 0 && gi < wc && gj < hc && hcm[(size_t)gj * wc + gi] > a;
+        }
+        std::fill(sc.need.begin(), sc.need.end(), 0.0);
+        for (Top &tp : sc.top) tp.reset();
+        for (const Merged &o : T.mnear.offs) {
+            int qi = fx0 + o.dx, qj = fy0 + o.dy;
+            if (qi < 0 || qj < 0 || qi >= c.cx || qj >= c.cy) continue;
+            const PatchGrad g = patch_grad(*c.t, qi, qj);
+            for (size_t e = o.first; e < o.first + o.count; ++e) {
+                int s = T.mnear.secs[e];
+                sc.need[(size_t)s] = std::max(sc.need[(size_t)s], max_slope(c, s, g));
+            }
+        }
+        for (size_t m = 0; m < T.mfine.offs.size(); ++m) {
+            const Merged &o = T.mfine.offs[m];
+            if (!sc.alive[T.fine_group[m]]) continue;  // its coarse cell is not above a
+            int qi = fx0 + o.dx, qj = fy0 + o.dy;
+            if (qi < 0 || qj < 0 || qi >= c.cx || qj >= c.cy) continue;
+            double rise = fine_max(*c.t, qi, qj) - a;
+            if (rise <= 0.0) continue;
+            for (size_t e = o.first; e < o.first + o.count; ++e)
+                sc.top[(size_t)T.mfine.secs[e]].add(rise / T.mfine.rhos[e], qi, qj);
+        }
+        if (r == 1) {  // a coarse cell is a fine cell: refinable too
+            for (const Merged &o : T.mcoarse.offs) {
+                int gi = ci + o.dx, gj = cj + o.dy;
+                if (gi < 0 || gj < 0 || gi >= wc || gj >= hc) continue;
+                double rise = hcm[(size_t)gj * wc + gi] - a;
+                if (rise <= 0.0) continue;
+                for (size_t e = o.first; e < o.first + o.count; ++e)
+                    sc.top[(size_t)T.mcoarse.secs[e]].add(rise / T.mcoarse.rhos[e], gi, gj);
+            }
+        } else if (sc.winmax[(size_t)ci] > a) {
+            // per sector, nearest offsets first; no term beyond rho can
+            // exceed (window max - a) / rho, so stop once that is no more
+            // than what the sector needs already
+            const double hw = sc.winmax[(size_t)ci] - a;
+            for (int s = 0; s < c.n; ++s) {
+                double nd = sc.need[(size_t)s];
+                for (const SecOffset &o : T.by_sector[(size_t)s]) {
+                    if (hw * o.inv_rho <= nd) break;
+                    int gi = ci + o.dx, gj = cj + o.dy;
+                    if (gi < 0 || gj < 0 || gi >= wc || gj >= hc) continue;
+                    double rise = hcm[(size_t)gj * wc + gi] - a;
+                    if (rise > 0.0) nd = std::max(nd, rise * o.inv_rho);
+                }
+                sc.need[(size_t)s] = nd;
+            }
+        }
+        const int fx1 = std::min(fx0 + r, c.cx), fy1 = std::min(fy0 + r, c.cy);
+        for (int s = 0; s < c.n; ++s) {
+            Top &tp = sc.top[(size_t)s];
+            const double other = std::max(sc.need[(size_t)s], tp.rest);
+            const double nd = refined_need(c, s, a, tp, other, fx0, fx1, fy0, fy1, sc.stack);
+            codes[(size_t)s * L.plane + f] = code_for(c, std::max(0.0, nd));
+        }
+    }
+}
+
+// ---- the far terms, slice by slice ---------------------------------------
+
+constexpr double SQRT2 = 1.41421356237309515;  // rounded up
+
+// A worker's counts and the arrays of its full DTs (allocated on first use).
+struct FarWorker {
+    size_t narrowed = 0, queries = 0, full = 0;
+    uint64_t rows = 0;
+    std::vector<int64_t> dt, dmin;
+    std::vector<ddt::Point> ft;
+};
+
+// What one slice's sectors read.
+struct FarSlice {
+    const Ctx *c;
+    int k, rw, wc, hc;
+    size_t plane;
+    double top;                                       // L_k+1
+    const ddt::BitLines *bl;                          // B_k
+    const std::vector<uint16_t> *k0;                  // apex level per coarse cell
+    const std::vector<double> *lvd;                   // levels
+    const std::vector<uint8_t> *thr;                  // per cell: codes at or below it cannot narrow
+    const double *cot_of, *skip_rise;                 // per code
+    const std::vector<std::vector<ddt::Wedge>> *pieces;  // W'_s per sector
+    double row_budget;                                // query rows before a full DT
+    std::once_flag *prepared_once;                    // the line-traversal tables, built on first need
+    std::unique_ptr<ddt::Prepared> *prepared;
+};
+
+// Slice k's far terms for sector s: every cell whose code a far term could
+// narrow asks its capped DT (or reads the full DT once the queries cost
+// more than one); went_full: the sector's previous slice switched to a full
+// DT (then this one starts with it; it is updated).
+void far_sector(const FarSlice &F, int s, uint8_t *went_full, FarWorker &w, uint8_t *codes)
+{
+    const Ctx &c = *F.c;
+    const int r = c.r;
+    const std::vector<uint16_t> &k0 = *F.k0;
+    const ddt::CappedQuery<ddt::EuclideanSq> q(*F.bl, (*F.pieces)[(size_t)s], ddt::EuclideanSq());
+    uint8_t *cs = &codes[(size_t)s * F.plane];
+    size_t nq = 0;
+    const int64_t *dtf = nullptr;  // the full DT, once switched to it
+    for (size_t f = 0; f < F.plane; ++f) {
+        if (cs[f] <= (*F.thr)[f]) continue;
+        const uint16_t kf = k0[f];
+        if (kf > F.k) continue;
+        const uint8_t code = cs[f];
+        const double rise = F.top - (*F.lvd)[kf];
+        if (rise <= 0.0 || rise < F.skip_rise[code]) continue;
+        const double cot = F.cot_of[code];
+        // term = (top - a) / (r max(Rw, sqrt(D2) - sqrt2)) > cot needs X =
+        // (top - a) / cot > r Rw and D2 < (X / r + sqrt2)^2: only distances
+        // below that cap are asked for (exactly)
+        int64_t cap = ddt::Inf<int64_t>::value;
+        if (cot > 0.0) {
+            const double x = rise / cot;
+            if (x <= r * (double)F.rw) continue;
+            const double lim = x / r + SQRT2, l2 = lim * lim * (1.0 + 1e-12) + 1.0;
+            if (l2 < 4.0e18) cap = (int64_t)l2 + 1;
+        }
+        if (!dtf && (*went_full || F.row_budget <= 0.0 || (double)q.rows_visited() > F.row_budget)) {
+            // the queries cost more than a full transform would: finish
+            // this slice and sector with one (the same values)
+            std::call_once(*F.prepared_once, [&] {
+                std::vector<uint8_t> bits(F.plane);
+                for (size_t g = 0; g < F.plane; ++g) bits[g] = k0[g] > F.k;
+                F.prepared->reset(new ddt::Prepared(F.wc, F.hc, bits.data()));
+            });
+            ddt::Options opt;
+            opt.feature_transform = false;
+            const auto &ps = (*F.pieces)[(size_t)s];
+            if (ps.empty()) {
+                ddt::unconstrained(**F.prepared, ddt::EuclideanSq(), w.dmin, w.ft, opt);
+            } else {
+                for (size_t p = 0; p < ps.size(); ++p) {
+                    ddt::directional(**F.prepared, ps[p], ddt::EuclideanSq(), p == 0 ? w.dmin : w.dt, w.ft, opt);
+                    if (p > 0)
+                        for (size_t g = 0; g < F.plane; ++g) w.dmin[g] = std::min(w.dmin[g], w.dt[g]);
+                }
+            }
+            dtf = w.dmin.data();
+            w.full++;
+        }
+        int64_t d2;
+        if (dtf) {
+            d2 = dtf[f];
+        } else {
+            ++nq;
+            d2 = q.query((int)(f % (size_t)F.wc), (int)(f / (size_t)F.wc), cap);
+        }
+        if (d2 >= cap) continue;
+        const double d = std::sqrt((double)d2) * (1.0 - 1e-15) - SQRT2;
+        const double term = rise / (r * std::max((double)F.rw, d));
+        if (term > cot) {
+            const uint8_t nc = code_for(c, term);
+            if (nc < cs[f]) {
+                cs[f] = nc;
+                w.narrowed++;
+            }
+        }
+    }
+    *went_full = dtf != nullptr;
+    w.queries += nq;
+    w.rows += q.rows_visited();
+}
+
 }  // namespace
 
 void slice_angles(const Ctx &c, const SliceInput &in, uint8_t *codes, SliceStats *st)
@@ -171,8 +523,7 @@ void slice_angles(const Ctx &c, const SliceInput &in, uint8_t *codes, SliceStats
     const std::vector<int> &lv = *in.levels;
     const std::vector<uint16_t> &k0 = *in.apex_level;
     // apex of a cell: its level (one table, no per-cell array)
-    std::vector<double> lvd(lv.begin(), lv.end());
-    auto apex_of = [&](size_t f) { return lvd[k0[f]]; };
+    const std::vector<double> lvd(lv.begin(), lv.end());
     const int K = (int)lv.size() - 1;
 
     // cot of each code as a double lower bound, for the monotone update
@@ -180,210 +531,21 @@ void slice_angles(const Ctx &c, const SliceInput &in, uint8_t *codes, SliceStats
     for (int k = 0; k < 256; ++k) cot_of[k] = c.cot_ok[k] ? ((double)c.cot_q16[k] * (1.0 - 1e-9) - 3.0) / 65536.0 : -INF;  // stricter than code_for
 
     auto t_start = std::chrono::steady_clock::now();
-    // ---- near + window terms, threads over rows of coarse cells.  The
-    // per-sector offset lists are merged: each offset is visited once per
-    // cell (one height load and compare), then credited to its sectors.
-    std::vector<std::vector<WinOffset>> win, wfine, wnear;
-    window_offsets(c, std::max(rw, FINE_RING), &wfine, &win, &wnear);
-    struct Merged {
-        int dx, dy;
-        size_t first, count;  // into secs / rhos
-    };
-    struct MergedList {
-        std::vector<Merged> offs;
-        std::vector<int> secs;
-        std::vector<double> rhos;
-    };
-    auto merge = [&](const std::vector<std::vector<WinOffset>> &per) {
-        std::map<std::pair<int, int>, std::vector<std::pair<int, double>>> m;
-        for (int s = 0; s < c.n; ++s)
-            for (const WinOffset &o : per[(size_t)s]) m[{o.dy, o.dx}].push_back({s, o.rho});
-        MergedList out;
-        for (const auto &kv : m) {
-            out.offs.push_back(Merged{kv.first.second, kv.first.first, out.secs.size(), kv.second.size()});
-            for (const auto &e : kv.second) {
-                out.secs.push_back(e.first);
-                out.rhos.push_back(e.second);
-            }
-        }
-        return out;
-    };
-    const MergedList mnear = merge(wnear), mfine = merge(wfine), mcoarse = merge(win);
+    // ---- near + window terms, threads over rows of coarse cells
     {
+        const LocalTables tables = local_tables(c, rw);
+        const LocalInput L{&c, &tables, &hcm, &lvd, &k0, rw, wc, hc, plane};
         std::atomic<int> next{0};
-        // the fine window's three largest terms per sector (value, cell),
-        // and the largest of the rest, for the sub-square refinement
-        struct Top {
-            double v[3];
-            int qi[3], qj[3];
-            double rest;
-            void reset()
-            {
-                v[0] = v[1] = v[2] = rest = -INF;
-            }
-            void add(double x, int i, int j)
-            {
-                if (x <= v[2]) {
-                    rest = std::max(rest, x);
-                    return;
-                }
-                rest = std::max(rest, v[2]);
-                int k = 2;
-                while (k > 0 && x > v[k - 1]) {
-                    v[k] = v[k - 1], qi[k] = qi[k - 1], qj[k] = qj[k - 1];
-                    --k;
-                }
-                v[k] = x, qi[k] = i, qj[k] = j;
-            }
-        };
-        // each fine-ring offset's coarse cell, as an index into alive[]
-        constexpr int RING_SIDE = 2 * FINE_RING + 1, RING_GROUPS = RING_SIDE * RING_SIDE;
-        std::vector<uint8_t> fine_group(mfine.offs.size());
-        for (size_t m = 0; m < mfine.offs.size(); ++m) {
-            auto fdiv = [r](int v) { return v >= 0 ? v / r : -((-v + r - 1) / r); };
-            int gx = fdiv(mfine.offs[m].dx) + FINE_RING, gy = fdiv(mfine.offs[m].dy) + FINE_RING;
-            if (gx < 0 || gy < 0 || gx >= RING_SIDE || gy >= RING_SIDE) throw Error("slice builder: fine ring offset");
-            fine_group[m] = (uint8_t)(gy * RING_SIDE + gx);
-        }
-        // the coarse window per sector, by increasing rho (for r > 1), with
-        // 1 / rho: a product instead of a division per term (within an ulp
-        // of the quotient, far inside code_for's margin)
-        struct SecOffset {
-            int dx, dy;
-            double inv_rho;
-        };
-        std::vector<std::vector<SecOffset>> by_sector((size_t)c.n);
-        for (const Merged &o : mcoarse.offs)
-            for (size_t e = o.first; e < o.first + o.count; ++e)
-                by_sector[(size_t)mcoarse.secs[e]].push_back(SecOffset{o.dx, o.dy, 1.0 / mcoarse.rhos[e]});
-        for (auto &l : by_sector)
-            std::stable_sort(l.begin(), l.end(),
-                             [](const SecOffset &x, const SecOffset &y) { return x.inv_rho > y.inv_rho; });
         auto worker = [&]() {
-            std::vector<uint16_t> colmax((size_t)wc), winmax((size_t)wc);
-            bool alive[RING_GROUPS];
-            std::vector<double> need((size_t)c.n);
-            std::vector<Top> top((size_t)c.n);
-            struct Sub {
-                int k;
-                int64_t i, j;
-            };
-            std::vector<Sub> stack;
+            LocalScratch sc;
+            sc.colmax.resize((size_t)wc);
+            sc.winmax.resize((size_t)wc);
+            sc.need.resize((size_t)c.n);
+            sc.top.resize((size_t)c.n);
             for (;;) {
                 int cj = next.fetch_add(1);
                 if (cj >= hc) break;
-                if (r > 1) {  // the window's max height around each cell of the row
-                    const int rww = std::max(rw, FINE_RING);
-                    std::fill(colmax.begin(), colmax.end(), (uint16_t)0);
-                    for (int gj = std::max(0, cj - rww); gj <= std::min(hc - 1, cj + rww); ++gj)
-                        for (int gi = 0; gi < wc; ++gi)
-                            colmax[(size_t)gi] = std::max(colmax[(size_t)gi], hcm[(size_t)gj * wc + gi]);
-                    for (int ci = 0; ci < wc; ++ci) {
-                        uint16_t m = 0;
-                        for (int gi = std::max(0, ci - rww); gi <= std::min(wc - 1, ci + rww); ++gi)
-                            m = std::max(m, colmax[(size_t)gi]);
-                        winmax[(size_t)ci] = m;
-                    }
-                }
-                for (int ci = 0; ci < wc; ++ci) {
-                    size_t f = (size_t)cj * wc + ci;
-                    double a = apex_of(f);
-                    int fx0 = ci * r, fy0 = cj * r;
-                    // the coarse cells of the fine ring that rise above a
-                    for (int g = 0; g < RING_GROUPS; ++g) {
-                        int gi = ci + g % RING_SIDE - FINE_RING, gj = cj + g / RING_SIDE - FINE_RING;
-                        alive[g] = gi >= 0 && gj >= 0 && gi < wc && gj < hc && hcm[(size_t)gj * wc + gi] > a;
-                    }
-                    std::fill(need.begin(), need.end(), 0.0);
-                    for (Top &tp : top) tp.reset();
-                    for (const Merged &o : mnear.offs) {
-                        int qi = fx0 + o.dx, qj = fy0 + o.dy;
-                        if (qi < 0 || qj < 0 || qi >= c.cx || qj >= c.cy) continue;
-                        const PatchGrad g = patch_grad(*c.t, qi, qj);
-                        for (size_t e = o.first; e < o.first + o.count; ++e) {
-                            int s = mnear.secs[e];
-                            need[(size_t)s] = std::max(need[(size_t)s], max_slope(c, s, g));
-                        }
-                    }
-                    for (size_t m = 0; m < mfine.offs.size(); ++m) {
-                        const Merged &o = mfine.offs[m];
-                        if (!alive[fine_group[m]]) continue;  // its coarse cell is not above a
-                        int qi = fx0 + o.dx, qj = fy0 + o.dy;
-                        if (qi < 0 || qj < 0 || qi >= c.cx || qj >= c.cy) continue;
-                        double rise = fine_max(*c.t, qi, qj) - a;
-                        if (rise <= 0.0) continue;
-                        for (size_t e = o.first; e < o.first + o.count; ++e)
-                            top[(size_t)mfine.secs[e]].add(rise / mfine.rhos[e], qi, qj);
-                    }
-                    if (r == 1) {  // a coarse cell is a fine cell: refinable too
-                        for (const Merged &o : mcoarse.offs) {
-                            int gi = ci + o.dx, gj = cj + o.dy;
-                            if (gi < 0 || gj < 0 || gi >= wc || gj >= hc) continue;
-                            double rise = hcm[(size_t)gj * wc + gi] - a;
-                            if (rise <= 0.0) continue;
-                            for (size_t e = o.first; e < o.first + o.count; ++e)
-                                top[(size_t)mcoarse.secs[e]].add(rise / mcoarse.rhos[e], gi, gj);
-                        }
-                    } else if (winmax[(size_t)ci] > a) {
-                        // per sector, nearest offsets first; no term beyond
-                        // rho can exceed (window max - a) / rho, so stop once
-                        // that is no more than what the sector needs already
-                        const double hw = winmax[(size_t)ci] - a;
-                        for (int s = 0; s < c.n; ++s) {
-                            double nd = need[(size_t)s];
-                            for (const SecOffset &o : by_sector[(size_t)s]) {
-                                if (hw * o.inv_rho <= nd) break;
-                                int gi = ci + o.dx, gj = cj + o.dy;
-                                if (gi < 0 || gj < 0 || gi >= wc || gj >= hc) continue;
-                                double rise = hcm[(size_t)gj * wc + gi] - a;
-                                if (rise > 0.0) nd = std::max(nd, rise * o.inv_rho);
-                            }
-                            need[(size_t)s] = nd;
-                        }
-                    }
-                    const int fx1 = std::min(fx0 + r, c.cx), fy1 = std::min(fy0 + r, c.cy);
-                    for (int s = 0; s < c.n; ++s) {
-                        // Refine the largest fine-window terms to 1/8-cell
-                        // sub-squares (the column bound at the cell's tallest
-                        // corner and nearest point over-estimates most next
-                        // to F) while one of them is the maximum; at most 3.
-                        Top &tp = top[(size_t)s];
-                        double other = std::max(need[(size_t)s], tp.rest);
-                        bool done[3] = {false, false, false};
-                        for (int it = 0; it < 3; ++it) {
-                            int m = 0;
-                            for (int q = 1; q < 3; ++q)
-                                if (tp.v[q] > tp.v[m]) m = q;
-                            if (tp.v[m] <= other || done[m]) break;
-                            // best-first over the quadtree of sub-squares: a
-                            // sub-square's bound covers its children, so only
-                            // those above every other term are split; the
-                            // result is exact where it matters (above `floor`)
-                            const double floor = other;
-                            double vr = -INF;
-                            stack.clear();
-                            stack.push_back(Sub{0, tp.qi[m], tp.qj[m]});
-                            while (!stack.empty()) {
-                                Sub sq = stack.back();
-                                stack.pop_back();
-                                for (int d = 0; d < 4; ++d) {
-                                    int64_t ci2 = sq.i * 2 + (d & 1), cj2 = sq.j * 2 + (d >> 1);
-                                    double b = sub_term(c, s, a, sq.k + 1, ci2, cj2, fx0, fx1, fy0, fy1);
-                                    if (b <= std::max(floor, vr)) continue;
-                                    if (sq.k + 1 == SUB_DEPTH)
-                                        vr = b;
-                                    else
-                                        stack.push_back(Sub{sq.k + 1, ci2, cj2});
-                                }
-                            }
-                            // vr = -INF: nothing of the cell rises above floor
-                            tp.v[m] = std::min(tp.v[m], std::max(vr, floor));
-                            done[m] = true;
-                        }
-                        double nd = std::max(other, std::max(tp.v[0], std::max(tp.v[1], tp.v[2])));
-                        codes[(size_t)s * plane + f] = code_for(c, std::max(0.0, nd));
-                    }
-                }
+                local_row(L, cj, sc, codes);
             }
         };
         std::vector<std::thread> pool;
@@ -394,19 +556,12 @@ void slice_angles(const Ctx &c, const SliceInput &in, uint8_t *codes, SliceStats
     auto t_local = std::chrono::steady_clock::now();
     hcm = std::vector<uint16_t>();  // not needed below: B_k comes from the apex levels
     // ---- far terms, slice by slice, bottom-up
-    constexpr double SQRT2 = 1.41421356237309515;  // rounded up
     const double delta = std::asin(std::min(1.0, SQRT2 / (rw + 1))) + 1e-7;
     std::vector<std::vector<ddt::Wedge>> pieces((size_t)c.n);
     for (int s = 0; s < c.n; ++s) pieces[(size_t)s] = widened_pieces(c, s, delta);
     int kmin = K;
     for (uint16_t v : k0) kmin = std::min(kmin, (int)v);
-    std::vector<size_t> narrowed((size_t)nthreads, 0), queries((size_t)nthreads, 0), full((size_t)nthreads, 0);
-    std::vector<uint64_t> rows((size_t)nthreads, 0);
-    struct Scratch {  // a full DT's arrays per thread, allocated on first use
-        std::vector<int64_t> dt, dmin;
-        std::vector<ddt::Point> ft;
-    };
-    std::vector<Scratch> scratch((size_t)nthreads);
+    std::vector<FarWorker> workers((size_t)nthreads);
     // per sector: did the previous slice switch to a full DT?  Then this one
     // starts with it (the needed cells change slowly from slice to slice).
     std::vector<uint8_t> went_full((size_t)c.n, 0);
@@ -433,7 +588,7 @@ void slice_angles(const Ctx &c, const SliceInput &in, uint8_t *codes, SliceStats
         // A cell can be narrowed only if its code is one whose skip test
         // passes: rise >= skip_rise[code], rise = top - its apex level, the
         // same for every sector.  thr[f] = (the least such code) - 1, 255 when
-        // none: every cell the tests below accept has code > thr[f], so the
+        // none: every cell the tests accept has code > thr[f], so the
         // sectors' loops first compare one byte (same result; most cells stop
         // there; the slice phase at 2048^2, r = 3 measured 5-10% faster).
         std::vector<uint8_t> thr_of_level((size_t)K + 1);
@@ -450,82 +605,17 @@ void slice_angles(const Ctx &c, const SliceInput &in, uint8_t *codes, SliceStats
         }
         std::vector<uint8_t> thr(plane);
         for (size_t f = 0; f < plane; ++f) thr[f] = thr_of_level[k0[f]];
-        // the line-traversal tables, built when a sector first needs a full DT
         std::once_flag prepared_once;
         std::unique_ptr<ddt::Prepared> prepared;
+        const FarSlice F{&c,  k,      rw,        wc,      hc,         plane,          top,           &bl,
+                         &k0, &lvd,   &thr,      cot_of,  skip_rise,  &pieces,        row_budget,    &prepared_once,
+                         &prepared};
         std::atomic<int> next{0};
         auto worker = [&](int tid) {
             for (;;) {
                 int s = next.fetch_add(1);
                 if (s >= c.n) break;
-                const ddt::CappedQuery<ddt::EuclideanSq> q(bl, pieces[(size_t)s], ddt::EuclideanSq());
-                uint8_t *cs = &codes[(size_t)s * plane];
-                size_t nq = 0;
-                const int64_t *dtf = nullptr;  // the full DT, once switched to it
-                for (size_t f = 0; f < plane; ++f) {
-                    if (cs[f] <= thr[f]) continue;
-                    const uint16_t kf = k0[f];
-                    if (kf > k) continue;
-                    const uint8_t code = cs[f];
-                    const double rise = top - lvd[kf];
-                    if (rise <= 0.0 || rise < skip_rise[code]) continue;
-                    const double cot = cot_of[code];
-                    // term = (top - a) / (r max(Rw, sqrt(D2) - sqrt2)) > cot
-                    // needs X = (top - a) / cot > r Rw and D2 < (X / r + sqrt2)^2:
-                    // only distances below that cap are asked for (exactly)
-                    int64_t cap = ddt::Inf<int64_t>::value;
-                    if (cot > 0.0) {
-                        const double x = rise / cot;
-                        if (x <= r * (double)rw) continue;
-                        const double lim = x / r + SQRT2, l2 = lim * lim * (1.0 + 1e-12) + 1.0;
-                        if (l2 < 4.0e18) cap = (int64_t)l2 + 1;
-                    }
-                    if (!dtf && (went_full[(size_t)s] || row_budget <= 0.0 || (double)q.rows_visited() > row_budget)) {
-                        // the queries cost more than a full transform would:
-                        // finish this slice and sector with one (the same values)
-                        std::call_once(prepared_once, [&] {
-                            std::vector<uint8_t> bits(plane);
-                            for (size_t g = 0; g < plane; ++g) bits[g] = k0[g] > k;
-                            prepared.reset(new ddt::Prepared(wc, hc, bits.data()));
-                        });
-                        Scratch &sc = scratch[(size_t)tid];
-                        ddt::Options opt;
-                        opt.feature_transform = false;
-                        const auto &ps = pieces[(size_t)s];
-                        if (ps.empty()) {
-                            ddt::unconstrained(*prepared, ddt::EuclideanSq(), sc.dmin, sc.ft, opt);
-                        } else {
-                            for (size_t p = 0; p < ps.size(); ++p) {
-                                ddt::directional(*prepared, ps[p], ddt::EuclideanSq(), p == 0 ? sc.dmin : sc.dt,
-                                                 sc.ft, opt);
-                                if (p > 0)
-                                    for (size_t g = 0; g < plane; ++g) sc.dmin[g] = std::min(sc.dmin[g], sc.dt[g]);
-                            }
-                        }
-                        dtf = sc.dmin.data();
-                        full[(size_t)tid]++;
-                    }
-                    int64_t d2;
-                    if (dtf) {
-                        d2 = dtf[f];
-                    } else {
-                        ++nq;
-                        d2 = q.query((int)(f % (size_t)wc), (int)(f / (size_t)wc), cap);
-                    }
-                    if (d2 >= cap) continue;
-                    const double d = std::sqrt((double)d2) * (1.0 - 1e-15) - SQRT2;
-                    const double term = rise / (r * std::max((double)rw, d));
-                    if (term > cot) {
-                        const uint8_t nc = code_for(c, term);
-                        if (nc < cs[f]) {
-                            cs[f] = nc;
-                            narrowed[(size_t)tid]++;
-                        }
-                    }
-                }
-                went_full[(size_t)s] = dtf != nullptr;
-                queries[(size_t)tid] += nq;
-                rows[(size_t)tid] += q.rows_visited();
+                far_sector(F, s, &went_full[(size_t)s], workers[(size_t)tid], codes);
             }
         };
         std::vector<std::thread> pool;
@@ -535,10 +625,12 @@ void slice_angles(const Ctx &c, const SliceInput &in, uint8_t *codes, SliceStats
     if (in.progress) in.progress((size_t)(K - kmin), (size_t)(K - kmin));
     if (st) {
         auto t_end = std::chrono::steady_clock::now();
-        for (size_t v : narrowed) st->far_narrowed += v;
-        for (size_t v : queries) st->queries += v;
-        for (size_t v : full) st->full_dts += v;
-        for (uint64_t v : rows) st->query_rows += v;
+        for (const FarWorker &w : workers) {
+            st->far_narrowed += w.narrowed;
+            st->queries += w.queries;
+            st->full_dts += w.full;
+            st->query_rows += w.rows;
+        }
         st->seconds_local = std::chrono::duration<double>(t_local - t_start).count();
         st->seconds_dt = std::chrono::duration<double>(t_end - t_local).count();
     }
