@@ -131,122 +131,130 @@ void posts_in_view(const ct_package &p, const Terrain &t, const LibCamera &cam, 
 
 }  // namespace
 
-int demo_main_job(const std::vector<uint8_t> &bytes, const Terrain &t, const std::map<std::string, std::string> &opt)
-{
-    ct_package p;
-    if (ct_package_open(&p, bytes.data(), bytes.size()) != CT_OK) throw Error("demo: the package did not open");
-    const std::string cpath = opt.at("--camera");
-    const CameraModel cm = read_cameramodel(cpath);
-    LibCamera cam = lib_camera(cm, cpath);
-    const unsigned W = cm.width, H = cm.height;
-    if (W == 0 || H == 0) throw Error(cpath + ": no image size");
-    std::string why;
-    ct_effects fx = demo_effects(p, cam, opt, cpath, &why);
-    fx.flags |= CT_EFFECT_EARTH_FIT;  // batches only; ignored without the true Earth
-    ct_utm zone;
-    const bool utm = ct_utm_zone_of_epsg((int32_t)p.epsg, &zone) == CT_OK;
-    int step = 32;
-    if (opt.count("--step")) {
-        step = std::atoi(opt.at("--step").c_str());
-        if (step < 1 || step > 4096) throw Error("--step needs a number of pixels in [1, 4096]");
-    }
-    const std::string dir = opt.count("-o") ? opt.at("-o") : "demo";
-    {
-        std::error_code ec;
-        std::filesystem::create_directories(dir, ec);
-        if (ec) throw Error(dir + ": cannot create the directory (" + ec.message() + ")");
-    }
+namespace {
 
-    // ---- the pixels: a grid, then the border (for the footprint's outline)
-    std::vector<Px> grid, border;
-    auto px_of = [](double u, double v) {
-        Px q{u, v, 0, 0};
-        pixel_to_q16(u, v, &q.uq, &q.vq);
-        return q;
-    };
-    for (unsigned v = 0; v < H; v += (unsigned)step)
-        for (unsigned u = 0; u < W; u += (unsigned)step) grid.push_back(px_of(u, v));
-    for (unsigned u = 0; u + 1 < W; u += 4) border.push_back(px_of(u, 0));
-    for (unsigned v = 0; v + 1 < H; v += 4) border.push_back(px_of(W - 1, v));
-    for (unsigned u = W - 1; u > 0; u -= std::min(u, 4u)) border.push_back(px_of(u, H - 1));
-    for (unsigned v = H - 1; v > 0; v -= std::min(v, 4u)) border.push_back(px_of(0, v));
-    auto batch = [&](const std::vector<Px> &px, ct_method m, std::vector<ct_geo> *out) {
-        std::vector<int64_t> uv(2 * px.size());
-        for (size_t k = 0; k < px.size(); ++k) {
-            uv[2 * k] = px[k].uq;
-            uv[2 * k + 1] = px[k].vq;
-        }
-        out->assign(px.size(), ct_geo{});
-        const clk::time_point t0 = clk::now();
-        const ct_status st = ct_geolocate_batch(&p, &cam.cam, &cam.pose, m, &fx, uv.data(), px.size(), out->data(),
-                                                out->size());
-        const double s = seconds_since(t0);
-        if (st != CT_OK) throw Error(cpath + ": cannot geolocate from this camera (" + status_name(st) + ")");
-        return s;
-    };
-    std::vector<ct_geo> gd, gi, gb;
-    const double sd = batch(grid, CT_METHOD_DIRECTIONAL, &gd);
-    const double si = batch(grid, CT_METHOD_INCREMENTAL, &gi);
-    batch(border, CT_METHOD_DIRECTIONAL, &gb);
-    long hits = 0, differ = 0;
-    double steps_d = 0, steps_i = 0, rmin = 1e300, rmax = 0;
-    for (size_t k = 0; k < grid.size(); ++k) {
-        differ += gd[k].status != gi[k].status || gd[k].hit.e_nm != gi[k].hit.e_nm || gd[k].hit.n_nm != gi[k].hit.n_nm ||
-                  gd[k].hit.h_nm != gi[k].hit.h_nm;
-        steps_d += gd[k].hit.steps;
-        steps_i += gi[k].hit.steps;
-        if (!is_hit(gd[k].status)) continue;
-        hits++;
-        rmin = std::min(rmin, range_m(cam.pose, gd[k]));
-        rmax = std::max(rmax, range_m(cam.pose, gd[k]));
+// What the demo's parts share: the package, the camera, the effects and the
+// grid's and border's results.
+struct Demo {
+    ct_package p;
+    std::string cpath;
+    LibCamera cam;
+    unsigned W = 0, H = 0;
+    ct_effects fx;
+    std::string why;  // why these effects
+    bool utm = false;
+    ct_utm zone;
+    int step = 32;
+    std::vector<Px> grid, border;  // the pixels: a grid, and the image's border (the footprint's outline)
+    std::vector<ct_geo> gd, gb;    // their results, directional
+    double rmin = 1e300, rmax = 0;  // the grid's hits' range, m
+};
+
+Px px_of(double u, double v)
+{
+    Px q{u, v, 0, 0};
+    pixel_to_q16(u, v, &q.uq, &q.vq);
+    return q;
+}
+
+// ct_geolocate_batch over px: its seconds.
+double geolocate_px(const Demo &d, const std::vector<Px> &px, ct_method m, std::vector<ct_geo> *out)
+{
+    std::vector<int64_t> uv(2 * px.size());
+    for (size_t k = 0; k < px.size(); ++k) {
+        uv[2 * k] = px[k].uq;
+        uv[2 * k + 1] = px[k].vq;
     }
-    const double n = (double)std::max<size_t>(1, grid.size());
-    std::printf("camera %s: %ux%u pixels, centre E %.1f N %.1f h %.1f m; effects: %s%s (%s)\n", cpath.c_str(), W, H,
-                cam.pose.e_nm * 1e-9, cam.pose.n_nm * 1e-9, cam.pose.h_nm * 1e-9,
-                (fx.flags & CT_EFFECT_ALL) == 0u ? "none (straight lines of sight)"
-                : (fx.flags & CT_EFFECT_ALL) == CT_EFFECT_ALL ? "curvature, refraction (k 0.13)"
-                : (fx.flags & CT_EFFECT_CURVATURE) ? "curvature" : "refraction (k 0.13)",
-                (fx.flags & CT_EFFECT_CURVATURE) && utm ? " -- the true Earth (WGS84, map fitted per batch)" : "",
-                why.c_str());
+    out->assign(px.size(), ct_geo{});
+    const clk::time_point t0 = clk::now();
+    const ct_status st = ct_geolocate_batch(&d.p, &d.cam.cam, &d.cam.pose, m, &d.fx, uv.data(), px.size(), out->data(),
+                                            out->size());
+    const double s = seconds_since(t0);
+    if (st != CT_OK) throw Error(d.cpath + ": cannot geolocate from this camera (" + status_name(st) + ")");
+    return s;
+}
+
+// The grid and the border geolocated (the grid with both methods, compared);
+// the summary printed.
+void geolocate_grid(Demo &d)
+{
+    for (unsigned v = 0; v < d.H; v += (unsigned)d.step)
+        for (unsigned u = 0; u < d.W; u += (unsigned)d.step) d.grid.push_back(px_of(u, v));
+    for (unsigned u = 0; u + 1 < d.W; u += 4) d.border.push_back(px_of(u, 0));
+    for (unsigned v = 0; v + 1 < d.H; v += 4) d.border.push_back(px_of(d.W - 1, v));
+    for (unsigned u = d.W - 1; u > 0; u -= std::min(u, 4u)) d.border.push_back(px_of(u, d.H - 1));
+    for (unsigned v = d.H - 1; v > 0; v -= std::min(v, 4u)) d.border.push_back(px_of(0, v));
+    std::vector<ct_geo> gi;
+    const double sd = geolocate_px(d, d.grid, CT_METHOD_DIRECTIONAL, &d.gd);
+    const double si = geolocate_px(d, d.grid, CT_METHOD_INCREMENTAL, &gi);
+    geolocate_px(d, d.border, CT_METHOD_DIRECTIONAL, &d.gb);
+    long hits = 0, differ = 0;
+    double steps_d = 0, steps_i = 0;
+    for (size_t k = 0; k < d.grid.size(); ++k) {
+        const ct_geo &a = d.gd[k], &b = gi[k];
+        differ += a.status != b.status || a.hit.e_nm != b.hit.e_nm || a.hit.n_nm != b.hit.n_nm || a.hit.h_nm != b.hit.h_nm;
+        steps_d += a.hit.steps;
+        steps_i += b.hit.steps;
+        if (!is_hit(a.status)) continue;
+        hits++;
+        d.rmin = std::min(d.rmin, range_m(d.cam.pose, a));
+        d.rmax = std::max(d.rmax, range_m(d.cam.pose, a));
+    }
+    const double n = (double)std::max<size_t>(1, d.grid.size());
+    const uint32_t fl = d.fx.flags;
+    std::printf("camera %s: %ux%u pixels, centre E %.1f N %.1f h %.1f m; effects: %s%s (%s)\n", d.cpath.c_str(), d.W,
+                d.H, d.cam.pose.e_nm * 1e-9, d.cam.pose.n_nm * 1e-9, d.cam.pose.h_nm * 1e-9,
+                (fl & CT_EFFECT_ALL) == 0u ? "none (straight lines of sight)"
+                : (fl & CT_EFFECT_ALL) == CT_EFFECT_ALL ? "curvature, refraction (k 0.13)"
+                : (fl & CT_EFFECT_CURVATURE) ? "curvature" : "refraction (k 0.13)",
+                (fl & CT_EFFECT_CURVATURE) && d.utm ? " -- the true Earth (WGS84, map fitted per batch)" : "",
+                d.why.c_str());
     std::printf("geolocated %zu pixels (every %d px): %ld hit; directional %.2f us and %.1f steps per pixel, "
                 "incremental %.2f us and %.1f steps (the same hits%s)\n\n",
-                grid.size(), step, hits, sd * 1e6 / n, steps_d / n, si * 1e6 / n, steps_i / n,
+                d.grid.size(), d.step, hits, sd * 1e6 / n, steps_d / n, si * 1e6 / n, steps_i / n,
                 differ ? ": NO, they differ" : ", bit for bit");
-    // a few pixels: the corners, the centre and the middles of two edges
+}
+
+// A few pixels' ground points: the corners, the centre and the middles of
+// two edges.
+void print_sample_pixels(const Demo &d)
+{
     std::printf("%9s %9s  %-9s %13s %14s %9s %10s %13s %13s %6s\n", "u", "v", "status", "E (m)", "N (m)", "h (m)",
                 "range (m)", "lat (deg)", "lon (deg)", "steps");
+    const double W = d.W, H = d.H;
     const double show[][2] = {{0, 0}, {W - 1.0, 0}, {(W - 1) / 2.0, (H - 1) / 2.0}, {0, H - 1.0},
                               {W - 1.0, H - 1.0}, {(W - 1) / 2.0, 0}, {(W - 1) / 2.0, H - 1.0}};
     for (const auto &s : show) {
         const Px q = px_of(s[0], s[1]);
         ct_geo g;
-        const ct_status st = ct_geolocate(&p, &cam.cam, &cam.pose, CT_METHOD_DIRECTIONAL, &fx, q.uq, q.vq, &g);
+        const ct_status st = ct_geolocate(&d.p, &d.cam.cam, &d.cam.pose, CT_METHOD_DIRECTIONAL, &d.fx, q.uq, q.vq, &g);
         if (is_hit(st)) {
             int64_t la = 0, lo = 0;
-            const bool ll = utm && ct_utm_inverse(&zone, g.hit.e_nm, g.hit.n_nm, &la, &lo) == CT_OK;
+            const bool ll = d.utm && ct_utm_inverse(&d.zone, g.hit.e_nm, g.hit.n_nm, &la, &lo) == CT_OK;
             const double k = 180 / M_PI / std::ldexp(1.0, 61);
             std::printf("%9.1f %9.1f  %-9s %13.3f %14.3f %9.3f %10.1f %13.7f %13.7f %6u\n", s[0], s[1],
                         status_name(st).c_str(), g.hit.e_nm * 1e-9, g.hit.n_nm * 1e-9, g.hit.h_nm * 1e-9,
-                        range_m(cam.pose, g), ll ? la * k : NAN, ll ? lo * k : NAN, g.hit.steps);
+                        range_m(d.cam.pose, g), ll ? la * k : NAN, ll ? lo * k : NAN, g.hit.steps);
         } else {
             std::printf("%9.1f %9.1f  %-9s %13s %14s %9s %10s %13s %13s %6u\n", s[0], s[1], status_name(st).c_str(),
                         "-", "-", "-", "-", "-", "-", g.hit.steps);
         }
     }
+}
 
-    // ---- what the camera sees: every post projected into the image and
-    // geolocated back
+// What the camera sees: every post projected into the image and geolocated
+// back; per post 1 (seen), 2 (in the view but hidden) or 0.
+std::vector<uint8_t> posts_seen(const Demo &d, const Terrain &t)
+{
     const clk::time_point tv = clk::now();
-    const double pe = p.posting_e_nm * 1e-9, pn = p.posting_n_nm * 1e-9;
-    const double E0 = p.origin_e_nm * 1e-9, N0 = p.origin_n_nm * 1e-9;
+    const double pe = d.p.posting_e_nm * 1e-9, pn = d.p.posting_n_nm * 1e-9;
+    const double E0 = d.p.origin_e_nm * 1e-9, N0 = d.p.origin_n_nm * 1e-9;
     std::vector<Px> seen;
     std::vector<size_t> seen_post;
-    posts_in_view(p, t, cam, W, H, &seen, &seen_post);
-    double R[9];  // R_map_cam, for the heading in the picture
-    for (int k = 0; k < 9; ++k) R[k] = cam.pose.R_map_cam_q30[k] / 1073741824.0;
+    posts_in_view(d.p, t, d.cam, d.W, d.H, &seen, &seen_post);
     std::vector<ct_geo> gs;
-    batch(seen, CT_METHOD_DIRECTIONAL, &gs);
-    std::vector<uint8_t> state((size_t)t.width * t.height, 0);  // 1 visible, 2 hidden
+    geolocate_px(d, seen, CT_METHOD_DIRECTIONAL, &gs);
+    std::vector<uint8_t> state((size_t)t.width * t.height, 0);
     long visible = 0;
     for (size_t k = 0; k < seen.size(); ++k) {
         const size_t post = seen_post[k];
@@ -258,11 +266,19 @@ int demo_main_job(const std::vector<uint8_t> &bytes, const Terrain &t, const std
     }
     std::printf("\n%zu of %d posts inside the camera's view: %ld seen, %ld hidden behind terrain (%.2f s)\n",
                 seen.size(), t.width * t.height, visible, (long)seen.size() - visible, seconds_since(tv));
+    return state;
+}
 
-    // ---- the picture: the posts around the footprint and the camera (a
-    // fifth of their extent to spare), about 900 pixels on its longer side
-    double x0 = (cam.pose.e_nm * 1e-9 - E0) / pe, x1 = x0, y0 = (cam.pose.n_nm * 1e-9 - N0) / pn, y1 = y0;
-    for (const std::vector<ct_geo> *v : {&gd, &gb})
+// The picture (DIR/footprint.png) and the grid's table (DIR/pixels.csv):
+// the posts around the footprint and the camera (a fifth of their extent
+// to spare), about 900 pixels on its longer side.
+void draw_footprint(const Demo &d, const Terrain &t, const std::vector<uint8_t> &state, const std::string &dir)
+{
+    const double pe = d.p.posting_e_nm * 1e-9, pn = d.p.posting_n_nm * 1e-9;
+    const double E0 = d.p.origin_e_nm * 1e-9, N0 = d.p.origin_n_nm * 1e-9;
+    const ct_pose &pose = d.cam.pose;
+    double x0 = (pose.e_nm * 1e-9 - E0) / pe, x1 = x0, y0 = (pose.n_nm * 1e-9 - N0) / pn, y1 = y0;
+    for (const std::vector<ct_geo> *v : {&d.gd, &d.gb})
         for (const ct_geo &g : *v) {
             if (!is_hit(g.status)) continue;
             const double x = (g.hit.e_nm * 1e-9 - E0) / pe, y = (g.hit.n_nm * 1e-9 - N0) / pn;
@@ -290,8 +306,8 @@ int demo_main_job(const std::vector<uint8_t> &bytes, const Terrain &t, const std
         *y = ((n_nm * 1e-9 - N0) / pn - j0) * zoom;
     };
     // the footprint's outline: consecutive border hits joined
-    for (size_t k = 0; k < gb.size(); ++k) {
-        const ct_geo &a = gb[k], &b = gb[(k + 1) % gb.size()];
+    for (size_t k = 0; k < d.gb.size(); ++k) {
+        const ct_geo &a = d.gb[k], &b = d.gb[(k + 1) % d.gb.size()];
         if (!is_hit(a.status) || !is_hit(b.status)) continue;
         double bx0, by0, bx1, by1;
         pic(a.hit.e_nm, a.hit.n_nm, &bx0, &by0);
@@ -301,31 +317,34 @@ int demo_main_job(const std::vector<uint8_t> &bytes, const Terrain &t, const std
                 Rgb{220, 30, 30});
     }
     // the grid's hits, coloured by range; the table beside the picture
-    const double span = std::max(1.0, rmax - rmin);
+    const double span = std::max(1.0, d.rmax - d.rmin);
     std::string csv = "u,v,status,E,N,h,range,steps,px,py\n";
-    for (size_t k = 0; k < grid.size(); ++k) {
+    for (size_t k = 0; k < d.grid.size(); ++k) {
+        const ct_geo &g = d.gd[k];
         char line[256];
-        if (!is_hit(gd[k].status)) {
-            std::snprintf(line, sizeof line, "%.1f,%.1f,%s,nan,nan,nan,nan,%u,nan,nan\n", grid[k].u, grid[k].v,
-                          status_name(gd[k].status).c_str(), gd[k].hit.steps);
+        if (!is_hit(g.status)) {
+            std::snprintf(line, sizeof line, "%.1f,%.1f,%s,nan,nan,nan,nan,%u,nan,nan\n", d.grid[k].u, d.grid[k].v,
+                          status_name(g.status).c_str(), g.hit.steps);
             csv += line;
             continue;
         }
         double x, y;
-        pic(gd[k].hit.e_nm, gd[k].hit.n_nm, &x, &y);
-        const double r = range_m(cam.pose, gd[k]);
-        im.disc((int)std::floor(x), (int)std::floor(y), 2, viridis((r - rmin) / span));
-        std::snprintf(line, sizeof line, "%.1f,%.1f,%s,%s,%s,%s,%.3f,%u,%d,%d\n", grid[k].u, grid[k].v,
-                      status_name(gd[k].status).c_str(), nm_to_decimal(gd[k].hit.e_nm).c_str(),
-                      nm_to_decimal(gd[k].hit.n_nm).c_str(), nm_to_decimal(gd[k].hit.h_nm).c_str(), r,
-                      gd[k].hit.steps, (int)std::floor(x), (int)std::floor(y));
+        pic(g.hit.e_nm, g.hit.n_nm, &x, &y);
+        const double r = range_m(pose, g);
+        im.disc((int)std::floor(x), (int)std::floor(y), 2, viridis((r - d.rmin) / span));
+        std::snprintf(line, sizeof line, "%.1f,%.1f,%s,%s,%s,%s,%.3f,%u,%d,%d\n", d.grid[k].u, d.grid[k].v,
+                      status_name(g.status).c_str(), nm_to_decimal(g.hit.e_nm).c_str(),
+                      nm_to_decimal(g.hit.n_nm).c_str(), nm_to_decimal(g.hit.h_nm).c_str(), r, g.hit.steps,
+                      (int)std::floor(x), (int)std::floor(y));
         csv += line;
     }
-    // the camera and its heading
+    // the camera and its heading (the optical axis in the map frame: the
+    // third column of R_map_cam, its E and N)
     {
         double cx, cy;
-        pic(cam.pose.e_nm, cam.pose.n_nm, &cx, &cy);
-        const double ax = R[2], ay = R[5], al = std::hypot(ax, ay);  // optical axis, map frame (E, N)
+        pic(pose.e_nm, pose.n_nm, &cx, &cy);
+        const double ax = pose.R_map_cam_q30[2] / 1073741824.0, ay = pose.R_map_cam_q30[5] / 1073741824.0;
+        const double al = std::hypot(ax, ay);
         if (al > 1e-6) {
             const double dx = ax / al * 60, dy = -ay / al * 60 * (pn < 0 ? 1 : -1);
             for (int o = -1; o <= 1; ++o)
@@ -339,20 +358,51 @@ int demo_main_job(const std::vector<uint8_t> &bytes, const Terrain &t, const std
     const int bx = 10, by = ph + 8, bw = std::min(256, im.w - 20);
     for (int x = 0; x < bw; ++x)
         for (int y = 0; y < 12; ++y) im.set(bx + x, by + y, viridis((double)x / std::max(1, bw - 1)));
-    draw_text(im, bx, by + 16, std::to_string((long)std::lround(rmin)), 2);
-    const std::string far = std::to_string((long)std::lround(rmax));
+    draw_text(im, bx, by + 16, std::to_string((long)std::lround(d.rmin)), 2);
+    const std::string far = std::to_string((long)std::lround(d.rmax));
     draw_text(im, bx + bw - 8 * (int)far.size(), by + 16, far, 2);
     const std::string png = dir + "/footprint.png", csvp = dir + "/pixels.csv";
     char desc[256];
     std::snprintf(desc, sizeof desc,
                   "conetrace demo: %s; posts %d..%d x %d..%d of the DEM, %d picture pixels per post, range %.0f..%.0f m",
-                  cpath.c_str(), i0, i1, j0, j1, zoom, rmin, rmax);
+                  d.cpath.c_str(), i0, i1, j0, j1, zoom, d.rmin, d.rmax);
     write_png_atomic(png, im, desc, "conetrace demo");
     write_file_atomic(csvp, std::vector<uint8_t>(csv.begin(), csv.end()));
     std::printf("\npicture: %s (%dx%d: hillshade of posts %d..%d x %d..%d, north up, %d pixels per post; warm: ground "
                 "the camera sees; blue: in its view but hidden; red: the footprint's outline; dots: the grid's hits "
                 "by range, %.0f..%.0f m; white: the camera, black line: its heading)\npixels:  %s\n",
-                png.c_str(), im.w, im.h, i0, i1, j0, j1, zoom, rmin, rmax, csvp.c_str());
+                png.c_str(), im.w, im.h, i0, i1, j0, j1, zoom, d.rmin, d.rmax, csvp.c_str());
+}
+
+}  // namespace
+
+int demo_main_job(const std::vector<uint8_t> &bytes, const Terrain &t, const std::map<std::string, std::string> &opt)
+{
+    Demo d;
+    if (ct_package_open(&d.p, bytes.data(), bytes.size()) != CT_OK) throw Error("demo: the package did not open");
+    d.cpath = opt.at("--camera");
+    const CameraModel cm = read_cameramodel(d.cpath);
+    d.cam = lib_camera(cm, d.cpath);
+    d.W = cm.width;
+    d.H = cm.height;
+    if (d.W == 0 || d.H == 0) throw Error(d.cpath + ": no image size");
+    d.fx = demo_effects(d.p, d.cam, opt, d.cpath, &d.why);
+    d.fx.flags |= CT_EFFECT_EARTH_FIT;  // batches only; ignored without the true Earth
+    d.utm = ct_utm_zone_of_epsg((int32_t)d.p.epsg, &d.zone) == CT_OK;
+    if (opt.count("--step")) {
+        d.step = std::atoi(opt.at("--step").c_str());
+        if (d.step < 1 || d.step > 4096) throw Error("--step needs a number of pixels in [1, 4096]");
+    }
+    const std::string dir = opt.count("-o") ? opt.at("-o") : "demo";
+    {
+        std::error_code ec;
+        std::filesystem::create_directories(dir, ec);
+        if (ec) throw Error(dir + ": cannot create the directory (" + ec.message() + ")");
+    }
+    geolocate_grid(d);
+    print_sample_pixels(d);
+    const std::vector<uint8_t> state = posts_seen(d, t);
+    draw_footprint(d, t, state, dir);
     return 0;
 }
 
