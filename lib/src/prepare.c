@@ -111,6 +111,169 @@ static void normalize_dir(const int64_t U[3], const dir_mag *g, unsigned zs, int
 }
 
 
+/* The caller's ray clipped to the box [lo, hi] (no floor: z has only hi),
+ * in exact 128-bit rationals of its unnormalised direction: *tin, *tout
+ * and the entry face's axis *kin (-1: the origin is inside) and coordinate
+ * *kin_at.  seg != 0: the ray also ends at t = 1.  Returns CT_OK, or
+ * CT_MISS when the ray never enters the box.  |bound - o| < 2^47, |U| <=
+ * 2^62: the rationals' products < 2^110. */
+static ct_status clip_to_box(const int64_t O[3], const int64_t U[3], const int64_t lo[3], const int64_t hi[3], int seg,
+                             bigrt *tin, bigrt *tout, int *kin, int64_t *kin_at)
+{
+    int k, has_out = 0;
+    tin->n = ct_i128_from64(0);
+    tin->d = 1;
+    *tout = *tin;
+    *kin = -1;
+    *kin_at = 0;
+    /* A segment that starts and ends inside the box (the bent walk's usual
+     * case) needs no clipping: tin = 0, and every box exit is at t >= 1.
+     * |O| <= 2^46, |U| <= 2^62: O + U fits in int64. */
+    k = 0;
+    if (seg) {
+        int in = 1;
+        for (k = 0; k < 3; ++k) { /* bound: 3 axes */
+            int64_t e = O[k] + U[k];
+            if ((k < 2 && (O[k] < lo[k] || e < lo[k])) || O[k] > hi[k] || e > hi[k]) {
+                in = 0;
+            }
+        }
+        if (in) {
+            has_out = 1;
+            tout->n = ct_i128_from64(1);
+            k = 3; /* skip the clip below */
+        } else {
+            k = 0;
+        }
+    }
+    /* bound: 3 axes */
+    for (; k < 3; ++k) {
+        bigrt a, b;
+        int floorless = (k == 2);
+        if (U[k] == 0) {
+            if ((!floorless && O[k] < lo[k]) || O[k] > hi[k]) {
+                return CT_MISS;
+            }
+            continue;
+        }
+        a.d = b.d = ct_abs64(U[k]);
+        /* |bound - o| < 2^47 */
+        if (U[k] > 0) {
+            a.n = ct_i128_from64(lo[k] - O[k]);
+            b.n = ct_i128_from64(hi[k] - O[k]);
+            if (!floorless && bigrt_lt(tin, &a)) {
+                *tin = a;
+                *kin = k;
+                *kin_at = lo[k];
+            }
+            if (!has_out || bigrt_lt(&b, tout)) {
+                *tout = b;
+                has_out = 1;
+            }
+        } else {
+            a.n = ct_i128_from64(O[k] - hi[k]);
+            b.n = ct_i128_from64(O[k] - lo[k]);
+            if (bigrt_lt(tin, &a)) {
+                *tin = a;
+                *kin = k;
+                *kin_at = hi[k];
+            }
+            if (!floorless && (!has_out || bigrt_lt(&b, tout))) {
+                *tout = b;
+                has_out = 1;
+            }
+        }
+    }
+    if (seg) {
+        bigrt one;
+        one.n = ct_i128_from64(1);
+        one.d = 1;
+        if (!has_out || bigrt_lt(&one, tout)) {
+            *tout = one;
+            has_out = 1;
+        }
+    }
+    return has_out && bigrt_lt(tout, tin) ? CT_MISS : CT_OK;
+}
+
+/* The entry point O + tin U (tin > 0), rounded to Q16 and kept in the box;
+ * CT_BELOW when it lies below -2^46 (every surface is >= 0; its z would not
+ * fit the rounding).  The box has no floor: a ray may enter through a side
+ * face far below the terrain (z unbounded below).  (oz + 2^46) d + n U_z <
+ * 0 with |oz + 2^46| <= 2^47, d <= 2^62, n < 2^48: 128-bit. */
+static ct_status entry_point(int64_t O[3], const int64_t U[3], const bigrt *tin, int kin, int64_t kin_at,
+                             const int64_t lo[3], const int64_t hi[3])
+{
+    int k;
+    ct_i128 zq = ct_i128_add(ct_i128_mul(O[2] + CT_MAX_ORIGIN_Q16, tin->d), ct_i128_mul128_64(tin->n, U[2]));
+    if (ct_i128_sign(zq) < 0) {
+        return CT_BELOW;
+    }
+    for (k = 0; k < 3; ++k) { /* bound: 3 axes */
+        /* on the entry face's axis the point is the face itself, exactly
+         * (o + (bound - o)/U U): no division */
+        O[k] = k == kin ? kin_at : round_axis(O[k], U[k], tin);
+    }
+    for (k = 0; k < 3; ++k) { /* bound: 3 axes */
+        if (O[k] > hi[k]) {
+            O[k] = hi[k];
+        }
+        if (k < 2 && O[k] < lo[k]) {
+            O[k] = lo[k];
+        }
+    }
+    return CT_OK;
+}
+
+/* The quantised ray from the (entry) point O and the caller's direction U:
+ * the per-axis scaling (z in units of 2^zs Q16, see ct_prepared), the
+ * direction normalised, the origin's z rounded to those units (O[2] <=
+ * hi[2], a multiple of 2^16, stays in the box; |O[2]| <= 2^46), the
+ * horizontal length's bounds and the sector.  Returns CT_OK or
+ * ct_sector_of's error. */
+static ct_status quantise(const ct_package *p, const int64_t O[3], const int64_t U[3], ct_prepared *out)
+{
+    int32_t D[3];
+    dir_mag mag = dir_magnitudes(U);
+    unsigned zs = dir_zshift(&mag, p->zshift_max);
+    int64_t oz = O[2];
+    normalize_dir(U, &mag, zs, D);
+    if (zs > 0u && D[0] == 0 && D[1] == 0) {
+        /* horizontal components too small to survive: a vertical ray,
+         * which the tracer handles in Q16 */
+        zs = 0u;
+        normalize_dir(U, &mag, zs, D);
+    }
+    if (zs > 0u) {
+        oz = floor_shr(oz + (INT64_C(1) << (zs - 1u)), zs);
+    }
+    out->ox = O[0];
+    out->oy = O[1];
+    out->oz = oz;
+    out->dx = D[0];
+    out->dy = D[1];
+    out->dz = D[2];
+    out->zshift = (int32_t)zs;
+    {
+        /* dx^2 + dy^2 <= 2^53 */
+        uint64_t l2 = (uint64_t)((int64_t)D[0] * D[0] + (int64_t)D[1] * D[1]);
+        uint64_t l = ct_isqrt64(l2);
+        out->len_lo = (int64_t)l;
+        out->len_hi = (int64_t)l + (l * l != l2 ? 1 : 0);
+    }
+    if (D[0] != 0 || D[1] != 0) {
+        uint32_t s;
+        ct_status st = ct_sector_of(p, D[0], D[1], &s);
+        if (st != CT_OK) {
+            return st;
+        }
+        out->sector = (int32_t)s;
+    } else {
+        out->sector = -1;
+    }
+    return CT_OK;
+}
+
 /* Preparation in two parts.  prep_geom clips the ray to p's box and
  * quantises it (origin, direction, zshift, length, sector): geometry only,
  * no heights read, so a tile set prepares against its whole extent (a
@@ -123,13 +286,11 @@ static void normalize_dir(const int64_t U[3], const dir_mag *g, unsigned zs, int
  * or an error. */
 static ct_status prep_geom(const ct_package *p, const ct_ray *ray, int seg, ct_prepared *out)
 {
-    int32_t D[3];
     int64_t O[3], U[3], lo[3], hi[3];
     bigrt tin, tout;
-    int k, has_out = 0, kin = -1;
-    unsigned zs;
-    dir_mag mag;
-    int64_t kin_at = 0; /* the entry face's coordinate on axis kin */
+    int k, kin;
+    int64_t kin_at; /* the entry face's coordinate on axis kin */
+    ct_status st;
     CT_ASSERT(p != NULL && ray != NULL && out != NULL);
     if (p == NULL || ray == NULL || out == NULL) {
         return CT_ERR_ARG;
@@ -156,150 +317,15 @@ static ct_status prep_geom(const ct_package *p, const ct_ray *ray, int seg, ct_p
     lo[2] = 0; /* unused: the box has no floor (a ray entering below the
                   surface is BELOW) */
     hi[2] = ((int64_t)p->hmax + 1) * ONE16;
-    tin.n = ct_i128_from64(0);
-    tin.d = 1;
-    tout = tin;
-    /* A segment that starts and ends inside the box (the bent walk's usual
-     * case) needs no clipping: tin = 0, and every box exit is at t >= 1.
-     * |O| <= 2^46, |U| <= 2^62: O + U fits in int64. */
-    if (seg) {
-        int in = 1;
-        for (k = 0; k < 3; ++k) { /* bound: 3 axes */
-            int64_t e = O[k] + U[k];
-            if ((k < 2 && (O[k] < lo[k] || e < lo[k])) || O[k] > hi[k] || e > hi[k]) {
-                in = 0;
-            }
-        }
-        if (in) {
-            has_out = 1;
-            tout.n = ct_i128_from64(1);
-            k = 3; /* skip the clip below */
-        } else {
-            k = 0;
-        }
-    } else {
-        k = 0;
+    st = clip_to_box(O, U, lo, hi, seg, &tin, &tout, &kin, &kin_at);
+    if (st == CT_OK && ct_i128_sign(tin.n) > 0) {
+        st = entry_point(O, U, &tin, kin, kin_at, lo, hi);
     }
-    /* Clip the caller's ray (unnormalised direction, exact 128-bit
-     * rationals) to the box.  bound: 3 axes */
-    for (; k < 3; ++k) {
-        bigrt a, b;
-        int floorless = (k == 2);
-        if (U[k] == 0) {
-            if ((!floorless && O[k] < lo[k]) || O[k] > hi[k]) {
-                out->start = CT_MISS;
-                return CT_MISS;
-            }
-            continue;
-        }
-        a.d = b.d = ct_abs64(U[k]);
-        /* |bound - o| < 2^47 */
-        if (U[k] > 0) {
-            a.n = ct_i128_from64(lo[k] - O[k]);
-            b.n = ct_i128_from64(hi[k] - O[k]);
-            if (!floorless && bigrt_lt(&tin, &a)) {
-                tin = a;
-                kin = k;
-                kin_at = lo[k];
-            }
-            if (!has_out || bigrt_lt(&b, &tout)) {
-                tout = b;
-                has_out = 1;
-            }
-        } else {
-            a.n = ct_i128_from64(O[k] - hi[k]);
-            b.n = ct_i128_from64(O[k] - lo[k]);
-            if (bigrt_lt(&tin, &a)) {
-                tin = a;
-                kin = k;
-                kin_at = hi[k];
-            }
-            if (!floorless && (!has_out || bigrt_lt(&b, &tout))) {
-                tout = b;
-                has_out = 1;
-            }
-        }
+    if (st != CT_OK) {
+        out->start = st;
+        return st;
     }
-    if (seg) {
-        bigrt one;
-        one.n = ct_i128_from64(1);
-        one.d = 1;
-        if (!has_out || bigrt_lt(&one, &tout)) {
-            tout = one;
-            has_out = 1;
-        }
-    }
-    if (has_out && bigrt_lt(&tout, &tin)) {
-        out->start = CT_MISS;
-        return CT_MISS;
-    }
-    if (ct_i128_sign(tin.n) > 0) {
-        /* The box has no floor: a ray may enter through a side face far
-         * below the terrain (z unbounded below).  Below -2^46 it is BELOW
-         * (every surface is >= 0) and its z would not fit the rounding:
-         * (oz + 2^46) * d + n * U_z < 0, with |oz + 2^46| <= 2^47,
-         * d <= 2^62, n < 2^48: 128-bit.                                    */
-        ct_i128 zq = ct_i128_add(ct_i128_mul(O[2] + CT_MAX_ORIGIN_Q16, tin.d),
-                                 ct_i128_mul128_64(tin.n, U[2]));
-        if (ct_i128_sign(zq) < 0) {
-            out->start = CT_BELOW;
-            return CT_BELOW;
-        }
-        /* the entry point, rounded to Q16 and kept in the box */
-        for (k = 0; k < 3; ++k) {
-            /* on the entry face's axis the point is the face itself, exactly
-             * (o + (bound - o)/U U): no division */
-            O[k] = k == kin ? kin_at : round_axis(O[k], U[k], &tin);
-        }
-        for (k = 0; k < 3; ++k) {
-            if (O[k] > hi[k]) {
-                O[k] = hi[k];
-            }
-            if (k < 2 && O[k] < lo[k]) {
-                O[k] = lo[k];
-            }
-        }
-    }
-    /* per-axis scaling: z in units of 2^zs Q16 (see ct_prepared); the
-     * origin's z rounded to them (O[2] <= hi[2], a multiple of 2^16, stays
-     * in the box; |O[2]| <= 2^46 here) */
-    mag = dir_magnitudes(U);
-    zs = dir_zshift(&mag, p->zshift_max);
-    normalize_dir(U, &mag, zs, D);
-    if (zs > 0u && D[0] == 0 && D[1] == 0) {
-        /* horizontal components too small to survive: a vertical ray,
-         * which the tracer handles in Q16 */
-        zs = 0u;
-        normalize_dir(U, &mag, zs, D);
-    }
-    if (zs > 0u) {
-        O[2] = floor_shr(O[2] + (INT64_C(1) << (zs - 1u)), zs);
-    }
-    out->ox = O[0];
-    out->oy = O[1];
-    out->oz = O[2];
-    out->dx = D[0];
-    out->dy = D[1];
-    out->dz = D[2];
-    out->zshift = (int32_t)zs;
-    {
-        /* dx^2 + dy^2 <= 2^53 */
-        uint64_t l2 = (uint64_t)((int64_t)D[0] * D[0] + (int64_t)D[1] * D[1]);
-        uint64_t l = ct_isqrt64(l2);
-        out->len_lo = (int64_t)l;
-        out->len_hi = (int64_t)l + (l * l != l2 ? 1 : 0);
-    }
-    if (D[0] != 0 || D[1] != 0) {
-        uint32_t s;
-        ct_status st = ct_sector_of(p, D[0], D[1], &s);
-        if (st != CT_OK) {
-            return st;
-        }
-        out->sector = (int32_t)s;
-    } else {
-        out->sector = -1;
-    }
-    return CT_OK;
+    return quantise(p, O, U, out);
 }
 
 void ct_prepared_first_cell(const ct_package *p, const ct_prepared *r, int32_t *i, int32_t *j)
