@@ -465,6 +465,105 @@ ct_status ct_trace_bent_set_ts(const ct_package *p, ct_tileset *ts, const ct_ray
     return trace_polyline(p, ts, ray, bs, m, h);
 }
 
+/* The polyline's parameters from the caller's ray (the observer and the
+ * tangent): its direction reduced to |U| <= 2^30, rounding.  Returns 0 when
+ * the horizontal part vanishes there (below 2^-31 of the ray: no bending
+ * over the tile). */
+static int bent_init(bent *b, const ct_package *p, const ct_ray *ray, const ct_bend *bd)
+{
+    int64_t mx;
+    unsigned sh = 0u;
+    b->p = p;
+    b->ox = ray->x_q16;
+    b->oy = ray->y_q16;
+    b->oz = ray->z_q16;
+    b->ux = ray->dx;
+    b->uy = ray->dy;
+    b->uz = ray->dz;
+    mx = ct_max64(ct_abs64(b->ux), ct_max64(ct_abs64(b->uy), ct_abs64(b->uz)));
+    while ((mx >> sh) > DIR_MAX) { /* bound: 32 halvings (|U| <= 2^62) */
+        sh++;
+    }
+    if (sh > 0u) {
+        int64_t half = INT64_C(1) << (sh - 1u);
+        b->ux = b->ux >= 0 ? (b->ux + half) >> sh : -((-b->ux + half) >> sh);
+        b->uy = b->uy >= 0 ? (b->uy + half) >> sh : -((-b->uy + half) >> sh);
+        b->uz = b->uz >= 0 ? (b->uz + half) >> sh : -((-b->uz + half) >> sh);
+    }
+    if (b->ux == 0 && b->uy == 0) {
+        return 0;
+    }
+    /* ux^2 + uy^2 <= 2^61 */
+    b->L = (int64_t)ct_isqrt64((uint64_t)(b->ux * b->ux + b->uy * b->uy));
+    b->coeff = bd->coeff_q16;
+    b->radius = bd->radius_nm;
+    b->posting = ct_abs64(p->posting_e_nm);
+    return 1;
+}
+
+/* Whether the run of segments va .. vb (run: more than one segment) may be
+ * skipped untraced: the max-mipmap shows it above all terrain under it, and
+ * ct_ray_prepare_segment's answer for each segment is known without it --
+ * off the tile or above the box (CT_MISS), or inside the box above the
+ * surface (CT_OK: the polyline has entered; *entered set). */
+static int run_culled(const ct_package *p, const ct_bend *bd, const ct_tileset *ts, const v3 *va, const v3 *vb, int run,
+                      int64_t chord_q16, int64_t ztop, int *entered)
+{
+    int over = 0, inside;
+    if (ts != NULL || (bd->flags & CT_BEND_NO_CULL) != 0u || !run_above_terrain(p, va, vb, run, chord_q16, &over)) {
+        return 0;
+    }
+    inside = run_inside(p, va, vb, ztop);
+    if (!over || run_floor(va, vb, run, chord_q16) > ztop || inside) {
+        if (inside) {
+            *entered = 1;
+        }
+        return 1;
+    }
+    return 0;
+}
+
+typedef enum { SEG_SKIP, SEG_BELOW, SEG_TRACED } seg_outcome;
+
+/* One segment of the polyline traced exactly, over the set (ts) or p:
+ * SEG_SKIP when it never enters the box; SEG_BELOW when it starts below the
+ * surface before the polyline entered the box (the whole trace is then
+ * CT_BELOW); else SEG_TRACED with its status returned, *sh its trace and
+ * tn / td where the segment ends on its prepared ray.  A start below the
+ * surface after the polyline entered is a hit there: the polyline crossed
+ * the surface within the vertex rounding between the previous segment's
+ * end and this start.  Errors (< 0) are returned as they come. */
+static ct_status trace_segment(const ct_package *p, ct_tileset *ts, const ct_ray *seg, int entered, ct_method m,
+                               seg_outcome *oc, ct_hit *sh, int64_t *tn, int64_t *td)
+{
+    ct_prepared pr;
+    ct_status st;
+    *oc = SEG_SKIP;
+    if (ts != NULL) {
+        st = ct_tileset_trace_segment(ts, seg, NULL, entered, m, sh, tn, td);
+        if (st >= 0 && (*td != 0 || st == CT_NO_DATA)) {
+            *oc = SEG_TRACED;
+        }
+        return st;
+    }
+    st = ct_ray_prepare_segment(p, seg, &pr);
+    if (st < 0 || st == CT_MISS) {
+        return st;
+    }
+    if (st == CT_BELOW) {
+        if (!entered) {
+            *oc = SEG_BELOW;
+            return st;
+        }
+        pr.start = CT_HIT;
+    }
+    st = ct_trace_prepared_own(p, &pr, m, sh);
+    *tn = pr.tend_n;
+    *td = pr.tend_d;
+    *oc = SEG_TRACED;
+    return st;
+}
+
 /* The polyline (c < 0, or the lowered model out of range); its own
  * function, kept out of line, so that its large frame is not on the
  * lowered walk's stack.  The ray is checked by the caller.  ts != NULL: a
@@ -482,36 +581,9 @@ CT_NOINLINE static ct_status trace_polyline(const ct_package *p, ct_tileset *ts,
     uint32_t steps = 0u, iters = 0u;
     v3 va, vb;
     ct_status st;
-    b.p = p;
-    b.ox = ray->x_q16;
-    b.oy = ray->y_q16;
-    b.oz = ray->z_q16;
-    b.ux = ray->dx;
-    b.uy = ray->dy;
-    b.uz = ray->dz;
-    {
-        /* reduce to |U| <= 2^30, rounding. bound: 32 halvings */
-        int64_t mx = ct_max64(ct_abs64(b.ux), ct_max64(ct_abs64(b.uy), ct_abs64(b.uz)));
-        unsigned sh = 0u;
-        while ((mx >> sh) > DIR_MAX) {
-            sh++;
-        }
-        if (sh > 0u) {
-            int64_t half = INT64_C(1) << (sh - 1u);
-            b.ux = b.ux >= 0 ? (b.ux + half) >> sh : -((-b.ux + half) >> sh);
-            b.uy = b.uy >= 0 ? (b.uy + half) >> sh : -((-b.uy + half) >> sh);
-            b.uz = b.uz >= 0 ? (b.uz + half) >> sh : -((-b.uz + half) >> sh);
-        }
-    }
-    if (b.ux == 0 && b.uy == 0) {
-        /* horizontal part below 2^-31 of the ray: no bending over the tile */
+    if (!bent_init(&b, p, ray, bd)) {
         return ts != NULL ? ct_tileset_trace(ts, ray, m, h) : ct_trace(p, ray, m, h);
     }
-    /* ux^2 + uy^2 <= 2^61 */
-    b.L = (int64_t)ct_isqrt64((uint64_t)(b.ux * b.ux + b.uy * b.uy));
-    b.coeff = bd->coeff_q16;
-    b.radius = bd->radius_nm;
-    b.posting = ct_abs64(p->posting_e_nm);
     h->steps = h->iters = 0u;
     if (!range_in_box(&b, &s0, &s1)) {
         h->x_q16 = h->y_q16 = h->z_q16 = 0;
@@ -539,10 +611,10 @@ CT_NOINLINE static ct_status trace_polyline(const ct_package *p, ct_tileset *ts,
     q = 0;
     for (k = k0; k < k1;) { /* bound: see above */
         ct_ray seg;
-        ct_prepared pr;
         ct_hit sh;
-        int64_t tn, td;
-        int over = 0, run = 0;
+        int64_t tn = 0, td = 0;
+        seg_outcome oc;
+        int run;
         int64_t kn = k + ((int64_t)1 << q);
         if (q > 0 && kn > k1) {
             q--;
@@ -558,24 +630,15 @@ CT_NOINLINE static ct_status trace_polyline(const ct_package *p, ct_tileset *ts,
         if (!run && b.coeff > 0 && va.z > ztop && vb.z >= va.z) {
             break;
         }
-        if (ts == NULL && (bd->flags & CT_BEND_NO_CULL) == 0u && run_above_terrain(p, &va, &vb, run, chord_q16, &over)) {
-            int inside = run_inside(p, &va, &vb, ztop);
-            /* skipped when ct_ray_prepare_segment's answer for each segment
-             * is known without it: off the tile or above the box (CT_MISS),
-             * or inside the box above the surface (CT_OK: entered) */
-            if (!over || run_floor(&va, &vb, run, chord_q16) > ztop || inside) {
-                if (inside) {
-                    entered = 1;
-                }
-                steps++;
-                iters++;
-                va = vb;
-                k = kn;
-                if (q < CT_BEND_MAX_RUN_LOG2) {
-                    q++;
-                }
-                continue;
+        if (run_culled(p, bd, ts, &va, &vb, run, chord_q16, ztop, &entered)) {
+            steps++;
+            iters++;
+            va = vb;
+            k = kn;
+            if (q < CT_BEND_MAX_RUN_LOG2) {
+                q++;
             }
+            continue;
         }
         if (run) {
             q--;
@@ -606,41 +669,17 @@ CT_NOINLINE static ct_status trace_polyline(const ct_package *p, ct_tileset *ts,
         if (seg.dx == 0 && seg.dy == 0 && seg.dz == 0) {
             continue;
         }
-        if (ts != NULL) {
-            /* the segment over the set (below the surface at its start
-             * after the polyline entered the box: a hit there, as below) */
-            st = ct_tileset_trace_segment(ts, &seg, NULL, entered, m, &sh, &tn, &td);
-            if (st < 0) {
-                return st;
-            }
-            if (td == 0 && st != CT_NO_DATA) {
-                continue; /* never in the box */
-            }
-        } else {
-            st = ct_ray_prepare_segment(p, &seg, &pr);
-            if (st < 0) {
-                return st;
-            }
-            if (st == CT_MISS) {
-                continue;
-            }
-            if (st == CT_BELOW) {
-                if (!entered) {
-                    h->steps = steps;
-                    h->iters = iters;
-                    return CT_BELOW;
-                }
-                /* the polyline crossed the surface within the vertex
-                 * rounding between the previous segment's end and this
-                 * start */
-                pr.start = CT_HIT;
-            }
-            st = ct_trace_prepared_own(p, &pr, m, &sh);
-            if (st < 0) {
-                return st;
-            }
-            tn = pr.tend_n;
-            td = pr.tend_d;
+        st = trace_segment(p, ts, &seg, entered, m, &oc, &sh, &tn, &td);
+        if (st < 0) {
+            return st;
+        }
+        if (oc == SEG_SKIP) {
+            continue;
+        }
+        if (oc == SEG_BELOW) {
+            h->steps = steps;
+            h->iters = iters;
+            return CT_BELOW;
         }
         entered = 1;
         steps += sh.steps;
