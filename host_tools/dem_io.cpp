@@ -11,6 +11,7 @@
 // before ours (OpenImageIO installs its own silent ones too).
 
 #include "dem_io.hpp"
+#include "temp_output.hpp"
 
 #include <geotiffio.h>
 #include <geovalues.h>
@@ -31,7 +32,6 @@
 #include <limits>
 #include <memory>
 #include <mutex>
-#include <random>
 #include <sstream>
 #include <type_traits>
 
@@ -348,25 +348,6 @@ void mark_valid(DemRaster &r)
 // ---------------------------------------------------------------------------
 // writing
 
-struct TempFile {
-    std::string path;
-    bool armed = false;
-    ~TempFile()
-    {
-        if (armed) ::unlink(path.c_str());
-    }
-};
-
-std::string random_suffix()
-{
-    static std::mutex m;
-    static std::mt19937_64 rng{std::random_device{}() ^ ((uint64_t)::getpid() << 32)};
-    std::lock_guard<std::mutex> lock(m);
-    char s[17];
-    std::snprintf(s, sizeof s, "%08x", (unsigned)(rng() & 0xffffffffu));
-    return s;
-}
-
 template <typename T>
 void to_integer(const std::string &path, const std::vector<double> &values, bool has_nodata,
                 double nodata, const char *tname, std::vector<unsigned char> &out)
@@ -409,8 +390,7 @@ void to_float32(const std::string &path, const std::vector<double> &values,
 }
 
 // The samples `data` (bits, sample format and predictor as TIFF tags) as a
-// single-band TIFF at `path`, written to a temporary file next to it and
-// renamed; GeoTIFF tags when geo is given (and GDAL_NODATA when nodata_text
+// single-band TIFF at `path`, written through a TempOutput (host_io.hpp); GeoTIFF tags when geo is given (and GDAL_NODATA when nodata_text
 // is), an ImageDescription when desc is not empty.
 void write_tiff(const std::string &path, int width, int height, const std::vector<unsigned char> &data,
                 uint16_t bits, uint16_t sfmt, uint16_t predictor, const Georef *geo, const std::string *nodata_text,
@@ -420,23 +400,13 @@ void write_tiff(const std::string &path, int width, int height, const std::vecto
     tiff_init_once();
     MsgSink sink;  // must outlive the TIFF handle
     SinkScope scope(&sink);
-    TempFile tmp;
-    int fd = -1;
-    for (int attempt = 0; attempt < 100 && fd < 0; attempt++) {
-        tmp.path = path + ".tmp-" + random_suffix();
-        fd = ::open(tmp.path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-        if (fd < 0 && errno != EEXIST)
-            throw fail("cannot create temporary file '" + tmp.path + "': " + std::strerror(errno));
-    }
-    if (fd < 0) throw fail("cannot create a temporary file next to the output");
-    tmp.armed = true;
+    TempOutput tmp(path);
+    const int fd = tmp.fd();
 
     const bool big = data.size() > 0xE0000000ull;
-    TiffPtr tif(open_tiff(tmp.path, big ? "w8" : "w", sink, fd));
-    if (!tif) {
-        ::close(fd);
-        throw fail("cannot open for writing: " + sink.text("unknown libtiff error"));
-    }
+    TiffPtr tif(open_tiff(tmp.temp_path(), big ? "w8" : "w", sink, fd));
+    if (!tif) throw fail("cannot open for writing: " + sink.text("unknown libtiff error"));
+    tmp.fd_handed_over();  // TIFFClose closes it
     TIFF *t = tif.get();
     auto check = [&](bool ok, const char *what) {
         if (!ok || !sink.errors.empty())
@@ -495,10 +465,7 @@ void write_tiff(const std::string &path, int width, int height, const std::vecto
         throw fail(std::string("fsync failed: ") + std::strerror(errno));
     tif.reset();  // closes fd
     check(true, "closing TIFF");
-
-    if (::rename(tmp.path.c_str(), path.c_str()) != 0)
-        throw fail("cannot rename '" + tmp.path + "' to the output: " + std::strerror(errno));
-    tmp.armed = false;
+    tmp.commit();
 }
 
 }  // namespace

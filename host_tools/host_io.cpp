@@ -35,23 +35,21 @@ void open_package_file(const std::string &path, std::vector<uint8_t> *bytes, ct_
     if (st != CT_OK) throw Error(path + ": not a valid package (" + status_name(st) + ")");
 }
 
-AtomicFile::AtomicFile(const std::string &path) : path_(path), tmp_(path + ".tmp." + std::to_string((long)getpid()))
+AtomicFile::AtomicFile(const std::string &path) : tmp_(path)
 {
-    f_ = std::fopen(tmp_.c_str(), "wb");
-    if (!f_) fail(errno);
+    f_ = ::fdopen(tmp_.fd(), "wb");
+    if (!f_) tmp_.fail(errno);
+    tmp_.fd_handed_over();  // the stream owns it now
 }
 
 AtomicFile::~AtomicFile()
 {
     if (f_) std::fclose(f_);
-    if (!done_) std::remove(tmp_.c_str());
 }
-
-void AtomicFile::fail(int err) const { throw Error(path_ + ": cannot write (" + std::strerror(err) + ")"); }
 
 void AtomicFile::write(const void *p, size_t n)
 {
-    if (std::fwrite(p, 1, n, f_) != n) fail(errno);
+    if (std::fwrite(p, 1, n, f_) != n) tmp_.fail(errno);
 }
 
 void AtomicFile::patch(size_t offset, const void *p, size_t n)
@@ -59,19 +57,17 @@ void AtomicFile::patch(size_t offset, const void *p, size_t n)
     const long here = std::ftell(f_);
     if (here < 0 || std::fseek(f_, (long)offset, SEEK_SET) != 0 || std::fwrite(p, 1, n, f_) != n ||
         std::fseek(f_, here, SEEK_SET) != 0)
-        fail(errno);
+        tmp_.fail(errno);
 }
 
 void AtomicFile::commit()
 {
-    bool ok = std::fflush(f_) == 0;
-    int e = errno;
-    ok = std::fclose(f_) == 0 && ok;
-    if (ok) e = errno;
+    if (std::fflush(f_) != 0) tmp_.fail(errno);
+    if (::fsync(::fileno(f_)) != 0 && errno != EINVAL && errno != EROFS) tmp_.fail(errno);
+    std::FILE *f = f_;
     f_ = nullptr;
-    if (!ok) fail(e);
-    if (std::rename(tmp_.c_str(), path_.c_str()) != 0) fail(errno);
-    done_ = true;
+    if (std::fclose(f) != 0) tmp_.fail(errno);
+    tmp_.commit();
 }
 
 void write_file_atomic(const std::string &path, const std::vector<uint8_t> &bytes)

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "conetrace.h"
+#include "temp_output.hpp"
 #include "terrain.hpp"
 
 namespace ct_host {
@@ -24,10 +25,10 @@ std::vector<uint8_t> read_file(const std::string &path);
 // (<status>)") or read_file's.
 void open_package_file(const std::string &path, std::vector<uint8_t> *bytes, ct_package *pkg);
 
-// An output file written atomically: bytes go to "<path>.tmp.<pid>", which
-// commit() renames to path; destroyed without commit() (an error on the
-// way), the temporary is removed.  Never a partial output file.  Every
-// failure throws Error("<path>: cannot write (<reason>)").
+// An output file written atomically through a TempOutput: commit() flushes,
+// syncs and renames it onto path; destroyed without commit() (an error on
+// the way), the temporary is removed.  Every failure throws Error("<path>:
+// cannot write (<reason>)").
 class AtomicFile {
 public:
     explicit AtomicFile(const std::string &path);
@@ -39,10 +40,8 @@ public:
     void commit();
 
 private:
-    [[noreturn]] void fail(int err) const;
-    std::string path_, tmp_;
+    TempOutput tmp_;
     std::FILE *f_ = nullptr;
-    bool done_ = false;
 };
 // The whole file at once, through AtomicFile.
 void write_file_atomic(const std::string &path, const std::vector<uint8_t> &bytes);

@@ -117,8 +117,8 @@ void build_package_to(const Terrain &t, const BuildOptions &opt, PackageSink &si
 // The same into memory.
 std::vector<uint8_t> build_package(const Terrain &t, const BuildOptions &opt,
                                    BuildStats *stats = nullptr);
-// The same into a file, atomically ("<path>.tmp.<pid>" then rename): no
-// partial file is left on any error.  Throws Error("<path>: ...").
+// The same into a file, atomically (host_io.hpp's AtomicFile: a temporary
+// file beside it, synced and renamed): no partial file is left on any error.  Throws Error("<path>: ...").
 void build_package_file(const Terrain &t, const BuildOptions &opt, const std::string &path,
                         BuildStats *stats = nullptr);
 

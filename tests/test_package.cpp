@@ -322,7 +322,7 @@ void test_streamed_file_same_bytes()
     FILE *f = fopen(path.c_str(), "rb");
     TEST_ASSERT_MSG(f == nullptr, "a failed build left %s", path.c_str());
     if (f) fclose(f);
-    const std::string cmd = "ls " + path + ".tmp.* >/dev/null 2>&1";
+    const std::string cmd = "ls " + path + ".tmp-* >/dev/null 2>&1";
     TEST_ASSERT_MSG(std::system(cmd.c_str()) != 0, "a failed build left a temporary file");
 }
 

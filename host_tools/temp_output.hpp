@@ -1,0 +1,38 @@
+// temp_output.hpp -- the temporary file behind every output file the host
+// tools write (host_io.hpp's AtomicFile, dem_io's GeoTIFF writer).
+#pragma once
+
+#include <string>
+
+namespace ct_host {
+
+// The temporary file behind every output (AtomicFile, the GeoTIFF writer):
+// created next to the destination as "<path>.tmp-<8 hex digits>" (O_EXCL,
+// a fresh random suffix on a clash), renamed onto the destination only by
+// commit(), after the data reached the disk (fsync); removed when destroyed
+// uncommitted (an error on the way).  Never a partial output file.  Fails
+// with Error("<path>: cannot create a temporary file next to it (<reason>)"),
+// Error("<path>: cannot write (<reason>)") or Error("<path>: cannot rename
+// the temporary file '<tmp>' onto it (<reason>)").
+class TempOutput {
+public:
+    explicit TempOutput(const std::string &path);
+    ~TempOutput();
+    TempOutput(const TempOutput &) = delete;
+    TempOutput &operator=(const TempOutput &) = delete;
+    int fd() const { return fd_; }
+    const std::string &temp_path() const { return tmp_; }
+    // A writer that closes the descriptor itself (fclose of an fdopen'ed
+    // stream, TIFFClose) says so first, after its own fsync.
+    void fd_handed_over() { fd_ = -1; }
+    // fsync and close the descriptor if still held, then rename.
+    void commit();
+    [[noreturn]] void fail(int err) const;
+
+private:
+    std::string path_, tmp_;
+    int fd_ = -1;
+    bool done_ = false;
+};
+
+}  // namespace ct_host
