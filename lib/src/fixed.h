@@ -27,6 +27,17 @@
 #define CT_NOINLINE
 #endif
 
+/* A hint to start loading a cache line, on hosts with caches (GCC and clang
+ * on x86-64 and AArch64); nothing on the flight MCUs, which have none (the
+ * code around it is compiled out there: CT_HAVE_PREFETCH 0).               */
+#if defined(__GNUC__) && (defined(__x86_64__) || defined(__aarch64__))
+#define CT_PREFETCH(a) __builtin_prefetch((a))
+#define CT_HAVE_PREFETCH 1
+#else
+#define CT_PREFETCH(a) ((void)0)
+#define CT_HAVE_PREFETCH 0
+#endif
+
 typedef struct {
     uint64_t hi;
     uint64_t lo;

@@ -917,6 +917,12 @@ static ct_status walk_cones(const ctx *c, uint32_t plane, ct_hit *h)
     int tin_ok = 1;
     int64_t lb;      /* lower_ahead at (i, j), -1 when not formed */
     cexit e;
+#if CT_HAVE_PREFETCH
+    /* angle planes far beyond a host's L2 cache (over 1 MB): a step's code
+     * is a miss, so the one a jump as long again would reach is asked for
+     * early (below) */
+    const int pf = (uint64_t)p->coarse_x * p->coarse_y * p->sectors > (UINT64_C(1) << 20);
+#endif
     i = c->i0;
     j = c->j0;
     /* bound: each iteration leaves at least one fine cell */
@@ -978,6 +984,20 @@ static ct_status walk_cones(const ctx *c, uint32_t plane, ct_hit *h)
                     tj.d = T_ONE;
                     locate(c, tj, &ni, &nj);
                     if (ni != i || nj != j) {
+#if CT_HAVE_PREFETCH
+                        if (pf) {
+                            /* a hint only: T2 = tn + dt < 2^36, times |d| <=
+                             * 2^26; a cell off the tile is not asked for */
+                            int64_t T2 = tn + dt;
+                            int64_t px = floor_shr(r->ox + floor_shr(T2 * (int64_t)r->dx, CT_T_FRAC_BITS), 16u);
+                            int64_t py = floor_shr(r->oy + floor_shr(T2 * (int64_t)r->dy, CT_T_FRAC_BITS), 16u);
+                            if (px >= 0 && py >= 0 && px < c->cx && py < c->cy) {
+                                size_t k2 = coarse_index(p, (int32_t)px, (int32_t)py);
+                                CT_PREFETCH(ang + k2);
+                                CT_PREFETCH(p->apex + 2u * k2);
+                            }
+                        }
+#endif
                         if (!rt_lt(tj, c->tend)) {
                             h->iters = it + 1u;
                             return CT_MISS;
