@@ -1364,7 +1364,12 @@ ct_status ct_geolocate_batch_tiles(ct_tileset *ts, const ct_camera *cam, const c
 /* ct_los over a tile set: the same answers as on the merged package (the
  * segment, or the true Earth's pieces, walked tile by tile), and
  * CT_NO_DATA when the line of sight reaches a tile the set does not hold
- * before anything blocks it (*block: where it entered that tile).        */
+ * before anything blocks it (*block: where it entered that tile).
+ *   [in,out] ts  the set (its cache is updated).
+ *   [in]  a_nm .. method  as ct_los, in the set's map frame (ts->frame).
+ *   [out] block  as ct_los's, or where the line of sight entered a tile
+ *                the set does not hold (CT_NO_DATA).
+ * Errors: ct_los's.                                                        */
 ct_status ct_los_tiles(ct_tileset *ts, const int64_t a_nm[3], const int64_t b_nm[3], const ct_effects *effects,
                        int64_t margin_nm, ct_method method, ct_hit *block);
 
