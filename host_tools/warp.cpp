@@ -192,6 +192,173 @@ bool dem_needs_warp(const std::string &path, const WarpOptions &o)
     return s.utm_epsg != (o.south ? 32700 : 32600) + o.utm_zone;
 }
 
+namespace {
+
+// What warp_dem's steps share: the source, its CRS, the GDAL error text.
+struct Warp {
+    const std::string &path;
+    Source &s;
+    GdalErrors &errs;
+    Error fail(const std::string &why) const { return Error(path + ": " + why); }
+};
+
+// The UTM zone: given, or that of the DEM's centre (*south set).
+int utm_zone_for(const Warp &w, OGRSpatialReferenceH ssrs, const WarpOptions &opt, bool *south)
+{
+    *south = opt.south;
+    if (opt.utm_zone != 0) return opt.utm_zone;
+    const int W = GDALGetRasterXSize((GDALDatasetH)w.s.ds.get()), H = GDALGetRasterYSize((GDALDatasetH)w.s.ds.get());
+    SrsPtr wgs84 = epsg_srs(4326);
+    CtPtr ct(wgs84 ? OCTNewCoordinateTransformation(ssrs, (OGRSpatialReferenceH)wgs84.get()) : nullptr);
+    double lon, lat;
+    if (!ct || !pixel_to(w.s, (OGRCoordinateTransformationH)ct.get(), 0.5 * W, 0.5 * H, &lon, &lat))
+        throw w.fail("cannot locate the DEM's centre in WGS84 (" + w.errs.text("no transformation") + ")");
+    if (!(lat >= -90 && lat <= 90 && lon >= -540 && lon <= 540))
+        throw w.fail("the DEM's centre (" + num(lat) + ", " + num(lon) + ") is not on the earth");
+    lon = std::fmod(lon + 180.0, 360.0);
+    if (lon < 0) lon += 360.0;
+    *south = lat < 0;
+    return std::min(60, std::max(1, (int)std::floor(lon / 6.0) + 1));
+}
+
+// The posting: given, or the source posting at the centre in UTM metres
+// (rounded to two significant digits).
+double posting_for(const Warp &w, OGRCoordinateTransformationH to_utm, int epsg, double given)
+{
+    if (given != 0) return given;
+    const int W = GDALGetRasterXSize((GDALDatasetH)w.s.ds.get()), H = GDALGetRasterYSize((GDALDatasetH)w.s.ds.get());
+    const double cx = std::floor(0.5 * W) + 0.5, cy = std::floor(0.5 * H) + 0.5;
+    double e0, n0, e1, n1, e2, n2;
+    if (!pixel_to(w.s, to_utm, cx, cy, &e0, &n0) || !pixel_to(w.s, to_utm, cx + 1, cy, &e1, &n1) ||
+        !pixel_to(w.s, to_utm, cx, cy + 1, &e2, &n2))
+        throw w.fail("cannot transform the DEM's centre onto EPSG:" + std::to_string(epsg));
+    const double dx = std::hypot(e1 - e0, n1 - n0), dy = std::hypot(e2 - e0, n2 - n0);
+    const double p = std::sqrt(dx * dy);
+    if (!(p > 1e-6 && p < 1e6)) throw w.fail("source posting of " + num(p) + " m at the centre is not usable; give --posting");
+    return round_2_digits(p);
+}
+
+std::string wkt_of(OGRSpatialReferenceH srs)
+{
+    char *wkt = nullptr;
+    OSRExportToWkt(srs, &wkt);
+    const std::string out = wkt ? wkt : "";
+    CPLFree(wkt);
+    return out;
+}
+
+// The output size GDAL will choose (as gdalwarp -tr): oversized grids are
+// refused before any pixel is read.
+void check_output_size(const Warp &w, const std::string &swkt, const std::string &dwkt, double posting)
+{
+    const std::string so = "SRC_SRS=" + swkt, dso = "DST_SRS=" + dwkt;
+    const char *topts[] = {so.c_str(), dso.c_str(), nullptr};
+    GDALDatasetH src = (GDALDatasetH)w.s.ds.get();
+    void *tr = GDALCreateGenImgProjTransformer2(src, nullptr, (char **)topts);
+    if (!tr) throw w.fail("cannot set up the transformation (" + w.errs.text("?") + ")");
+    double sgt[6], ext[4];
+    int npx = 0, nln = 0;
+    CPLErr e = GDALSuggestedWarpOutput2(src, GDALGenImgProjTransform, tr, sgt, &npx, &nln, ext, 0);
+    GDALDestroyGenImgProjTransformer(tr);
+    if (e != CE_None) throw w.fail("cannot compute the output extent (" + w.errs.text("?") + ")");
+    const double nx = (npx * std::fabs(sgt[1]) + posting / 2) / posting;
+    const double ny = (nln * std::fabs(sgt[5]) + posting / 2) / posting;
+    if (nx > 32768 || ny > 32768)
+        throw w.fail("resampled at " + num(posting) + " m it would be " + num(std::floor(nx)) + " x " +
+                     num(std::floor(ny)) + " posts, over the package limit of 32768 per side; give a coarser --posting");
+}
+
+// The heights (0 where invalid) and their validity as two float64 bands of
+// an in-memory dataset with the source's georeference.
+DsPtr in_memory_copy(const Warp &w, GDALRasterBandH band, OGRSpatialReferenceH ssrs)
+{
+    GDALDatasetH src = (GDALDatasetH)w.s.ds.get();
+    const int W = GDALGetRasterXSize(src), H = GDALGetRasterYSize(src);
+    std::vector<double> h((size_t)W * H);
+    std::vector<uint8_t> m((size_t)W * H);
+    if (GDALRasterIO(band, GF_Read, 0, 0, W, H, h.data(), W, H, GDT_Float64, 0, 0) != CE_None)
+        throw w.fail("cannot read the heights (" + w.errs.text("read error") + ")");
+    if (GDALRasterIO(GDALGetMaskBand(band), GF_Read, 0, 0, W, H, m.data(), W, H, GDT_Byte, 0, 0) != CE_None)
+        throw w.fail("cannot read the nodata mask (" + w.errs.text("read error") + ")");
+    GDALDriverH drv = GDALGetDriverByName("MEM");
+    if (!drv) throw w.fail("GDAL has no MEM driver");
+    DsPtr mem(GDALCreate(drv, "", W, H, 2, GDT_Float64, nullptr));
+    if (!mem) throw w.fail("cannot allocate " + std::to_string(W) + " x " + std::to_string(H) + " in memory");
+    GDALDatasetH md = (GDALDatasetH)mem.get();
+    GDALSetGeoTransform(md, w.s.gt);
+    GDALSetSpatialRef(md, ssrs);
+    std::vector<double> v((size_t)W * H);
+    for (size_t k = 0; k < v.size(); ++k) {
+        const bool ok = m[k] != 0 && std::isfinite(h[k]);
+        v[k] = ok ? 1.0 : 0.0;
+        if (!ok) h[k] = 0.0;
+    }
+    if (GDALRasterIO(GDALGetRasterBand(md, 1), GF_Write, 0, 0, W, H, h.data(), W, H, GDT_Float64, 0, 0) != CE_None ||
+        GDALRasterIO(GDALGetRasterBand(md, 2), GF_Write, 0, 0, W, H, v.data(), W, H, GDT_Float64, 0, 0) != CE_None)
+        throw w.fail("cannot fill the in-memory copy (" + w.errs.text("write error") + ")");
+    return mem;
+}
+
+// gdalwarp -of MEM -s_srs SRC -t_srs EPSG:326zz -tr P P -r bilinear -et 0
+// -ot Float64 -wo INIT_DEST=0 over the in-memory copy (released here).
+DsPtr warped(const Warp &w, DsPtr mem, const std::string &swkt, const std::string &dwkt, double posting)
+{
+    const std::string tr = num(posting);
+    std::vector<std::string> args = {"-of", "MEM", "-s_srs", swkt, "-t_srs", dwkt, "-tr", tr, tr,
+                                     "-r", "bilinear", "-et", "0", "-ot", "Float64", "-wo", "INIT_DEST=0",
+                                     "-wo", "NUM_THREADS=ALL_CPUS"};
+    std::vector<char *> argv;
+    for (std::string &a : args) argv.push_back(&a[0]);
+    argv.push_back(nullptr);
+    GDALWarpAppOptions *wo = GDALWarpAppOptionsNew(argv.data(), nullptr);
+    if (!wo) throw w.fail("bad warp options (" + w.errs.text("?") + ")");
+    GDALDatasetH srcs[1] = {(GDALDatasetH)mem.get()};
+    int usage_error = 0;
+    DsPtr out(GDALWarp("", nullptr, 1, srcs, wo, &usage_error));
+    GDALWarpAppOptionsFree(wo);
+    mem.reset();
+    if (!out) throw w.fail("resampling failed (" + w.errs.text("GDALWarp failed") + ")");
+    return out;
+}
+
+// The warped dataset as a DemRaster (heights NaN where not every source
+// post under them was valid).
+DemRaster raster_of(const Warp &w, GDALDatasetH od, int epsg)
+{
+    DemRaster r;
+    r.width = GDALGetRasterXSize(od);
+    r.height = GDALGetRasterYSize(od);
+    double ogt[6];
+    if (GDALGetGeoTransform(od, ogt) != CE_None || ogt[2] != 0 || ogt[4] != 0)
+        throw w.fail("resampling produced no north-up grid");
+    const size_t n = (size_t)r.width * r.height;
+    r.h.resize(n);
+    r.valid.resize(n);
+    std::vector<double> v(n);
+    if (GDALRasterIO(GDALGetRasterBand(od, 1), GF_Read, 0, 0, r.width, r.height, r.h.data(), r.width, r.height,
+                     GDT_Float64, 0, 0) != CE_None ||
+        GDALRasterIO(GDALGetRasterBand(od, 2), GF_Read, 0, 0, r.width, r.height, v.data(), r.width, r.height,
+                     GDT_Float64, 0, 0) != CE_None)
+        throw w.fail("cannot read the resampled grid (" + w.errs.text("read error") + ")");
+    for (size_t k = 0; k < n; ++k) {
+        // validity 1 up to rounding: every source post with a weight above
+        // 1e-9 was valid (the height error from the rest is below 1e-9 h)
+        r.valid[k] = v[k] >= 1.0 - 1e-9 && std::isfinite(r.h[k]);
+        if (!r.valid[k]) r.h[k] = std::nan("");
+    }
+    r.sample_type = "float64";
+    r.has_georef = true;
+    r.geo.origin_e = ogt[0];
+    r.geo.origin_n = ogt[3];
+    r.geo.posting_e = ogt[1];
+    r.geo.posting_n = ogt[5];
+    r.geo.epsg = epsg;
+    r.geo.source_epsg = w.s.epsg;
+    return r;
+}
+
+}  // namespace
+
 DemRaster warp_dem(const std::string &path, const WarpOptions &opt)
 {
     auto fail = [&](const std::string &why) { return Error(path + ": " + why); };
@@ -213,147 +380,19 @@ DemRaster warp_dem(const std::string &path, const WarpOptions &opt)
     if (!(opt.posting_m >= 0 && opt.posting_m <= 1e6)) throw fail("invalid posting " + num(opt.posting_m) + " m");
 
     GdalErrors errs;
-    // the zone: given, or that of the DEM's centre
-    int zone = opt.utm_zone;
-    bool south = opt.south;
-    if (zone == 0) {
-        SrsPtr wgs84 = epsg_srs(4326);
-        CtPtr ct(wgs84 ? OCTNewCoordinateTransformation(ssrs, (OGRSpatialReferenceH)wgs84.get()) : nullptr);
-        double lon, lat;
-        if (!ct || !pixel_to(s, (OGRCoordinateTransformationH)ct.get(), 0.5 * W, 0.5 * H, &lon, &lat))
-            throw fail("cannot locate the DEM's centre in WGS84 (" + errs.text("no transformation") + ")");
-        if (!(lat >= -90 && lat <= 90 && lon >= -540 && lon <= 540))
-            throw fail("the DEM's centre (" + num(lat) + ", " + num(lon) + ") is not on the earth");
-        lon = std::fmod(lon + 180.0, 360.0);
-        if (lon < 0) lon += 360.0;
-        zone = std::min(60, std::max(1, (int)std::floor(lon / 6.0) + 1));
-        south = lat < 0;
-    }
+    const Warp w{path, s, errs};
+    bool south = false;
+    const int zone = utm_zone_for(w, ssrs, opt, &south);
     const int epsg = (south ? 32700 : 32600) + zone;
     SrsPtr dsrs = epsg_srs(epsg);
-    if (!dsrs) throw fail("EPSG:" + std::to_string(epsg) + " unknown to PROJ (" + errs.text("?") + ")");
+    if (!dsrs) throw w.fail("EPSG:" + std::to_string(epsg) + " unknown to PROJ (" + errs.text("?") + ")");
     CtPtr to_utm(OCTNewCoordinateTransformation(ssrs, (OGRSpatialReferenceH)dsrs.get()));
-    if (!to_utm) throw fail("no transformation onto EPSG:" + std::to_string(epsg) + " (" + errs.text("?") + ")");
-
-    // the posting: given, or the source posting at the centre in UTM metres
-    double posting = opt.posting_m;
-    if (posting == 0) {
-        const double cx = std::floor(0.5 * W) + 0.5, cy = std::floor(0.5 * H) + 0.5;
-        double e0, n0, e1, n1, e2, n2;
-        OGRCoordinateTransformationH ct = (OGRCoordinateTransformationH)to_utm.get();
-        if (!pixel_to(s, ct, cx, cy, &e0, &n0) || !pixel_to(s, ct, cx + 1, cy, &e1, &n1) ||
-            !pixel_to(s, ct, cx, cy + 1, &e2, &n2))
-            throw fail("cannot transform the DEM's centre onto EPSG:" + std::to_string(epsg));
-        const double dx = std::hypot(e1 - e0, n1 - n0), dy = std::hypot(e2 - e0, n2 - n0);
-        const double p = std::sqrt(dx * dy);
-        if (!(p > 1e-6 && p < 1e6))
-            throw fail("source posting of " + num(p) + " m at the centre is not usable; give --posting");
-        posting = round_2_digits(p);
-    }
-
-    char *dst_wkt = nullptr, *src_wkt = nullptr;
-    OSRExportToWkt((OGRSpatialReferenceH)dsrs.get(), &dst_wkt);
-    OSRExportToWkt(ssrs, &src_wkt);
-    const std::string dwkt = dst_wkt ? dst_wkt : "", swkt = src_wkt ? src_wkt : "";
-    CPLFree(dst_wkt);
-    CPLFree(src_wkt);
-
-    // the output size GDAL will choose (as gdalwarp -tr): refuse oversized
-    // grids before any pixel is read
-    {
-        const std::string so = "SRC_SRS=" + swkt, dso = "DST_SRS=" + dwkt;
-        const char *topts[] = {so.c_str(), dso.c_str(), nullptr};
-        void *tr = GDALCreateGenImgProjTransformer2(src, nullptr, (char **)topts);
-        if (!tr) throw fail("cannot set up the transformation (" + errs.text("?") + ")");
-        double sgt[6], ext[4];
-        int npx = 0, nln = 0;
-        CPLErr e = GDALSuggestedWarpOutput2(src, GDALGenImgProjTransform, tr, sgt, &npx, &nln, ext, 0);
-        GDALDestroyGenImgProjTransformer(tr);
-        if (e != CE_None) throw fail("cannot compute the output extent (" + errs.text("?") + ")");
-        const double nx = (npx * std::fabs(sgt[1]) + posting / 2) / posting;
-        const double ny = (nln * std::fabs(sgt[5]) + posting / 2) / posting;
-        if (nx > 32768 || ny > 32768)
-            throw fail("resampled at " + num(posting) + " m it would be " + num(std::floor(nx)) + " x " +
-                       num(std::floor(ny)) + " posts, over the package limit of 32768 per side; give a coarser --posting");
-    }
-
-    // heights (0 where invalid) and validity as two float64 bands in memory
-    DsPtr mem;
-    {
-        std::vector<double> h((size_t)W * H);
-        std::vector<uint8_t> m((size_t)W * H);
-        if (GDALRasterIO(band, GF_Read, 0, 0, W, H, h.data(), W, H, GDT_Float64, 0, 0) != CE_None)
-            throw fail("cannot read the heights (" + errs.text("read error") + ")");
-        if (GDALRasterIO(GDALGetMaskBand(band), GF_Read, 0, 0, W, H, m.data(), W, H, GDT_Byte, 0, 0) != CE_None)
-            throw fail("cannot read the nodata mask (" + errs.text("read error") + ")");
-        GDALDriverH drv = GDALGetDriverByName("MEM");
-        if (!drv) throw fail("GDAL has no MEM driver");
-        mem.reset(GDALCreate(drv, "", W, H, 2, GDT_Float64, nullptr));
-        if (!mem) throw fail("cannot allocate " + std::to_string(W) + " x " + std::to_string(H) + " in memory");
-        GDALDatasetH md = (GDALDatasetH)mem.get();
-        GDALSetGeoTransform(md, s.gt);
-        GDALSetSpatialRef(md, ssrs);
-        std::vector<double> v((size_t)W * H);
-        for (size_t k = 0; k < v.size(); ++k) {
-            const bool ok = m[k] != 0 && std::isfinite(h[k]);
-            v[k] = ok ? 1.0 : 0.0;
-            if (!ok) h[k] = 0.0;
-        }
-        if (GDALRasterIO(GDALGetRasterBand(md, 1), GF_Write, 0, 0, W, H, h.data(), W, H, GDT_Float64, 0, 0) !=
-                CE_None ||
-            GDALRasterIO(GDALGetRasterBand(md, 2), GF_Write, 0, 0, W, H, v.data(), W, H, GDT_Float64, 0, 0) !=
-                CE_None)
-            throw fail("cannot fill the in-memory copy (" + errs.text("write error") + ")");
-    }
-
-    // gdalwarp -of MEM -s_srs SRC -t_srs EPSG:326zz -tr P P -r bilinear -et 0 -ot Float64 -wo INIT_DEST=0
-    const std::string tr = num(posting);
-    std::vector<std::string> args = {"-of", "MEM", "-s_srs", swkt, "-t_srs", dwkt, "-tr", tr, tr,
-                                     "-r", "bilinear", "-et", "0", "-ot", "Float64", "-wo", "INIT_DEST=0",
-                                     "-wo", "NUM_THREADS=ALL_CPUS"};
-    std::vector<char *> argv;
-    for (std::string &a : args) argv.push_back(&a[0]);
-    argv.push_back(nullptr);
-    GDALWarpAppOptions *wo = GDALWarpAppOptionsNew(argv.data(), nullptr);
-    if (!wo) throw fail("bad warp options (" + errs.text("?") + ")");
-    GDALDatasetH srcs[1] = {(GDALDatasetH)mem.get()};
-    int usage_error = 0;
-    DsPtr out(GDALWarp("", nullptr, 1, srcs, wo, &usage_error));
-    GDALWarpAppOptionsFree(wo);
-    mem.reset();
-    if (!out) throw fail("resampling failed (" + errs.text("GDALWarp failed") + ")");
-
-    GDALDatasetH od = (GDALDatasetH)out.get();
-    DemRaster r;
-    r.width = GDALGetRasterXSize(od);
-    r.height = GDALGetRasterYSize(od);
-    double ogt[6];
-    if (GDALGetGeoTransform(od, ogt) != CE_None || ogt[2] != 0 || ogt[4] != 0)
-        throw fail("resampling produced no north-up grid");
-    const size_t n = (size_t)r.width * r.height;
-    r.h.resize(n);
-    r.valid.resize(n);
-    std::vector<double> v(n);
-    if (GDALRasterIO(GDALGetRasterBand(od, 1), GF_Read, 0, 0, r.width, r.height, r.h.data(), r.width, r.height,
-                     GDT_Float64, 0, 0) != CE_None ||
-        GDALRasterIO(GDALGetRasterBand(od, 2), GF_Read, 0, 0, r.width, r.height, v.data(), r.width, r.height,
-                     GDT_Float64, 0, 0) != CE_None)
-        throw fail("cannot read the resampled grid (" + errs.text("read error") + ")");
-    for (size_t k = 0; k < n; ++k) {
-        // validity 1 up to rounding: every source post with a weight above
-        // 1e-9 was valid (the height error from the rest is below 1e-9 h)
-        r.valid[k] = v[k] >= 1.0 - 1e-9 && std::isfinite(r.h[k]);
-        if (!r.valid[k]) r.h[k] = std::nan("");
-    }
-    r.sample_type = "float64";
-    r.has_georef = true;
-    r.geo.origin_e = ogt[0];
-    r.geo.origin_n = ogt[3];
-    r.geo.posting_e = ogt[1];
-    r.geo.posting_n = ogt[5];
-    r.geo.epsg = epsg;
-    r.geo.source_epsg = s.epsg;
-    return r;
+    if (!to_utm) throw w.fail("no transformation onto EPSG:" + std::to_string(epsg) + " (" + errs.text("?") + ")");
+    const double posting = posting_for(w, (OGRCoordinateTransformationH)to_utm.get(), epsg, opt.posting_m);
+    const std::string dwkt = wkt_of((OGRSpatialReferenceH)dsrs.get()), swkt = wkt_of(ssrs);
+    check_output_size(w, swkt, dwkt, posting);
+    DsPtr out = warped(w, in_memory_copy(w, band, ssrs), swkt, dwkt, posting);
+    return raster_of(w, (GDALDatasetH)out.get(), epsg);
 }
 
 }  // namespace ct_host
