@@ -228,6 +228,142 @@ static ct_status no_data(const ct_tileset *ts, const ct_prepared *r, const ct_lo
     return CT_NO_DATA;
 }
 
+/* The lowered model (lw) moved into tile grid coordinates: the frame's
+ * grid shifted by (ox, oy) Q16. */
+static void lower_shifted(const ct_lower *lw, int64_t ox, int64_t oy, ct_lower *ll)
+{
+    *ll = *lw;
+    ll->obx -= ox;
+    ll->oby -= oy;
+}
+
+/* Where a set's trace starts: the prepared ray's first point decided
+ * against tile (a, bb) -- loaded unless the point is above its tallest post
+ * (the manifest says) -- and (i, j) moved into the tile's grid.  *tp: the
+ * tile when it was loaded (else NULL).  Returns prep_finish's status, or
+ * CT_NO_DATA (*h filled) when the tile is not available. */
+static ct_status set_start(ct_tileset *ts, const ct_ray *ray, int seg, const ct_lower *lw, uint32_t a, uint32_t bb,
+                           int32_t ci, int32_t cj, ct_prepared *r, const ct_package **tp, int32_t *i, int32_t *j,
+                           int64_t tend[2], ct_hit *h)
+{
+    const ct_package *F = &ts->frame;
+    const uint8_t *e0 = ts->entries + (size_t)(bb * ts->tiles_x + a) * CT_SET_ENTRY_SIZE;
+    int64_t ox = (int64_t)tile_first(ts, a) * ONE16, oy = (int64_t)tile_first(ts, bb) * ONE16;
+    ct_lower ll;
+    ct_status st;
+    *tp = NULL;
+    /* |oz 2^zs| <= 2^46 */
+    if (e0[12] != 0u && r->oz * (INT64_C(1) << r->zshift) > (int64_t)ct_ld16(e0 + 10) * ONE16) {
+        st = ct_tile_prep_finish(F, NULL, 0, 0, ci, cj, ray, seg, lw, r);
+    } else {
+        *tp = tile_get(ts, a, bb);
+        if (*tp == NULL) {
+            r->tend_n = 0;
+            r->tend_d = 1;
+            r->start = CT_OK;
+            if (tend != NULL) { /* in the box, stopped at its first point */
+                tend[0] = 0;
+                tend[1] = 1;
+            }
+            return no_data(ts, r, lw, a, bb, 0, 1, h);
+        }
+        if (lw != NULL) {
+            lower_shifted(lw, ox, oy, &ll);
+        }
+        st = ct_tile_prep_finish(F, *tp, ox, oy, ci, cj, ray, seg, lw != NULL ? &ll : NULL, r);
+    }
+    *i -= (int32_t)(ox >> 16);
+    *j -= (int32_t)(oy >> 16);
+    return st;
+}
+
+/* Where the ray leaves tile (a, bb) (as trace.c's cell exit): the face (1
+ * x, 2 y, 3 a corner) and the parameter en / ed; a vertical ray stays in
+ * its tile (tend). */
+static int tile_exit(const ct_tileset *ts, const ct_prepared *r, uint32_t a, uint32_t bb, int64_t *en, int64_t *ed)
+{
+    const ct_package *F = &ts->frame;
+    int32_t sx = r->dx > 0 ? 1 : (r->dx < 0 ? -1 : 0), sy = r->dy > 0 ? 1 : (r->dy < 0 ? -1 : 0);
+    int64_t adx = ct_abs64(r->dx), ady = ct_abs64(r->dy);
+    int64_t x0 = (int64_t)tile_first(ts, a), y0 = (int64_t)tile_first(ts, bb);
+    int64_t x1 = x0 + (int64_t)tile_posts_at(ts, a, F->width) - 1;
+    int64_t y1 = y0 + (int64_t)tile_posts_at(ts, bb, F->height) - 1;
+    int64_t nx = 0, ny = 0;
+    int face;
+    if (sx != 0) {
+        nx = ((sx > 0 ? x1 : x0) * ONE16 - r->ox) * sx;
+    }
+    if (sy != 0) {
+        ny = ((sy > 0 ? y1 : y0) * ONE16 - r->oy) * sy;
+    }
+    if (sy == 0) {
+        face = 1;
+    } else if (sx == 0) {
+        face = 2;
+    } else {
+        int64_t lx = nx * ady, ly = ny * adx;
+        face = lx < ly ? 1 : (ly < lx ? 2 : 3);
+    }
+    *en = face == 2 ? ny : nx;
+    *ed = face == 2 ? ady : adx;
+    if (sx == 0 && sy == 0) {
+        *en = r->tend_n;
+        *ed = r->tend_d;
+    }
+    return face;
+}
+
+/* Whether the ray may meet tile entry e's terrain between tn / td and its
+ * exit en / ed: its lowest point there (at the exit, or tend if earlier,
+ * for a descending ray; else at the entry) at or below the tile's tallest
+ * post, or the manifest does not say.  Lowered terrain is lower still.
+ * z d = oz d + n dz < 2^61 (trace.c's exit_sign), hmax 2^16 d < 2^59. */
+static int tile_may_hit(const uint8_t *e, const ct_prepared *r, int64_t tn, int64_t td, int64_t en, int64_t ed)
+{
+    int64_t ln = tn, ld = td;
+    if (r->dz < 0) {
+        ln = en;
+        ld = ed;
+        if (t_lt(r->tend_n, r->tend_d, ln, ld)) {
+            ln = r->tend_n;
+            ld = r->tend_d;
+        }
+    }
+    return e[12] == 0u || r->oz * ld + ln * (int64_t)r->dz <= (int64_t)ct_ld16(e + 10) * (ONE16 >> r->zshift) * ld;
+}
+
+/* The walk over tile tp from tn / td (entry face(s) eface, cell (i, j) of
+ * the tile's grid): the ray (and the observer) shifted into the tile's grid
+ * in place and back -- no copies on the walk's stack -- and a hit moved
+ * back into the frame's.  Its steps and iterations add to *h's. */
+static ct_status walk_tile(const ct_package *tp, ct_prepared *r, int64_t x0, int64_t y0, int64_t tn, int64_t td,
+                           int eface, int32_t i, int32_t j, const ct_lower *lw, ct_method m, ct_hit *h)
+{
+    const uint32_t steps = h->steps, iters = h->iters;
+    ct_lower ll;
+    ct_status st;
+    r->ox -= x0 * ONE16;
+    r->oy -= y0 * ONE16;
+    if (lw != NULL) {
+        lower_shifted(lw, x0 * ONE16, y0 * ONE16, &ll);
+    }
+    st = ct_trace_tile(tp, r, tn, td, eface, i, j, lw != NULL ? &ll : NULL, m, h);
+    r->ox += x0 * ONE16;
+    r->oy += y0 * ONE16;
+    h->steps += steps;
+    h->iters += iters;
+    if (st == CT_HIT || st == CT_HIT_VOID) {
+        /* the tile's map position is the frame's: its origin is the
+         * frame's plus x0 postings exactly, so ct_grid_to_map rounded the
+         * same product (less x0 2^16 posting) */
+        h->x_q16 += x0 * ONE16;
+        h->y_q16 += y0 * ONE16;
+        h->cell_x += (int32_t)x0;
+        h->cell_y += (int32_t)y0;
+    }
+    return st;
+}
+
 /* The trace over the set; lw: the lowered model in the frame's grid
  * (NULL: straight); seg, below_hit: ct_tileset_trace_segment's; *tend:
  * the prepared ray's end (NULL: not wanted). */
@@ -237,11 +373,10 @@ static ct_status set_trace(ct_tileset *ts, const ct_ray *ray, int seg, const ct_
     const ct_package *F = &ts->frame;
     const ct_package *tp = NULL; /* tile (a, bb) when already fetched */
     ct_prepared r;
-    ct_lower ll;
     ct_status st;
     int32_t i, j, ci, cj, sx, sy;
     uint32_t a, bb, it;
-    int64_t tn = 0, td = 1, adx, ady;
+    int64_t tn = 0, td = 1;
     int eface = 0; /* the walk's entry face(s) in tile (a, bb): 0 the first */
     ct_hit_clear(h);
     if ((unsigned)m >= (unsigned)CT_METHOD_COUNT) {
@@ -260,36 +395,9 @@ static ct_status set_trace(ct_tileset *ts, const ct_ray *ray, int seg, const ct_
     bb = tile_of(ts, cj, ts->tiles_y);
     sx = r.dx > 0 ? 1 : (r.dx < 0 ? -1 : 0);
     sy = r.dy > 0 ? 1 : (r.dy < 0 ? -1 : 0);
-    adx = ct_abs64(r.dx);
-    ady = ct_abs64(r.dy);
-    {
-        /* the first point above the tile's tallest post (the manifest
-         * says): started without loading it.  |oz 2^zs| <= 2^46. */
-        const uint8_t *e0 = ts->entries + (size_t)(bb * ts->tiles_x + a) * CT_SET_ENTRY_SIZE;
-        int64_t ox = (int64_t)tile_first(ts, a) * ONE16, oy = (int64_t)tile_first(ts, bb) * ONE16;
-        if (e0[12] != 0u && r.oz * (INT64_C(1) << r.zshift) > (int64_t)ct_ld16(e0 + 10) * ONE16) {
-            st = ct_tile_prep_finish(F, NULL, 0, 0, ci, cj, ray, seg, lw, &r);
-        } else {
-            tp = tile_get(ts, a, bb);
-            if (tp == NULL) {
-                r.tend_n = 0;
-                r.tend_d = 1;
-                r.start = CT_OK;
-                if (tend != NULL) { /* in the box, stopped at its first point */
-                    tend[0] = 0;
-                    tend[1] = 1;
-                }
-                return no_data(ts, &r, lw, a, bb, 0, 1, h);
-            }
-            if (lw != NULL) {
-                ll = *lw;
-                ll.obx -= ox;
-                ll.oby -= oy;
-            }
-            st = ct_tile_prep_finish(F, tp, ox, oy, ci, cj, ray, seg, lw != NULL ? &ll : NULL, &r);
-        }
-        i -= (int32_t)(ox >> 16);
-        j -= (int32_t)(oy >> 16);
+    st = set_start(ts, ray, seg, lw, a, bb, ci, cj, &r, &tp, &i, &j, tend, h);
+    if (st == CT_NO_DATA) {
+        return st;
     }
     if (st == CT_BELOW && below_hit) {
         r.start = CT_HIT; /* tend stays 0: the hit is at the first point */
@@ -305,79 +413,18 @@ static ct_status set_trace(ct_tileset *ts, const ct_ray *ray, int seg, const ct_
     /* bound: a ray crosses at most tiles_x + tiles_y - 1 tiles */
     for (it = 0u; it < ts->tiles_x + ts->tiles_y; ++it) {
         const uint8_t *e = ts->entries + (size_t)(bb * ts->tiles_x + a) * CT_SET_ENTRY_SIZE;
-        int64_t x0 = (int64_t)tile_first(ts, a), y0 = (int64_t)tile_first(ts, bb);
-        int64_t x1 = x0 + (int64_t)tile_posts_at(ts, a, F->width) - 1;
-        int64_t y1 = y0 + (int64_t)tile_posts_at(ts, bb, F->height) - 1;
-        int64_t nx = 0, ny = 0, en, ed, ln, ld;
-        int face;
-        /* where the ray leaves the tile (as trace.c's cell exit) */
-        if (sx != 0) {
-            nx = ((sx > 0 ? x1 : x0) * ONE16 - r.ox) * sx;
-        }
-        if (sy != 0) {
-            ny = ((sy > 0 ? y1 : y0) * ONE16 - r.oy) * sy;
-        }
-        if (sy == 0) {
-            face = 1;
-        } else if (sx == 0) {
-            face = 2;
-        } else {
-            int64_t lx = nx * ady, ly = ny * adx;
-            face = lx < ly ? 1 : (ly < lx ? 2 : 3);
-        }
-        en = face == 2 ? ny : nx;
-        ed = face == 2 ? ady : adx;
-        if (sx == 0 && sy == 0) {
-            en = r.tend_n; /* a vertical ray stays in its tile */
-            ed = r.tend_d;
-        }
-        /* the ray's lowest point on the tile: at its exit (descending, the
-         * earlier of the exit and tend) or entry; above the tile's tallest
-         * post, nothing there can be hit (lowered terrain is lower still):
-         * z d = oz d + n dz < 2^61 (trace.c's exit_sign), hmax 2^16 d <
-         * 2^59 */
-        ln = tn;
-        ld = td;
-        if (r.dz < 0) {
-            ln = en;
-            ld = ed;
-            if (t_lt(r.tend_n, r.tend_d, ln, ld)) {
-                ln = r.tend_n;
-                ld = r.tend_d;
-            }
-        }
-        if (e[12] == 0u || r.oz * ld + ln * (int64_t)r.dz <= (int64_t)ct_ld16(e + 10) * (ONE16 >> r.zshift) * ld) {
-            const uint32_t steps = h->steps, iters = h->iters;
+        int64_t en, ed;
+        const int face = tile_exit(ts, &r, a, bb, &en, &ed);
+        if (tile_may_hit(e, &r, tn, td, en, ed)) {
             if (tp == NULL) {
                 tp = tile_get(ts, a, bb);
                 if (tp == NULL) {
                     return no_data(ts, &r, lw, a, bb, tn, td, h);
                 }
             }
-            /* the ray (and the observer) in the tile's grid, shifted in
-             * place and back: no copies on the walk's stack */
-            r.ox -= x0 * ONE16;
-            r.oy -= y0 * ONE16;
-            if (lw != NULL) {
-                ll = *lw;
-                ll.obx -= x0 * ONE16;
-                ll.oby -= y0 * ONE16;
-            }
-            st = ct_trace_tile(tp, &r, tn, td, eface, i, j, lw != NULL ? &ll : NULL, m, h);
-            r.ox += x0 * ONE16;
-            r.oy += y0 * ONE16;
-            h->steps += steps;
-            h->iters += iters;
+            st = walk_tile(tp, &r, (int64_t)tile_first(ts, a), (int64_t)tile_first(ts, bb), tn, td, eface, i, j, lw,
+                           m, h);
             if (st != CT_MISS) {
-                if (st == CT_HIT || st == CT_HIT_VOID) {
-                    /* the tile's map position is the frame's: its origin is
-                     * the frame's plus x0 postings exactly, so ct_grid_to_map
-                     * rounded the same product (less x0 2^16 posting) */
-                    h->x_q16 += x0 * ONE16;
-                    h->y_q16 += y0 * ONE16;
-                    h->cell_x += (int32_t)x0;
-                    h->cell_y += (int32_t)y0;
-                }
                 return st;
             }
         }

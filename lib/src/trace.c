@@ -67,6 +67,8 @@ typedef struct {
                            canonical entry of the tile's first cell         */
     int32_t i0, j0;     /* the cell holding the ray at t0 (located, or the
                            tile set's)                                      */
+    int prefetch;       /* hosts: ask for the next cone's code early (the
+                           angle planes, or a tile set's, are large)        */
 } ctx;
 
 /* Height code h >= 0 (< 2^17) in the ray's z units: one 32x32 product. */
@@ -917,12 +919,6 @@ static ct_status walk_cones(const ctx *c, uint32_t plane, ct_hit *h)
     int tin_ok = 1;
     int64_t lb;      /* lower_ahead at (i, j), -1 when not formed */
     cexit e;
-#if CT_HAVE_PREFETCH
-    /* angle planes far beyond a host's L2 cache (over 1 MB): a step's code
-     * is a miss, so the one a jump as long again would reach is asked for
-     * early (below) */
-    const int pf = (uint64_t)p->coarse_x * p->coarse_y * p->sectors > (UINT64_C(1) << 20);
-#endif
     i = c->i0;
     j = c->j0;
     /* bound: each iteration leaves at least one fine cell */
@@ -985,7 +981,7 @@ static ct_status walk_cones(const ctx *c, uint32_t plane, ct_hit *h)
                     locate(c, tj, &ni, &nj);
                     if (ni != i || nj != j) {
 #if CT_HAVE_PREFETCH
-                        if (pf) {
+                        if (c->prefetch) {
                             /* a hint only: T2 = tn + dt < 2^36, times |d| <=
                              * 2^26; a cell off the tile is not asked for */
                             int64_t T2 = tn + dt;
@@ -1234,6 +1230,11 @@ static ct_status trace_impl(const ct_package *p, const ct_prepared *r, ct_method
     c.lw = lw;
     c.ratio_q30 = 0;
     c.t0 = ws != NULL ? ws->t0 : T_ZERO;
+    /* angle planes far beyond a host's L2 cache (over 1 MB), or a tile of a
+     * set (its tiles' planes together): a cone step's code is a miss, so
+     * walk_cones asks for the next one early (hosts only) */
+    c.prefetch = CT_HAVE_PREFETCH &&
+                 (ws != NULL || (uint64_t)p->coarse_x * p->coarse_y * p->sectors > (UINT64_C(1) << 20));
     if (lw != NULL && lw->cull && (r->dx != 0 || r->dy != 0)) {
         /* len_lo 2^30 < 2^56.5; the quotient in [2^30, 2^30.5] */
         c.ratio_q30 = (r->len_lo << 30) / (c.adx >= c.ady ? c.adx : c.ady);
