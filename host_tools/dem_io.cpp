@@ -18,7 +18,6 @@
 #include <tiffio.h>
 #include <xtiffio.h>
 
-#include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -401,12 +400,15 @@ void write_tiff(const std::string &path, int width, int height, const std::vecto
     MsgSink sink;  // must outlive the TIFF handle
     SinkScope scope(&sink);
     TempOutput tmp(path);
-    const int fd = tmp.fd();
-
+    // TIFFClose closes the descriptor it was given: a duplicate, so that tmp
+    // syncs, closes and renames the file itself on commit
+    const int fd = ::dup(tmp.fd());
     const bool big = data.size() > 0xE0000000ull;
-    TiffPtr tif(open_tiff(tmp.temp_path(), big ? "w8" : "w", sink, fd));
-    if (!tif) throw fail("cannot open for writing: " + sink.text("unknown libtiff error"));
-    tmp.fd_handed_over();  // TIFFClose closes it
+    TiffPtr tif(fd < 0 ? nullptr : open_tiff(tmp.temp_path(), big ? "w8" : "w", sink, fd));
+    if (!tif) {
+        if (fd >= 0) ::close(fd);
+        throw fail("cannot open for writing: " + sink.text(fd < 0 ? std::strerror(errno) : "unknown libtiff error"));
+    }
     TIFF *t = tif.get();
     auto check = [&](bool ok, const char *what) {
         if (!ok || !sink.errors.empty())
@@ -461,11 +463,9 @@ void write_tiff(const std::string &path, int width, int height, const std::vecto
         check(TIFFWriteEncodedStrip(t, strip, chunk.data(), bytes) == bytes, "writing pixel data");
     }
     check(TIFFFlush(t) == 1, "writing TIFF directory");
-    if (::fsync(TIFFFileno(t)) != 0 && errno != EINVAL && errno != EROFS)
-        throw fail(std::string("fsync failed: ") + std::strerror(errno));
-    tif.reset();  // closes fd
+    tif.reset();  // closes the duplicate
     check(true, "closing TIFF");
-    tmp.commit();
+    tmp.commit();  // fsync, close, rename
 }
 
 }  // namespace

@@ -37,9 +37,13 @@ void open_package_file(const std::string &path, std::vector<uint8_t> *bytes, ct_
 
 AtomicFile::AtomicFile(const std::string &path) : tmp_(path)
 {
-    f_ = ::fdopen(tmp_.fd(), "wb");
-    if (!f_) tmp_.fail(errno);
-    tmp_.fd_handed_over();  // the stream owns it now
+    const int fd = ::dup(tmp_.fd());  // the stream closes its own
+    f_ = fd < 0 ? nullptr : ::fdopen(fd, "wb");
+    if (!f_) {
+        const int err = errno;
+        if (fd >= 0) ::close(fd);
+        tmp_.fail(err);
+    }
 }
 
 AtomicFile::~AtomicFile()
@@ -62,12 +66,12 @@ void AtomicFile::patch(size_t offset, const void *p, size_t n)
 
 void AtomicFile::commit()
 {
-    if (std::fflush(f_) != 0) tmp_.fail(errno);
-    if (::fsync(::fileno(f_)) != 0 && errno != EINVAL && errno != EROFS) tmp_.fail(errno);
     std::FILE *f = f_;
     f_ = nullptr;
-    if (std::fclose(f) != 0) tmp_.fail(errno);
-    tmp_.commit();
+    const bool flushed = std::fflush(f) == 0;
+    const int err = errno;
+    if (std::fclose(f) != 0 || !flushed) tmp_.fail(flushed ? errno : err);
+    tmp_.commit();  // fsync, close, rename
 }
 
 void write_file_atomic(const std::string &path, const std::vector<uint8_t> &bytes)

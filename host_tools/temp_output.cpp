@@ -47,13 +47,11 @@ void TempOutput::fail(int err) const { throw Error(path_ + ": cannot write (" + 
 
 void TempOutput::commit()
 {
-    if (fd_ >= 0) {
-        // EINVAL / EROFS: a file system that cannot sync (the data is written)
-        if (::fsync(fd_) != 0 && errno != EINVAL && errno != EROFS) fail(errno);
-        const int fd = fd_;
-        fd_ = -1;
-        if (::close(fd) != 0) fail(errno);
-    }
+    // EINVAL / EROFS: a file system that cannot sync (the data is written)
+    if (::fsync(fd_) != 0 && errno != EINVAL && errno != EROFS) fail(errno);
+    const int fd = fd_;
+    fd_ = -1;
+    if (::close(fd) != 0) fail(errno);
     if (std::rename(tmp_.c_str(), path_.c_str()) != 0)
         throw Error(path_ + ": cannot rename the temporary file '" + tmp_ + "' onto it (" + std::strerror(errno) + ")");
     done_ = true;

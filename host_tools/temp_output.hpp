@@ -20,12 +20,11 @@ public:
     ~TempOutput();
     TempOutput(const TempOutput &) = delete;
     TempOutput &operator=(const TempOutput &) = delete;
+    // The descriptor stays TempOutput's: a writer that closes what it is
+    // given (fclose of an fdopen'ed stream, TIFFClose) gets a dup of it.
     int fd() const { return fd_; }
     const std::string &temp_path() const { return tmp_; }
-    // A writer that closes the descriptor itself (fclose of an fdopen'ed
-    // stream, TIFFClose) says so first, after its own fsync.
-    void fd_handed_over() { fd_ = -1; }
-    // fsync and close the descriptor if still held, then rename.
+    // After the writer flushed: fsync, close, rename.
     void commit();
     [[noreturn]] void fail(int err) const;
 

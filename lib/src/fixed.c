@@ -36,26 +36,24 @@ static uint64_t knuth_digit(uint64_t un, uint64_t un_next, uint64_t vn1, uint64_
  * the remainder are < vn. */
 static uint64_t udiv128(uint64_t hi, uint64_t lo, uint64_t d, uint64_t *rem)
 {
-#if defined(CT_NATIVE_INT128) && defined(__x86_64__) && defined(__GNUC__)
-    /* x86-64's DIV divides hi:lo by d in one instruction (hi < d: the
-     * quotient fits); the compiler's 128-bit division would call a general
-     * library routine instead */
-    uint64_t q, r;
-    if (hi < d) { /* else DIV would trap; the C division below wraps as the
-                     portable path does (callers keep hi < d) */
+#ifdef CT_NATIVE_INT128
+#if defined(__x86_64__) && defined(__GNUC__)
+    /* x86-64's DIV divides hi:lo by d in one instruction when the quotient
+     * fits (hi < d, as callers keep it; else DIV would trap and the C
+     * division below wraps, as the portable path does); the compiler's
+     * 128-bit division would call a general library routine instead */
+    if (hi < d) {
+        uint64_t q, r;
         __asm__("divq %4" : "=a"(q), "=d"(r) : "a"(lo), "d"(hi), "rm"(d) : "cc");
         *rem = r;
         return q;
     }
+#endif
     {
         ct_nu128 n = ((ct_nu128)hi << 64) | (ct_nu128)lo;
         *rem = (uint64_t)(n % d);
         return (uint64_t)(n / d);
     }
-#elif defined(CT_NATIVE_INT128)
-    ct_nu128 n = ((ct_nu128)hi << 64) | (ct_nu128)lo;
-    *rem = (uint64_t)(n % d);
-    return (uint64_t)(n / d);
 #else
     const uint64_t m32 = 0xFFFFFFFFu;
     unsigned s = 64u - ct_bitlen64(d); /* leading zeros; d > 0 */

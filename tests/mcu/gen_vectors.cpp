@@ -1017,7 +1017,6 @@ std::vector<Pkg> make_packages(const Dem &dem, int nrays, std::string *generator
         uint32_t n, r;
     };
     const Spec specs[] = {{8, 2}, {24, 1}};
-    std::string &gen_name = *generator;
     std::vector<Pkg> pkgs;
     Rng g(20240601u);
     for (const Spec &s : specs) {
@@ -1040,7 +1039,7 @@ std::vector<Pkg> make_packages(const Dem &dem, int nrays, std::string *generator
             std::fprintf(stderr, "gen_vectors: WARNING: build_package N=%u r=%u threw: %s\n", s.n, s.r, e.what());
         }
         if (st != CT_OK) {
-            gen_name = "degenerate (FALLBACK: build_package failed)";
+            *generator = "degenerate (FALLBACK: build_package failed)";
         }
         std::snprintf(nm_, sizeof nm_, "N%u_r%u_%s", s.n, s.r, st == CT_OK ? "build_package" : "degenerate_fallback");
 #else
