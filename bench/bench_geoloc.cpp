@@ -23,7 +23,10 @@
 // disagree.
 //
 // Options: --quick (every 4th pixel in each direction, 300 samples),
-//          --samples N, --scene NAME (only that one).
+//          --samples N, --scene NAME (only that one),
+//          --profile B (no table: B batches of the whole image with the
+//          scene's effects and the 8 px grid, directional, for perf or
+//          callgrind; prints ns per pixel of the best batch).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -69,7 +72,7 @@ Run geolocate(const scene::World &w, const std::vector<int64_t> &uv, ct_method m
 
 int main(int argc, char **argv)
 {
-    int stride = 1, samples = 2000;
+    int stride = 1, samples = 2000, profile = 0;
     std::string only;
     for (int k = 1; k < argc; ++k) {
         if (!std::strcmp(argv[k], "--quick")) {
@@ -79,12 +82,15 @@ int main(int argc, char **argv)
             samples = std::atoi(argv[++k]);
         } else if (!std::strcmp(argv[k], "--scene") && k + 1 < argc) {
             only = argv[++k];
+        } else if (!std::strcmp(argv[k], "--profile") && k + 1 < argc) {
+            profile = std::max(1, std::atoi(argv[++k]));
         } else {
-            std::fprintf(stderr, "usage: ct_bench_geoloc [--quick] [--samples N] [--scene NAME]\n");
+            std::fprintf(stderr, "usage: ct_bench_geoloc [--quick] [--samples N] [--scene NAME] [--profile B]\n");
             return 2;
         }
     }
     const char *names[] = {"nadir", "oblique30", "grazing3", "long30km", "wide_opencv8"};
+    if (profile == 0) {
     std::printf("geolocation benchmark: every %spixel of each scene's image, one thread; ns per pixel\n",
                 stride == 1 ? "" : "4th (--quick) ");
     std::printf("| scene | effects | pixels hit | unproject ns | directional: trace ns / steps | incremental: trace ns / "
@@ -92,6 +98,7 @@ int main(int argc, char **argv)
                 "straight (dir.) | true Earth dir.: trace ns / steps | true Earth / sphere | true Earth fitted dir.: trace ns "
                 "/ steps | fitted / straight | whole image dir. ns: lens / 8 px grid |\n");
     std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+    }
     for (const char *name : names) {
         if (!only.empty() && only != name) continue;
         scene::World *w;
@@ -143,6 +150,14 @@ int main(int argc, char **argv)
             return 1;
         }
         std::vector<ct_geo> gg;
+        if (profile > 0) {
+            double best = 1e30;
+            for (int b = 0; b < profile; ++b)
+                best = std::min(best, geolocate(*w, uv, CT_METHOD_DIRECTIONAL, &fx, &gg, &grid_cam).ns);
+            std::printf("%s: whole image, 8 px grid, directional: %.0f ns per pixel (best of %d)\n", name, best, profile);
+            delete w;
+            continue;
+        }
         std::vector<double> r_eff, r_inc, r_true, r_fit;
         for (int round = 0; round <= rounds; ++round) {
             double u = unproject_ns();

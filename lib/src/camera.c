@@ -483,17 +483,19 @@ ct_status ct_camera_init_grid(ct_camera *cam, const ct_unproject_grid *g)
     return CT_OK;
 }
 
-/* Catmull-Rom weights, doubled, for t in [0, 1) given in Q20: Q60.  Each
- * term < 5 * 2^60 < 2^63; the weights sum to 2^61 and sum |w| < 2.6 * 2^60. */
+/* Catmull-Rom weights, doubled, for t in [0, 1) given in Q20: Q30.  The
+ * polynomials are formed in Q60 (each term < 5 * 2^60 < 2^63) and rounded to
+ * Q30: the weights sum to 2^31 (within 2 LSB) and sum |w| < 2.6 * 2^30. */
 static void cr_weights(int64_t t, int64_t w[4])
 {
     int64_t t2 = t * t << GRID_T_BITS; /* t^2, Q60 */
     int64_t t3 = t * t * t;            /* t^3, Q60 */
     int64_t t1 = t << 40;              /* t, Q60   */
-    w[0] = -t3 + 2 * t2 - t1;
-    w[1] = 3 * t3 - 5 * t2 + (INT64_C(2) << 60);
-    w[2] = -3 * t3 + 4 * t2 + t1;
-    w[3] = t3 - t2;
+    const int64_t half = INT64_C(1) << 29;
+    w[0] = (-t3 + 2 * t2 - t1 + half) >> 30;
+    w[1] = (3 * t3 - 5 * t2 + (INT64_C(2) << 60) + half) >> 30;
+    w[2] = (-3 * t3 + 4 * t2 + t1 + half) >> 30;
+    w[3] = (t3 - t2 + half) >> 30;
 }
 
 /* Node index and fraction (Q20) along one axis: the pixel lies in
@@ -511,55 +513,65 @@ static int grid_axis(int64_t p, int64_t p0, int64_t step, uint32_t n, uint32_t *
     return 1;
 }
 
+/* Bicubic (Catmull-Rom) interpolation of the 4 x 4 nodes around the pixel,
+ * then normalised; all in 64 bits.  Scaling and overflow: nodes |r| <=
+ * 2^30 + 2^12 (checked at init), weights Q30 with sum |w| < 2.6 * 2^30, so
+ * a row's sum sum_a w_a r_a < 2.6 * 2^60.01 < 2^62 (Q60, doubled), rounded
+ * to Q30 (< 2^31.4); the column's sum_b w_b row_b < 2.6 * 2^31.4 * 2^30 <
+ * 2^62.8 (Q60, four times the interpolated vector: coherent unit rays give
+ * |V| ~ 2^62).  V >> 32 (rounded) leaves |V'_k| < 2^30.8 and |V'|^2 < 3 *
+ * 2^61.6 < 2^64 (unsigned).  |V'| shorter than 2^29 means the 16 rays
+ * disagree.  The unit result is |V'_k| f / 2^32 with f = floor(2^62 / L),
+ * L = floor(|V'|) >= 2^29: f <= 2^33, products < 2^63.8 (unsigned). */
 static ct_status grid_unproject(const ct_camera *c, int64_t u, int64_t v, int32_t out[3])
 {
     const ct_unproject_grid *g = &c->grid;
     uint32_t i, j, a, b, k;
     int64_t tu, tv, wu[4], wv[4], row[4][3], V[3];
-    ct_i128 l2;
-    int64_t L;
+    uint64_t l2 = 0u, L, f;
     if (!grid_axis(u, g->u0_q16, g->step_q16, g->nu, &i, &tu) ||
         !grid_axis(v, g->v0_q16, g->step_q16, g->nv, &j, &tv)) {
         return CT_ERR_UNPROJECT;
     }
     cr_weights(tu, wu);
     cr_weights(tv, wv);
-    /* along u for rows j-1 .. j+2: |w| < 2^61.3, |ray| <= 2^30: sums
-     * < 2^93 (128-bit); >> 44 leaves < 2^49.  bound: 4 x 4 x 3 */
+    /* along u for rows j-1 .. j+2.  bound: 4 x 4 x 3 */
     for (b = 0u; b < 4u; ++b) {
         const int32_t *rowp = g->rays_q30 + 3u * ((j + b - 1u) * g->nu + (i - 1u));
-        for (k = 0u; k < 3u; ++k) {
-            ct_i128 acc = ct_i128_from64(0);
-            for (a = 0u; a < 4u; ++a) {
-                const int32_t *r = rowp + 3u * a;
-                if (k == 0u && r[0] == 0 && r[1] == 0 && r[2] == 0) {
-                    return CT_ERR_UNPROJECT; /* a node without a ray */
-                }
-                acc = ct_i128_add(acc, ct_i128_mul(wu[a], r[k]));
+        int64_t acc[3] = {0, 0, 0};
+        for (a = 0u; a < 4u; ++a) {
+            const int32_t *r = rowp + 3u * a;
+            if (r[0] == 0 && r[1] == 0 && r[2] == 0) {
+                return CT_ERR_UNPROJECT; /* a node without a ray */
             }
-            row[b][k] = ct_i128_to64(ct_i128_sar(acc, 44u));
+            acc[0] += wu[a] * r[0];
+            acc[1] += wu[a] * r[1];
+            acc[2] += wu[a] * r[2];
+        }
+        for (k = 0u; k < 3u; ++k) { /* bound: 3 components */
+            row[b][k] = (acc[k] + (INT64_C(1) << 29)) >> 30;
         }
     }
-    /* along v: < 4 * 2^61.3 * 2^49 = 2^112.3; >> 62 leaves < 2^51 */
+    /* along v, then V' = V / 2^32 rounded.  bound: 3 x 4 */
     for (k = 0u; k < 3u; ++k) {
-        ct_i128 acc = ct_i128_from64(0);
+        int64_t acc = 0;
         for (b = 0u; b < 4u; ++b) {
-            acc = ct_i128_add(acc, ct_i128_mul(wv[b], row[b][k]));
+            acc += wv[b] * row[b][k];
         }
-        V[k] = ct_i128_to64(ct_i128_sar(acc, 62u));
+        V[k] = (acc + (INT64_C(1) << 31)) >> 32;
+        l2 += (uint64_t)(V[k] * V[k]);
     }
-    /* coherent unit rays give |V| ~ 2^46 (weights sum to 2, Q60 x Q30 >>
-     * 106): shorter than 2^45 means the 16 rays disagree */
-    l2 = ct_i128_add(ct_i128_add(ct_i128_mul(V[0], V[0]), ct_i128_mul(V[1], V[1])), ct_i128_mul(V[2], V[2]));
-    L = (int64_t)ct_i128_isqrt(l2); /* l2 < 3 * 2^102 */
-    if (L < (INT64_C(1) << 45)) {
+    L = ct_isqrt64(l2);
+    if (L < (UINT64_C(1) << 29)) {
         return CT_ERR_UNPROJECT;
     }
-    /* bound: 3 components; |V 2^30| < 2^81, quotient <= 2^30 */
+    f = (UINT64_C(1) << 62) / L;
+    /* bound: 3 components; a quotient just above 2^30 (V' along an axis,
+     * L rounded down) is clamped to the unit */
     for (k = 0u; k < 3u; ++k) {
-        int64_t q = 0;
-        (void)ct_i128_round_div_lim(ct_i128_shl(ct_i128_from64(V[k]), 30u), L, INT64_C(1) << 30, &q);
-        out[k] = (int32_t)q;
+        uint64_t q = ((uint64_t)ct_abs64(V[k]) * f + (UINT64_C(1) << 31)) >> 32;
+        int32_t m = q > (UINT64_C(1) << 30) ? (INT32_C(1) << 30) : (int32_t)q;
+        out[k] = V[k] < 0 ? -m : m;
     }
     /* the result must lie within 60 deg of each of its 16 nodes (cos >=
      * 1/2: dot >= 2^59 in Q60; products < 2^61, sums < 2^63).
