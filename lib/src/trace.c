@@ -1190,6 +1190,114 @@ typedef struct {
     int32_t i, j;
 } wstart;
 
+/* The walk's context for prepared ray r on p (lw: a bent ray's lowered
+ * terrain, or NULL; ws: a tile set's start, or NULL). */
+static void set_ctx(ctx *c, const ct_package *p, const ct_prepared *r, const ct_lower *lw, const wstart *ws)
+{
+    c->p = p;
+    c->r = r;
+    c->sx = sgn64(r->dx);
+    c->sy = sgn64(r->dy);
+    c->adx = ct_abs64(r->dx);
+    c->ady = ct_abs64(r->dy);
+    c->cx = (int32_t)p->cells_x;
+    c->cy = (int32_t)p->cells_y;
+    c->zs = (unsigned)r->zshift;
+    c->zone = (uint32_t)1 << (16u - c->zs);
+    c->zmul = (uint32_t)1 << c->zs;
+    c->dzf = (int64_t)r->dz * (int64_t)c->zmul;
+    c->tend.n = r->tend_n;
+    c->tend.d = r->tend_d;
+    c->lw = lw;
+    c->ratio_q30 = 0;
+    c->t0 = ws != NULL ? ws->t0 : T_ZERO;
+    /* angle planes far beyond a host's L2 cache (over 1 MB), or a tile of a
+     * set (its tiles' planes together): a cone step's code is a miss, so
+     * walk_cones asks for the next one early (hosts only) */
+    c->prefetch = CT_HAVE_PREFETCH &&
+                 (ws != NULL || (uint64_t)p->coarse_x * p->coarse_y * p->sectors > (UINT64_C(1) << 20));
+    if (lw != NULL && lw->cull && (r->dx != 0 || r->dy != 0)) {
+        /* len_lo 2^30 < 2^56.5; the quotient in [2^30, 2^30.5] */
+        c->ratio_q30 = (r->len_lo << 30) / (c->adx >= c->ady ? c->adx : c->ady);
+    }
+}
+
+/* A walk that starts at t0 > 0 on a tile's entry face (ws).  Returns 1
+ * with the trace's result in *st when the seam point decides it, else 0
+ * with the walk's first cell in c->i0, c->j0. */
+static int seam_start(ctx *c, ct_method m, const wstart *ws, ct_hit *h, ct_status *st)
+{
+    /* a tile set's later tile: the walk starts on the seam, where the
+     * previous tile's walk left the ray above its surface (a cell test
+     * found f > 0 there, or a cone promised no point strictly below the
+     * surface).  f = 0 -- the ray touching the surface on the seam
+     * after a cone jump -- is a hit there.  The cone walks see f > 0
+     * from the cone above the seam point where there is one; the sign
+     * is tested from the posts otherwise. */
+    int32_t i, j;
+    const ct_package *p = c->p;
+    const ct_prepared *r = c->r;
+    if (r->start != CT_OK || (r->dx == 0 && r->dy == 0)) {
+        *st = CT_ERR_RAY;
+        return 1;
+    }
+    /* on the entry face the cell is known; the other axis located */
+    i = (ws->face & 1) ? ws->i : locate_axis(r->ox, r->dx, c->sx, c->cx, c->t0);
+    j = (ws->face & 2) ? ws->j : locate_axis(r->oy, r->dy, c->sy, c->cy, c->t0);
+    if (!inside(c, i, j)) {
+        *st = CT_MISS;
+        return 1;
+    }
+    if (m == CT_METHOD_INCREMENTAL || m == CT_METHOD_HIERARCHICAL ||
+        !above_apex(c, m == CT_METHOD_CONE ? (p->sectors == 1u ? 0u : p->sectors) : (uint32_t)r->sector, i,
+                    j)) {
+        if (entry_sign(c, i, j, c->t0) <= 0) {
+            fill_hit(c, c->t0.d == T_ONE ? c->t0.n : ct_floor_div(c->t0.n * T_ONE, c->t0.d), i, j, h);
+            h->steps = 1u;
+            h->iters = 1u;
+            *st = hit_status(p, i, j);
+            return 1;
+        }
+    }
+    c->i0 = i;
+    c->j0 = j;
+    return 0;
+}
+
+/* A vertical ray (f(0) > 0 was established at preparation): its hit
+ * below the first point, or a miss when it rises. */
+static ct_status vertical_trace(const ctx *c, ct_hit *h)
+{
+    const ct_package *p = c->p;
+    const ct_prepared *r = c->r;
+    const ct_lower *lw = c->lw;
+    int32_t i, j;
+    int64_t s, tq;
+    h->steps = 1u;
+    h->iters = 1u;
+    if (r->dz > 0) {
+        return CT_MISS;
+    }
+    locate(c, T_ZERO, &i, &j);
+    if (lw != NULL) {
+        /* the lowered surface rounded up to Q16 2^16 (a hit at or
+         * above it); |s| < 2^50 as below */
+        ct_i128 sl = ct_surface_low_q48(p, lw, i, j, r->ox, r->oy);
+        s = -ct_i128_floor_div(ct_i128_neg(sl), ONE16);
+    } else {
+        s = surface_q32(p, i, j, r->ox, r->oy);
+    }
+    /* t = (oz*2^16 - s) / (2^16 * |dz|) ; in Q26, floored:
+     * (oz*2^16 - s) < 2^50, * 2^26 / 2^16 = * 2^10: < 2^60 */
+    tq = ct_floor_div((r->oz * ONE16 - s) * 1024, -(int64_t)r->dz);
+    fill_hit(c, tq, i, j, h);
+    /* report the exact surface height at a vertical hit (for a bent
+     * ray: the lowered surface's, plus the rise there) */
+    h->z_q16 = -ct_floor_div(-s, ONE16) + (lw != NULL ? ct_lower_at(lw, h->x_q16, h->y_q16) : 0);
+    (void)ct_grid_to_map(p, h->x_q16, h->y_q16, h->z_q16, &h->e_nm, &h->n_nm, &h->h_nm);
+    return hit_status(p, i, j);
+}
+
 /* ws: where the walk starts (a tile set's tile); NULL: t = 0, located. */
 static ct_status trace_impl(const ct_package *p, const ct_prepared *r, ct_method m, int checked,
                             const ct_lower *lw, const wstart *ws, ct_hit *h)
@@ -1213,62 +1321,11 @@ static ct_status trace_impl(const ct_package *p, const ct_prepared *r, ct_method
     if (st != CT_OK) {
         return st;
     }
-    c.p = p;
-    c.r = r;
-    c.sx = sgn64(r->dx);
-    c.sy = sgn64(r->dy);
-    c.adx = ct_abs64(r->dx);
-    c.ady = ct_abs64(r->dy);
-    c.cx = (int32_t)p->cells_x;
-    c.cy = (int32_t)p->cells_y;
-    c.zs = (unsigned)r->zshift;
-    c.zone = (uint32_t)1 << (16u - c.zs);
-    c.zmul = (uint32_t)1 << c.zs;
-    c.dzf = (int64_t)r->dz * (int64_t)c.zmul;
-    c.tend.n = r->tend_n;
-    c.tend.d = r->tend_d;
-    c.lw = lw;
-    c.ratio_q30 = 0;
-    c.t0 = ws != NULL ? ws->t0 : T_ZERO;
-    /* angle planes far beyond a host's L2 cache (over 1 MB), or a tile of a
-     * set (its tiles' planes together): a cone step's code is a miss, so
-     * walk_cones asks for the next one early (hosts only) */
-    c.prefetch = CT_HAVE_PREFETCH &&
-                 (ws != NULL || (uint64_t)p->coarse_x * p->coarse_y * p->sectors > (UINT64_C(1) << 20));
-    if (lw != NULL && lw->cull && (r->dx != 0 || r->dy != 0)) {
-        /* len_lo 2^30 < 2^56.5; the quotient in [2^30, 2^30.5] */
-        c.ratio_q30 = (r->len_lo << 30) / (c.adx >= c.ady ? c.adx : c.ady);
-    }
+    set_ctx(&c, p, r, lw, ws);
     if (c.t0.n > 0) {
-        /* a tile set's later tile: the walk starts on the seam, where the
-         * previous tile's walk left the ray above its surface (a cell test
-         * found f > 0 there, or a cone promised no point strictly below the
-         * surface).  f = 0 -- the ray touching the surface on the seam
-         * after a cone jump -- is a hit there.  The cone walks see f > 0
-         * from the cone above the seam point where there is one; the sign
-         * is tested from the posts otherwise. */
-        int32_t i, j;
-        if (r->start != CT_OK || (r->dx == 0 && r->dy == 0)) {
-            return CT_ERR_RAY;
+        if (seam_start(&c, m, ws, h, &st)) {
+            return st;
         }
-        /* on the entry face the cell is known; the other axis located */
-        i = (ws->face & 1) ? ws->i : locate_axis(r->ox, r->dx, c.sx, c.cx, c.t0);
-        j = (ws->face & 2) ? ws->j : locate_axis(r->oy, r->dy, c.sy, c.cy, c.t0);
-        if (!inside(&c, i, j)) {
-            return CT_MISS;
-        }
-        if (m == CT_METHOD_INCREMENTAL || m == CT_METHOD_HIERARCHICAL ||
-            !above_apex(&c, m == CT_METHOD_CONE ? (p->sectors == 1u ? 0u : p->sectors) : (uint32_t)r->sector, i,
-                        j)) {
-            if (entry_sign(&c, i, j, c.t0) <= 0) {
-                fill_hit(&c, c.t0.d == T_ONE ? c.t0.n : ct_floor_div(c.t0.n * T_ONE, c.t0.d), i, j, h);
-                h->steps = 1u;
-                h->iters = 1u;
-                return hit_status(p, i, j);
-            }
-        }
-        c.i0 = i;
-        c.j0 = j;
     } else if (r->start == CT_HIT) {
         int32_t i, j;
         locate(&c, T_ZERO, &i, &j);
@@ -1281,32 +1338,7 @@ static ct_status trace_impl(const ct_package *p, const ct_prepared *r, ct_method
     } else if (r->start != CT_OK) {
         return CT_ERR_RAY;
     } else if (r->dx == 0 && r->dy == 0) {
-        /* vertical: f(0) > 0 was established at preparation */
-        int32_t i, j;
-        int64_t s, tq;
-        h->steps = 1u;
-        h->iters = 1u;
-        if (r->dz > 0) {
-            return CT_MISS;
-        }
-        locate(&c, T_ZERO, &i, &j);
-        if (lw != NULL) {
-            /* the lowered surface rounded up to Q16 2^16 (a hit at or
-             * above it); |s| < 2^50 as below */
-            ct_i128 sl = ct_surface_low_q48(p, lw, i, j, r->ox, r->oy);
-            s = -ct_i128_floor_div(ct_i128_neg(sl), ONE16);
-        } else {
-            s = surface_q32(p, i, j, r->ox, r->oy);
-        }
-        /* t = (oz*2^16 - s) / (2^16 * |dz|) ; in Q26, floored:
-         * (oz*2^16 - s) < 2^50, * 2^26 / 2^16 = * 2^10: < 2^60 */
-        tq = ct_floor_div((r->oz * ONE16 - s) * 1024, -(int64_t)r->dz);
-        fill_hit(&c, tq, i, j, h);
-        /* report the exact surface height at a vertical hit (for a bent
-         * ray: the lowered surface's, plus the rise there) */
-        h->z_q16 = -ct_floor_div(-s, ONE16) + (lw != NULL ? ct_lower_at(lw, h->x_q16, h->y_q16) : 0);
-        (void)ct_grid_to_map(p, h->x_q16, h->y_q16, h->z_q16, &h->e_nm, &h->n_nm, &h->h_nm);
-        return hit_status(p, i, j);
+        return vertical_trace(&c, h);
     }
     if (ws != NULL && ws->face == 0) {
         c.i0 = ws->i; /* the first point's cell, from the set */
