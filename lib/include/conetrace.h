@@ -967,7 +967,9 @@ ct_status ct_camera_init_grid(ct_camera *cam, const ct_unproject_grid *grid);
  *                      forward), Q30, z > 0.
  *   [out] iters        Newton iterations used (<= CT_UNPROJECT_MAX_ITERS).
  * Scaling and overflow: normalised coordinates in Q32 (x^2 + y^2 <= 64),
- * the distortion's Horner sums in Q44/Q38 (camera.c beside each product).  */
+ * the distortion's Horner sums in Q44/Q38 (camera.c beside each product).
+ * A grid: Catmull-Rom weights in Q30 times Q30 nodes, sums in Q60 below
+ * 2^63 in 64-bit, normalised by one reciprocal (grid_unproject).          */
 ct_status ct_camera_unproject(const ct_camera *cam, int64_t u_q16,
                               int64_t v_q16, int32_t ray_cam_q30[3],
                               uint32_t *iters);
