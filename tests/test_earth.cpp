@@ -2,7 +2,7 @@
 // exact mode (ct_effects CT_EFFECT_CURVATURE with earth_radius_nm == 0 on a
 // UTM package: a line of sight straight in Earth-fixed coordinates, bent by
 // refraction k t^2 / 2R when asked) against the independent PROJ reference
-// of tests/earth_reference.hpp.
+// of tests/kit/earth_reference.hpp.
 //
 // The fixture jacksboro_fault_dem.tif (EPSG:32617, 30 m posting, ~12 x 10
 // km, ~300 km west of zone 17's central meridian: point scale 1.0008,

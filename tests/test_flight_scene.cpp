@@ -27,7 +27,7 @@
 //       intrinsics.  Pixels outside the image are dropped; the reference
 //       traced from the (unrounded) pixel's mrcal-unprojected ray must hit P
 //       within kVisibleM, else P is occluded (counted, not used for (a));
-//   (b) the PROJ reference (tests/earth_reference.hpp) from the ray of the
+//   (b) the PROJ reference (tests/kit/earth_reference.hpp) from the ray of the
 //       pixel the library is given (Q16), for every pixel of (a) -- occluded
 //       ones included -- and some random pixels (misses, sky).
 // The library (ct_geolocate, CT_METHOD_DIRECTIONAL) geolocates every pixel:
