@@ -794,128 +794,143 @@ void compare(unsigned flags)
 // 2^47 nm, degrees 4 .. 6): the fit is interpolation, so the error is
 // largest between its points and near the cube's corners -- sampled at
 // random points, at the corners and on the faces' middles.
-void test_fitted_map()
+// The fitted image g (Q24 grid units) of Earth-fixed offset D against the
+// reference: long-double geodetic coordinates (PROJ's own ECEF -> geodetic
+// is one Bowring step, off by tens of um 70 km from the ellipsoid), PROJ's
+// transverse Mercator; the largest |dE|, |dN|, |dh| (m) so far in err.
+void fit_error(const ct_package &pk, const ct_earth &es, const int64_t D[3], const int64_t g[3], double err[3])
 {
     earth_ref::Proj &pj = proj();
-    World *w = jacksboro();
+    ld X[3], E, N, h, lat, lon;
+    for (int k = 0; k < 3; ++k) X[k] = (ld)(es.c[k] + D[k]) * 1e-9L;
+    earth_ref::geodetic_ld(X, &lat, &lon, &h);
+    pj.utm(lat * 180 / kPi, lon * 180 / kPi, &E, &N);
+    const ld fe = pk.origin_e_nm * 1e-9L + (ld)(g[0] + (INT64_C(1) << 23)) * (ld)pk.posting_e_nm * 1e-9L / 16777216.0L;
+    const ld fn = pk.origin_n_nm * 1e-9L + (ld)(g[1] + (INT64_C(1) << 23)) * (ld)pk.posting_n_nm * 1e-9L / 16777216.0L;
+    const ld fh = pk.height_offset_nm * 1e-9L + (ld)g[2] * (ld)pk.height_scale_nm * 1e-9L / 16777216.0L;
+    err[0] = std::max(err[0], (double)std::fabs(fe - E));
+    err[1] = std::max(err[1], (double)std::fabs(fn - N));
+    err[2] = std::max(err[2], (double)std::fabs(fh - h));
+}
+
+// The map ct_earth_setup fits for a camera back_km east of the tile (3 km
+// up, looking west 10 deg down): its cube's corners, edge and face middles
+// and centre and nrand random points against the reference, a point just
+// outside refused.  The cube's size joins *seen, its largest error *worst.
+void check_fit_for_camera(World *w, ld back_km, ct_rng *rng, int nrand, uint32_t *seen, double *worst)
+{
     const ct_package &pk = w->p;
+    Pose p;
+    TEST_ASSERT(make_pose(w->sf, {"far", 201045 + back_km * 1000, 4065840, 3000, 270, -10}, &p));
+    ct_earth es;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_earth_setup(&pk, &p.pose, CT_REFRACTION_K_STD_Q16, CT_EARTH_RADIUS_NM,
+                                                CT_EFFECTS_CHORD_NM, 0u, 1, nullptr, &es));
+    TEST_ASSERT_MSG(es.map == &es.fit && es.fit.deg >= 4 && es.fit.deg <= CT_EARTH_MAP_DEG,
+                    "no fit %d km back (range %.1f km)", (int)back_km, es.tmax_nm * 1e-12);
+    *seen |= 1u << es.fit.qrho % 32u;
+    const int64_t half = INT64_C(1) << es.fit.qrho;
+    double err[3] = {0, 0, 0};
+    auto check = [&](const int64_t D[3]) {
+        int64_t g[3];
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_earth_image24(&pk, &es, D, 1, g));
+        fit_error(pk, es, D, g, err);
+    };
+    for (int c = 0; c < 27; ++c) {  // corners, edge and face middles, centre
+        const int64_t D[3] = {(c % 3 - 1) * half, (c / 3 % 3 - 1) * half, (c / 9 - 1) * half};
+        check(D);
+    }
+    for (int k = 0; k < nrand; ++k) {
+        const int64_t D[3] = {ct_rng_range(rng, -half, half), ct_rng_range(rng, -half, half),
+                              ct_rng_range(rng, -half, half)};
+        check(D);
+    }
+    // just outside the cube: no fitted image
+    const int64_t Dout[3] = {half + 1, 0, 0};
+    int64_t gout[3];
+    TEST_ASSERT_EQUAL_INT(CT_ERR_RANGE, ct_earth_image24(&pk, &es, Dout, 1, gout));
+    const double e = std::max(err[0], std::max(err[1], err[2]));
+    std::printf("  camera %3.0Lf km east of the tile: range %.1f km, cube half-width 2^%u nm (%.1f km), degree %d "
+                "(%d exact images): fit vs the reference max |dE| %.2g, |dN| %.2g, |dh| %.2g m\n",
+                back_km, es.tmax_nm * 1e-12, es.fit.qrho, (double)half * 1e-12, es.fit.deg,
+                (es.fit.deg + 1) * (es.fit.deg + 1) * (es.fit.deg + 1), err[0], err[1], err[2]);
+    *worst = std::max(*worst, e);
+}
+
+// Maps a kept map's users refuse: another package's, one never fitted, bad
+// arguments to ct_earth_map_init (km fitted for pk, p a pose over it).
+void check_kept_map_refusals(const ct_package &pk, const Pose &p, ct_earth_map *km)
+{
+    ct_effects fx = {CT_EFFECT_CURVATURE, 0, 0, 0, km};
+    ct_geo g;
+    Cam cam = make_camera();
+    TEST_ASSERT(ct_geolocate(&pk, &cam.cam, &p.pose, CT_METHOD_DIRECTIONAL, &fx, 100 << 16, 100 << 16, &g) >= 0);
+    ct_package other = pk;
+    other.origin_e_nm += 1;
+    TEST_ASSERT_EQUAL_INT(CT_ERR_EFFECTS,
+                          ct_geolocate(&other, &cam.cam, &p.pose, CT_METHOD_DIRECTIONAL, &fx, 100 << 16, 100 << 16, &g));
+    // ct_los refuses the same maps (its effects checked as ct_geolocate's)
+    const int64_t la[3] = {p.pose.e_nm, p.pose.n_nm, p.pose.h_nm};
+    const int64_t lb[3] = {201045000000000, 4065840000000000, 300000000000};
+    ct_hit lh;
+    TEST_ASSERT(ct_los(&pk, la, lb, &fx, 0, CT_METHOD_DIRECTIONAL, &lh) >= 0);
+    TEST_ASSERT_EQUAL_INT(CT_ERR_EFFECTS, ct_los(&other, la, lb, &fx, 0, CT_METHOD_DIRECTIONAL, &lh));
+    static ct_earth_map blank;
+    fx.earth_map = &blank;
+    TEST_ASSERT_EQUAL_INT(CT_ERR_EFFECTS,
+                          ct_geolocate(&pk, &cam.cam, &p.pose, CT_METHOD_DIRECTIONAL, &fx, 100 << 16, 100 << 16, &g));
+    TEST_ASSERT_EQUAL_INT(CT_ERR_EFFECTS, ct_los(&pk, la, lb, &fx, 0, CT_METHOD_DIRECTIONAL, &lh));
+    TEST_ASSERT_EQUAL_INT(CT_ERR_RANGE, ct_earth_map_init(&pk, 201045000000000, 4065840000000000, 0, 0, &blank));
+    TEST_ASSERT_EQUAL_INT(CT_ERR_RANGE, ct_earth_map_init(&pk, 201045000000000, 4065840000000000, 0,
+                                                          (INT64_C(1) << 47) + 1, &blank));
+    TEST_ASSERT_EQUAL_INT(CT_ERR_ARG, ct_earth_map_init(&pk, 0, 0, 0, 1, nullptr));
+    other = pk;
+    other.epsg = 0;
+    TEST_ASSERT_EQUAL_INT(CT_ERR_CRS, ct_earth_map_init(&other, 201045000000000, 4065840000000000, 0,
+                                                        INT64_C(1) << 44, &blank));
+    TEST_ASSERT(blank.ready != CT_EARTH_MAP_READY);
+}
+
+// A map kept across calls (ct_earth_map_init): centred on the tile at 500 m,
+// 70 km cube; checked through a camera 3 km up at the centre at nrand
+// random points (its largest error joins *worst), then what refuses it.
+void check_kept_map(World *w, ct_rng *rng, int nrand, double *worst)
+{
+    const ct_package &pk = w->p;
+    static ct_earth_map km;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_earth_map_init(&pk, INT64_C(201045) * 1000000000, INT64_C(4065840) * 1000000000,
+                                                   INT64_C(500) * 1000000000, INT64_C(60000) * 1000000000, &km));
+    TEST_ASSERT_EQUAL_INT(46, (int)km.qrho);
+    TEST_ASSERT_EQUAL_INT(6, km.deg);
+    Pose p;
+    TEST_ASSERT(make_pose(w->sf, {"kept", 201045, 4065840, 3000, 0, -30}, &p));
+    ct_earth es;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_earth_setup(&pk, &p.pose, 0, CT_EARTH_RADIUS_NM, CT_EFFECTS_CHORD_NM, 0u, 0,
+                                                &km, &es));
+    TEST_ASSERT(es.map == &km);
+    const int64_t half = INT64_C(1) << km.qrho;
+    double err[3] = {0, 0, 0};
+    for (int k = 0; k < nrand; ++k) {
+        int64_t D[3], g[3];
+        for (int a = 0; a < 3; ++a) D[a] = ct_rng_range(rng, -half, half) - es.moff[a];
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_earth_image24(&pk, &es, D, 1, g));
+        fit_error(pk, es, D, g, err);
+    }
+    std::printf("  kept map (ct_earth_map_init, centre of the tile, 2^%u nm, degree %d): fit vs the reference max "
+                "|dE| %.2g, |dN| %.2g, |dh| %.2g m\n", km.qrho, km.deg, err[0], err[1], err[2]);
+    *worst = std::max(*worst, std::max(err[0], std::max(err[1], err[2])));
+    check_kept_map_refusals(pk, p, &km);
+}
+
+void test_fitted_map()
+{
+    World *w = jacksboro();
     ct_rng rng;
     ct_rng_seed(&rng, ct_test_seed() * 31 + 7);
     const int nrand = std::max(200, (int)std::lround(3000 * ct_test_scale()));
     uint32_t seen = 0;
     double worst = 0;
-    for (ld back_km : {0.0L, 12.0L, 40.0L, 100.0L}) {
-        Pose p;
-        TEST_ASSERT(make_pose(w->sf, {"far", 201045 + back_km * 1000, 4065840, 3000, 270, -10}, &p));
-        ct_earth es;
-        TEST_ASSERT_EQUAL_INT(CT_OK, ct_earth_setup(&pk, &p.pose, CT_REFRACTION_K_STD_Q16, CT_EARTH_RADIUS_NM,
-                                                    CT_EFFECTS_CHORD_NM, 0u, 1, nullptr, &es));
-        TEST_ASSERT_MSG(es.map == &es.fit && es.fit.deg >= 4 && es.fit.deg <= CT_EARTH_MAP_DEG,
-                        "no fit %d km back (range %.1f km)", (int)back_km, es.tmax_nm * 1e-12);
-        seen |= 1u << es.fit.qrho % 32u;
-        const int64_t half = INT64_C(1) << es.fit.qrho;
-        double err[3] = {0, 0, 0};
-        auto check = [&](const int64_t D[3]) {
-            int64_t g[3];
-            TEST_ASSERT_EQUAL_INT(CT_OK, ct_earth_image24(&pk, &es, D, 1, g));
-            // the reference: long-double geodetic coordinates (PROJ's own
-            // ECEF -> geodetic is one Bowring step, off by tens of um 70 km
-            // from the ellipsoid), PROJ's transverse Mercator
-            ld X[3], E, N, h, lat, lon;
-            for (int k = 0; k < 3; ++k) X[k] = (ld)(es.c[k] + D[k]) * 1e-9L;
-            earth_ref::geodetic_ld(X, &lat, &lon, &h);
-            pj.utm(lat * 180 / kPi, lon * 180 / kPi, &E, &N);
-            const ld fe = pk.origin_e_nm * 1e-9L + (ld)(g[0] + (INT64_C(1) << 23)) * (ld)pk.posting_e_nm * 1e-9L / 16777216.0L;
-            const ld fn = pk.origin_n_nm * 1e-9L + (ld)(g[1] + (INT64_C(1) << 23)) * (ld)pk.posting_n_nm * 1e-9L / 16777216.0L;
-            const ld fh = pk.height_offset_nm * 1e-9L + (ld)g[2] * (ld)pk.height_scale_nm * 1e-9L / 16777216.0L;
-            err[0] = std::max(err[0], (double)std::fabs(fe - E));
-            err[1] = std::max(err[1], (double)std::fabs(fn - N));
-            err[2] = std::max(err[2], (double)std::fabs(fh - h));
-        };
-        for (int c = 0; c < 27; ++c) {  // corners, edge and face middles, centre
-            const int64_t D[3] = {(c % 3 - 1) * half, (c / 3 % 3 - 1) * half, (c / 9 - 1) * half};
-            check(D);
-        }
-        for (int k = 0; k < nrand; ++k) {
-            const int64_t D[3] = {ct_rng_range(&rng, -half, half), ct_rng_range(&rng, -half, half),
-                                  ct_rng_range(&rng, -half, half)};
-            check(D);
-        }
-        // just outside the cube: no fitted image
-        const int64_t Dout[3] = {half + 1, 0, 0};
-        int64_t gout[3];
-        TEST_ASSERT_EQUAL_INT(CT_ERR_RANGE, ct_earth_image24(&pk, &es, Dout, 1, gout));
-        const double e = std::max(err[0], std::max(err[1], err[2]));
-        std::printf("  camera %3.0Lf km east of the tile: range %.1f km, cube half-width 2^%u nm (%.1f km), degree %d "
-                    "(%d exact images): fit vs the reference max |dE| %.2g, |dN| %.2g, |dh| %.2g m\n",
-                    back_km, es.tmax_nm * 1e-12, es.fit.qrho, (double)half * 1e-12, es.fit.deg,
-                    (es.fit.deg + 1) * (es.fit.deg + 1) * (es.fit.deg + 1), err[0], err[1], err[2]);
-        worst = std::max(worst, e);
-    }
-    // a map kept across calls (ct_earth_map_init): centred on the tile at
-    // 500 m, 70 km cube; checked through a camera 3 km up at the centre
-    {
-        static ct_earth_map km;
-        TEST_ASSERT_EQUAL_INT(CT_OK, ct_earth_map_init(&pk, INT64_C(201045) * 1000000000, INT64_C(4065840) * 1000000000,
-                                                       INT64_C(500) * 1000000000, INT64_C(60000) * 1000000000, &km));
-        TEST_ASSERT_EQUAL_INT(46, (int)km.qrho);
-        TEST_ASSERT_EQUAL_INT(6, km.deg);
-        Pose p;
-        TEST_ASSERT(make_pose(w->sf, {"kept", 201045, 4065840, 3000, 0, -30}, &p));
-        ct_earth es;
-        TEST_ASSERT_EQUAL_INT(CT_OK, ct_earth_setup(&pk, &p.pose, 0, CT_EARTH_RADIUS_NM, CT_EFFECTS_CHORD_NM, 0u, 0,
-                                                    &km, &es));
-        TEST_ASSERT(es.map == &km);
-        const int64_t half = INT64_C(1) << km.qrho;
-        double err[3] = {0, 0, 0};
-        for (int k = 0; k < nrand; ++k) {
-            int64_t D[3], g[3];
-            for (int a = 0; a < 3; ++a) D[a] = ct_rng_range(&rng, -half, half) - es.moff[a];
-            TEST_ASSERT_EQUAL_INT(CT_OK, ct_earth_image24(&pk, &es, D, 1, g));
-            ld X[3], E, N, h, lat, lon;
-            for (int a = 0; a < 3; ++a) X[a] = (ld)(es.c[a] + D[a]) * 1e-9L;
-            earth_ref::geodetic_ld(X, &lat, &lon, &h);
-            pj.utm(lat * 180 / kPi, lon * 180 / kPi, &E, &N);
-            err[0] = std::max(err[0], (double)std::fabs(pk.origin_e_nm * 1e-9L +
-                                                        (ld)(g[0] + (INT64_C(1) << 23)) * (ld)pk.posting_e_nm * 1e-9L / 16777216.0L - E));
-            err[1] = std::max(err[1], (double)std::fabs(pk.origin_n_nm * 1e-9L +
-                                                        (ld)(g[1] + (INT64_C(1) << 23)) * (ld)pk.posting_n_nm * 1e-9L / 16777216.0L - N));
-            err[2] = std::max(err[2], (double)std::fabs(pk.height_offset_nm * 1e-9L +
-                                                        (ld)g[2] * (ld)pk.height_scale_nm * 1e-9L / 16777216.0L - h));
-        }
-        std::printf("  kept map (ct_earth_map_init, centre of the tile, 2^%u nm, degree %d): fit vs the reference max "
-                    "|dE| %.2g, |dN| %.2g, |dh| %.2g m\n", km.qrho, km.deg, err[0], err[1], err[2]);
-        worst = std::max(worst, std::max(err[0], std::max(err[1], err[2])));
-        // refused: another package's map, a map never fitted, bad arguments
-        ct_effects fx = {CT_EFFECT_CURVATURE, 0, 0, 0, &km};
-        ct_geo g;
-        Cam cam = make_camera();
-        TEST_ASSERT(ct_geolocate(&pk, &cam.cam, &p.pose, CT_METHOD_DIRECTIONAL, &fx, 100 << 16, 100 << 16, &g) >= 0);
-        ct_package other = pk;
-        other.origin_e_nm += 1;
-        TEST_ASSERT_EQUAL_INT(CT_ERR_EFFECTS,
-                              ct_geolocate(&other, &cam.cam, &p.pose, CT_METHOD_DIRECTIONAL, &fx, 100 << 16, 100 << 16, &g));
-        // ct_los refuses the same maps (its effects checked as ct_geolocate's)
-        const int64_t la[3] = {p.pose.e_nm, p.pose.n_nm, p.pose.h_nm};
-        const int64_t lb[3] = {201045000000000, 4065840000000000, 300000000000};
-        ct_hit lh;
-        TEST_ASSERT(ct_los(&pk, la, lb, &fx, 0, CT_METHOD_DIRECTIONAL, &lh) >= 0);
-        TEST_ASSERT_EQUAL_INT(CT_ERR_EFFECTS, ct_los(&other, la, lb, &fx, 0, CT_METHOD_DIRECTIONAL, &lh));
-        static ct_earth_map blank;
-        fx.earth_map = &blank;
-        TEST_ASSERT_EQUAL_INT(CT_ERR_EFFECTS,
-                              ct_geolocate(&pk, &cam.cam, &p.pose, CT_METHOD_DIRECTIONAL, &fx, 100 << 16, 100 << 16, &g));
-        TEST_ASSERT_EQUAL_INT(CT_ERR_EFFECTS, ct_los(&pk, la, lb, &fx, 0, CT_METHOD_DIRECTIONAL, &lh));
-        TEST_ASSERT_EQUAL_INT(CT_ERR_RANGE, ct_earth_map_init(&pk, 201045000000000, 4065840000000000, 0, 0, &blank));
-        TEST_ASSERT_EQUAL_INT(CT_ERR_RANGE, ct_earth_map_init(&pk, 201045000000000, 4065840000000000, 0,
-                                                              (INT64_C(1) << 47) + 1, &blank));
-        TEST_ASSERT_EQUAL_INT(CT_ERR_ARG, ct_earth_map_init(&pk, 0, 0, 0, 1, nullptr));
-        other = pk;
-        other.epsg = 0;
-        TEST_ASSERT_EQUAL_INT(CT_ERR_CRS, ct_earth_map_init(&other, 201045000000000, 4065840000000000, 0,
-                                                            INT64_C(1) << 44, &blank));
-        TEST_ASSERT(blank.ready != CT_EARTH_MAP_READY);
-    }
+    for (ld back_km : {0.0L, 12.0L, 40.0L, 100.0L}) check_fit_for_camera(w, back_km, &rng, nrand, &seen, &worst);
+    check_kept_map(w, &rng, nrand, &worst);
     TEST_ASSERT_MSG(seen == (1u << 44 % 32) + (1u << 45 % 32) + (1u << 46 % 32) + (1u << 47 % 32),
                     "the poses did not make every cube size (mask %x)", seen);
     TEST_ASSERT_MSG(worst <= kFitMaxM, "fitted map off PROJ by %.3g m (> %.3g m)", worst, kFitMaxM);
@@ -923,7 +938,7 @@ void test_fitted_map()
     Pose far;
     TEST_ASSERT(make_pose(w->sf, {"far", 201045 + 130000, 4065840, 3000, 270, -10}, &far));
     ct_earth es;
-    const ct_status st = ct_earth_setup(&pk, &far.pose, 0, CT_EARTH_RADIUS_NM, CT_EFFECTS_CHORD_NM, 0u, 1, nullptr, &es);
+    const ct_status st = ct_earth_setup(&w->p, &far.pose, 0, CT_EARTH_RADIUS_NM, CT_EFFECTS_CHORD_NM, 0u, 1, nullptr, &es);
     TEST_ASSERT(st != CT_OK || es.map == nullptr);
 }
 
