@@ -1,4 +1,4 @@
-// bench_ddt.cpp -- directional distance transforms (host_tools/ddt.hpp) on
+// bench_ddt.cpp -- directional distance transforms (host_tools/ddt/ddt.hpp) on
 // cross-sections of the real DEM (fixtures/jacksboro_fault_dem.tif): bitmaps
 // with 1 where height >= a slice level, at the native 403 x 344 and at
 // 2048 x 2048 (mirror-tiled).  For N = 24 sectors (squared Euclidean) it

@@ -5,7 +5,7 @@
 // ct_geolocate_batch with the scene's effects, with the directional and the
 // incremental method in the same run (tracing = whole - unprojection); the
 // steps per pixel; hits; and the error statistics against the scene's
-// ground truth (tests/scene.hpp: mrcal + the reference tracer, --samples
+// ground truth (tests/kit/scene.hpp: mrcal + the reference tracer, --samples
 // points).  Also the directional trace without effects (straight rays),
 // to show what bending costs (column "with effects / straight": the
 // median of per-round ratios; "incr. / dir." likewise), and, for scenes

@@ -66,7 +66,7 @@ if(_ct_embree_target)
   # PROJECT_SOURCE_DIR here, but robust if bench/ ever calls project()).
   get_filename_component(_ct_embree_root "${CMAKE_CURRENT_LIST_DIR}/.." ABSOLUTE)
   add_executable(test_embree_baseline ${_ct_embree_root}/tests/test_embree_baseline.cpp)
-  target_include_directories(test_embree_baseline PRIVATE ${_ct_embree_root}/tests)
+  target_include_directories(test_embree_baseline PRIVATE ${_ct_embree_root}/tests/kit)
   target_link_libraries(test_embree_baseline PRIVATE ct_embree_baseline)
   target_compile_options(test_embree_baseline PRIVATE ${_ct_embree_warnings})
   add_test(NAME test_embree_baseline COMMAND test_embree_baseline)

@@ -1,6 +1,6 @@
 // tradeoff.cpp -- `make tradeoff`: what each knob buys and costs.
 //
-// On the bundled DEM and the scenes of fixtures/scenes/ (tests/scene.hpp:
+// On the bundled DEM and the scenes of fixtures/scenes/ (tests/kit/scene.hpp:
 // ground truth by mrcal and the independent reference tracer), every knob
 // that trades accuracy, memory or build time against tracing time, one at a
 // time from the defaults (N = 24, r = 3, slice builder, directional, the

@@ -283,7 +283,7 @@ static std::string fixture_package()
 // unknown command: the usage on stderr and exit 2.
 // The binary starts light: OpenImageIO and GDAL (~200 shared libraries
 // between them) are loaded only from the plugin conetrace_heavy.so when a
-// DEM is read (host_tools/heavy_door.hpp), never by the dynamic linker at
+// DEM is read (host_tools/cli/heavy_door.hpp), never by the dynamic linker at
 // start-up; a binary without its plugin says so when it needs it and runs
 // every other command.
 static void test_light_start(void)

@@ -1,4 +1,4 @@
-// test_ddt.cpp -- directional distance transforms (host_tools/ddt.hpp) against
+// test_ddt.cpp -- directional distance transforms (host_tools/ddt/ddt.hpp) against
 // a brute force that scans every feature with the flight library's closed
 // wedge test (ct_in_wedge) or, for explicit wedges, an independent 128-bit
 // cross-product test.  Every DT value must be equal (doubles bitwise); every

@@ -2,7 +2,7 @@
 // exact mode (ct_effects CT_EFFECT_CURVATURE with earth_radius_nm == 0 on a
 // UTM package: a line of sight straight in Earth-fixed coordinates, bent by
 // refraction k t^2 / 2R when asked) against the independent PROJ reference
-// of tests/earth_reference.hpp.
+// of tests/kit/earth_reference.hpp.
 //
 // The fixture jacksboro_fault_dem.tif (EPSG:32617, 30 m posting, ~12 x 10
 // km, ~300 km west of zone 17's central meridian: point scale 1.0008,
@@ -523,147 +523,172 @@ std::vector<PoseDef> pose_defs()
     return v;
 }
 
-void compare(unsigned flags)
+// compare()'s pose families, in pose_defs()' order.
+const char *const kFamilies[] = {"nadir", "oblique30", "oblique20", "grazing5", "grazing3", "long"};
+constexpr int kFamilyCount = 6;
+
+// What compare() gathers: per family, each mode's statistics against the
+// reference (the exact mode, the old parabola on a 6371 km sphere, the fitted
+// map, the kept map) and the reference's hits and their ranges; over every
+// family, the fitted map against the exact mode and the ct_los checks.
+struct Tally {
+    Stat exact[kFamilyCount], old[kFamilyCount], fitted[kFamilyCount], kmap[kFamilyCount];
+    ld rng_sum[kFamilyCount] = {0};
+    long ref_hits[kFamilyCount] = {0};
+    double fit_vs_exact = 0;
+    long fit_status_diff = 0, los_checked = 0, los_bad = 0, first_reports = 0;
+};
+
+// The effects of the four modes.
+struct Modes {
+    ct_effects exact, old, fit, kept;
+};
+
+// The effects of the four modes for the flags; the kept map, one for every
+// pose: the tile's centre at 500 m, a cube of 70 km (every pose's range from
+// there, with 10 km to spare).
+void make_modes(unsigned flags, const ct_package &p, Modes *m)
+{
+    static ct_earth_map kept;
+    m->exact = {flags, CT_REFRACTION_K_STD_Q16, 0, 0, nullptr};
+    m->old = m->fit = m->kept = m->exact;
+    m->old.earth_radius_nm = CT_EARTH_RADIUS_NM;
+    m->fit.flags |= CT_EFFECT_EARTH_FIT;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_earth_map_init(&p, INT64_C(201045) * 1000000000, INT64_C(4065840) * 1000000000,
+                                                   INT64_C(500) * 1000000000, INT64_C(60000) * 1000000000, &kept));
+    m->kept.earth_map = &kept;
+}
+
+// A pixel, its pose and the reference's result for it.
+struct PixelCase {
+    const PoseDef *d;
+    int64_t u, v;
+    const earth_ref::Los *L;
+    const earth_ref::Result *r;
+};
+
+// One mode's status and hit for a pixel, judged against the reference into
+// s; the first 8 status mismatches of the reported modes are printed.
+void judge(World *w, const PixelCase &c, Stat &s, int status, const ct_geo &gg, bool report, long *first_reports)
 {
     earth_ref::Proj &pj = proj();
-    World *w = jacksboro();
-    Cam cam = make_camera();
-    const std::vector<PoseDef> defs = pose_defs();
-    const char *families[] = {"nadir", "oblique30", "oblique20", "grazing5", "grazing3", "long"};
-    const int nf = 6;
-    Stat exact[nf], old[nf], fitted[nf], kmap[nf];
-    ld rng_sum[nf] = {0};
-    long ref_hits[nf] = {0};
-    ct_rng rng;
-    ct_rng_seed(&rng, ct_test_seed() * 1009 + flags);
-    const int npix = std::max(1, (int)std::lround(kPixelsPerPose * ct_test_scale()));
-    const ct_effects fx = {flags, CT_REFRACTION_K_STD_Q16, 0, 0, nullptr};
-    ct_effects fx_old = fx, fx_fit = fx, fx_kept = fx;
-    fx_old.earth_radius_nm = CT_EARTH_RADIUS_NM;
-    fx_fit.flags |= CT_EFFECT_EARTH_FIT;
-    // one map for every pose, kept across calls: the tile's centre at 500 m,
-    // a cube of 70 km (every pose's range from there, with 10 km to spare)
-    static ct_earth_map kept;
-    TEST_ASSERT_EQUAL_INT(CT_OK, ct_earth_map_init(&w->p, INT64_C(201045) * 1000000000, INT64_C(4065840) * 1000000000,
-                                                   INT64_C(500) * 1000000000, INT64_C(60000) * 1000000000, &kept));
-    fx_kept.earth_map = &kept;
-    double fit_vs_exact = 0;
-    long fit_status_diff = 0, los_checked = 0, los_bad = 0;
-    long first_reports = 0;
-    auto t0 = std::chrono::steady_clock::now();
-    for (const PoseDef &d : defs) {
-        int f = 0;
-        while (std::strcmp(families[f], d.family) != 0) f++;
-        Pose p;
-        TEST_ASSERT_MSG(make_pose(w->sf, d, &p), "pose %s", d.family);
-        std::vector<int64_t> uv(2 * (size_t)npix);
-        for (int k = 0; k < npix; ++k) {
-            uv[2 * k] = ct_rng_range(&rng, 0, (int64_t)(cam.w - 1) << 16);
-            uv[2 * k + 1] = ct_rng_range(&rng, 0, (int64_t)(cam.h - 1) << 16);
+    const PoseDef &d = *c.d;
+    const earth_ref::Result &r = *c.r;
+    const int64_t u = c.u, v = c.v;
+    if (r.wall && status == CT_BELOW) {
+        // the path enters the tile's side below the surface: the
+        // reference hits that wall; the library may call it BELOW
+        s.wall_below++;
+        return;
+    }
+    if (status != r.status) {
+        s.mismatch++;
+        if (report && (*first_reports)++ < 8)
+            std::printf("    %s yaw %.0Lf px (%.2f, %.2f): library status %d (%.3f %.3f %.3f), reference %d "
+                        "(%.3Lf %.3Lf %.3Lf, range %.0Lf m, clearance %.3Lg m)\n",
+                        d.family, d.yaw, u / 65536.0, v / 65536.0, status, gg.hit.e_nm * 1e-9,
+                        gg.hit.n_nm * 1e-9, gg.hit.h_nm * 1e-9, r.status, r.e, r.n, r.h, r.range, r.min_clear);
+        return;
+    }
+    if (status != CT_HIT) {
+        s.miss_agree++;
+        return;
+    }
+    const ld le = gg.hit.e_nm * 1e-9L, ln = gg.hit.n_nm * 1e-9L, lh = gg.hit.h_nm * 1e-9L;
+    char what[300];
+    const earth_ref::OffPath op = earth_ref::off_path(pj, w->sf, *c.L, le, ln, lh);
+    std::snprintf(what, sizeof what,
+                  "yaw %.0Lf px (%.2f, %.2f): reference (%.3Lf, %.3Lf, %.3Lf) range %.0Lf m, library - "
+                  "reference (%+.4Lf, %+.4Lf, %+.4Lf) m; the library's hit is %.4Lf m off the path, "
+                  "%+.4Lf m along it, the path's clearance there %+.4Lf m",
+                  d.yaw, u / 65536.0, v / 65536.0, r.e, r.n, r.h, r.range, le - r.e, ln - r.n, lh - r.h,
+                  op.dist, op.t - r.t, op.clearance);
+    s.add((double)dist3(le, ln, lh, r.e, r.n, r.h), what);
+    s.max_off = std::max(s.max_off, (double)op.dist);
+}
+
+// ct_los on the true Earth from the camera centre to the reference's hit r:
+// visible (0.5 m margin), a point 30 m under it hidden.
+void check_los(World *w, const Pose &p, const PoseDef &d, const earth_ref::Result &r, const ct_effects &fx, Tally &T)
+{
+    const int64_t A[3] = {p.pose.e_nm, p.pose.n_nm, p.pose.h_nm};
+    const int64_t B[3] = {std::llround(r.e * 1e9L), std::llround(r.n * 1e9L), std::llround(r.h * 1e9L)};
+    const int64_t B2[3] = {B[0], B[1], B[2] - INT64_C(30000000000)};
+    ct_hit lb;
+    const ct_status v1 = ct_los(&w->p, A, B, &fx, 500000000, CT_METHOD_DIRECTIONAL, &lb);
+    const ct_status v2 = ct_los(&w->p, A, B2, &fx, 500000000, CT_METHOD_DIRECTIONAL, &lb);
+    T.los_checked++;
+    if (v1 != CT_OK || v2 != CT_HIT) {
+        T.los_bad++;
+        if (T.los_bad <= 5)
+            std::printf("    ct_los %s yaw %.0Lf: to the reference hit %d (want %d), 30 m under it %d "
+                        "(want %d)\n", d.family, d.yaw, v1, CT_OK, v2, CT_HIT);
+    }
+}
+
+// One pose of family f: its pixels uv (u, v pairs, Q16) geolocated in the
+// four modes -- the fitted and the kept map as one batch each, the batch's
+// first pixel also alone (bit for bit ct_geolocate's) -- and judged against
+// the reference; ct_los to each reference hit.
+void run_pose(World *w, const Cam &cam, const Pose &p, int f, const std::vector<int64_t> &uv, const Modes &m,
+              Tally &T)
+{
+    earth_ref::Proj &pj = proj();
+    const PoseDef &d = p.def;
+    const int npix = (int)(uv.size() / 2);
+    std::vector<ct_geo> gf((size_t)npix), gk((size_t)npix);
+    TEST_ASSERT(ct_geolocate_batch(&w->p, &cam.cam, &p.pose, CT_METHOD_DIRECTIONAL, &m.fit, uv.data(),
+                                   (size_t)npix, gf.data(), gf.size()) == CT_OK);
+    TEST_ASSERT(ct_geolocate_batch(&w->p, &cam.cam, &p.pose, CT_METHOD_DIRECTIONAL, &m.kept, uv.data(),
+                                   (size_t)npix, gk.data(), gk.size()) == CT_OK);
+    {
+        ct_geo g1;
+        const ct_status s1 = ct_geolocate(&w->p, &cam.cam, &p.pose, CT_METHOD_DIRECTIONAL, &m.fit, uv[0], uv[1], &g1);
+        TEST_ASSERT(s1 == gf[0].status && g1.hit.e_nm == gf[0].hit.e_nm && g1.hit.n_nm == gf[0].hit.n_nm &&
+                    g1.hit.h_nm == gf[0].hit.h_nm && g1.hit.steps == gf[0].hit.steps);
+    }
+    for (int k = 0; k < npix; ++k) {
+        const int64_t u = uv[2 * k], v = uv[2 * k + 1];
+        ld ray[3];
+        earth_ref::pinhole_ray(cam.fx, cam.fy, cam.cx, cam.cy, (ld)u / 65536, (ld)v / 65536, ray);
+        const earth_ref::Los L = earth_ref::los_from_pose(pj, p.pose, ray, &m.exact);
+        earth_ref::Result r = earth_ref::trace(pj, w->sf, L);
+        ct_geo g, go;
+        const ct_status st = ct_geolocate(&w->p, &cam.cam, &p.pose, CT_METHOD_DIRECTIONAL, &m.exact, u, v, &g);
+        const ct_status so = ct_geolocate(&w->p, &cam.cam, &p.pose, CT_METHOD_DIRECTIONAL, &m.old, u, v, &go);
+        const int ls = st == CT_HIT_VOID ? CT_HIT : st, los = so == CT_HIT_VOID ? CT_HIT : so;
+        if (r.min_clear < kSkipClearM) {
+            T.exact[f].skipped++;
+            T.old[f].skipped++;
+            T.fitted[f].skipped++;
+            T.kmap[f].skipped++;
+            continue;
         }
-        // the fitted map: the whole pose in one batch, its first pixel also
-        // alone (the batch's results are ct_geolocate's, bit for bit)
-        std::vector<ct_geo> gf((size_t)npix), gk((size_t)npix);
-        TEST_ASSERT(ct_geolocate_batch(&w->p, &cam.cam, &p.pose, CT_METHOD_DIRECTIONAL, &fx_fit, uv.data(),
-                                       (size_t)npix, gf.data(), gf.size()) == CT_OK);
-        TEST_ASSERT(ct_geolocate_batch(&w->p, &cam.cam, &p.pose, CT_METHOD_DIRECTIONAL, &fx_kept, uv.data(),
-                                       (size_t)npix, gk.data(), gk.size()) == CT_OK);
-        {
-            ct_geo g1;
-            const ct_status s1 =
-                ct_geolocate(&w->p, &cam.cam, &p.pose, CT_METHOD_DIRECTIONAL, &fx_fit, uv[0], uv[1], &g1);
-            TEST_ASSERT(s1 == gf[0].status && g1.hit.e_nm == gf[0].hit.e_nm && g1.hit.n_nm == gf[0].hit.n_nm &&
-                        g1.hit.h_nm == gf[0].hit.h_nm && g1.hit.steps == gf[0].hit.steps);
+        if (r.status == CT_HIT) {
+            T.rng_sum[f] += r.range;
+            T.ref_hits[f]++;
         }
-        for (int k = 0; k < npix; ++k) {
-            const int64_t u = uv[2 * k], v = uv[2 * k + 1];
-            ld ray[3];
-            earth_ref::pinhole_ray(cam.fx, cam.fy, cam.cx, cam.cy, (ld)u / 65536, (ld)v / 65536, ray);
-            const earth_ref::Los L = earth_ref::los_from_pose(pj, p.pose, ray, &fx);
-            earth_ref::Result r = earth_ref::trace(pj, w->sf, L);
-            ct_geo g, go;
-            const ct_status st = ct_geolocate(&w->p, &cam.cam, &p.pose, CT_METHOD_DIRECTIONAL, &fx, u, v, &g);
-            const ct_status so = ct_geolocate(&w->p, &cam.cam, &p.pose, CT_METHOD_DIRECTIONAL, &fx_old, u, v, &go);
-            const int ls = st == CT_HIT_VOID ? CT_HIT : st, los = so == CT_HIT_VOID ? CT_HIT : so;
-            if (r.min_clear < kSkipClearM) {
-                exact[f].skipped++;
-                old[f].skipped++;
-                fitted[f].skipped++;
-                kmap[f].skipped++;
-                continue;
-            }
-            if (r.status == CT_HIT) {
-                rng_sum[f] += r.range;
-                ref_hits[f]++;
-            }
-            auto judge = [&](Stat &s, int status, const ct_geo &gg, bool report) {
-                if (r.wall && status == CT_BELOW) {
-                    // the path enters the tile's side below the surface: the
-                    // reference hits that wall; the library may call it BELOW
-                    s.wall_below++;
-                    return;
-                }
-                if (status != r.status) {
-                    s.mismatch++;
-                    if (report && first_reports++ < 8)
-                        std::printf("    %s yaw %.0Lf px (%.2f, %.2f): library status %d (%.3f %.3f %.3f), reference %d "
-                                    "(%.3Lf %.3Lf %.3Lf, range %.0Lf m, clearance %.3Lg m)\n",
-                                    d.family, d.yaw, u / 65536.0, v / 65536.0, status, gg.hit.e_nm * 1e-9,
-                                    gg.hit.n_nm * 1e-9, gg.hit.h_nm * 1e-9, r.status, r.e, r.n, r.h, r.range, r.min_clear);
-                    return;
-                }
-                if (status != CT_HIT) {
-                    s.miss_agree++;
-                    return;
-                }
-                const ld le = gg.hit.e_nm * 1e-9L, ln = gg.hit.n_nm * 1e-9L, lh = gg.hit.h_nm * 1e-9L;
-                char what[300];
-                const earth_ref::OffPath op = earth_ref::off_path(pj, w->sf, L, le, ln, lh);
-                std::snprintf(what, sizeof what,
-                              "yaw %.0Lf px (%.2f, %.2f): reference (%.3Lf, %.3Lf, %.3Lf) range %.0Lf m, library - "
-                              "reference (%+.4Lf, %+.4Lf, %+.4Lf) m; the library's hit is %.4Lf m off the path, "
-                              "%+.4Lf m along it, the path's clearance there %+.4Lf m",
-                              d.yaw, u / 65536.0, v / 65536.0, r.e, r.n, r.h, r.range, le - r.e, ln - r.n, lh - r.h,
-                              op.dist, op.t - r.t, op.clearance);
-                s.add((double)dist3(le, ln, lh, r.e, r.n, r.h), what);
-                s.max_off = std::max(s.max_off, (double)op.dist);
-            };
-            judge(exact[f], ls, g, true);
-            judge(old[f], los, go, false);
-            const int lfs = gf[k].status == CT_HIT_VOID ? CT_HIT : gf[k].status;
-            judge(fitted[f], lfs, gf[k], true);
-            judge(kmap[f], gk[k].status == CT_HIT_VOID ? CT_HIT : gk[k].status, gk[k], true);
-            // ct_los on the true Earth from the camera centre: the
-            // reference's hit is visible (0.5 m margin), a point 30 m under
-            // it hidden
-            if (r.status == CT_HIT && !r.wall) {
-                const int64_t A[3] = {p.pose.e_nm, p.pose.n_nm, p.pose.h_nm};
-                const int64_t B[3] = {std::llround(r.e * 1e9L), std::llround(r.n * 1e9L), std::llround(r.h * 1e9L)};
-                const int64_t B2[3] = {B[0], B[1], B[2] - INT64_C(30000000000)};
-                ct_hit lb;
-                const ct_status v1 = ct_los(&w->p, A, B, &fx, 500000000, CT_METHOD_DIRECTIONAL, &lb);
-                const ct_status v2 = ct_los(&w->p, A, B2, &fx, 500000000, CT_METHOD_DIRECTIONAL, &lb);
-                los_checked++;
-                if (v1 != CT_OK || v2 != CT_HIT) {
-                    los_bad++;
-                    if (los_bad <= 5)
-                        std::printf("    ct_los %s yaw %.0Lf: to the reference hit %d (want %d), 30 m under it %d "
-                                    "(want %d)\n", d.family, d.yaw, v1, CT_OK, v2, CT_HIT);
-                }
-            }
-            if (lfs != ls) {
-                fit_status_diff++;
-            } else if (ls == CT_HIT) {
-                fit_vs_exact = std::max(fit_vs_exact, (double)dist3(gf[k].hit.e_nm * 1e-9L, gf[k].hit.n_nm * 1e-9L,
+        const PixelCase c = {&d, u, v, &L, &r};
+        judge(w, c, T.exact[f], ls, g, true, &T.first_reports);
+        judge(w, c, T.old[f], los, go, false, &T.first_reports);
+        const int lfs = gf[k].status == CT_HIT_VOID ? CT_HIT : gf[k].status;
+        judge(w, c, T.fitted[f], lfs, gf[k], true, &T.first_reports);
+        judge(w, c, T.kmap[f], gk[k].status == CT_HIT_VOID ? CT_HIT : gk[k].status, gk[k], true, &T.first_reports);
+        if (r.status == CT_HIT && !r.wall) check_los(w, p, d, r, m.exact, T);
+        if (lfs != ls) {
+            T.fit_status_diff++;
+        } else if (ls == CT_HIT) {
+            T.fit_vs_exact = std::max(T.fit_vs_exact, (double)dist3(gf[k].hit.e_nm * 1e-9L, gf[k].hit.n_nm * 1e-9L,
                                                                     gf[k].hit.h_nm * 1e-9L, g.hit.e_nm * 1e-9L,
                                                                     g.hit.n_nm * 1e-9L, g.hit.h_nm * 1e-9L));
-            }
         }
     }
-    const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    std::printf("  effects %s: %d pixels per pose, %zu poses; reference %.1f s, %ld PROJ samples\n",
-                flags & CT_EFFECT_REFRACTION ? "curvature+refraction (k 0.13)" : "curvature", npix, defs.size(), secs,
-                pj.calls);
+}
+
+// The per-family table: the exact mode and the old parabola, then the
+// fitted map; ex and fi summed over the families.
+void print_families(Tally &T, Total *ex, Total *fi)
+{
     std::printf("  hits: both hit (compared); miss: both miss; skip: reference clearance < %.2f m before the hit; "
                 "bad: status differs; wall: the reference hits the tile's side (entering below the surface) and the "
                 "library says CT_BELOW (accepted)\n",
@@ -671,28 +696,35 @@ void compare(unsigned flags)
     std::printf("  %-10s %5s %5s %5s | %-46s | %-46s\n", "family", "hits", "miss", "skip",
                 "exact mode (radius 0): median / RMS / max, bad, wall",
                 "old parabola (6371 km): median / RMS / max, bad, wall");
-    Total ex, fi, km;
-    for (int f = 0; f < nf; ++f) {
+    for (int f = 0; f < kFamilyCount; ++f) {
+        Stat &e = T.exact[f], &o = T.old[f];
         std::printf("  %-10s %5ld %5ld %5ld | %8.4f %8.4f %9.4f m %4ld %4ld | %8.4f %8.4f %9.4f m %4ld %4ld  (mean range "
                     "%.0f m)\n",
-                    families[f], exact[f].n, exact[f].miss_agree, exact[f].skipped, exact[f].median(), exact[f].rms(),
-                    exact[f].max, exact[f].mismatch, exact[f].wall_below, old[f].median(), old[f].rms(), old[f].max,
-                    old[f].mismatch, old[f].wall_below, (double)(rng_sum[f] / std::max<long>(1, ref_hits[f])));
-        if (exact[f].n) std::printf("  %-10s   worst (exact mode): %s\n", "", exact[f].worst);
-        ex.add(exact[f]);
+                    kFamilies[f], e.n, e.miss_agree, e.skipped, e.median(), e.rms(), e.max, e.mismatch, e.wall_below,
+                    o.median(), o.rms(), o.max, o.mismatch, o.wall_below,
+                    (double)(T.rng_sum[f] / std::max<long>(1, T.ref_hits[f])));
+        if (e.n) std::printf("  %-10s   worst (exact mode): %s\n", "", e.worst);
+        ex->add(e);
     }
-    for (int f = 0; f < nf; ++f) {
+    for (int f = 0; f < kFamilyCount; ++f) {
+        Stat &s = T.fitted[f];
         std::printf("  %-10s fitted map (CT_EFFECT_EARTH_FIT): %5ld hits, median / RMS / max %8.4f %8.4f %9.4f m, "
                     "bad %ld, wall %ld\n",
-                    families[f], fitted[f].n, fitted[f].median(), fitted[f].rms(), fitted[f].max, fitted[f].mismatch,
-                    fitted[f].wall_below);
-        if (fitted[f].n) std::printf("  %-10s   worst (fitted map): %s\n", "", fitted[f].worst);
-        fi.add(fitted[f]);
+                    kFamilies[f], s.n, s.median(), s.rms(), s.max, s.mismatch, s.wall_below);
+        if (s.n) std::printf("  %-10s   worst (fitted map): %s\n", "", s.worst);
+        fi->add(s);
     }
+}
+
+// The totals against their bounds: ct_los, the kept map, the fitted map,
+// the exact mode.
+void check_totals(Tally &T, const Total &ex, const Total &fi)
+{
     std::printf("  ct_los on the true Earth: %ld reference hits visible from the camera, 30 m under them hidden; "
-                "%ld wrong\n", los_checked, los_bad);
-    TEST_ASSERT_MSG(los_bad == 0 && los_checked > 300, "ct_los: %ld wrong of %ld", los_bad, los_checked);
-    for (int f = 0; f < nf; ++f) km.add(kmap[f]);
+                "%ld wrong\n", T.los_checked, T.los_bad);
+    TEST_ASSERT_MSG(T.los_bad == 0 && T.los_checked > 300, "ct_los: %ld wrong of %ld", T.los_bad, T.los_checked);
+    Total km;
+    for (int f = 0; f < kFamilyCount; ++f) km.add(T.kmap[f]);
     const double kworst = km.worst, kworst_off = km.worst_off, krms = km.rms();
     const long kbad = km.bad, kn = km.n;
     std::printf("  kept map (ct_earth_map_init, one for all poses): %ld hits within %.4f m of the reference path, RMS "
@@ -704,7 +736,7 @@ void compare(unsigned flags)
     const long fbad = fi.bad;
     std::printf("  fitted map: hits within %.4f m of the reference path, RMS %.4f m, max %.4f m from the reference "
                 "hit; vs the exact map's hits: up to %.4f m apart, %ld statuses differ\n",
-                fworst_off, frms, fworst, fit_vs_exact, fit_status_diff);
+                fworst_off, frms, fworst, T.fit_vs_exact, T.fit_status_diff);
     TEST_ASSERT_MSG(fworst_off <= kMaxOffPathM, "fitted map: a hit %.4f m off the reference path (> %.4f m)",
                     fworst_off, kMaxOffPathM);
     TEST_ASSERT_MSG(frms <= kMaxRmsM, "fitted map: RMS %.4f m (> %.4f m)", frms, kMaxRmsM);
@@ -721,133 +753,184 @@ void compare(unsigned flags)
     TEST_ASSERT_MSG(worst <= kMaxErrM, "library exact mode off the reference by up to %.4f m (> %.4f m)", worst, kMaxErrM);
 }
 
+// The library's true Earth with these effects against the reference: every
+// pose of pose_defs() with kPixelsPerPose seeded pixels, in the four modes.
+void compare(unsigned flags)
+{
+    earth_ref::Proj &pj = proj();
+    World *w = jacksboro();
+    Cam cam = make_camera();
+    const std::vector<PoseDef> defs = pose_defs();
+    Tally T;
+    ct_rng rng;
+    ct_rng_seed(&rng, ct_test_seed() * 1009 + flags);
+    const int npix = std::max(1, (int)std::lround(kPixelsPerPose * ct_test_scale()));
+    Modes m;
+    make_modes(flags, w->p, &m);
+    auto t0 = std::chrono::steady_clock::now();
+    for (const PoseDef &d : defs) {
+        int f = 0;
+        while (std::strcmp(kFamilies[f], d.family) != 0) f++;
+        Pose p;
+        TEST_ASSERT_MSG(make_pose(w->sf, d, &p), "pose %s", d.family);
+        std::vector<int64_t> uv(2 * (size_t)npix);
+        for (int k = 0; k < npix; ++k) {
+            uv[2 * k] = ct_rng_range(&rng, 0, (int64_t)(cam.w - 1) << 16);
+            uv[2 * k + 1] = ct_rng_range(&rng, 0, (int64_t)(cam.h - 1) << 16);
+        }
+        run_pose(w, cam, p, f, uv, m, T);
+    }
+    const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    std::printf("  effects %s: %d pixels per pose, %zu poses; reference %.1f s, %ld PROJ samples\n",
+                flags & CT_EFFECT_REFRACTION ? "curvature+refraction (k 0.13)" : "curvature", npix, defs.size(), secs,
+                pj.calls);
+    Total ex, fi;
+    print_families(T, &ex, &fi);
+    check_totals(T, ex, fi);
+}
+
 // The fitted map (CT_EFFECT_EARTH_FIT) against PROJ's ECEF -> UTM over its
 // whole cube, for cameras ever farther west of the tile (cubes of 2^44 ..
 // 2^47 nm, degrees 4 .. 6): the fit is interpolation, so the error is
 // largest between its points and near the cube's corners -- sampled at
 // random points, at the corners and on the faces' middles.
-void test_fitted_map()
+// The fitted image g (Q24 grid units) of Earth-fixed offset D against the
+// reference: long-double geodetic coordinates (PROJ's own ECEF -> geodetic
+// is one Bowring step, off by tens of um 70 km from the ellipsoid), PROJ's
+// transverse Mercator; the largest |dE|, |dN|, |dh| (m) so far in err.
+void fit_error(const ct_package &pk, const ct_earth &es, const int64_t D[3], const int64_t g[3], double err[3])
 {
     earth_ref::Proj &pj = proj();
-    World *w = jacksboro();
+    ld X[3], E, N, h, lat, lon;
+    for (int k = 0; k < 3; ++k) X[k] = (ld)(es.c[k] + D[k]) * 1e-9L;
+    earth_ref::geodetic_ld(X, &lat, &lon, &h);
+    pj.utm(lat * 180 / kPi, lon * 180 / kPi, &E, &N);
+    const ld fe = pk.origin_e_nm * 1e-9L + (ld)(g[0] + (INT64_C(1) << 23)) * (ld)pk.posting_e_nm * 1e-9L / 16777216.0L;
+    const ld fn = pk.origin_n_nm * 1e-9L + (ld)(g[1] + (INT64_C(1) << 23)) * (ld)pk.posting_n_nm * 1e-9L / 16777216.0L;
+    const ld fh = pk.height_offset_nm * 1e-9L + (ld)g[2] * (ld)pk.height_scale_nm * 1e-9L / 16777216.0L;
+    err[0] = std::max(err[0], (double)std::fabs(fe - E));
+    err[1] = std::max(err[1], (double)std::fabs(fn - N));
+    err[2] = std::max(err[2], (double)std::fabs(fh - h));
+}
+
+// The map ct_earth_setup fits for a camera back_km east of the tile (3 km
+// up, looking west 10 deg down): its cube's corners, edge and face middles
+// and centre and nrand random points against the reference, a point just
+// outside refused.  The cube's size joins *seen, its largest error *worst.
+void check_fit_for_camera(World *w, ld back_km, ct_rng *rng, int nrand, uint32_t *seen, double *worst)
+{
     const ct_package &pk = w->p;
+    Pose p;
+    TEST_ASSERT(make_pose(w->sf, {"far", 201045 + back_km * 1000, 4065840, 3000, 270, -10}, &p));
+    ct_earth es;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_earth_setup(&pk, &p.pose, CT_REFRACTION_K_STD_Q16, CT_EARTH_RADIUS_NM,
+                                                CT_EFFECTS_CHORD_NM, 0u, 1, nullptr, &es));
+    TEST_ASSERT_MSG(es.map == &es.fit && es.fit.deg >= 4 && es.fit.deg <= CT_EARTH_MAP_DEG,
+                    "no fit %d km back (range %.1f km)", (int)back_km, es.tmax_nm * 1e-12);
+    *seen |= 1u << es.fit.qrho % 32u;
+    const int64_t half = INT64_C(1) << es.fit.qrho;
+    double err[3] = {0, 0, 0};
+    auto check = [&](const int64_t D[3]) {
+        int64_t g[3];
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_earth_image24(&pk, &es, D, 1, g));
+        fit_error(pk, es, D, g, err);
+    };
+    for (int c = 0; c < 27; ++c) {  // corners, edge and face middles, centre
+        const int64_t D[3] = {(c % 3 - 1) * half, (c / 3 % 3 - 1) * half, (c / 9 - 1) * half};
+        check(D);
+    }
+    for (int k = 0; k < nrand; ++k) {
+        const int64_t D[3] = {ct_rng_range(rng, -half, half), ct_rng_range(rng, -half, half),
+                              ct_rng_range(rng, -half, half)};
+        check(D);
+    }
+    // just outside the cube: no fitted image
+    const int64_t Dout[3] = {half + 1, 0, 0};
+    int64_t gout[3];
+    TEST_ASSERT_EQUAL_INT(CT_ERR_RANGE, ct_earth_image24(&pk, &es, Dout, 1, gout));
+    const double e = std::max(err[0], std::max(err[1], err[2]));
+    std::printf("  camera %3.0Lf km east of the tile: range %.1f km, cube half-width 2^%u nm (%.1f km), degree %d "
+                "(%d exact images): fit vs the reference max |dE| %.2g, |dN| %.2g, |dh| %.2g m\n",
+                back_km, es.tmax_nm * 1e-12, es.fit.qrho, (double)half * 1e-12, es.fit.deg,
+                (es.fit.deg + 1) * (es.fit.deg + 1) * (es.fit.deg + 1), err[0], err[1], err[2]);
+    *worst = std::max(*worst, e);
+}
+
+// Maps a kept map's users refuse: another package's, one never fitted, bad
+// arguments to ct_earth_map_init (km fitted for pk, p a pose over it).
+void check_kept_map_refusals(const ct_package &pk, const Pose &p, ct_earth_map *km)
+{
+    ct_effects fx = {CT_EFFECT_CURVATURE, 0, 0, 0, km};
+    ct_geo g;
+    Cam cam = make_camera();
+    TEST_ASSERT(ct_geolocate(&pk, &cam.cam, &p.pose, CT_METHOD_DIRECTIONAL, &fx, 100 << 16, 100 << 16, &g) >= 0);
+    ct_package other = pk;
+    other.origin_e_nm += 1;
+    TEST_ASSERT_EQUAL_INT(CT_ERR_EFFECTS,
+                          ct_geolocate(&other, &cam.cam, &p.pose, CT_METHOD_DIRECTIONAL, &fx, 100 << 16, 100 << 16, &g));
+    // ct_los refuses the same maps (its effects checked as ct_geolocate's)
+    const int64_t la[3] = {p.pose.e_nm, p.pose.n_nm, p.pose.h_nm};
+    const int64_t lb[3] = {201045000000000, 4065840000000000, 300000000000};
+    ct_hit lh;
+    TEST_ASSERT(ct_los(&pk, la, lb, &fx, 0, CT_METHOD_DIRECTIONAL, &lh) >= 0);
+    TEST_ASSERT_EQUAL_INT(CT_ERR_EFFECTS, ct_los(&other, la, lb, &fx, 0, CT_METHOD_DIRECTIONAL, &lh));
+    static ct_earth_map blank;
+    fx.earth_map = &blank;
+    TEST_ASSERT_EQUAL_INT(CT_ERR_EFFECTS,
+                          ct_geolocate(&pk, &cam.cam, &p.pose, CT_METHOD_DIRECTIONAL, &fx, 100 << 16, 100 << 16, &g));
+    TEST_ASSERT_EQUAL_INT(CT_ERR_EFFECTS, ct_los(&pk, la, lb, &fx, 0, CT_METHOD_DIRECTIONAL, &lh));
+    TEST_ASSERT_EQUAL_INT(CT_ERR_RANGE, ct_earth_map_init(&pk, 201045000000000, 4065840000000000, 0, 0, &blank));
+    TEST_ASSERT_EQUAL_INT(CT_ERR_RANGE, ct_earth_map_init(&pk, 201045000000000, 4065840000000000, 0,
+                                                          (INT64_C(1) << 47) + 1, &blank));
+    TEST_ASSERT_EQUAL_INT(CT_ERR_ARG, ct_earth_map_init(&pk, 0, 0, 0, 1, nullptr));
+    other = pk;
+    other.epsg = 0;
+    TEST_ASSERT_EQUAL_INT(CT_ERR_CRS, ct_earth_map_init(&other, 201045000000000, 4065840000000000, 0,
+                                                        INT64_C(1) << 44, &blank));
+    TEST_ASSERT(blank.ready != CT_EARTH_MAP_READY);
+}
+
+// A map kept across calls (ct_earth_map_init): centred on the tile at 500 m,
+// 70 km cube; checked through a camera 3 km up at the centre at nrand
+// random points (its largest error joins *worst), then what refuses it.
+void check_kept_map(World *w, ct_rng *rng, int nrand, double *worst)
+{
+    const ct_package &pk = w->p;
+    static ct_earth_map km;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_earth_map_init(&pk, INT64_C(201045) * 1000000000, INT64_C(4065840) * 1000000000,
+                                                   INT64_C(500) * 1000000000, INT64_C(60000) * 1000000000, &km));
+    TEST_ASSERT_EQUAL_INT(46, (int)km.qrho);
+    TEST_ASSERT_EQUAL_INT(6, km.deg);
+    Pose p;
+    TEST_ASSERT(make_pose(w->sf, {"kept", 201045, 4065840, 3000, 0, -30}, &p));
+    ct_earth es;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_earth_setup(&pk, &p.pose, 0, CT_EARTH_RADIUS_NM, CT_EFFECTS_CHORD_NM, 0u, 0,
+                                                &km, &es));
+    TEST_ASSERT(es.map == &km);
+    const int64_t half = INT64_C(1) << km.qrho;
+    double err[3] = {0, 0, 0};
+    for (int k = 0; k < nrand; ++k) {
+        int64_t D[3], g[3];
+        for (int a = 0; a < 3; ++a) D[a] = ct_rng_range(rng, -half, half) - es.moff[a];
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_earth_image24(&pk, &es, D, 1, g));
+        fit_error(pk, es, D, g, err);
+    }
+    std::printf("  kept map (ct_earth_map_init, centre of the tile, 2^%u nm, degree %d): fit vs the reference max "
+                "|dE| %.2g, |dN| %.2g, |dh| %.2g m\n", km.qrho, km.deg, err[0], err[1], err[2]);
+    *worst = std::max(*worst, std::max(err[0], std::max(err[1], err[2])));
+    check_kept_map_refusals(pk, p, &km);
+}
+
+void test_fitted_map()
+{
+    World *w = jacksboro();
     ct_rng rng;
     ct_rng_seed(&rng, ct_test_seed() * 31 + 7);
     const int nrand = std::max(200, (int)std::lround(3000 * ct_test_scale()));
     uint32_t seen = 0;
     double worst = 0;
-    for (ld back_km : {0.0L, 12.0L, 40.0L, 100.0L}) {
-        Pose p;
-        TEST_ASSERT(make_pose(w->sf, {"far", 201045 + back_km * 1000, 4065840, 3000, 270, -10}, &p));
-        ct_earth es;
-        TEST_ASSERT_EQUAL_INT(CT_OK, ct_earth_setup(&pk, &p.pose, CT_REFRACTION_K_STD_Q16, CT_EARTH_RADIUS_NM,
-                                                    CT_EFFECTS_CHORD_NM, 0u, 1, nullptr, &es));
-        TEST_ASSERT_MSG(es.map == &es.fit && es.fit.deg >= 4 && es.fit.deg <= CT_EARTH_MAP_DEG,
-                        "no fit %d km back (range %.1f km)", (int)back_km, es.tmax_nm * 1e-12);
-        seen |= 1u << es.fit.qrho % 32u;
-        const int64_t half = INT64_C(1) << es.fit.qrho;
-        double err[3] = {0, 0, 0};
-        auto check = [&](const int64_t D[3]) {
-            int64_t g[3];
-            TEST_ASSERT_EQUAL_INT(CT_OK, ct_earth_image24(&pk, &es, D, 1, g));
-            // the reference: long-double geodetic coordinates (PROJ's own
-            // ECEF -> geodetic is one Bowring step, off by tens of um 70 km
-            // from the ellipsoid), PROJ's transverse Mercator
-            ld X[3], E, N, h, lat, lon;
-            for (int k = 0; k < 3; ++k) X[k] = (ld)(es.c[k] + D[k]) * 1e-9L;
-            earth_ref::geodetic_ld(X, &lat, &lon, &h);
-            pj.utm(lat * 180 / kPi, lon * 180 / kPi, &E, &N);
-            const ld fe = pk.origin_e_nm * 1e-9L + (ld)(g[0] + (INT64_C(1) << 23)) * (ld)pk.posting_e_nm * 1e-9L / 16777216.0L;
-            const ld fn = pk.origin_n_nm * 1e-9L + (ld)(g[1] + (INT64_C(1) << 23)) * (ld)pk.posting_n_nm * 1e-9L / 16777216.0L;
-            const ld fh = pk.height_offset_nm * 1e-9L + (ld)g[2] * (ld)pk.height_scale_nm * 1e-9L / 16777216.0L;
-            err[0] = std::max(err[0], (double)std::fabs(fe - E));
-            err[1] = std::max(err[1], (double)std::fabs(fn - N));
-            err[2] = std::max(err[2], (double)std::fabs(fh - h));
-        };
-        for (int c = 0; c < 27; ++c) {  // corners, edge and face middles, centre
-            const int64_t D[3] = {(c % 3 - 1) * half, (c / 3 % 3 - 1) * half, (c / 9 - 1) * half};
-            check(D);
-        }
-        for (int k = 0; k < nrand; ++k) {
-            const int64_t D[3] = {ct_rng_range(&rng, -half, half), ct_rng_range(&rng, -half, half),
-                                  ct_rng_range(&rng, -half, half)};
-            check(D);
-        }
-        // just outside the cube: no fitted image
-        const int64_t Dout[3] = {half + 1, 0, 0};
-        int64_t gout[3];
-        TEST_ASSERT_EQUAL_INT(CT_ERR_RANGE, ct_earth_image24(&pk, &es, Dout, 1, gout));
-        const double e = std::max(err[0], std::max(err[1], err[2]));
-        std::printf("  camera %3.0Lf km east of the tile: range %.1f km, cube half-width 2^%u nm (%.1f km), degree %d "
-                    "(%d exact images): fit vs the reference max |dE| %.2g, |dN| %.2g, |dh| %.2g m\n",
-                    back_km, es.tmax_nm * 1e-12, es.fit.qrho, (double)half * 1e-12, es.fit.deg,
-                    (es.fit.deg + 1) * (es.fit.deg + 1) * (es.fit.deg + 1), err[0], err[1], err[2]);
-        worst = std::max(worst, e);
-    }
-    // a map kept across calls (ct_earth_map_init): centred on the tile at
-    // 500 m, 70 km cube; checked through a camera 3 km up at the centre
-    {
-        static ct_earth_map km;
-        TEST_ASSERT_EQUAL_INT(CT_OK, ct_earth_map_init(&pk, INT64_C(201045) * 1000000000, INT64_C(4065840) * 1000000000,
-                                                       INT64_C(500) * 1000000000, INT64_C(60000) * 1000000000, &km));
-        TEST_ASSERT_EQUAL_INT(46, (int)km.qrho);
-        TEST_ASSERT_EQUAL_INT(6, km.deg);
-        Pose p;
-        TEST_ASSERT(make_pose(w->sf, {"kept", 201045, 4065840, 3000, 0, -30}, &p));
-        ct_earth es;
-        TEST_ASSERT_EQUAL_INT(CT_OK, ct_earth_setup(&pk, &p.pose, 0, CT_EARTH_RADIUS_NM, CT_EFFECTS_CHORD_NM, 0u, 0,
-                                                    &km, &es));
-        TEST_ASSERT(es.map == &km);
-        const int64_t half = INT64_C(1) << km.qrho;
-        double err[3] = {0, 0, 0};
-        for (int k = 0; k < nrand; ++k) {
-            int64_t D[3], g[3];
-            for (int a = 0; a < 3; ++a) D[a] = ct_rng_range(&rng, -half, half) - es.moff[a];
-            TEST_ASSERT_EQUAL_INT(CT_OK, ct_earth_image24(&pk, &es, D, 1, g));
-            ld X[3], E, N, h, lat, lon;
-            for (int a = 0; a < 3; ++a) X[a] = (ld)(es.c[a] + D[a]) * 1e-9L;
-            earth_ref::geodetic_ld(X, &lat, &lon, &h);
-            pj.utm(lat * 180 / kPi, lon * 180 / kPi, &E, &N);
-            err[0] = std::max(err[0], (double)std::fabs(pk.origin_e_nm * 1e-9L +
-                                                        (ld)(g[0] + (INT64_C(1) << 23)) * (ld)pk.posting_e_nm * 1e-9L / 16777216.0L - E));
-            err[1] = std::max(err[1], (double)std::fabs(pk.origin_n_nm * 1e-9L +
-                                                        (ld)(g[1] + (INT64_C(1) << 23)) * (ld)pk.posting_n_nm * 1e-9L / 16777216.0L - N));
-            err[2] = std::max(err[2], (double)std::fabs(pk.height_offset_nm * 1e-9L +
-                                                        (ld)g[2] * (ld)pk.height_scale_nm * 1e-9L / 16777216.0L - h));
-        }
-        std::printf("  kept map (ct_earth_map_init, centre of the tile, 2^%u nm, degree %d): fit vs the reference max "
-                    "|dE| %.2g, |dN| %.2g, |dh| %.2g m\n", km.qrho, km.deg, err[0], err[1], err[2]);
-        worst = std::max(worst, std::max(err[0], std::max(err[1], err[2])));
-        // refused: another package's map, a map never fitted, bad arguments
-        ct_effects fx = {CT_EFFECT_CURVATURE, 0, 0, 0, &km};
-        ct_geo g;
-        Cam cam = make_camera();
-        TEST_ASSERT(ct_geolocate(&pk, &cam.cam, &p.pose, CT_METHOD_DIRECTIONAL, &fx, 100 << 16, 100 << 16, &g) >= 0);
-        ct_package other = pk;
-        other.origin_e_nm += 1;
-        TEST_ASSERT_EQUAL_INT(CT_ERR_EFFECTS,
-                              ct_geolocate(&other, &cam.cam, &p.pose, CT_METHOD_DIRECTIONAL, &fx, 100 << 16, 100 << 16, &g));
-        // ct_los refuses the same maps (its effects checked as ct_geolocate's)
-        const int64_t la[3] = {p.pose.e_nm, p.pose.n_nm, p.pose.h_nm};
-        const int64_t lb[3] = {201045000000000, 4065840000000000, 300000000000};
-        ct_hit lh;
-        TEST_ASSERT(ct_los(&pk, la, lb, &fx, 0, CT_METHOD_DIRECTIONAL, &lh) >= 0);
-        TEST_ASSERT_EQUAL_INT(CT_ERR_EFFECTS, ct_los(&other, la, lb, &fx, 0, CT_METHOD_DIRECTIONAL, &lh));
-        static ct_earth_map blank;
-        fx.earth_map = &blank;
-        TEST_ASSERT_EQUAL_INT(CT_ERR_EFFECTS,
-                              ct_geolocate(&pk, &cam.cam, &p.pose, CT_METHOD_DIRECTIONAL, &fx, 100 << 16, 100 << 16, &g));
-        TEST_ASSERT_EQUAL_INT(CT_ERR_EFFECTS, ct_los(&pk, la, lb, &fx, 0, CT_METHOD_DIRECTIONAL, &lh));
-        TEST_ASSERT_EQUAL_INT(CT_ERR_RANGE, ct_earth_map_init(&pk, 201045000000000, 4065840000000000, 0, 0, &blank));
-        TEST_ASSERT_EQUAL_INT(CT_ERR_RANGE, ct_earth_map_init(&pk, 201045000000000, 4065840000000000, 0,
-                                                              (INT64_C(1) << 47) + 1, &blank));
-        TEST_ASSERT_EQUAL_INT(CT_ERR_ARG, ct_earth_map_init(&pk, 0, 0, 0, 1, nullptr));
-        other = pk;
-        other.epsg = 0;
-        TEST_ASSERT_EQUAL_INT(CT_ERR_CRS, ct_earth_map_init(&other, 201045000000000, 4065840000000000, 0,
-                                                            INT64_C(1) << 44, &blank));
-        TEST_ASSERT(blank.ready != CT_EARTH_MAP_READY);
-    }
+    for (ld back_km : {0.0L, 12.0L, 40.0L, 100.0L}) check_fit_for_camera(w, back_km, &rng, nrand, &seen, &worst);
+    check_kept_map(w, &rng, nrand, &worst);
     TEST_ASSERT_MSG(seen == (1u << 44 % 32) + (1u << 45 % 32) + (1u << 46 % 32) + (1u << 47 % 32),
                     "the poses did not make every cube size (mask %x)", seen);
     TEST_ASSERT_MSG(worst <= kFitMaxM, "fitted map off PROJ by %.3g m (> %.3g m)", worst, kFitMaxM);
@@ -855,7 +938,7 @@ void test_fitted_map()
     Pose far;
     TEST_ASSERT(make_pose(w->sf, {"far", 201045 + 130000, 4065840, 3000, 270, -10}, &far));
     ct_earth es;
-    const ct_status st = ct_earth_setup(&pk, &far.pose, 0, CT_EARTH_RADIUS_NM, CT_EFFECTS_CHORD_NM, 0u, 1, nullptr, &es);
+    const ct_status st = ct_earth_setup(&w->p, &far.pose, 0, CT_EARTH_RADIUS_NM, CT_EFFECTS_CHORD_NM, 0u, 1, nullptr, &es);
     TEST_ASSERT(st != CT_OK || es.map == nullptr);
 }
 

@@ -27,7 +27,7 @@
 //       intrinsics.  Pixels outside the image are dropped; the reference
 //       traced from the (unrounded) pixel's mrcal-unprojected ray must hit P
 //       within kVisibleM, else P is occluded (counted, not used for (a));
-//   (b) the PROJ reference (tests/earth_reference.hpp) from the ray of the
+//   (b) the PROJ reference (tests/kit/earth_reference.hpp) from the ray of the
 //       pixel the library is given (Q16), for every pixel of (a) -- occluded
 //       ones included -- and some random pixels (misses, sky).
 // The library (ct_geolocate, CT_METHOD_DIRECTIONAL) geolocates every pixel:
@@ -449,10 +449,78 @@ struct Px {
     ld inc;       // (a): the incidence there (deg)
 };
 
-void run_pose(World &w, const Camera &cam, const Pose &p, uint64_t seed, Row *row, ProjEgm96 &egm)
+// A candidate for (a) from a random pixel: its first hit (a straight
+// Earth-fixed line), a surface point near it (visible, mostly) or behind it
+// (occluded, often), that point's pixel through mrcal, and whether the
+// reference from that pixel comes back to the point (s.truth).  false: no
+// sample (no hit, off the tile, a void cell, off the image).
+bool sample_point(World &w, const Camera &cam, const Pose &p, ct_rng *rng, Row *row, Px *out)
 {
     earth_ref::Proj &pj = *w.pj;
     const earth_ref::Surface &sf = w.sf;
+    const double W = cam.model.width, H = cam.model.height;
+    // a random pixel's first hit (straight Earth-fixed line)
+    ld ray[3];
+    if (!mrcal_ray(cam, ct_rng_unit(rng) * (W - 1), ct_rng_unit(rng) * (H - 1), ray)) return false;
+    const earth_ref::Los L0 = earth_ref::los_from_wgs84(pj, p.lat, p.lon, p.h, p.qd, ray, nullptr);
+    const earth_ref::Result r0 = earth_ref::trace(pj, sf, L0);
+    if (r0.status != CT_HIT || r0.wall) return false;
+    // a surface point near it (visible, mostly) or behind it (occluded, often)
+    ld e, n;
+    if (row->tries % 2) {
+        e = r0.e + (ct_rng_unit(rng) * 2 - 1) * sf.pe;
+        n = r0.n + (ct_rng_unit(rng) * 2 - 1) * sf.pe;
+    } else {
+        const ld Ce = (ld)p.pose.e_nm * 1e-9L, Cn = (ld)p.pose.n_nm * 1e-9L, f = 1 + 0.6L * ct_rng_unit(rng);
+        e = Ce + (r0.e - Ce) * f;
+        n = Cn + (r0.n - Cn) * f;
+    }
+    ld x, y;
+    sf.grid(e, n, &x, &y);
+    if (!sf.inside(x, y) || !cell_valid(w, x, y)) return false;
+    Px s;
+    s.P[0] = e;
+    s.P[1] = n;
+    s.P[2] = sf.height(x, y);
+    // the true line of sight C -> P, Earth-fixed, into the camera frame, projected by mrcal
+    ld lat, lon, X[3], v[3], rc[3];
+    pj.utm_inverse(e, n, &lat, &lon);
+    pj.ecef(lat, lon, s.P[2], X);
+    for (int k = 0; k < 3; ++k) v[k] = X[k] - p.C[k];
+    cam_of_ecef(p, v, rc);
+    double u, vv;
+    if (!(rc[2] > 0) || !mrcal_pixel(cam, rc, &u, &vv) || !(u >= 0 && vv >= 0 && u <= W - 1 && vv <= H - 1)) {
+        row->off_image++;
+        return false;
+    }
+    s.uq = std::llround(u * 65536);
+    s.vq = std::llround(vv * 65536);
+    // occluded?  the reference from the pixel's ray must come back to P
+    ld ray_p[3];
+    s.truth = false;
+    if (mrcal_ray(cam, u, vv, ray_p)) {
+        const earth_ref::Los Lp = earth_ref::los_from_wgs84(pj, p.lat, p.lon, p.h, p.qd, ray_p, nullptr);
+        const earth_ref::Result rp = earth_ref::trace(pj, sf, Lp);
+        s.inc = incidence_deg(pj, sf, Lp, rp);
+        if (rp.status == CT_HIT && dist3(rp.e, rp.n, rp.h, s.P[0], s.P[1], s.P[2]) <= kVisibleM) {
+            if (rp.min_clear < kSkipClearM) {
+                row->grazing_a++;
+            } else {
+                s.truth = true;
+            }
+        } else {
+            row->occluded++;
+        }
+    }
+    *out = s;
+    return true;
+}
+
+// The pixels of one pose and camera: candidates for (a) until
+// kVisiblePerPose of them are visible (or 200 tries per one wanted), then
+// kRandomPerPose random pixels for (b); both counts scaled.
+std::vector<Px> sample_pixels(World &w, const Camera &cam, const Pose &p, uint64_t seed, Row *row)
+{
     const double W = cam.model.width, H = cam.model.height;
     ct_rng rng;
     ct_rng_seed(&rng, seed);
@@ -462,60 +530,9 @@ void run_pose(World &w, const Camera &cam, const Pose &p, uint64_t seed, Row *ro
     int visible = 0;
     while (visible < want && row->tries < 200L * want) {
         row->tries++;
-        // a random pixel's first hit (straight Earth-fixed line)
-        ld ray[3];
-        if (!mrcal_ray(cam, ct_rng_unit(&rng) * (W - 1), ct_rng_unit(&rng) * (H - 1), ray)) continue;
-        const earth_ref::Los L0 = earth_ref::los_from_wgs84(pj, p.lat, p.lon, p.h, p.qd, ray, nullptr);
-        const earth_ref::Result r0 = earth_ref::trace(pj, sf, L0);
-        if (r0.status != CT_HIT || r0.wall) continue;
-        // a surface point near it (visible, mostly) or behind it (occluded, often)
-        ld e, n;
-        if (row->tries % 2) {
-            e = r0.e + (ct_rng_unit(&rng) * 2 - 1) * sf.pe;
-            n = r0.n + (ct_rng_unit(&rng) * 2 - 1) * sf.pe;
-        } else {
-            const ld Ce = (ld)p.pose.e_nm * 1e-9L, Cn = (ld)p.pose.n_nm * 1e-9L, f = 1 + 0.6L * ct_rng_unit(&rng);
-            e = Ce + (r0.e - Ce) * f;
-            n = Cn + (r0.n - Cn) * f;
-        }
-        ld x, y;
-        sf.grid(e, n, &x, &y);
-        if (!sf.inside(x, y) || !cell_valid(w, x, y)) continue;
         Px s;
-        s.P[0] = e;
-        s.P[1] = n;
-        s.P[2] = sf.height(x, y);
-        // the true line of sight C -> P, Earth-fixed, into the camera frame, projected by mrcal
-        ld lat, lon, X[3], v[3], rc[3];
-        pj.utm_inverse(e, n, &lat, &lon);
-        pj.ecef(lat, lon, s.P[2], X);
-        for (int k = 0; k < 3; ++k) v[k] = X[k] - p.C[k];
-        cam_of_ecef(p, v, rc);
-        double u, vv;
-        if (!(rc[2] > 0) || !mrcal_pixel(cam, rc, &u, &vv) || !(u >= 0 && vv >= 0 && u <= W - 1 && vv <= H - 1)) {
-            row->off_image++;
-            continue;
-        }
-        s.uq = std::llround(u * 65536);
-        s.vq = std::llround(vv * 65536);
-        // occluded?  the reference from the pixel's ray must come back to P
-        ld ray_p[3];
-        s.truth = false;
-        if (mrcal_ray(cam, u, vv, ray_p)) {
-            const earth_ref::Los Lp = earth_ref::los_from_wgs84(pj, p.lat, p.lon, p.h, p.qd, ray_p, nullptr);
-            const earth_ref::Result rp = earth_ref::trace(pj, sf, Lp);
-            s.inc = incidence_deg(pj, sf, Lp, rp);
-            if (rp.status == CT_HIT && dist3(rp.e, rp.n, rp.h, s.P[0], s.P[1], s.P[2]) <= kVisibleM) {
-                if (rp.min_clear < kSkipClearM) {
-                    row->grazing_a++;
-                } else {
-                    s.truth = true;
-                    visible++;
-                }
-            } else {
-                row->occluded++;
-            }
-        }
+        if (!sample_point(w, cam, p, &rng, row, &s)) continue;
+        if (s.truth) visible++;
         px.push_back(s);
     }
     for (int k = 0; k < nrand; ++k) {
@@ -526,115 +543,149 @@ void run_pose(World &w, const Camera &cam, const Pose &p, uint64_t seed, Row *ro
         px.push_back(s);
     }
     row->pixels = (long)px.size();
+    return px;
+}
 
-    ct_effects fx[NM];
+// The library's modes' effects; which of them refract.
+void mode_effects(ct_effects fx[NM])
+{
     fx[M_EXACT] = {CT_EFFECT_CURVATURE, CT_REFRACTION_K_STD_Q16, 0, 0, nullptr};
     fx[M_EXACT_REFR] = {CT_EFFECT_CURVATURE | CT_EFFECT_REFRACTION, CT_REFRACTION_K_STD_Q16, 0, 0, nullptr};
     fx[M_STRAIGHT] = {0, 0, 0, 0, nullptr};
     fx[M_PARABOLA] = {CT_EFFECT_CURVATURE, CT_REFRACTION_K_STD_Q16, CT_EARTH_RADIUS_NM, 0, nullptr};
     fx[M_PARABOLA_REFR] = {CT_EFFECT_CURVATURE | CT_EFFECT_REFRACTION, CT_REFRACTION_K_STD_Q16, CT_EARTH_RADIUS_NM, 0, nullptr};
-    const bool refr[NM] = {false, true, false, false, true};
+}
+const bool kRefracts[NM] = {false, true, false, false, true};
+
+// A pixel's reference paths and hits without (0) and with (1) refraction,
+// and the incidence at each hit (90: none).
+struct PxRefs {
+    earth_ref::Los los[2];
+    earth_ref::Result ref[2];
+    ld inc[2] = {90, 90};
+};
+
+// The exact mode's hit g in geodetic coordinates: the library's
+// (ct_utm_inverse; h_ell = h) vs PROJ's conversion of the same map point and
+// of the reference hit r, and its height in the EGM96 datum vs PROJ's.
+void check_geodetic(World &w, const ct_geo &g, const earth_ref::Result &r, Row *row, ProjEgm96 &egm)
+{
+    earth_ref::Proj &pj = *w.pj;
+    const ld le = g.hit.e_nm * 1e-9L, ln = g.hit.n_nm * 1e-9L, lh = g.hit.h_nm * 1e-9L;
+    int64_t la_q, lo_q, N_nm;
+    if (ct_utm_inverse(&w.zone, g.hit.e_nm, g.hit.n_nm, &la_q, &lo_q) != CT_OK ||
+        ct_package_geoid(&w.p, g.hit.e_nm, g.hit.n_nm, &N_nm) != CT_OK) {
+        row->geo_conv = INFINITY;
+        return;
+    }
+    const ld lat_l = deg_of_q61(la_q), lon_l = deg_of_q61(lo_q);
+    ld lat_p, lon_p, Xl[3], Xp[3], Xr[3], lat_r, lon_r;
+    pj.utm_inverse(le, ln, &lat_p, &lon_p);
+    pj.ecef(lat_l, lon_l, lh, Xl);
+    pj.ecef(lat_p, lon_p, lh, Xp);
+    pj.utm_inverse(r.e, r.n, &lat_r, &lon_r);
+    pj.ecef(lat_r, lon_r, r.h, Xr);
+    auto d3 = [](const ld a3[3], const ld b3[3]) {
+        return std::sqrt((a3[0] - b3[0]) * (a3[0] - b3[0]) + (a3[1] - b3[1]) * (a3[1] - b3[1]) +
+                         (a3[2] - b3[2]) * (a3[2] - b3[2]));
+    };
+    row->geo_conv = std::max(row->geo_conv, (double)d3(Xl, Xp));
+    row->geo_vs_map = std::max(row->geo_vs_map, (double)std::fabs(d3(Xl, Xr) - dist3(le, ln, lh, r.e, r.n, r.h)));
+    // the height in the EGM96 datum
+    const ld H_lib = lh - N_nm * 1e-9L, H_proj = egm.height(lat_p, lon_p, lh);
+    const ld H_ref = egm.height(lat_r, lon_r, r.h);
+    row->egm = std::max(row->egm, (double)std::fabs(H_lib - H_proj));
+    row->egm_ref = std::max(row->egm_ref, (double)std::fabs(H_lib - H_ref));
+    if (!(std::fabs(H_proj - lh) > 10)) row->egm = INFINITY;  // PROJ must apply the geoid (N ~ -31 m)
+}
+
+// Mode m's geolocation of pixel s, judged against (a) the point s was
+// sampled for, when visible (straight Earth-fixed lines only), and (b) the
+// reference hit with the mode's refraction; the exact mode's hit also in
+// geodetic coordinates.
+void judge_mode(World &w, const Camera &cam, const Pose &p, const Px &s, const PxRefs &R, int m,
+                const ct_effects fx[NM], Row *row, ProjEgm96 &egm)
+{
+    ct_geo g;
+    const ct_status st = ct_geolocate(&w.p, &cam.lib.cam, &p.pose, CT_METHOD_DIRECTIONAL,
+                                      m == M_STRAIGHT ? nullptr : &fx[m], s.uq, s.vq, &g);
+    if (st == CT_ERR_UNPROJECT) {
+        if (m == 0) row->unproject++;
+        return;
+    }
+    const int ls = st == CT_HIT_VOID ? CT_HIT : st;
+    const ld le = g.hit.e_nm * 1e-9L, ln = g.hit.n_nm * 1e-9L, lh = g.hit.h_nm * 1e-9L;
+    // (a): straight Earth-fixed lines only
+    if (s.truth && !kRefracts[m]) {
+        if (ls != CT_HIT)
+            row->a[m].bad++;
+        else
+            row->a[m].add((double)dist3(le, ln, lh, s.P[0], s.P[1], s.P[2]), s.inc >= kMinIncidenceDeg);
+    }
+    // (b)
+    const int k = kRefracts[m] ? 1 : 0;
+    const earth_ref::Result &r = R.ref[k];
+    if (m == M_EXACT && s.truth && r.status == CT_HIT)
+        row->routes.add((double)dist3(r.e, r.n, r.h, s.P[0], s.P[1], s.P[2]), true);
+    Stat &b = row->b[m];
+    if (r.min_clear < kSkipClearM) {
+        b.skip++;
+        return;
+    }
+    if (r.wall && ls == CT_BELOW) {
+        b.wall++;
+        return;
+    }
+    if (ls != r.status) {
+        b.bad++;
+        if (m == M_EXACT || m == M_EXACT_REFR)
+            std::printf("    %s %s mode %d px (%.3f, %.3f): library status %d (%.3Lf %.3Lf %.3Lf), reference %d "
+                        "(%.3Lf %.3Lf %.3Lf, clearance %.3Lg m)\n",
+                        p.def.name, cam.name, m, s.uq / 65536.0, s.vq / 65536.0, (int)st, le, ln, lh, r.status,
+                        r.e, r.n, r.h, r.min_clear);
+        return;
+    }
+    if (ls != CT_HIT) {
+        b.miss++;
+        return;
+    }
+    const double err = (double)dist3(le, ln, lh, r.e, r.n, r.h);
+    if (m == M_EXACT || m == M_EXACT_REFR) {
+        // where the library's hit lies relative to the reference path
+        const earth_ref::OffPath op = earth_ref::off_path(*w.pj, w.sf, R.los[k], le, ln, lh);
+        row->max_off = std::max(row->max_off, (double)op.dist);
+        row->min_inc = std::min(row->min_inc, R.inc[k]);
+        if (err > b.max_all && err > 0.005)
+            std::snprintf(row->worst[k], sizeof row->worst[k],
+                          "px (%.2f, %.2f): reference (%.3Lf, %.3Lf, %.3Lf) range %.0Lf m, incidence %.2Lf deg, "
+                          "clearance before %.3Lg m; library - reference (%+.4Lf, %+.4Lf, %+.4Lf) m; the "
+                          "library's hit %.4Lf m off the path, %+.4Lf m along it, the path's clearance there "
+                          "%+.4Lf m",
+                          s.uq / 65536.0, s.vq / 65536.0, r.e, r.n, r.h, r.range, R.inc[k], r.min_clear, le - r.e,
+                          ln - r.n, lh - r.h, op.dist, op.t - r.t, op.clearance);
+    }
+    b.add(err, R.inc[k] >= kMinIncidenceDeg);
+    if (m == M_EXACT) check_geodetic(w, g, r, row, egm);
+}
+
+// One pose and camera: the sampled pixels, their reference paths, and every
+// mode's geolocation of them judged (judge_mode), into row.
+void run_pose(World &w, const Camera &cam, const Pose &p, uint64_t seed, Row *row, ProjEgm96 &egm)
+{
+    earth_ref::Proj &pj = *w.pj;
+    const std::vector<Px> px = sample_pixels(w, cam, p, seed, row);
+    ct_effects fx[NM];
+    mode_effects(fx);
     for (const Px &s : px) {
         ld ray[3];
         if (!mrcal_ray(cam, s.uq / 65536.0, s.vq / 65536.0, ray)) continue;
-        earth_ref::Los los[2];
-        earth_ref::Result ref[2];
-        ld inc[2] = {90, 90};
+        PxRefs R;
         for (int k = 0; k < 2; ++k) {
-            los[k] = earth_ref::los_from_wgs84(pj, p.lat, p.lon, p.h, p.qd, ray, &fx[k ? M_EXACT_REFR : M_EXACT]);
-            ref[k] = earth_ref::trace(pj, sf, los[k]);
-            if (ref[k].status == CT_HIT) inc[k] = incidence_deg(pj, sf, los[k], ref[k]);
+            R.los[k] = earth_ref::los_from_wgs84(pj, p.lat, p.lon, p.h, p.qd, ray, &fx[k ? M_EXACT_REFR : M_EXACT]);
+            R.ref[k] = earth_ref::trace(pj, w.sf, R.los[k]);
+            if (R.ref[k].status == CT_HIT) R.inc[k] = incidence_deg(pj, w.sf, R.los[k], R.ref[k]);
         }
-        for (int m = 0; m < NM; ++m) {
-            ct_geo g;
-            const ct_status st = ct_geolocate(&w.p, &cam.lib.cam, &p.pose, CT_METHOD_DIRECTIONAL,
-                                              m == M_STRAIGHT ? nullptr : &fx[m], s.uq, s.vq, &g);
-            if (st == CT_ERR_UNPROJECT) {
-                if (m == 0) row->unproject++;
-                continue;
-            }
-            const int ls = st == CT_HIT_VOID ? CT_HIT : st;
-            const ld le = g.hit.e_nm * 1e-9L, ln = g.hit.n_nm * 1e-9L, lh = g.hit.h_nm * 1e-9L;
-            // (a): straight Earth-fixed lines only
-            if (s.truth && !refr[m]) {
-                if (ls != CT_HIT)
-                    row->a[m].bad++;
-                else
-                    row->a[m].add((double)dist3(le, ln, lh, s.P[0], s.P[1], s.P[2]), s.inc >= kMinIncidenceDeg);
-            }
-            // (b)
-            const earth_ref::Result &r = ref[refr[m] ? 1 : 0];
-            if (m == M_EXACT && s.truth && r.status == CT_HIT)
-                row->routes.add((double)dist3(r.e, r.n, r.h, s.P[0], s.P[1], s.P[2]), true);
-            Stat &b = row->b[m];
-            if (r.min_clear < kSkipClearM) {
-                b.skip++;
-                continue;
-            }
-            if (r.wall && ls == CT_BELOW) {
-                b.wall++;
-                continue;
-            }
-            if (ls != r.status) {
-                b.bad++;
-                if (m == M_EXACT || m == M_EXACT_REFR)
-                    std::printf("    %s %s mode %d px (%.3f, %.3f): library status %d (%.3Lf %.3Lf %.3Lf), reference %d "
-                                "(%.3Lf %.3Lf %.3Lf, clearance %.3Lg m)\n",
-                                p.def.name, cam.name, m, s.uq / 65536.0, s.vq / 65536.0, (int)st, le, ln, lh, r.status,
-                                r.e, r.n, r.h, r.min_clear);
-                continue;
-            }
-            if (ls != CT_HIT) {
-                b.miss++;
-                continue;
-            }
-            const double err = (double)dist3(le, ln, lh, r.e, r.n, r.h);
-            const int k = refr[m] ? 1 : 0;
-            if (m == M_EXACT || m == M_EXACT_REFR) {
-                // where the library's hit lies relative to the reference path
-                const earth_ref::OffPath op = earth_ref::off_path(pj, sf, los[k], le, ln, lh);
-                row->max_off = std::max(row->max_off, (double)op.dist);
-                row->min_inc = std::min(row->min_inc, inc[k]);
-                if (err > b.max_all && err > 0.005)
-                    std::snprintf(row->worst[k], sizeof row->worst[k],
-                                  "px (%.2f, %.2f): reference (%.3Lf, %.3Lf, %.3Lf) range %.0Lf m, incidence %.2Lf deg, "
-                                  "clearance before %.3Lg m; library - reference (%+.4Lf, %+.4Lf, %+.4Lf) m; the "
-                                  "library's hit %.4Lf m off the path, %+.4Lf m along it, the path's clearance there "
-                                  "%+.4Lf m",
-                                  s.uq / 65536.0, s.vq / 65536.0, r.e, r.n, r.h, r.range, inc[k], r.min_clear, le - r.e,
-                                  ln - r.n, lh - r.h, op.dist, op.t - r.t, op.clearance);
-            }
-            b.add(err, inc[k] >= kMinIncidenceDeg);
-            if (m != M_EXACT) continue;
-            // the hit in geodetic coordinates: the library's (ct_utm_inverse;
-            // h_ell = h) vs PROJ's conversion of the same map point
-            int64_t la_q, lo_q, N_nm;
-            if (ct_utm_inverse(&w.zone, g.hit.e_nm, g.hit.n_nm, &la_q, &lo_q) != CT_OK ||
-                ct_package_geoid(&w.p, g.hit.e_nm, g.hit.n_nm, &N_nm) != CT_OK) {
-                row->geo_conv = INFINITY;
-                continue;
-            }
-            const ld lat_l = deg_of_q61(la_q), lon_l = deg_of_q61(lo_q);
-            ld lat_p, lon_p, Xl[3], Xp[3], Xr[3], lat_r, lon_r;
-            pj.utm_inverse(le, ln, &lat_p, &lon_p);
-            pj.ecef(lat_l, lon_l, lh, Xl);
-            pj.ecef(lat_p, lon_p, lh, Xp);
-            pj.utm_inverse(r.e, r.n, &lat_r, &lon_r);
-            pj.ecef(lat_r, lon_r, r.h, Xr);
-            auto d3 = [](const ld a3[3], const ld b3[3]) {
-                return std::sqrt((a3[0] - b3[0]) * (a3[0] - b3[0]) + (a3[1] - b3[1]) * (a3[1] - b3[1]) +
-                                 (a3[2] - b3[2]) * (a3[2] - b3[2]));
-            };
-            row->geo_conv = std::max(row->geo_conv, (double)d3(Xl, Xp));
-            row->geo_vs_map =
-                std::max(row->geo_vs_map, (double)std::fabs(d3(Xl, Xr) - dist3(le, ln, lh, r.e, r.n, r.h)));
-            // the height in the EGM96 datum
-            const ld H_lib = lh - N_nm * 1e-9L, H_proj = egm.height(lat_p, lon_p, lh);
-            const ld H_ref = egm.height(lat_r, lon_r, r.h);
-            row->egm = std::max(row->egm, (double)std::fabs(H_lib - H_proj));
-            row->egm_ref = std::max(row->egm_ref, (double)std::fabs(H_lib - H_ref));
-            if (!(std::fabs(H_proj - lh) > 10)) row->egm = INFINITY;  // PROJ must apply the geoid (N ~ -31 m)
-        }
+        for (int m = 0; m < NM; ++m) judge_mode(w, cam, p, s, R, m, fx, row, egm);
     }
 }
 

@@ -7,7 +7,7 @@
 // lenses, and a splined stereographic lens baked into an unprojection
 // grid), seeded random points of the bilinear surface are projected to
 // pixels with mrcal (mrcal_transform_point_rt + mrcal_project).  Each
-// point's visibility is decided by the reference tracer (tests/reference.hpp)
+// point's visibility is decided by the reference tracer (tests/kit/reference.hpp)
 // on the exact ray from the camera centre to the point, with a clearance
 // margin so grazing tangents are not counted either way.  Then:
 //   - visible points: ct_geolocate returns CT_HIT within GEO_TOL_M

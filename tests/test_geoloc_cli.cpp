@@ -732,7 +732,7 @@ void test_geoloc_tolerance()
 }
 
 // `conetrace viewshed` against a brute-force exact line of sight per post by
-// the independent reference tracer (tests/reference.hpp): the observer 5 m
+// the independent reference tracer (tests/kit/reference.hpp): the observer 5 m
 // above a post of the test DEM, every post a target 1.75 m above it; hidden
 // when the reference's first hit of the segment lies more than the margin
 // (1 cm) before the post.  Identical except ties (the segment within 1 cm
@@ -960,7 +960,7 @@ void test_shadows()
 
 // `conetrace view`: the oblique30 scene's camera over its package, no
 // effects; its range image against surface points projected by mrcal
-// (tests/scene.hpp: visible points, their pixel by mrcal_project, their
+// (tests/kit/scene.hpp: visible points, their pixel by mrcal_project, their
 // range from the reference tracer's first hit): each point's range lies
 // between its four neighbouring pixel centres' rendered ranges (0.1 % to
 // spare), where those four agree within 2 % (not across an occluding edge).

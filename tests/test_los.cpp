@@ -1,5 +1,5 @@
 // test_los.cpp -- ct_los (intervisibility) against the independent reference
-// tracer (tests/reference.hpp, long double, no code shared with lib/).
+// tracer (tests/kit/reference.hpp, long double, no code shared with lib/).
 //
 // On the adversarial DEMs (spikes, knife walls, pits, flat, terraces, the
 // 16-bit extremes): seeded pairs of an observer A (the surface plus 0..40 %

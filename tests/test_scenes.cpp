@@ -1,6 +1,6 @@
 // test_scenes.cpp -- geolocation scenes (fixtures/scenes/*.scene) against
 // ground truth made by mrcal and the independent long-double reference
-// tracer, with exactly the effects each scene lists (tests/scene.hpp).
+// tracer, with exactly the effects each scene lists (tests/kit/scene.hpp).
 //
 // Per scene:
 //   - the committed .cameramodel matches the scene's lens and pose;

@@ -1,4 +1,4 @@
-// test_tiles.cpp -- tile sets (lib/src/tiles.c, host_tools/tileset.cpp).
+// test_tiles.cpp -- tile sets (lib/src/tiles.c, host_tools/package/tileset.cpp).
 //
 //  - seams: seeded rays over DEMs cut into tiles (the fixture mirror-tiled,
 //    generated adversarial DEMs), plus rays built to run along seams,

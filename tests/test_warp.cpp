@@ -1,4 +1,4 @@
-// test_warp.cpp -- geographic DEMs resampled onto UTM (host_tools/warp.hpp)
+// test_warp.cpp -- geographic DEMs resampled onto UTM (host_tools/warp/warp.hpp)
 // and `conetrace build` on them, end to end.
 //
 // Inputs: the bundled fixture (EPSG:32617, 30 m) warped onto EPSG:4326 by

@@ -615,7 +615,7 @@ ct_status ct_status_name(ct_status s, const char **out);
 /* reference-frame (here: map-frame) points into the camera frame; the      */
 /* library takes the inverse pose, R_map_cam and the camera centre in nm.   */
 /* The conversion rt_cam_ref -> (R_map_cam, centre) runs on the host in     */
-/* long double (host_tools/camera_host.cpp,                                 */
+/* long double (host_tools/camera/camera_host.cpp,                          */
 /* ct_host::pose_from_rt_cam_ref) and stored with ct_pose_init; a           */
 /* navigation solution gives the pose through ct_pose_from_wgs84 or         */
 /* ct_pose_from_map (below).                                                */

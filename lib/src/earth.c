@@ -1011,30 +1011,42 @@ CT_NOINLINE static ct_status trace_piece(const ct_package *p, ct_tileset *ts, co
     return CT_MISS;
 }
 
-ct_status ct_trace_earth(const ct_package *p, const ct_earth *es, const int64_t dg[3], ct_method m, ct_hit *h)
+/* Refraction's bending direction w = up - (up . d) d, normalised (Q30); up
+ * is the frame's third column.  Near the vertical (|w| < 2^-10)
+ * refraction bends nothing worth a term: pa->refract stays 0. */
+static void refraction_axis(path *pa, const ct_earth *es)
 {
-    return ct_trace_earth_set(p, NULL, es, dg, m, h);
+    int64_t up[3], dq[3], dot = 0, n2, nn;
+    int k;
+    for (k = 0; k < 3; ++k) { /* bound: 3 */
+        up[k] = es->frame_q30[3 * k + 2];
+        dq[k] = ct_floor_div(pa->d[k] + (INT64_C(1) << 8), INT64_C(1) << 9); /* Q30 */
+        dot += up[k] * dq[k];                                               /* < 2^62 */
+    }
+    dot = ct_floor_div(dot + (INT64_C(1) << 29), INT64_C(1) << 30);
+    n2 = 0;
+    for (k = 0; k < 3; ++k) { /* bound: 3 */
+        pa->w[k] = up[k] - ct_floor_div(dot * dq[k] + (INT64_C(1) << 29), INT64_C(1) << 30);
+        n2 += pa->w[k] * pa->w[k];
+    }
+    nn = (int64_t)ct_isqrt64((uint64_t)n2);
+    if (nn >= (INT64_C(1) << 20)) {
+        for (k = 0; k < 3; ++k) { /* bound: 3 */
+            pa->w[k] = ct_floor_div(pa->w[k] * (INT64_C(1) << 30) + nn / 2, nn);
+        }
+        pa->refract = 1;
+    }
 }
 
-ct_status ct_trace_earth_set(const ct_package *p, ct_tileset *ts, const ct_earth *es, const int64_t dg[3], ct_method m,
-                             ct_hit *h)
+/* The path of the line of sight with grid direction dg (Q39): its
+ * direction in Earth-fixed axes, refraction's bending direction, and the
+ * interpolation nodes over [0, tmax]. */
+static void path_init(path *pa, const ct_package *p, const ct_earth *es, const int64_t dg[3])
 {
-    path pa;
-    gv A, B, M;
-    fit f;
-    int64_t ta = 0, L = PIECE_FIRST_NM;
-    uint32_t piece, steps = 0u, iters = 0u;
-    ct_status st;
     int k;
-    if (p == NULL || es == NULL || dg == NULL || h == NULL) {
-        return CT_ERR_ARG;
-    }
-    if ((uint32_t)m >= (uint32_t)CT_METHOD_COUNT) {
-        return CT_ERR_METHOD;
-    }
-    pa.p = p;
-    pa.es = es;
-    pa.zone = es->zone;
+    pa->p = p;
+    pa->es = es;
+    pa->zone = es->zone;
     /* d = frame dg: |frame| <= 2^30, |dg| <= 2^40: products < 2^70 */
     for (k = 0; k < 3; ++k) { /* bound: 3 axes */
         ct_i128 s = ct_i128_from64(0);
@@ -1042,124 +1054,173 @@ ct_status ct_trace_earth_set(const ct_package *p, ct_tileset *ts, const ct_earth
         for (j = 0; j < 3; ++j) { /* bound: 3 terms */
             s = ct_i128_add(s, ct_i128_mul(es->frame_q30[3 * k + j], dg[j]));
         }
-        pa.d[k] = ct_i128_round_shr(s, 30u);
-        pa.w[k] = 0;
+        pa->d[k] = ct_i128_round_shr(s, 30u);
+        pa->w[k] = 0;
     }
-    pa.refract = 0;
+    pa->refract = 0;
     if (es->refr_k_q16 != 0) {
-        /* w = up - (up . d) d, normalised (Q30); up is the frame's third
-         * column.  Near the vertical (|w| < 2^-10) refraction bends nothing
-         * worth a term. */
-        int64_t up[3], dq[3], dot = 0, n2, nn;
-        for (k = 0; k < 3; ++k) { /* bound: 3 */
-            up[k] = es->frame_q30[3 * k + 2];
-            dq[k] = ct_floor_div(pa.d[k] + (INT64_C(1) << 8), INT64_C(1) << 9); /* Q30 */
-            dot += up[k] * dq[k];                                              /* < 2^62 */
+        refraction_axis(pa, es);
+    }
+    pa->interp = 0;
+    set_nodes(pa, es->tmax_nm);
+}
+
+/* One piece of the path, from A (at ta) to B (at ta + Lc) through its
+ * middle M: the chord and quadratic fitted through them (f), 1 when it
+ * is off the tile (nothing to trace), the lowering it is traced against
+ * (lwp: &lw or NULL) and its value at B (dB), the model's largest errors
+ * sideways and vertically (elat, Q24; evert, Q16 height units).  Not to be
+ * copied: lwp points into it. */
+typedef struct {
+    gv B, M;
+    fit f;
+    int64_t Lc, elat, evert, dB;
+    int off;
+    ct_lower lw;
+    const ct_lower *lwp;
+} piece;
+
+/* The errors' excess over the tolerances, the larger of the two, in
+ * 1/1024 (each error capped at 2^40): both < 2^62. */
+static int64_t excess_1024(const ct_earth *es, int64_t elat, int64_t evert)
+{
+    return ct_max64(ct_min64(elat, INT64_C(1) << 40) * 1024 / ct_max64(es->tol_q24, 1),
+                    ct_min64(evert, INT64_C(1) << 40) * 1024 / ct_max64(es->tolz_q16, 1));
+}
+
+/* The model of the piece from A with its B and M set, checked against the
+ * exact image: 1 when it is within the tolerances or off the tile, 0 when
+ * it must be shorter, -1 when a quarter point is beyond the projection's
+ * domain.  Sets f, off, lwp (and lw), elat, evert; dB only where the model
+ * was checked at the quarter points. */
+static int check_piece(const ct_package *p, const path *pa, const ct_earth *es, const gv *A, int64_t ta, piece *pc)
+{
+    int ok;
+    fit_piece(A, &pc->B, &pc->M, &pc->f);
+    pc->off = piece_off(p, A, &pc->B, &pc->M, &pc->f, es->tolz_q16);
+    pc->lwp = NULL;
+    pc->elat = pc->f.dev;
+    pc->evert = 0;
+    ok = pc->off || pc->f.dev <= es->tol_q24;
+    if (ok && !pc->off) {
+        uint64_t kf;
+        uint32_t ks;
+        if (ct_i128_sign(pc->f.num) > 0 && ct_i128_sign(pc->f.den) > 0 && rise_coeff(pc->f.num, pc->f.den, &kf, &ks) &&
+            ct_lower_setup_k(p, A->x, A->y, kf, ks, es->cull, &pc->lw) == CT_OK) {
+            pc->lwp = &pc->lw;
         }
-        dot = ct_floor_div(dot + (INT64_C(1) << 29), INT64_C(1) << 30);
-        n2 = 0;
-        for (k = 0; k < 3; ++k) { /* bound: 3 */
-            pa.w[k] = up[k] - ct_floor_div(dot * dq[k] + (INT64_C(1) << 29), INT64_C(1) << 30);
-            n2 += pa.w[k] * pa.w[k];
+        pc->dB = pc->lwp != NULL ? ct_lower_at(pc->lwp, pc->B.x, pc->B.y) : 0;
+        /* the model against the exact image at the quarter points */
+        if (quarter_errors(pa, ta, pc->Lc, A, &pc->B, &pc->f, pc->lwp, pc->dB, &pc->elat, &pc->evert) != CT_OK) {
+            return -1;
         }
-        nn = (int64_t)ct_isqrt64((uint64_t)n2);
-        if (nn >= (INT64_C(1) << 20)) {
-            for (k = 0; k < 3; ++k) { /* bound: 3 */
-                pa.w[k] = ct_floor_div(pa.w[k] * (INT64_C(1) << 30) + nn / 2, nn);
-            }
-            pa.refract = 1;
+        ok = pc->elat <= es->tol_q24 && pc->evert <= es->tolz_q16;
+    }
+    return ok;
+}
+
+/* The next piece from A (at ta): *L long at most (and no longer than the
+ * rest of the path), shortened until its model is within the tolerances
+ * or it is PIECE_MIN_NM long; *L is left at the length of the last try.
+ * CT_MISS when a vertex is beyond the projection's domain (nothing of this
+ * tile), else CT_OK. */
+static ct_status next_piece(const ct_package *p, const path *pa, const ct_earth *es, const gv *A, int64_t ta,
+                            int64_t *L, piece *pc)
+{
+    uint32_t r;
+    pc->dB = 0;
+    /* bound: EARTH_MAX_RETRIES + 1 tries */
+    for (r = 0u; r <= EARTH_MAX_RETRIES; ++r) {
+        int ok;
+        pc->Lc = ct_min64(*L, es->tmax_nm - ta);
+        if (vertex(pa, ta + pc->Lc, &pc->B) != CT_OK || vertex(pa, ta + pc->Lc / 2, &pc->M) != CT_OK) {
+            return CT_MISS;
+        }
+        ok = check_piece(p, pa, es, A, ta, pc);
+        if (ok < 0) {
+            return CT_MISS;
+        }
+        if (ok || pc->Lc <= PIECE_MIN_NM) {
+            break;
+        }
+        {
+            /* shorten by sqrt(tol / excess) * 0.8 (at least 1/8): excess >= tol */
+            int64_t fr = (int64_t)ct_isqrt64(
+                (uint64_t)((INT64_C(1) << 40) / ct_max64(excess_1024(es, pc->elat, pc->evert), 1024))); /* Q15 */
+            *L = ct_max64(PIECE_MIN_NM, ct_max64(pc->Lc / 8, ct_mul_shr(pc->Lc, fr * 4 / 5, 15u)));
         }
     }
-    pa.interp = 0;
-    set_nodes(&pa, es->tmax_nm);
+    return CT_OK;
+}
+
+/* The length to try for the piece after pc: longer where pc was well
+ * within the tolerances or off the tile. */
+static int64_t next_length(const ct_earth *es, const piece *pc)
+{
+    int64_t fr;
+    if (pc->off) {
+        return ct_min64(PIECE_MAX_NM, 2 * pc->Lc);
+    }
+    /* the errors grow as the square of the length: aim at 0.6 of the
+     * tolerance, by a factor in [1/2, 2] */
+    fr = (int64_t)ct_isqrt64(
+        (uint64_t)((INT64_C(1) << 40) / ct_max64(excess_1024(es, pc->elat, pc->evert), 64))); /* Q15 */
+    fr = ct_min64(INT64_C(2) << 15, ct_max64(INT64_C(1) << 14, fr * 25 / 32));
+    return ct_min64(PIECE_MAX_NM, ct_max64(PIECE_MIN_NM, ct_mul_shr(pc->Lc, fr, 15u)));
+}
+
+ct_status ct_trace_earth(const ct_package *p, const ct_earth *es, const int64_t dg[3], ct_method m, ct_hit *h)
+{
+    return ct_trace_earth_set(p, NULL, es, dg, m, h);
+}
+
+/* The line of sight as pieces of lowered walks from the camera: each piece
+ * chosen (next_piece), traced unless off the tile (trace_piece), until a
+ * hit, an error, the path's end or a path gone from the tile. */
+ct_status ct_trace_earth_set(const ct_package *p, ct_tileset *ts, const ct_earth *es, const int64_t dg[3], ct_method m,
+                             ct_hit *h)
+{
+    path pa;
+    gv A;
+    piece pc;
+    int64_t ta = 0, L = PIECE_FIRST_NM;
+    uint32_t n, steps = 0u, iters = 0u;
+    ct_status st;
+    if (p == NULL || es == NULL || dg == NULL || h == NULL) {
+        return CT_ERR_ARG;
+    }
+    if ((uint32_t)m >= (uint32_t)CT_METHOD_COUNT) {
+        return CT_ERR_METHOD;
+    }
+    path_init(&pa, p, es, dg);
     A.x = es->ox;
     A.y = es->oy;
     A.z = es->oz;
     A.fx = es->ox * 256; /* |ox| <= 2^46 */
     A.fy = es->oy * 256;
     A.fz = es->oz * 256;
-    /* bound: EARTH_MAX_PIECES pieces, each with at most EARTH_MAX_RETRIES
-     * + 1 tries */
-    for (piece = 0u; piece < EARTH_MAX_PIECES && ta < es->tmax_nm; ++piece) {
-        int64_t tb = ta, Lc = L, elat = 0, evert = 0, dB = 0;
-        int off = 0;
-        uint32_t r;
-        ct_lower lw;
-        const ct_lower *lwp = NULL;
-        for (r = 0u; r <= EARTH_MAX_RETRIES; ++r) {
-            int ok;
-            Lc = ct_min64(L, es->tmax_nm - ta);
-            tb = ta + Lc;
-            st = vertex(&pa, tb, &B);
-            if (st == CT_OK) {
-                st = vertex(&pa, ta + Lc / 2, &M);
-            }
-            if (st != CT_OK) {
-                /* beyond the projection's domain: nothing of this tile */
-                h->steps = steps;
-                h->iters = iters;
-                return CT_MISS;
-            }
-            fit_piece(&A, &B, &M, &f);
-            off = piece_off(p, &A, &B, &M, &f, es->tolz_q16);
-            lwp = NULL;
-            elat = f.dev;
-            evert = 0;
-            ok = off || f.dev <= es->tol_q24;
-            if (ok && !off) {
-                uint64_t kf;
-                uint32_t ks;
-                if (ct_i128_sign(f.num) > 0 && ct_i128_sign(f.den) > 0 && rise_coeff(f.num, f.den, &kf, &ks) &&
-                    ct_lower_setup_k(p, A.x, A.y, kf, ks, es->cull, &lw) == CT_OK) {
-                    lwp = &lw;
-                }
-                dB = lwp != NULL ? ct_lower_at(lwp, B.x, B.y) : 0;
-                /* the model against the exact image at the quarter points */
-                if (quarter_errors(&pa, ta, Lc, &A, &B, &f, lwp, dB, &elat, &evert) != CT_OK) {
-                    h->steps = steps;
-                    h->iters = iters;
-                    return CT_MISS;
-                }
-                ok = elat <= es->tol_q24 && evert <= es->tolz_q16;
-            }
-            if (ok || Lc <= PIECE_MIN_NM) {
-                break;
-            }
-            {
-                /* shorten by sqrt(tol / excess) * 0.8 (at least 1/8):
-                 * excess >= tol, both < 2^62 */
-                int64_t ex = ct_max64(ct_min64(elat, INT64_C(1) << 40) * 1024 / ct_max64(es->tol_q24, 1),
-                                      ct_min64(evert, INT64_C(1) << 40) * 1024 / ct_max64(es->tolz_q16, 1));
-                int64_t fr = (int64_t)ct_isqrt64((uint64_t)((INT64_C(1) << 40) / ct_max64(ex, 1024))); /* Q15 */
-                L = ct_max64(PIECE_MIN_NM, ct_max64(Lc / 8, ct_mul_shr(Lc, fr * 4 / 5, 15u)));
-            }
+    /* bound: EARTH_MAX_PIECES pieces (each with at most EARTH_MAX_RETRIES
+     * + 1 tries in next_piece) */
+    for (n = 0u; n < EARTH_MAX_PIECES && ta < es->tmax_nm; ++n) {
+        if (next_piece(p, &pa, es, &A, ta, &L, &pc) != CT_OK) {
+            h->steps = steps;
+            h->iters = iters;
+            return CT_MISS;
         }
-        if (!off) {
-            st = trace_piece(p, ts, &A, &B, &f, lwp, dB, ta == 0, m, h, &steps, &iters);
+        if (!pc.off) {
+            st = trace_piece(p, ts, &A, &pc.B, &pc.f, pc.lwp, pc.dB, ta == 0, m, h, &steps, &iters);
             if (st != CT_MISS) {
                 return st; /* a hit, the camera below the surface, or an error */
             }
         }
         steps++;
         iters++;
-        if (gone(p, &A, &B, &M, &f)) {
+        if (gone(p, &A, &pc.B, &pc.M, &pc.f)) {
             break;
         }
-        /* the next piece: longer where this one was well within the
-         * tolerance or off the tile */
-        if (off) {
-            L = ct_min64(PIECE_MAX_NM, 2 * Lc);
-        } else {
-            /* the errors grow as the square of the length: aim at 0.6 of
-             * the tolerance, by a factor in [1/2, 2] */
-            int64_t ex = ct_max64(ct_min64(elat, INT64_C(1) << 40) * 1024 / ct_max64(es->tol_q24, 1),
-                                  ct_min64(evert, INT64_C(1) << 40) * 1024 / ct_max64(es->tolz_q16, 1));
-            int64_t fr = (int64_t)ct_isqrt64((uint64_t)((INT64_C(1) << 40) / ct_max64(ex, 64))); /* Q15 */
-            fr = ct_min64(INT64_C(2) << 15, ct_max64(INT64_C(1) << 14, fr * 25 / 32));
-            L = ct_min64(PIECE_MAX_NM, ct_max64(PIECE_MIN_NM, ct_mul_shr(Lc, fr, 15u)));
-        }
-        A = B;
-        ta = tb;
+        L = next_length(es, &pc);
+        A = pc.B;
+        ta += pc.Lc;
     }
     h->steps = steps;
     h->iters = iters;

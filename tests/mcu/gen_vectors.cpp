@@ -389,153 +389,209 @@ void dir_from_angles(const ct_package &p, double az, double el, double scale, ct
     r.dz = (int64_t)std::llround(std::tan(el) * lsb_per_cell * scale);
 }
 
-ct_ray make_ray(Rng &g, const ct_package &p, int kind)
+// The tile's extent as the ray kinds use it: cells in x and y, and a height
+// just above its tallest post (Q16).
+struct TileBox {
+    int64_t cx, cy, top;
+};
+
+const double PI = 3.14159265358979323846;
+
+// kind 0: a camera above the tile looking down
+ct_ray ray_looking_down(Rng &g, const ct_package &p, const TileBox &b)
 {
-    const int64_t cx = p.cells_x, cy = p.cells_y;
-    const int64_t top = ((int64_t)p.hmax + 1) * ONE16;
     ct_ray r{};
-    const double PI = 3.14159265358979323846;
-    switch (kind) {
-    case 0: {  // camera above the tile looking down
-        r.x_q16 = g.range(-5 * ONE16, (cx + 5) * ONE16);
-        r.y_q16 = g.range(-5 * ONE16, (cy + 5) * ONE16);
-        r.z_q16 = top + g.range(0, 2500 * ONE16);
-        dir_from_angles(p, g.uni(0, 2 * PI), -g.uni(2, 85) * PI / 180, g.uni(1e3, 1e9), r);
-        break;
+    r.x_q16 = g.range(-5 * ONE16, (b.cx + 5) * ONE16);
+    r.y_q16 = g.range(-5 * ONE16, (b.cy + 5) * ONE16);
+    r.z_q16 = b.top + g.range(0, 2500 * ONE16);
+    dir_from_angles(p, g.uni(0, 2 * PI), -g.uni(2, 85) * PI / 180, g.uni(1e3, 1e9), r);
+    return r;
+}
+
+// kind 1: grazing from just above the surface
+ct_ray ray_grazing(Rng &g, const ct_package &p, const TileBox &b)
+{
+    ct_ray r{};
+    int64_t x = g.range(ONE16, (b.cx - 1) * ONE16), y = g.range(ONE16, (b.cy - 1) * ONE16);
+    r.x_q16 = x;
+    r.y_q16 = y;
+    r.z_q16 = surface_q16(p, x, y) + g.range(1, 64 * ONE16);
+    dir_from_angles(p, g.uni(0, 2 * PI), g.uni(-6, 1.5) * PI / 180, g.uni(1e4, 1e8), r);
+    return r;
+}
+
+// kind 2: from far outside, aimed exactly at a surface point
+ct_ray ray_aimed_from_afar(Rng &g, const ct_package &p, const TileBox &b)
+{
+    ct_ray r{};
+    double a = g.uni(0, 2 * PI), dist = g.uni(40, 400);
+    int64_t tx = g.range(0, b.cx * ONE16), ty = g.range(0, b.cy * ONE16);
+    int64_t tz = surface_q16(p, tx, ty);
+    r.x_q16 = tx + (int64_t)std::llround(std::cos(a) * dist * ONE16);
+    r.y_q16 = ty + (int64_t)std::llround(std::sin(a) * dist * ONE16);
+    r.z_q16 = tz + (int64_t)std::llround(dist * g.uni(0.2, 600.0) * ONE16);
+    r.dx = tx - r.x_q16;
+    r.dy = ty - r.y_q16;
+    r.dz = tz - r.z_q16;
+    return r;
+}
+
+// kind 3: axis-aligned and exact diagonals, origins on grid lines / posts
+ct_ray ray_on_grid_lines(Rng &g, const ct_package &p, const TileBox &b)
+{
+    ct_ray r{};
+    const int64_t cx = b.cx, cy = b.cy;
+    int64_t s = g.range(1, 1 << 20);
+    int which = (int)g.range(0, 5);
+    r.x_q16 = g.range(0, cx) * ONE16 + (g.chance(50) ? 0 : g.range(0, ONE16 - 1));
+    r.y_q16 = g.range(0, cy) * ONE16 + (g.chance(50) ? 0 : g.range(0, ONE16 - 1));
+    r.z_q16 = surface_q16(p, std::min(r.x_q16, cx * ONE16), std::min(r.y_q16, cy * ONE16)) + g.range(1, 400 * ONE16);
+    int64_t sx = g.chance(50) ? 1 : -1, sy = g.chance(50) ? 1 : -1;
+    r.dx = which == 0 ? 0 : (which == 1 ? sx * s : sx * s);
+    r.dy = which == 0 ? sy * s : (which == 1 ? 0 : sy * s);
+    if (which >= 3) {  // off-diagonal small integer slopes
+        r.dx = sx * s * g.range(1, 3);
+        r.dy = sy * s * g.range(1, 3);
     }
-    case 1: {  // grazing from just above the surface
-        int64_t x = g.range(ONE16, (cx - 1) * ONE16), y = g.range(ONE16, (cy - 1) * ONE16);
-        r.x_q16 = x;
-        r.y_q16 = y;
-        r.z_q16 = surface_q16(p, x, y) + g.range(1, 64 * ONE16);
-        dir_from_angles(p, g.uni(0, 2 * PI), g.uni(-6, 1.5) * PI / 180, g.uni(1e4, 1e8), r);
-        break;
-    }
-    case 2: {  // from far outside, aimed exactly at a surface point
-        double a = g.uni(0, 2 * PI), dist = g.uni(40, 400);
-        int64_t tx = g.range(0, cx * ONE16), ty = g.range(0, cy * ONE16);
-        int64_t tz = surface_q16(p, tx, ty);
-        r.x_q16 = tx + (int64_t)std::llround(std::cos(a) * dist * ONE16);
-        r.y_q16 = ty + (int64_t)std::llround(std::sin(a) * dist * ONE16);
-        r.z_q16 = tz + (int64_t)std::llround(dist * g.uni(0.2, 600.0) * ONE16);
-        r.dx = tx - r.x_q16;
-        r.dy = ty - r.y_q16;
-        r.dz = tz - r.z_q16;
-        break;
-    }
-    case 3: {  // axis-aligned and exact diagonals, origins on grid lines / posts
-        int64_t s = g.range(1, 1 << 20);
-        int which = (int)g.range(0, 5);
-        r.x_q16 = g.range(0, cx) * ONE16 + (g.chance(50) ? 0 : g.range(0, ONE16 - 1));
-        r.y_q16 = g.range(0, cy) * ONE16 + (g.chance(50) ? 0 : g.range(0, ONE16 - 1));
-        r.z_q16 = surface_q16(p, std::min(r.x_q16, cx * ONE16), std::min(r.y_q16, cy * ONE16)) + g.range(1, 400 * ONE16);
-        int64_t sx = g.chance(50) ? 1 : -1, sy = g.chance(50) ? 1 : -1;
-        r.dx = which == 0 ? 0 : (which == 1 ? sx * s : sx * s);
-        r.dy = which == 0 ? sy * s : (which == 1 ? 0 : sy * s);
-        if (which >= 3) {  // off-diagonal small integer slopes
-            r.dx = sx * s * g.range(1, 3);
-            r.dy = sy * s * g.range(1, 3);
-        }
-        r.dz = -s * g.range(0, 300);
-        break;
-    }
-    case 4: {  // vertical, down and up, some on posts and lines
-        r.x_q16 = g.chance(40) ? g.range(0, cx) * ONE16 : g.range(0, cx * ONE16);
-        r.y_q16 = g.chance(40) ? g.range(0, cy) * ONE16 : g.range(0, cy * ONE16);
-        r.z_q16 = top + g.range(-ONE16, 500 * ONE16);
-        r.dz = g.chance(80) ? -g.range(1, INT64_C(1) << 40) : g.range(1, 1000);
-        if (g.chance(15)) {  // vertical outside the tile
-            r.x_q16 = -g.range(1, 1000);
-        }
-        break;
-    }
-    case 5: {  // starts below / exactly on the surface
-        int64_t x = g.range(0, cx) * ONE16, y = g.range(0, cy) * ONE16;
-        if (g.chance(50)) {
-            x += g.range(0, ONE16 - 1);
-            y += g.range(0, ONE16 - 1);
-            x = std::min(x, cx * ONE16);
-            y = std::min(y, cy * ONE16);
-        }
-        int64_t s = surface_q16(p, x, y);
-        r.x_q16 = x;
-        r.y_q16 = y;
-        r.z_q16 = g.chance(50) ? s : s - g.range(1, 50 * ONE16);
-        dir_from_angles(p, g.uni(0, 2 * PI), g.uni(-40, 40) * PI / 180, 1e6, r);
-        break;
-    }
-    case 6: {  // upward and level rays over the tile (misses)
-        r.x_q16 = g.range(-10 * ONE16, (cx + 10) * ONE16);
-        r.y_q16 = g.range(-10 * ONE16, (cy + 10) * ONE16);
-        r.z_q16 = top + g.range(-50 * ONE16, 50 * ONE16);
-        dir_from_angles(p, g.uni(0, 2 * PI), g.uni(0, 30) * PI / 180, 1e7, r);
-        break;
-    }
-    case 7: {  // extreme scales and invalid rays
-        int v = (int)g.range(0, 5);
-        r.x_q16 = g.range(0, cx * ONE16);
-        r.y_q16 = g.range(0, cy * ONE16);
-        r.z_q16 = top + g.range(0, 100 * ONE16);
-        if (v == 0) {  // huge direction
-            r.dx = g.range(-(INT64_C(1) << 62), INT64_C(1) << 62);
-            r.dy = g.range(-(INT64_C(1) << 62), INT64_C(1) << 62);
-            r.dz = -(INT64_C(1) << 62) + g.range(0, 1000);
-        } else if (v == 1) {  // tiny direction
-            r.dx = g.range(-1, 1);
-            r.dy = g.range(-1, 1);
-            r.dz = -1;
-        } else if (v == 2) {  // origin far away, near the limit
-            r.x_q16 = CT_MAX_ORIGIN_Q16 - g.range(0, 1000);
-            r.y_q16 = -CT_MAX_ORIGIN_Q16 + g.range(0, 1000);
-            r.z_q16 = CT_MAX_ORIGIN_Q16 / 2;
-            r.dx = -(INT64_C(1) << 50);
-            r.dy = INT64_C(1) << 50;
-            r.dz = -(INT64_C(1) << 46);
-        } else if (v == 3) {  // origin beyond the limit
-            r.x_q16 = CT_MAX_ORIGIN_Q16 + 1;
-            r.dx = -1;
-            r.dz = -1;
-        } else if (v == 4) {  // zero direction
-            r.dx = r.dy = r.dz = 0;
-        } else {  // direction beyond 2^62
-            r.dx = INT64_MAX;
-            r.dz = -1;
-        }
-        break;
-    }
-    case 8: {  // aimed exactly at posts, edge midpoints, plateau points
-        int64_t tx = g.range(0, cx) * ONE16, ty = g.range(0, cy) * ONE16;
-        if (g.chance(30)) tx += ONE16 / 2;
-        if (g.chance(30)) ty += ONE16 / 2;
-        if (g.chance(25)) {  // the plateau (flat, exact ties)
-            tx = g.range(18, 23) * ONE16 + g.range(0, 5) * (ONE16 / 4);
-            ty = g.range(3, 8) * ONE16;
-        }
-        tx = std::min(tx, cx * ONE16);
-        ty = std::min(ty, cy * ONE16);
-        int64_t tz = surface_q16(p, tx, ty);
-        int64_t ddx = g.range(-20, 20) * ONE16 / 4, ddy = g.range(-20, 20) * ONE16 / 4;
-        int64_t ddz = g.range(g.chance(20) ? 0 : 1, 3000) * ONE16;
-        r.x_q16 = tx - ddx;
-        r.y_q16 = ty - ddy;
-        r.z_q16 = tz + ddz;
-        r.dx = ddx;
-        r.dy = ddy;
-        r.dz = -ddz;
-        if (r.dx == 0 && r.dy == 0 && r.dz == 0) r.dz = -1;
-        break;
-    }
-    default: {  // long low rays across the whole tile
-        bool alongx = g.chance(50);
-        r.x_q16 = alongx ? -g.range(0, 3 * ONE16) : g.range(0, cx * ONE16);
-        r.y_q16 = alongx ? g.range(0, cy * ONE16) : (cy * ONE16 + g.range(0, 3 * ONE16));
-        r.z_q16 = ((int64_t)p.hmin + (p.hmax - p.hmin) / 2) * ONE16 + g.range(0, (p.hmax - p.hmin) / 2 * ONE16);
-        dir_from_angles(p, alongx ? g.uni(-0.6, 0.6) : g.uni(-PI / 2 - 0.6, -PI / 2 + 0.6), g.uni(-2, 0.2) * PI / 180,
-                        g.uni(1e5, 1e9), r);
-        break;
-    }
+    r.dz = -s * g.range(0, 300);
+    return r;
+}
+
+// kind 4: vertical, down and up, some on posts and lines
+ct_ray ray_vertical(Rng &g, const TileBox &b)
+{
+    ct_ray r{};
+    r.x_q16 = g.chance(40) ? g.range(0, b.cx) * ONE16 : g.range(0, b.cx * ONE16);
+    r.y_q16 = g.chance(40) ? g.range(0, b.cy) * ONE16 : g.range(0, b.cy * ONE16);
+    r.z_q16 = b.top + g.range(-ONE16, 500 * ONE16);
+    r.dz = g.chance(80) ? -g.range(1, INT64_C(1) << 40) : g.range(1, 1000);
+    if (g.chance(15)) {  // vertical outside the tile
+        r.x_q16 = -g.range(1, 1000);
     }
     return r;
+}
+
+// kind 5: starts below / exactly on the surface
+ct_ray ray_from_the_surface(Rng &g, const ct_package &p, const TileBox &b)
+{
+    ct_ray r{};
+    int64_t x = g.range(0, b.cx) * ONE16, y = g.range(0, b.cy) * ONE16;
+    if (g.chance(50)) {
+        x += g.range(0, ONE16 - 1);
+        y += g.range(0, ONE16 - 1);
+        x = std::min(x, b.cx * ONE16);
+        y = std::min(y, b.cy * ONE16);
+    }
+    int64_t s = surface_q16(p, x, y);
+    r.x_q16 = x;
+    r.y_q16 = y;
+    r.z_q16 = g.chance(50) ? s : s - g.range(1, 50 * ONE16);
+    dir_from_angles(p, g.uni(0, 2 * PI), g.uni(-40, 40) * PI / 180, 1e6, r);
+    return r;
+}
+
+// kind 6: upward and level rays over the tile (misses)
+ct_ray ray_upward(Rng &g, const ct_package &p, const TileBox &b)
+{
+    ct_ray r{};
+    r.x_q16 = g.range(-10 * ONE16, (b.cx + 10) * ONE16);
+    r.y_q16 = g.range(-10 * ONE16, (b.cy + 10) * ONE16);
+    r.z_q16 = b.top + g.range(-50 * ONE16, 50 * ONE16);
+    dir_from_angles(p, g.uni(0, 2 * PI), g.uni(0, 30) * PI / 180, 1e7, r);
+    return r;
+}
+
+// kind 7: extreme scales and invalid rays
+ct_ray ray_extreme(Rng &g, const TileBox &b)
+{
+    ct_ray r{};
+    int v = (int)g.range(0, 5);
+    r.x_q16 = g.range(0, b.cx * ONE16);
+    r.y_q16 = g.range(0, b.cy * ONE16);
+    r.z_q16 = b.top + g.range(0, 100 * ONE16);
+    if (v == 0) {  // huge direction
+        r.dx = g.range(-(INT64_C(1) << 62), INT64_C(1) << 62);
+        r.dy = g.range(-(INT64_C(1) << 62), INT64_C(1) << 62);
+        r.dz = -(INT64_C(1) << 62) + g.range(0, 1000);
+    } else if (v == 1) {  // tiny direction
+        r.dx = g.range(-1, 1);
+        r.dy = g.range(-1, 1);
+        r.dz = -1;
+    } else if (v == 2) {  // origin far away, near the limit
+        r.x_q16 = CT_MAX_ORIGIN_Q16 - g.range(0, 1000);
+        r.y_q16 = -CT_MAX_ORIGIN_Q16 + g.range(0, 1000);
+        r.z_q16 = CT_MAX_ORIGIN_Q16 / 2;
+        r.dx = -(INT64_C(1) << 50);
+        r.dy = INT64_C(1) << 50;
+        r.dz = -(INT64_C(1) << 46);
+    } else if (v == 3) {  // origin beyond the limit
+        r.x_q16 = CT_MAX_ORIGIN_Q16 + 1;
+        r.dx = -1;
+        r.dz = -1;
+    } else if (v == 4) {  // zero direction
+        r.dx = r.dy = r.dz = 0;
+    } else {  // direction beyond 2^62
+        r.dx = INT64_MAX;
+        r.dz = -1;
+    }
+    return r;
+}
+
+// kind 8: aimed exactly at posts, edge midpoints, plateau points
+ct_ray ray_aimed_at_posts(Rng &g, const ct_package &p, const TileBox &b)
+{
+    ct_ray r{};
+    int64_t tx = g.range(0, b.cx) * ONE16, ty = g.range(0, b.cy) * ONE16;
+    if (g.chance(30)) tx += ONE16 / 2;
+    if (g.chance(30)) ty += ONE16 / 2;
+    if (g.chance(25)) {  // the plateau (flat, exact ties)
+        tx = g.range(18, 23) * ONE16 + g.range(0, 5) * (ONE16 / 4);
+        ty = g.range(3, 8) * ONE16;
+    }
+    tx = std::min(tx, b.cx * ONE16);
+    ty = std::min(ty, b.cy * ONE16);
+    int64_t tz = surface_q16(p, tx, ty);
+    int64_t ddx = g.range(-20, 20) * ONE16 / 4, ddy = g.range(-20, 20) * ONE16 / 4;
+    int64_t ddz = g.range(g.chance(20) ? 0 : 1, 3000) * ONE16;
+    r.x_q16 = tx - ddx;
+    r.y_q16 = ty - ddy;
+    r.z_q16 = tz + ddz;
+    r.dx = ddx;
+    r.dy = ddy;
+    r.dz = -ddz;
+    if (r.dx == 0 && r.dy == 0 && r.dz == 0) r.dz = -1;
+    return r;
+}
+
+// kind 9: long low rays across the whole tile
+ct_ray ray_long_low(Rng &g, const ct_package &p, const TileBox &b)
+{
+    ct_ray r{};
+    bool alongx = g.chance(50);
+    r.x_q16 = alongx ? -g.range(0, 3 * ONE16) : g.range(0, b.cx * ONE16);
+    r.y_q16 = alongx ? g.range(0, b.cy * ONE16) : (b.cy * ONE16 + g.range(0, 3 * ONE16));
+    r.z_q16 = ((int64_t)p.hmin + (p.hmax - p.hmin) / 2) * ONE16 + g.range(0, (p.hmax - p.hmin) / 2 * ONE16);
+    dir_from_angles(p, alongx ? g.uni(-0.6, 0.6) : g.uni(-PI / 2 - 0.6, -PI / 2 + 0.6), g.uni(-2, 0.2) * PI / 180,
+                    g.uni(1e5, 1e9), r);
+    return r;
+}
+
+// A ray of the given kind (0..9, pick_kind's shares) over package p.
+ct_ray make_ray(Rng &g, const ct_package &p, int kind)
+{
+    const TileBox b = {p.cells_x, p.cells_y, ((int64_t)p.hmax + 1) * ONE16};
+    switch (kind) {
+    case 0: return ray_looking_down(g, p, b);
+    case 1: return ray_grazing(g, p, b);
+    case 2: return ray_aimed_from_afar(g, p, b);
+    case 3: return ray_on_grid_lines(g, p, b);
+    case 4: return ray_vertical(g, b);
+    case 5: return ray_from_the_surface(g, p, b);
+    case 6: return ray_upward(g, p, b);
+    case 7: return ray_extreme(g, b);
+    case 8: return ray_aimed_at_posts(g, p, b);
+    default: return ray_long_low(g, p, b);
+    }
 }
 
 const int KIND_PCT[10] = {24, 14, 10, 10, 5, 6, 5, 6, 12, 8};  // sums to 100

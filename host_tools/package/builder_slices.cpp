@@ -399,6 +399,28 @@ void local_row(const LocalInput &L, int cj, LocalScratch &sc, uint8_t *codes)
     }
 }
 
+// The near and window terms of every cell (local_row), threads taking rows
+// of coarse cells in turn.
+void local_terms(const LocalInput &L, int nthreads, uint8_t *codes)
+{
+    std::atomic<int> next{0};
+    auto worker = [&]() {
+        LocalScratch sc;
+        sc.colmax.resize((size_t)L.wc);
+        sc.winmax.resize((size_t)L.wc);
+        sc.need.resize((size_t)L.c->n);
+        sc.top.resize((size_t)L.c->n);
+        for (;;) {
+            int cj = next.fetch_add(1);
+            if (cj >= L.hc) break;
+            local_row(L, cj, sc, codes);
+        }
+    };
+    std::vector<std::thread> pool;
+    for (int t = 0; t < nthreads; ++t) pool.emplace_back(worker);
+    for (auto &th : pool) th.join();
+}
+
 // ---- the far terms, slice by slice ---------------------------------------
 
 constexpr double SQRT2 = 1.41421356237309515;  // rounded up
@@ -505,6 +527,67 @@ void far_sector(const FarSlice &F, int s, uint8_t *went_full, FarWorker &w, uint
     w.rows += q.rows_visited();
 }
 
+// Per code: cot as a double lower bound, for the monotone update (stricter
+// than code_for); -INF for a code that is not valid.
+void code_cots(const Ctx &c, double cot_of[256])
+{
+    for (int k = 0; k < 256; ++k) cot_of[k] = c.cot_ok[k] ? ((double)c.cot_q16[k] * (1.0 - 1e-9) - 3.0) / 65536.0 : -INF;
+}
+
+// A far term is at most (top - a) / (r Rw): it cannot narrow code k unless
+// top - a > r Rw cot(k) (checked exactly in far_sector; a hair lower here).
+// Code 0 (degenerate) cannot narrow at all.
+void skip_rises(int r, int rw, const double cot_of[256], double skip_rise[256])
+{
+    for (int k = 0; k < 256; ++k)
+        skip_rise[k] = k == 0 ? INF : cot_of[k] > 0.0 ? r * (double)rw * cot_of[k] * (1.0 - 1e-12) : -INF;
+}
+
+// Slice k (top L_k+1 = top, K levels): a cell can be narrowed only if its
+// code is one whose skip test passes: rise >= skip_rise[code], rise = top -
+// its apex level, the same for every sector.  Per cell, (the least such
+// code) - 1, 255 when none: every cell the tests accept has a code above
+// it, so the sectors' loops first compare one byte (same result; most
+// cells stop there; the slice phase at 2048^2, r = 3 measured 5-10% faster).
+std::vector<uint8_t> narrow_thresholds(int K, int k, double top, const std::vector<double> &lvd,
+                                       const double skip_rise[256], const std::vector<uint16_t> &k0, size_t plane)
+{
+    std::vector<uint8_t> thr_of_level((size_t)K + 1);
+    for (int kf = 0; kf <= K; ++kf) {
+        int t = 255;
+        const double rise = top - lvd[(size_t)kf];
+        if (kf <= k && rise > 0.0)
+            for (int code = 1; code < 256; ++code)
+                if (!(rise < skip_rise[code])) {
+                    t = code - 1;
+                    break;
+                }
+        thr_of_level[(size_t)kf] = (uint8_t)t;
+    }
+    std::vector<uint8_t> thr(plane);
+    for (size_t f = 0; f < plane; ++f) thr[f] = thr_of_level[k0[f]];
+    return thr;
+}
+
+// Slice F.k's far terms in every sector (far_sector), threads taking
+// sectors in turn; went_full per sector, workers per thread.
+void far_terms(const FarSlice &F, int nthreads, std::vector<uint8_t> &went_full, std::vector<FarWorker> &workers,
+               uint8_t *codes)
+{
+    const int n = F.c->n;
+    std::atomic<int> next{0};
+    auto worker = [&](int tid) {
+        for (;;) {
+            int s = next.fetch_add(1);
+            if (s >= n) break;
+            far_sector(F, s, &went_full[(size_t)s], workers[(size_t)tid], codes);
+        }
+    };
+    std::vector<std::thread> pool;
+    for (int t = 0; t < std::min(nthreads, n); ++t) pool.emplace_back(worker, t);
+    for (auto &th : pool) th.join();
+}
+
 }  // namespace
 
 void slice_angles(const Ctx &c, const SliceInput &in, uint8_t *codes, SliceStats *st)
@@ -526,31 +609,14 @@ void slice_angles(const Ctx &c, const SliceInput &in, uint8_t *codes, SliceStats
     const std::vector<double> lvd(lv.begin(), lv.end());
     const int K = (int)lv.size() - 1;
 
-    // cot of each code as a double lower bound, for the monotone update
     double cot_of[256];
-    for (int k = 0; k < 256; ++k) cot_of[k] = c.cot_ok[k] ? ((double)c.cot_q16[k] * (1.0 - 1e-9) - 3.0) / 65536.0 : -INF;  // stricter than code_for
+    code_cots(c, cot_of);
 
     auto t_start = std::chrono::steady_clock::now();
-    // ---- near + window terms, threads over rows of coarse cells
+    // ---- near + window terms
     {
         const LocalTables tables = local_tables(c, rw);
-        const LocalInput L{&c, &tables, &hcm, &lvd, &k0, rw, wc, hc, plane};
-        std::atomic<int> next{0};
-        auto worker = [&]() {
-            LocalScratch sc;
-            sc.colmax.resize((size_t)wc);
-            sc.winmax.resize((size_t)wc);
-            sc.need.resize((size_t)c.n);
-            sc.top.resize((size_t)c.n);
-            for (;;) {
-                int cj = next.fetch_add(1);
-                if (cj >= hc) break;
-                local_row(L, cj, sc, codes);
-            }
-        };
-        std::vector<std::thread> pool;
-        for (int t = 0; t < nthreads; ++t) pool.emplace_back(worker);
-        for (auto &th : pool) th.join();
+        local_terms(LocalInput{&c, &tables, &hcm, &lvd, &k0, rw, wc, hc, plane}, nthreads, codes);
     }
 
     auto t_local = std::chrono::steady_clock::now();
@@ -565,12 +631,8 @@ void slice_angles(const Ctx &c, const SliceInput &in, uint8_t *codes, SliceStats
     // per sector: did the previous slice switch to a full DT?  Then this one
     // starts with it (the needed cells change slowly from slice to slice).
     std::vector<uint8_t> went_full((size_t)c.n, 0);
-    // A far term is at most (top - a) / (r Rw): it cannot narrow code k
-    // unless top - a > r Rw cot(k) (checked exactly below; a hair lower
-    // here).  Code 0 (degenerate) cannot narrow at all.
     double skip_rise[256];
-    for (int k = 0; k < 256; ++k)
-        skip_rise[k] = k == 0 ? INF : cot_of[k] > 0.0 ? r * (double)rw * cot_of[k] * (1.0 - 1e-12) : -INF;
+    skip_rises(r, rw, cot_of, skip_rise);
     // a query row costs ~2 ns, a full DT ~10-20 ns per cell (measured)
     const double row_budget = in.full_dt_rows * (double)plane;
     for (int k = kmin; k < K; ++k) {
@@ -585,42 +647,13 @@ void slice_angles(const Ctx &c, const SliceInput &in, uint8_t *codes, SliceStats
         if (nfeat == 0) break;  // and every higher slice is empty too
         if (st) st->slices++;
         const double top = lv[(size_t)k + 1];
-        // A cell can be narrowed only if its code is one whose skip test
-        // passes: rise >= skip_rise[code], rise = top - its apex level, the
-        // same for every sector.  thr[f] = (the least such code) - 1, 255 when
-        // none: every cell the tests accept has code > thr[f], so the
-        // sectors' loops first compare one byte (same result; most cells stop
-        // there; the slice phase at 2048^2, r = 3 measured 5-10% faster).
-        std::vector<uint8_t> thr_of_level((size_t)K + 1);
-        for (int kf = 0; kf <= K; ++kf) {
-            int t = 255;
-            const double rise = top - lvd[(size_t)kf];
-            if (kf <= k && rise > 0.0)
-                for (int code = 1; code < 256; ++code)
-                    if (!(rise < skip_rise[code])) {
-                        t = code - 1;
-                        break;
-                    }
-            thr_of_level[(size_t)kf] = (uint8_t)t;
-        }
-        std::vector<uint8_t> thr(plane);
-        for (size_t f = 0; f < plane; ++f) thr[f] = thr_of_level[k0[f]];
+        const std::vector<uint8_t> thr = narrow_thresholds(K, k, top, lvd, skip_rise, k0, plane);
         std::once_flag prepared_once;
         std::unique_ptr<ddt::Prepared> prepared;
         const FarSlice F{&c,  k,      rw,        wc,      hc,         plane,          top,           &bl,
                          &k0, &lvd,   &thr,      cot_of,  skip_rise,  &pieces,        row_budget,    &prepared_once,
                          &prepared};
-        std::atomic<int> next{0};
-        auto worker = [&](int tid) {
-            for (;;) {
-                int s = next.fetch_add(1);
-                if (s >= c.n) break;
-                far_sector(F, s, &went_full[(size_t)s], workers[(size_t)tid], codes);
-            }
-        };
-        std::vector<std::thread> pool;
-        for (int t = 0; t < std::min(nthreads, c.n); ++t) pool.emplace_back(worker, t);
-        for (auto &th : pool) th.join();
+        far_terms(F, nthreads, went_full, workers, codes);
     }
     if (in.progress) in.progress((size_t)(K - kmin), (size_t)(K - kmin));
     if (st) {
