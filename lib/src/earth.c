@@ -1091,14 +1091,16 @@ static int64_t excess_1024(const ct_earth *es, int64_t elat, int64_t evert)
 /* The model of the piece from A with its B and M set, checked against the
  * exact image: 1 when it is within the tolerances or off the tile, 0 when
  * it must be shorter, -1 when a quarter point is beyond the projection's
- * domain.  Sets f, off, lwp (and lw), elat, evert; dB only where the model
- * was checked at the quarter points. */
+ * domain.  Sets f, off, lwp (and lw), dB (0 without a lowering), elat,
+ * evert. */
 static int check_piece(const ct_package *p, const path *pa, const ct_earth *es, const gv *A, int64_t ta, piece *pc)
 {
     int ok;
     fit_piece(A, &pc->B, &pc->M, &pc->f);
     pc->off = piece_off(p, A, &pc->B, &pc->M, &pc->f, es->tolz_q16);
     pc->lwp = NULL;
+    pc->dB = 0; /* with lwp: a try that fails before the quarter points
+                   must not keep an earlier, longer try's lowering */
     pc->elat = pc->f.dev;
     pc->evert = 0;
     ok = pc->off || pc->f.dev <= es->tol_q24;
