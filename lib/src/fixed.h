@@ -188,7 +188,15 @@ static inline int ct_i128_sign(ct_i128 a)
     return (a.hi | a.lo) != 0u ? 1 : 0;
 }
 
-static inline int ct_i128_cmp(ct_i128 a, ct_i128 b) { return ct_i128_sign(ct_i128_sub(a, b)); }
+static inline int ct_i128_cmp(ct_i128 a, ct_i128 b)
+{
+#ifdef CT_NATIVE_INT128
+    ct_n128 x = ct_to_n(a), y = ct_to_n(b);
+    return (x > y) - (x < y);
+#else
+    return ct_i128_sign(ct_i128_sub(a, b));
+#endif
+}
 
 /* Unsigned 64 x 64 -> 128 from 32-bit halves. */
 static inline ct_i128 ct_umul64(uint64_t a, uint64_t b)
@@ -213,8 +221,12 @@ static inline uint64_t ct_uabs64(int64_t a) { return a < 0 ? (uint64_t)0 - (uint
 
 static inline ct_i128 ct_i128_mul(int64_t a, int64_t b)
 {
+#ifdef CT_NATIVE_INT128
+    return ct_from_n((ct_n128)a * (ct_n128)b);
+#else
     ct_i128 p = ct_umul64(ct_uabs64(a), ct_uabs64(b));
     return ((a < 0) != (b < 0)) ? ct_i128_neg(p) : p;
+#endif
 }
 
 static inline ct_i128 ct_i128_mul128_64(ct_i128 a, int64_t b)

@@ -9,28 +9,33 @@
 #include "tiles.h"
 #include "trace_core.h"
 
+/* A ray parameter n / d of the caller's ray: |n| < 2^48 (a distance to a
+ * face of the box, or 0 or 1), 0 < d <= 2^62 (a component of the caller's
+ * direction); compared in 128 bits. */
 typedef struct {
-    ct_i128 n;
+    int64_t n;
     int64_t d; /* > 0 */
 } bigrt;
 
-/* a < b for 128-bit rationals: |n| < 2^48, d <= 2^62: products < 2^110 */
+/* a < b: products |n| d < 2^110 */
 static int bigrt_lt(const bigrt *a, const bigrt *b)
 {
-    return ct_i128_cmp(ct_i128_mul128_64(a->n, b->d), ct_i128_mul128_64(b->n, a->d)) < 0;
+    return ct_i128_cmp(ct_i128_mul(a->n, b->d), ct_i128_mul(b->n, a->d)) < 0;
 }
 
-/* Round o + t*D to nearest on one axis: (o*d + n*D) / d, 128-bit:
- * |o| d < 2^46 2^62, |n D| < 2^48 2^62; quotient < 2^48. */
+/* Round o + t*D to nearest on one axis: o + round(n*D / d), the product
+ * 128-bit (|n D| < 2^48 2^62), the quotient q < 2^48 (so o + q fits).  The
+ * remainder n D - q d lies in [0, d) with d <= 2^62, so its low 64 bits
+ * (wrapping products) are the remainder itself. */
 static int64_t round_axis(int64_t o, int64_t D, const bigrt *t)
 {
-    ct_i128 num = ct_i128_add(ct_i128_mul(o, t->d), ct_i128_mul128_64(t->n, D));
+    ct_i128 num = ct_i128_mul(t->n, D);
     int64_t q = ct_i128_floor_div(num, t->d);
-    ct_i128 rem = ct_i128_sub(num, ct_i128_mul(q, t->d)); /* 0 <= rem < d */
-    if (ct_i128_cmp(ct_i128_shl(rem, 1), ct_i128_from64(t->d)) >= 0) {
+    uint64_t rem = num.lo - (uint64_t)q * (uint64_t)t->d; /* 0 <= rem < d */
+    if (rem >= (uint64_t)t->d - rem) {
         q += 1;
     }
-    return q;
+    return o + q;
 }
 
 /* a * 2^e for a <= 2^62 and a result known to be <= 2^32, rounded to
@@ -121,7 +126,7 @@ static ct_status clip_to_box(const int64_t O[3], const int64_t U[3], const int64
                              bigrt *tin, bigrt *tout, int *kin, int64_t *kin_at)
 {
     int k, has_out = 0;
-    tin->n = ct_i128_from64(0);
+    tin->n = 0;
     tin->d = 1;
     *tout = *tin;
     *kin = -1;
@@ -140,7 +145,7 @@ static ct_status clip_to_box(const int64_t O[3], const int64_t U[3], const int64
         }
         if (in) {
             has_out = 1;
-            tout->n = ct_i128_from64(1);
+            tout->n = 1;
             k = 3; /* skip the clip below */
         } else {
             k = 0;
@@ -159,8 +164,8 @@ static ct_status clip_to_box(const int64_t O[3], const int64_t U[3], const int64
         a.d = b.d = ct_abs64(U[k]);
         /* |bound - o| < 2^47 */
         if (U[k] > 0) {
-            a.n = ct_i128_from64(lo[k] - O[k]);
-            b.n = ct_i128_from64(hi[k] - O[k]);
+            a.n = lo[k] - O[k];
+            b.n = hi[k] - O[k];
             if (!floorless && bigrt_lt(tin, &a)) {
                 *tin = a;
                 *kin = k;
@@ -171,8 +176,8 @@ static ct_status clip_to_box(const int64_t O[3], const int64_t U[3], const int64
                 has_out = 1;
             }
         } else {
-            a.n = ct_i128_from64(O[k] - hi[k]);
-            b.n = ct_i128_from64(O[k] - lo[k]);
+            a.n = O[k] - hi[k];
+            b.n = O[k] - lo[k];
             if (bigrt_lt(tin, &a)) {
                 *tin = a;
                 *kin = k;
@@ -186,7 +191,7 @@ static ct_status clip_to_box(const int64_t O[3], const int64_t U[3], const int64
     }
     if (seg) {
         bigrt one;
-        one.n = ct_i128_from64(1);
+        one.n = 1;
         one.d = 1;
         if (!has_out || bigrt_lt(&one, tout)) {
             *tout = one;
@@ -205,7 +210,7 @@ static ct_status entry_point(int64_t O[3], const int64_t U[3], const bigrt *tin,
                              const int64_t lo[3], const int64_t hi[3])
 {
     int k;
-    ct_i128 zq = ct_i128_add(ct_i128_mul(O[2] + CT_MAX_ORIGIN_Q16, tin->d), ct_i128_mul128_64(tin->n, U[2]));
+    ct_i128 zq = ct_i128_add(ct_i128_mul(O[2] + CT_MAX_ORIGIN_Q16, tin->d), ct_i128_mul(tin->n, U[2]));
     if (ct_i128_sign(zq) < 0) {
         return CT_BELOW;
     }
@@ -318,7 +323,7 @@ static ct_status prep_geom(const ct_package *p, const ct_ray *ray, int seg, ct_p
                   surface is BELOW) */
     hi[2] = ((int64_t)p->hmax + 1) * ONE16;
     st = clip_to_box(O, U, lo, hi, seg, &tin, &tout, &kin, &kin_at);
-    if (st == CT_OK && ct_i128_sign(tin.n) > 0) {
+    if (st == CT_OK && tin.n > 0) {
         st = entry_point(O, U, &tin, kin, kin_at, lo, hi);
     }
     if (st != CT_OK) {
