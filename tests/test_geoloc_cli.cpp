@@ -731,6 +731,160 @@ void test_geoloc_tolerance()
     fs::remove(g_dir + "/pxt.csv");
 }
 
+// One viewshed of test_viewshed: the observer 5 m above post (oi, oj), the
+// map point (e, n) of that post; bent: 0 straight, 1 curvature and
+// refraction on the sphere, 2 on the true Earth (the UTM copy); the run
+// and its GeoTIFF.
+struct Viewshed {
+    int bent = 0, oi = 0, oj = 0;
+    int64_t e = 0, n = 0;
+    Run r;
+    ct_host::DemRaster vs;
+};
+
+const char *const kViewshedLabel[3] = {"", " (curvature, refraction: the sphere)",
+                                       " (curvature, refraction: the true Earth)"};
+
+// `conetrace viewshed` of the package p (tu.ctp when v->bent == 2, else
+// t.ctp) from v's observer, targets 1.75 m up, into v->r and v->vs: d's
+// posts, p's georeference, a PNG written too.
+void run_viewshed(const ct_package &p, const ref::Dem &d, Viewshed *v)
+{
+    int64_t h;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_grid_to_map(&p, (int64_t)v->oi << 16, (int64_t)v->oj << 16, 0, &v->e, &v->n, &h));
+    char obs[96];
+    std::snprintf(obs, sizeof obs, "%.9f,%.9f,5", v->e * 1e-9, v->n * 1e-9);
+    std::vector<std::string> args = {"viewshed", v->bent == 2 ? "tu.ctp" : "t.ctp", "--observer", obs,
+                                     "--target-height", "1.75", "-o", "vs.tif", "--png", "vs.png"};
+    if (v->bent) {
+        args.push_back("--effects");
+        args.push_back("curvature,refraction");
+    }
+    v->r = run(args);
+    TEST_ASSERT_MSG(v->r.code == 0, "viewshed: exit %d: %s", v->r.code, v->r.err.c_str());
+    v->vs = ct_host::read_dem(g_dir + "/vs.tif");
+    TEST_ASSERT_EQUAL_INT(d.w, v->vs.width);
+    TEST_ASSERT_EQUAL_INT(d.h, v->vs.height);
+    TEST_ASSERT(std::fabs(v->vs.geo.origin_e - p.origin_e_nm * 1e-9) < 1e-6 && v->vs.geo.epsg == (int)p.epsg);
+    TEST_ASSERT(fs::exists(g_dir + "/vs.png"));
+}
+
+// The true Earth's map as the command fits it, into *emap: once around the
+// observer A (map, nm) of p (d its posts), out to the tile's farthest
+// corner, its relief, the observer's height and a kilometre.
+void fit_viewshed_map(const ct_package &p, const ref::Dem &d, const int64_t A[3], ct_earth_map *emap)
+{
+    const double qe = p.posting_e_nm * 1e-9, qn = p.posting_n_nm * 1e-9;
+    double far = 0;
+    for (int c = 0; c < 4; ++c)
+        far = std::max(far, std::hypot(p.origin_e_nm * 1e-9 + (c & 1 ? d.w : 0) * qe - A[0] * 1e-9,
+                                       p.origin_n_nm * 1e-9 + (c & 2 ? d.h : 0) * qn - A[1] * 1e-9));
+    const double reach = far + (p.hmax - p.hmin) * p.height_scale_nm * 1e-9 + 5 + 1000;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_earth_map_init(&p, A[0], A[1], A[2], std::llround(reach * 1e9), emap));
+}
+
+// Every post of the viewshed v of p (d its posts) as ct_lib's ct_los
+// decides it, bit for bit: the posts the command proved hidden from a
+// neighbour's blocking point (Shortcut, cmd_viewshed.cpp) without calling
+// it included.
+void check_viewshed_los(const ct_package &p, const ref::Dem &d, const Viewshed &v)
+{
+    int64_t gx, gy, gz0, gz, ge, gn, gh;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_map_to_grid(&p, v.e, v.n, 0, &gx, &gy, &gz0));
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_surface_height(&p, gx, gy, &gz));
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_grid_to_map(&p, gx, gy, gz, &ge, &gn, &gh));
+    const int64_t A[3] = {v.e, v.n, gh + 5000000000};
+    ct_effects fx = {v.bent ? CT_EFFECT_CURVATURE | CT_EFFECT_REFRACTION : 0u, CT_REFRACTION_K_STD_Q16,
+                     v.bent == 2 ? 0 : CT_EARTH_RADIUS_NM, 0, nullptr};
+    ct_earth_map emap;
+    if (v.bent == 2) {
+        fit_viewshed_map(p, d, A, &emap);
+        if (ct_harness_g.current_failed) return;
+        fx.earth_map = &emap;
+        TEST_ASSERT(v.r.err.find("viewshed: the true Earth, its map fitted once;") != std::string::npos);
+    }
+    long differ = 0;
+    for (int j = 0; j < d.h; ++j)
+        for (int i = 0; i < d.w; ++i) {
+            int64_t pt[3];
+            TEST_ASSERT_EQUAL_INT(CT_OK, ct_grid_to_map(&p, (int64_t)i << 16, (int64_t)j << 16,
+                                                        (int64_t)d.at(i, j) << 16, &pt[0], &pt[1], &pt[2]));
+            pt[2] += 1750000000;
+            if (pt[0] == A[0] && pt[1] == A[1]) continue;
+            ct_hit hh;
+            const ct_status st = ct_los(&p, A, pt, &fx, 10000000, CT_METHOD_DIRECTIONAL, &hh);
+            TEST_ASSERT(st == CT_OK || st == CT_HIT || st == CT_BELOW);
+            differ += (v.vs.h[(size_t)j * d.w + i] == 1) != (st == CT_OK);
+        }
+    long proved = -1;
+    const size_t at = v.r.err.find(" hidden (");
+    TEST_ASSERT(at != std::string::npos && std::sscanf(v.r.err.c_str() + at, " hidden (%ld", &proved) == 1);
+    std::printf("  viewshed%s from post (%d, %d): %ld posts proved hidden without ct_los, %ld differ from "
+                "ct_los\n", kViewshedLabel[v.bent], v.oi, v.oj, proved, differ);
+    TEST_ASSERT_EQUAL_INT(0, differ);
+    TEST_ASSERT(proved > 0);
+}
+
+// Every post of the viewshed v (d its posts, posting pe x pn m, height
+// scale hs m) against the reference's exact segment to the target 1.75 m
+// above it (bent: on the sphere): hidden when the first hit lies more than
+// the margin (1 cm) before the post; ties (the segment within 1 cm of the
+// surface before the margin, or the first hit within 1 cm of it) counted.
+void check_viewshed_reference(const ref::Dem &d, ref::ld pe, ref::ld pn, ref::ld hs, const Viewshed &v)
+{
+    const ref::ld ox = v.oi, oy = v.oj, oz = d.at(v.oi, v.oj) + 5 / hs;
+    const ref::ld c = v.bent ? 1 - (ref::ld)CT_REFRACTION_K_STD_Q16 / 65536 : 0, R = 6371000.0L;
+    long ties = 0, bad = 0, seen = 0;
+    for (int j = 0; j < d.h; ++j)
+        for (int i = 0; i < d.w; ++i) {
+            const double got = v.vs.h[(size_t)j * d.w + i];
+            if (i == v.oi && j == v.oj) {
+                TEST_ASSERT(got == 1);
+                continue;
+            }
+            ref::Ray ry;
+            ry.ox = ox;
+            ry.oy = oy;
+            ry.oz = oz;
+            ry.dx = i - ox;
+            ry.dy = j - oy;
+            const ref::ld rho = std::hypot(ry.dx * pe, ry.dy * pn);
+            ry.kz = c * rho * rho / (2 * R) / hs;
+            const ref::ld tz = d.at(i, j) + 1.75L / hs;
+            ry.dz = tz - oz - ry.kz;
+            ry.tend = 1;
+            const ref::ld len = std::sqrt(rho * rho + std::pow((tz - oz) * hs, 2));
+            const ref::ld tcut = 1 - 0.01L / len, tie_t = 0.01L / len;
+            ref::Hit hh = ref::trace(d, ry);
+            const ref::ld clear = ref::min_clearance(d, ry, 0, std::max<ref::ld>(0, tcut - tie_t)) * hs;
+            if (std::fabs(clear) < 0.01L || (hh.status == ref::HIT && std::fabs(hh.t - tcut) < tie_t)) {
+                ties++;
+                continue;
+            }
+            const bool ref_seen = !(hh.status == ref::HIT && hh.t < tcut);
+            if ((got == 1) != ref_seen) bad++;
+            seen += ref_seen;
+        }
+    std::printf("  viewshed%s from post (%d, %d), 5 m up, targets 1.75 m: %ld posts seen by the reference, %ld "
+                "ties, %ld disagree\n", kViewshedLabel[v.bent], v.oi, v.oj, seen, ties, bad);
+    TEST_ASSERT_EQUAL_INT(0, bad);
+    TEST_ASSERT(ties * 10 < d.w * d.h && seen > 50);
+}
+
+// viewshed's errors: an observer off the tile, a bad radius, an Earth
+// radius without --effects, no observer.
+void check_viewshed_errors()
+{
+    Run off = run({"viewshed", "t.ctp", "--observer", "1,2,3", "-o", "vs.tif"});
+    TEST_ASSERT(off.code != 0 && off.err.find("is not over the tile") != std::string::npos);
+    Run rad = run({"viewshed", "t.ctp", "--observer", "500000,4000000,3", "--radius", "0", "-o", "vs.tif"});
+    TEST_ASSERT(rad.code != 0 && rad.err.find("--radius needs") != std::string::npos);
+    Run radius = run({"viewshed", "t.ctp", "--observer", "500000,4000000,3", "--earth-radius", "6e6", "-o", "vs.tif"});
+    TEST_ASSERT(radius.code != 0 && radius.err.find("--earth-radius needs --effects") != std::string::npos);
+    Run noobs = run({"viewshed", "t.ctp", "-o", "vs.tif"});
+    TEST_ASSERT(noobs.code != 0 && noobs.err.find("needs --observer") != std::string::npos);
+}
+
 // `conetrace viewshed` against a brute-force exact line of sight per post by
 // the independent reference tracer (tests/kit/reference.hpp): the observer 5 m
 // above a post of the test DEM, every post a target 1.75 m above it; hidden
@@ -745,8 +899,6 @@ void test_geoloc_tolerance()
 // the GeoTIFF's georeference and the errors.
 void test_viewshed()
 {
-    static const char *const kLabel[3] = {"", " (curvature, refraction: the sphere)",
-                                          " (curvature, refraction: the true Earth)"};
     Setup *s = setup();
     TEST_ASSERT(s != nullptr);
     const ref::Dem d = dem_cases::ref_dem(s->c.t);
@@ -762,119 +914,19 @@ void test_viewshed()
     for (int bent = 0; bent < 3; ++bent)  // straight, the sphere, the true Earth
         for (int oi : {20, 41}) {
             const ct_package &p = bent == 2 ? pu : s->p;
-            const int oj = oi == 20 ? 30 : 12;
-            int64_t e, n, h;
-            TEST_ASSERT_EQUAL_INT(CT_OK, ct_grid_to_map(&p, (int64_t)oi << 16, (int64_t)oj << 16, 0, &e, &n, &h));
-            char obs[96];
-            std::snprintf(obs, sizeof obs, "%.9f,%.9f,5", e * 1e-9, n * 1e-9);
-            std::vector<std::string> args = {"viewshed", bent == 2 ? "tu.ctp" : "t.ctp", "--observer", obs,
-                                             "--target-height", "1.75", "-o", "vs.tif", "--png", "vs.png"};
-            if (bent) {
-                args.push_back("--effects");
-                args.push_back("curvature,refraction");
-            }
-            Run r = run(args);
-            TEST_ASSERT_MSG(r.code == 0, "viewshed: exit %d: %s", r.code, r.err.c_str());
-            ct_host::DemRaster vs = ct_host::read_dem(g_dir + "/vs.tif");
-            TEST_ASSERT_EQUAL_INT(d.w, vs.width);
-            TEST_ASSERT_EQUAL_INT(d.h, vs.height);
-            TEST_ASSERT(std::fabs(vs.geo.origin_e - p.origin_e_nm * 1e-9) < 1e-6 && vs.geo.epsg == (int)p.epsg);
-            TEST_ASSERT(fs::exists(g_dir + "/vs.png"));
-            // every post as ct_lib's ct_los decides it, bit for bit: the
-            // posts the command proved hidden from a neighbour's blocking
-            // point (Shortcut, cmd_viewshed.cpp) without calling it included
-            {
-                int64_t gx, gy, gz0, gz, ge, gn, gh;
-                TEST_ASSERT_EQUAL_INT(CT_OK, ct_map_to_grid(&p, e, n, 0, &gx, &gy, &gz0));
-                TEST_ASSERT_EQUAL_INT(CT_OK, ct_surface_height(&p, gx, gy, &gz));
-                TEST_ASSERT_EQUAL_INT(CT_OK, ct_grid_to_map(&p, gx, gy, gz, &ge, &gn, &gh));
-                const int64_t A[3] = {e, n, gh + 5000000000};
-                ct_effects fx = {bent ? CT_EFFECT_CURVATURE | CT_EFFECT_REFRACTION : 0u, CT_REFRACTION_K_STD_Q16,
-                                 bent == 2 ? 0 : CT_EARTH_RADIUS_NM, 0, nullptr};
-                ct_earth_map emap;
-                if (bent == 2) {
-                    // the command's map: fitted once around the observer, out to
-                    // the tile's farthest corner, its relief, the observer's
-                    // height and a kilometre
-                    const double qe = p.posting_e_nm * 1e-9, qn = p.posting_n_nm * 1e-9;
-                    double far = 0;
-                    for (int c = 0; c < 4; ++c)
-                        far = std::max(far, std::hypot(p.origin_e_nm * 1e-9 + (c & 1 ? d.w : 0) * qe - e * 1e-9,
-                                                       p.origin_n_nm * 1e-9 + (c & 2 ? d.h : 0) * qn - n * 1e-9));
-                    const double reach = far + (p.hmax - p.hmin) * p.height_scale_nm * 1e-9 + 5 + 1000;
-                    TEST_ASSERT_EQUAL_INT(CT_OK, ct_earth_map_init(&p, A[0], A[1], A[2], std::llround(reach * 1e9), &emap));
-                    fx.earth_map = &emap;
-                    TEST_ASSERT(r.err.find("viewshed: the true Earth, its map fitted once;") != std::string::npos);
-                }
-                long differ = 0;
-                for (int j = 0; j < d.h; ++j)
-                    for (int i = 0; i < d.w; ++i) {
-                        int64_t pt[3];
-                        TEST_ASSERT_EQUAL_INT(CT_OK, ct_grid_to_map(&p, (int64_t)i << 16, (int64_t)j << 16,
-                                                                    (int64_t)d.at(i, j) << 16, &pt[0], &pt[1], &pt[2]));
-                        pt[2] += 1750000000;
-                        if (pt[0] == A[0] && pt[1] == A[1]) continue;
-                        ct_hit hh;
-                        const ct_status st = ct_los(&p, A, pt, &fx, 10000000, CT_METHOD_DIRECTIONAL, &hh);
-                        TEST_ASSERT(st == CT_OK || st == CT_HIT || st == CT_BELOW);
-                        differ += (vs.h[(size_t)j * d.w + i] == 1) != (st == CT_OK);
-                    }
-                long proved = -1;
-                const size_t at = r.err.find(" hidden (");
-                TEST_ASSERT(at != std::string::npos && std::sscanf(r.err.c_str() + at, " hidden (%ld", &proved) == 1);
-                std::printf("  viewshed%s from post (%d, %d): %ld posts proved hidden without ct_los, %ld differ from "
-                            "ct_los\n", kLabel[bent], oi, oj, proved, differ);
-                TEST_ASSERT_EQUAL_INT(0, differ);
-                TEST_ASSERT(proved > 0);
-            }
-            // the reference, post by post
-            const ref::ld ox = oi, oy = oj, oz = d.at(oi, oj) + 5 / hs;
-            const ref::ld c = bent ? 1 - (ref::ld)CT_REFRACTION_K_STD_Q16 / 65536 : 0, R = 6371000.0L;
-            long ties = 0, bad = 0, seen = 0;
-            for (int j = 0; j < d.h; ++j)
-                for (int i = 0; i < d.w; ++i) {
-                    const double got = vs.h[(size_t)j * d.w + i];
-                    if (i == oi && j == oj) {
-                        TEST_ASSERT(got == 1);
-                        continue;
-                    }
-                    ref::Ray ry;
-                    ry.ox = ox;
-                    ry.oy = oy;
-                    ry.oz = oz;
-                    ry.dx = i - ox;
-                    ry.dy = j - oy;
-                    const ref::ld rho = std::hypot(ry.dx * pe, ry.dy * pn);
-                    ry.kz = c * rho * rho / (2 * R) / hs;
-                    const ref::ld tz = d.at(i, j) + 1.75L / hs;
-                    ry.dz = tz - oz - ry.kz;
-                    ry.tend = 1;
-                    const ref::ld len = std::sqrt(rho * rho + std::pow((tz - oz) * hs, 2));
-                    const ref::ld tcut = 1 - 0.01L / len, tie_t = 0.01L / len;
-                    ref::Hit hh = ref::trace(d, ry);
-                    const ref::ld clear = ref::min_clearance(d, ry, 0, std::max<ref::ld>(0, tcut - tie_t)) * hs;
-                    if (std::fabs(clear) < 0.01L || (hh.status == ref::HIT && std::fabs(hh.t - tcut) < tie_t)) {
-                        ties++;
-                        continue;
-                    }
-                    const bool ref_seen = !(hh.status == ref::HIT && hh.t < tcut);
-                    if ((got == 1) != ref_seen) bad++;
-                    seen += ref_seen;
-                }
-            std::printf("  viewshed%s from post (%d, %d), 5 m up, targets 1.75 m: %ld posts seen by the reference, %ld "
-                        "ties, %ld disagree\n", kLabel[bent], oi, oj, seen, ties, bad);
-            TEST_ASSERT_EQUAL_INT(0, bad);
-            TEST_ASSERT(ties * 10 < d.w * d.h && seen > 50);
+            Viewshed v;
+            v.bent = bent;
+            v.oi = oi;
+            v.oj = oi == 20 ? 30 : 12;
+            run_viewshed(p, d, &v);
+            if (ct_harness_g.current_failed) return;
+            check_viewshed_los(p, d, v);
+            if (ct_harness_g.current_failed) return;
+            check_viewshed_reference(d, pe, pn, hs, v);
+            if (ct_harness_g.current_failed) return;
         }
-    // errors: an observer off the tile, a bad radius, a missing option
-    Run off = run({"viewshed", "t.ctp", "--observer", "1,2,3", "-o", "vs.tif"});
-    TEST_ASSERT(off.code != 0 && off.err.find("is not over the tile") != std::string::npos);
-    Run rad = run({"viewshed", "t.ctp", "--observer", "500000,4000000,3", "--radius", "0", "-o", "vs.tif"});
-    TEST_ASSERT(rad.code != 0 && rad.err.find("--radius needs") != std::string::npos);
-    Run radius = run({"viewshed", "t.ctp", "--observer", "500000,4000000,3", "--earth-radius", "6e6", "-o", "vs.tif"});
-    TEST_ASSERT(radius.code != 0 && radius.err.find("--earth-radius needs --effects") != std::string::npos);
-    Run noobs = run({"viewshed", "t.ctp", "-o", "vs.tif"});
-    TEST_ASSERT(noobs.code != 0 && noobs.err.find("needs --observer") != std::string::npos);
+    check_viewshed_errors();
+    if (ct_harness_g.current_failed) return;
     fs::remove(g_dir + "/vs.tif");
     fs::remove(g_dir + "/vs.png");
 }

@@ -221,28 +221,34 @@ static double expected_posting(const Grid &src)
 // ---------------------------------------------------------------------------
 // (a) warp_dem vs gdalwarp
 
-static void check_against_gdalwarp(int k)
+// warp_dem on input k (0 int16, 1 float32) and the source grid: the UTM zone
+// of the centre (84.35 W -> zone 16; the fixture itself is on 17N), the
+// source EPSG, a georeference, a round posting near the source's.
+static void warp_input(int k, ct_host::DemRaster *r, Grid *src)
 {
     TEST_ASSERT_MSG(make_inputs(), "could not make the EPSG:4326 inputs");
     const std::string &in = g_geo[k];
     TEST_ASSERT_MSG(ct_host::dem_needs_warp(in), "%s: dem_needs_warp false on EPSG:4326", in.c_str());
-    ct_host::DemRaster r;
     try {
-        r = ct_host::warp_dem(in);
+        *r = ct_host::warp_dem(in);
     } catch (const std::exception &e) {
         TEST_FAIL_MSG("warp_dem(%s): %s", in.c_str(), e.what());
     }
-    Grid src = read_grid(in);
-    TEST_ASSERT(src.good);
-    // zone of the centre: 84.35 W -> zone 16 (the fixture itself is on 17N)
-    TEST_ASSERT_EQUAL_INT(32616, r.geo.epsg);
-    TEST_ASSERT_EQUAL_INT(4326, r.geo.source_epsg);
-    TEST_ASSERT(r.has_georef);
-    const double P = r.geo.posting_e;
-    const double pexp = expected_posting(src);
-    TEST_ASSERT_MSG(P == std::round(P) && std::fabs(P - pexp) <= 0.51 && P == -r.geo.posting_n,
-                    "posting %.9g x %.9g m, expected the round of %.4f m", P, r.geo.posting_n, pexp);
+    *src = read_grid(in);
+    TEST_ASSERT(src->good);
+    TEST_ASSERT_EQUAL_INT(32616, r->geo.epsg);
+    TEST_ASSERT_EQUAL_INT(4326, r->geo.source_epsg);
+    TEST_ASSERT(r->has_georef);
+    const double P = r->geo.posting_e;
+    const double pexp = expected_posting(*src);
+    TEST_ASSERT_MSG(P == std::round(P) && std::fabs(P - pexp) <= 0.51 && P == -r->geo.posting_n,
+                    "posting %.9g x %.9g m, expected the round of %.4f m", P, r->geo.posting_n, pexp);
+}
 
+// gdalwarp of `in` onto EPSG:32616 at posting P, bilinear, float32: *a with
+// the exact transformation (-et 0), *d with the default approximate one.
+static void gdalwarp_refs(const std::string &in, double P, Grid *a, Grid *d)
+{
     const std::string tr = std::to_string((int)P);
     const std::string ref0 = in + ".et0.tif", refd = in + ".default.tif";
     Run g0 = run(g_root, CT_GDALWARP, {"-q", "-overwrite", "-t_srs", "EPSG:32616", "-tr", tr, tr, "-r", "bilinear",
@@ -250,18 +256,28 @@ static void check_against_gdalwarp(int k)
     Run gd = run(g_root, CT_GDALWARP, {"-q", "-overwrite", "-t_srs", "EPSG:32616", "-tr", tr, tr, "-r", "bilinear",
                                       "-ot", "Float32", "-dstnodata", "-9999", in, refd});
     TEST_ASSERT_MSG(g0.code == 0 && gd.code == 0, "gdalwarp onto UTM failed: %s%s", g0.err.c_str(), gd.err.c_str());
-    Grid a = read_grid(ref0), d = read_grid(refd);
-    TEST_ASSERT(a.good && d.good);
+    *a = read_grid(ref0);
+    *d = read_grid(refd);
+    TEST_ASSERT(a->good && d->good);
+}
 
-    // the same grid
+// Ours (r), gdalwarp -et 0 (a) and default gdalwarp (d) on the same grid.
+static void check_same_grid(const ct_host::DemRaster &r, const Grid &a, const Grid &d)
+{
     TEST_ASSERT_MSG(r.width == a.w && r.height == a.h, "grid %dx%d, gdalwarp %dx%d", r.width, r.height, a.w, a.h);
     TEST_ASSERT_MSG(std::fabs(r.geo.origin_e - a.gt[0]) < 1e-6 && std::fabs(r.geo.origin_n - a.gt[3]) < 1e-6 &&
                         r.geo.posting_e == a.gt[1] && r.geo.posting_n == a.gt[5] && a.gt[2] == 0 && a.gt[4] == 0,
                     "origin %.6f %.6f posting %g %g; gdalwarp %.6f %.6f %g %g", r.geo.origin_e, r.geo.origin_n,
                     r.geo.posting_e, r.geo.posting_n, a.gt[0], a.gt[3], a.gt[1], a.gt[5]);
     TEST_ASSERT(d.w == a.w && d.h == a.h && d.gt[0] == a.gt[0] && d.gt[3] == a.gt[3]);
+}
 
-    // heights
+// The heights of ours (r, input k, posting P) against gdalwarp -et 0 (a,
+// within kTolEt0) and default gdalwarp (d, kTolDefMax / kTolDefMean) on
+// the posts valid in both, and the voids: every gdalwarp void is ours,
+// ours has more (the footprints gdalwarp renormalises).  Prints a line.
+static void check_heights(int k, const ct_host::DemRaster &r, const Grid &a, const Grid &d, double P)
+{
     const size_t n = (size_t)r.width * r.height;
     double max0 = 0, maxd = 0, sumd = 0;
     size_t both = 0, bothd = 0, ref_void_ours_valid = 0, ours_void_ref_valid = 0, voids = 0;
@@ -295,12 +311,30 @@ static void check_against_gdalwarp(int k)
     // the holes make footprints that gdalwarp renormalises and we void
     TEST_ASSERT_MSG(ours_void_ref_valid > 200, "only %zu posts are voids here and valid in gdalwarp",
                     ours_void_ref_valid);
+}
 
-    // every post against the source mask at its exact source position:
-    // valid => the four posts of its bilinear cell are valid (they always
-    // have non-zero weight); void => an invalid (or missing) source post
-    // within the kernel radius (1 source post, up to 1.12 where GDAL
-    // widens the kernel for downsampling east-west here)
+// Whether an invalid source post of src lies within rad (source posts, max
+// norm, strictly) of source pixel position (x, y) (centre of pixel (c, l)
+// at (c + 0.5, l + 0.5)); posts off the source do not count (GDAL drops
+// their weights).
+static bool source_void_near(const Grid &src, double x, double y, double rad)
+{
+    for (int l = (int)std::floor(y - 0.5 - rad); l <= (int)std::ceil(y - 0.5 + rad); ++l)
+        for (int c = (int)std::floor(x - 0.5 - rad); c <= (int)std::ceil(x - 0.5 + rad); ++c) {
+            if (std::fabs(c + 0.5 - x) >= rad || std::fabs(l + 0.5 - y) >= rad) continue;
+            if (c < 0 || l < 0 || c >= src.w || l >= src.h) continue;  // GDAL drops those weights
+            if (!src.ok[(size_t)l * src.w + c]) return true;
+        }
+    return false;
+}
+
+// Every post of ours (r, posting P) against the source mask at its exact
+// source position: valid => the four posts of its bilinear cell are valid
+// (they always have non-zero weight); void => an invalid (or missing)
+// source post within the kernel radius (1 source post, up to 1.12 where
+// GDAL widens the kernel for downsampling east-west here).
+static void check_voids_against_source(const ct_host::DemRaster &r, const Grid &src, double P)
+{
     OGRSpatialReferenceH u = OSRNewSpatialReference(nullptr), g = OSRNewSpatialReference(nullptr);
     OSRImportFromEPSG(u, 32616);
     OSRImportFromEPSG(g, 4326);
@@ -319,21 +353,12 @@ static void check_against_gdalwarp(int k)
         for (int i = 0; i < r.width; ++i) {
             // source pixel coordinates; centre of pixel (c, l) at (c + 0.5, l + 0.5)
             const double x = (xs[i] - src.gt[0]) / src.gt[1], y = (ys[i] - src.gt[3]) / src.gt[5];
-            auto any_invalid = [&](double rad) {
-                for (int l = (int)std::floor(y - 0.5 - rad); l <= (int)std::ceil(y - 0.5 + rad); ++l)
-                    for (int c = (int)std::floor(x - 0.5 - rad); c <= (int)std::ceil(x - 0.5 + rad); ++c) {
-                        if (std::fabs(c + 0.5 - x) >= rad || std::fabs(l + 0.5 - y) >= rad) continue;
-                        if (c < 0 || l < 0 || c >= src.w || l >= src.h) continue;  // GDAL drops those weights
-                        if (!src.ok[(size_t)l * src.w + c]) return true;
-                    }
-                return false;
-            };
             const bool inside = x >= 0 && y >= 0 && x <= src.w && y <= src.h;
             const bool v = r.valid[(size_t)j * r.width + i];
-            if (v && (!inside || any_invalid(0.999))) {
+            if (v && (!inside || source_void_near(src, x, y, 0.999))) {
                 if (!bad_valid++) example = "valid post " + std::to_string(i) + "," + std::to_string(j);
             }
-            if (!v && inside && !any_invalid(1.15)) {
+            if (!v && inside && !source_void_near(src, x, y, 1.15)) {
                 if (!bad_void++) example += " void post " + std::to_string(i) + "," + std::to_string(j);
             }
         }
@@ -344,6 +369,24 @@ static void check_against_gdalwarp(int k)
     TEST_ASSERT_MSG(bad_valid == 0 && bad_void == 0,
                     "%zu valid posts touch nodata, %zu voids touch none (e.g. %s)", bad_valid, bad_void,
                     example.c_str());
+}
+
+// (a) warp_dem of input k against gdalwarp on the same file: the grid, the
+// heights and voids, every post against the source mask.
+static void check_against_gdalwarp(int k)
+{
+    ct_host::DemRaster r;
+    Grid src, a, d;
+    warp_input(k, &r, &src);
+    if (ct_harness_g.current_failed) return;
+    const double P = r.geo.posting_e;
+    gdalwarp_refs(g_geo[k], P, &a, &d);
+    if (ct_harness_g.current_failed) return;
+    check_same_grid(r, a, d);
+    if (ct_harness_g.current_failed) return;
+    check_heights(k, r, a, d, P);
+    if (ct_harness_g.current_failed) return;
+    check_voids_against_source(r, src, P);
 }
 
 static void test_warp_int16_vs_gdalwarp(void) { check_against_gdalwarp(0); }

@@ -503,54 +503,60 @@ inline SegOut segment_root(const Surface &sf, const Sample &a, const Sample &b, 
     return out;
 }
 
-}  // namespace detail
+// The trace's steps in t (m) and the height above which the path is clear
+// of the terrain.  The horizontal fraction of the direction is taken at C
+// (the path's horizontal speed changes little over a tile: the fine step
+// is kept below posting / 8 with a 10 % margin).
+struct Steps {
+    ld post = 0;       // the posting (m)
+    ld dt_fine = 0;    // step where the path may meet the terrain
+    ld dt_coarse = 0;  // step where it certainly does not
+    ld clear_h = 0;    // the tile's highest post + 1 m
+};
 
-// The reference first hit of the line of sight L on the surface.
-inline Result trace(Proj &pj, const Surface &sf, const Los &L)
+inline Steps steps_of(const Surface &sf, const Los &L)
 {
-    using detail::Sample;
-    Result res;
-    const ld post = std::fabs(sf.pe);
-    // horizontal fraction of the direction at C (the path's horizontal
-    // speed changes little over a tile: the step is kept below posting / 8
-    // with a 10 % margin)
+    Steps st;
+    st.post = std::fabs(sf.pe);
     ld e[3], n[3], u[3];
     enu_axes(L.lat, L.lon, e, n, u);
     const ld horiz = std::sqrt(std::max<ld>(0, 1 - dot3(L.d, u) * dot3(L.d, u)));
-    const ld dt_fine = std::min(post / 8 / std::max(horiz, 1e-6L) / 1.1L, 4 * post);
-    const ld dt_coarse = std::max(dt_fine, (ld)64);
-    const ld t_max = 300000;  // 300 km
-    const ld clear_h = sf.zmax + 1;
+    st.dt_fine = std::min(st.post / 8 / std::max(horiz, 1e-6L) / 1.1L, 4 * st.post);
+    st.dt_coarse = std::max(st.dt_fine, (ld)64);
+    st.clear_h = sf.zmax + 1;
+    return st;
+}
 
-    std::vector<std::pair<ld, ld>> pts;  // (t, clearance) along the path over the tile
-    Sample prev = detail::sample(pj, sf, L, 0);
-    res.samples = 1;
-    bool entered = false;
-    if (sf.inside(prev.x, prev.y)) {
-        entered = true;
-        const ld f0 = prev.h - sf.height(prev.x, prev.y);
-        if (f0 <= 0) {
-            res.status = f0 < 0 ? BELOW : HIT;
-            res.e = prev.E;
-            res.n = prev.N;
-            res.h = prev.h;
-            res.t = 0;
-            return res;
-        }
-    }
-    const Sample cam = prev;
-    // the result for a hit at range t on the path
-    auto hit_at = [&](ld t) {
-        Sample hs = detail::sample(pj, sf, L, t);
-        res.status = HIT;
-        res.e = hs.E;
-        res.n = hs.N;
-        res.h = hs.h;
-        res.t = t;
-        res.range = std::hypot(hs.E - cam.E, hs.N - cam.N);
-        return res;
-    };
+// res (the trace so far) completed as a hit at t on the path; cam is the
+// sample at t = 0.
+inline Result hit_at(Proj &pj, const Surface &sf, const Los &L, const Sample &cam, ld t, Result res)
+{
+    Sample hs = sample(pj, sf, L, t);
+    res.status = HIT;
+    res.e = hs.E;
+    res.n = hs.N;
+    res.h = hs.h;
+    res.t = t;
+    res.range = std::hypot(hs.E - cam.E, hs.N - cam.N);
+    return res;
+}
+
+// The march along the path from the sample prev (the camera's; entered:
+// the camera is over the tile) to the first segment that meets the
+// terrain (hit_t, its first root on the mapped segment; wall: the path
+// enters the tile's box there at or below the surface), or to a permanent
+// miss (hit_t = -1).  The clearances along the path over the tile are
+// appended to pts as (t, clearance), the samples taken added to *samples.
+struct March {
     ld hit_t = -1;
+    bool wall = false;
+};
+
+inline March march(Proj &pj, const Surface &sf, const Los &L, const Steps &st, Sample prev, bool entered,
+                   std::vector<std::pair<ld, ld>> &pts, long *samples)
+{
+    const ld t_max = 300000;  // 300 km
+    March out;
     int fine_left = 0;
     while (prev.t < t_max) {
         // permanent misses: outside the box and moving away; above every
@@ -558,85 +564,132 @@ inline Result trace(Proj &pj, const Surface &sf, const Los &L)
         Sample next;
         bool coarse_ok = false;
         if (fine_left <= 0) {
-            next = detail::sample(pj, sf, L, prev.t + dt_coarse);
-            res.samples++;
-            const ld out_prev = sf.outside_by(prev.x, prev.y) * post;
-            if (out_prev > 1.2L * dt_coarse + 2 * post ||
-                (prev.h > clear_h && next.h > clear_h)) {
+            next = sample(pj, sf, L, prev.t + st.dt_coarse);
+            (*samples)++;
+            const ld out_prev = sf.outside_by(prev.x, prev.y) * st.post;
+            if (out_prev > 1.2L * st.dt_coarse + 2 * st.post ||
+                (prev.h > st.clear_h && next.h > st.clear_h)) {
                 coarse_ok = true;
             } else {
-                fine_left = (int)std::ceil(dt_coarse / dt_fine) + 1;
+                fine_left = (int)std::ceil(st.dt_coarse / st.dt_fine) + 1;
             }
         }
         if (!coarse_ok) {
-            next = detail::sample(pj, sf, L, prev.t + dt_fine);
-            res.samples++;
+            next = sample(pj, sf, L, prev.t + st.dt_fine);
+            (*samples)++;
             fine_left--;
             std::vector<std::pair<ld, ld>> sp;
-            detail::SegOut so = detail::segment_root(sf, prev, next, sp);
+            SegOut so = segment_root(sf, prev, next, sp);
             for (auto &q : sp) pts.push_back({prev.t + q.first * (next.t - prev.t), q.second});
             if (so.s >= 0) {
-                hit_t = prev.t + so.s * (next.t - prev.t);
-                if (so.at_entry && !entered && so.f_entry <= 0) {
-                    // the path enters the tile's box at or below the surface:
-                    // that entry point (on the box's side) is the path's first
-                    // point at or below the terrain -- a hit on the wall
-                    res.wall = true;
-                    return hit_at(hit_t);
-                }
-                break;
+                out.hit_t = prev.t + so.s * (next.t - prev.t);
+                // the path enters the tile's box at or below the surface:
+                // that entry point (on the box's side) is the path's first
+                // point at or below the terrain -- a hit on the wall
+                out.wall = so.at_entry && !entered && so.f_entry <= 0;
+                return out;
             }
             if (!sp.empty()) entered = true;
         }
         const bool out_now = !sf.inside(next.x, next.y);
         if (out_now && sf.outside_by(next.x, next.y) > sf.outside_by(prev.x, prev.y) && entered) break;
         if (out_now && !entered && sf.outside_by(next.x, next.y) > sf.outside_by(prev.x, prev.y)) break;
-        if (next.h > clear_h && next.h > prev.h) break;
+        if (next.h > st.clear_h && next.h > prev.h) break;
         prev = next;
     }
-    // the smallest clearance at a local minimum before the hit: drop the
-    // final descent into the hit, keep everything before it
+    return out;
+}
+
+// The smallest clearance at a local minimum before the hit at hit_t (a
+// miss, hit_t < 0: anywhere) among the clearances pts (sorted here): the
+// final descent into the hit is dropped, everything before it kept.
+inline ld min_clear_before(std::vector<std::pair<ld, ld>> &pts, ld hit_t)
+{
+    ld min_clear = std::numeric_limits<ld>::infinity();
     std::sort(pts.begin(), pts.end());
     if (hit_t >= 0) {
         size_t k = pts.size();
         while (k > 0 && pts[k - 1].first > hit_t) --k;
         // walk back over the descent (clearance increasing backwards)
         while (k > 1 && pts[k - 2].second >= pts[k - 1].second) --k;
-        for (size_t m = 0; m + 1 < k; ++m) res.min_clear = std::min(res.min_clear, pts[m].second);
+        for (size_t m = 0; m + 1 < k; ++m) min_clear = std::min(min_clear, pts[m].second);
     } else {
-        for (auto &q : pts) res.min_clear = std::min(res.min_clear, q.second);
+        for (auto &q : pts) min_clear = std::min(min_clear, q.second);
     }
-    if (hit_t < 0) {
-        res.status = MISS;
-        return res;
-    }
-    // refine on the true path: F(a) > 0 >= F(b)
+    return min_clear;
+}
+
+// The root hit_t of the mapped segment refined on the true path by
+// bisection to < 0.1 um, once it is bracketed (F(a) > 0 >= F(b)); hit_t
+// itself when it cannot be.  The samples taken are added to *samples.
+inline ld refine(Proj &pj, const Surface &sf, const Los &L, ld hit_t, ld dt_fine, long *samples)
+{
     ld a = hit_t, b = hit_t, fa = 0, fb = 0;
     for (ld del = 1e-4L;; del *= 4) {
         a = std::max<ld>(0, hit_t - del);
-        fa = detail::clearance(pj, sf, L, a);
-        res.samples++;
+        fa = clearance(pj, sf, L, a);
+        (*samples)++;
         if (fa > 0 || a == 0) break;
     }
     for (ld del = 1e-4L; del < 4 * dt_fine; del *= 4) {
         b = hit_t + del;
-        fb = detail::clearance(pj, sf, L, b);
-        res.samples++;
+        fb = clearance(pj, sf, L, b);
+        (*samples)++;
         if (fb <= 0) break;
     }
     if (fa > 0 && fb <= 0) {
         while (b - a > 1e-7L) {
             ld m = 0.5L * (a + b);
-            ld fm = detail::clearance(pj, sf, L, m);
-            res.samples++;
+            ld fm = clearance(pj, sf, L, m);
+            (*samples)++;
             if (fm > 0)
                 a = m;
             else
                 b = m;
         }
-        hit_t = b;
+        return b;
     }
-    return hit_at(hit_t);
+    return hit_t;
+}
+
+}  // namespace detail
+
+// The reference first hit of the line of sight L on the surface: the camera
+// at or below the surface over the tile, else the march to the first
+// segment that meets the terrain, the smallest clearance before it, the
+// hit refined on the true path.
+inline Result trace(Proj &pj, const Surface &sf, const Los &L)
+{
+    using detail::Sample;
+    Result res;
+    const detail::Steps st = detail::steps_of(sf, L);
+    const Sample cam = detail::sample(pj, sf, L, 0);
+    res.samples = 1;
+    bool entered = false;
+    if (sf.inside(cam.x, cam.y)) {
+        entered = true;
+        const ld f0 = cam.h - sf.height(cam.x, cam.y);
+        if (f0 <= 0) {
+            res.status = f0 < 0 ? BELOW : HIT;
+            res.e = cam.E;
+            res.n = cam.N;
+            res.h = cam.h;
+            res.t = 0;
+            return res;
+        }
+    }
+    std::vector<std::pair<ld, ld>> pts;  // (t, clearance) along the path over the tile
+    const detail::March mr = detail::march(pj, sf, L, st, cam, entered, pts, &res.samples);
+    if (mr.wall) {
+        res.wall = true;
+        return detail::hit_at(pj, sf, L, cam, mr.hit_t, res);
+    }
+    res.min_clear = detail::min_clear_before(pts, mr.hit_t);
+    if (mr.hit_t < 0) {
+        res.status = MISS;
+        return res;
+    }
+    return detail::hit_at(pj, sf, L, cam, detail::refine(pj, sf, L, mr.hit_t, st.dt_fine, &res.samples), res);
 }
 
 // Where a map point (E, N, h) -- e.g. another tracer's hit -- lies relative
