@@ -166,7 +166,8 @@ static ct_status clip_to_box(const int64_t O[3], const int64_t U[3], const int64
         if (U[k] > 0) {
             a.n = lo[k] - O[k];
             b.n = hi[k] - O[k];
-            if (!floorless && bigrt_lt(tin, &a)) {
+            /* tin >= 0: an entry at a.n <= 0 (behind the origin) is never later */
+            if (!floorless && a.n > 0 && bigrt_lt(tin, &a)) {
                 *tin = a;
                 *kin = k;
                 *kin_at = lo[k];
@@ -178,7 +179,7 @@ static ct_status clip_to_box(const int64_t O[3], const int64_t U[3], const int64
         } else {
             a.n = O[k] - hi[k];
             b.n = O[k] - lo[k];
-            if (bigrt_lt(tin, &a)) {
+            if (a.n > 0 && bigrt_lt(tin, &a)) {
                 *tin = a;
                 *kin = k;
                 *kin_at = hi[k];
@@ -198,7 +199,8 @@ static ct_status clip_to_box(const int64_t O[3], const int64_t U[3], const int64
             has_out = 1;
         }
     }
-    return has_out && bigrt_lt(tout, tin) ? CT_MISS : CT_OK;
+    /* tin = 0 (the origin inside): a miss when tout < 0, by its sign */
+    return has_out && (tin->n == 0 ? tout->n < 0 : bigrt_lt(tout, tin)) ? CT_MISS : CT_OK;
 }
 
 /* The entry point O + tin U (tin > 0), rounded to Q16 and kept in the box;
