@@ -59,7 +59,8 @@ const UsageBlock kUsage[] = {
      "                [--emit-c NAME] [--vdatum egm96|ellipsoid|unknown]\n"
      "                [--utm ZONE{N|S}]   (geographic DEMs: resampled onto UTM at --posting M)\n"
      "                [--tile-size P|auto]  (a tile set: -o names a directory of tiles of P posts\n"
-     "                and their manifest; auto: tiles of at most 4 MB)\n"},
+     "                and their manifest; auto: tiles of at most 4 MB; a DEM over 32768 posts\n"
+     "                per side: a mosaic of tile sets DIR/set_<x>_<y>)\n"},
     {"info", "conetrace info PKG_or_TILESET\n"},
     {"trace", "conetrace trace PKG_or_TILESET --rays rays.csv [--method M] [--threads T] [--cache-tiles K]\n"
               "                -o hits.csv\n"},
@@ -237,10 +238,6 @@ int build_mosaic(const std::string &path, DemRows &rows, double posting, double 
     const int chunk = block * std::max(1, (int)std::min<size_t>(1u << 20, (4u << 20) / ((size_t)block * hd.width)));
     const int K = mosaic_set_tiles(P);
     const int tx = (hd.width - 1 + P - 2) / (P - 1), ty = (hd.height - 1 + P - 2) / (P - 1);
-    std::fprintf(stderr,
-                 "conetrace: %s is %dx%d posts, more than a tile set's frame holds (%d per side): building a mosaic of "
-                 "%d x %d tile sets of up to %d x %d tiles of %d posts, one band of tiles at a time\n",
-                 path.c_str(), hd.width, hd.height, kMaxPackagePosts, (tx + K - 1) / K, (ty + K - 1) / K, K, K, P);
     std::unique_ptr<Progress> bar;
     std::string phase;
     StreamedSetSummary sum;
@@ -251,6 +248,13 @@ int build_mosaic(const std::string &path, DemRows &rows, double posting, double 
             chunk, o, P, out, o.threads,
             [&](const char *what, size_t d, size_t n) {
                 if (phase != what) {
+                    if (phase.empty())  // the checks passed: what is built, then the progress
+                        std::fprintf(stderr,
+                                     "%s: %dx%d posts, more than a tile set's frame holds (%d per side): a mosaic of "
+                                     "%d x %d tile sets of up to %d x %d tiles of %d posts, one band of tiles at a "
+                                     "time\n",
+                                     path.c_str(), hd.width, hd.height, kMaxPackagePosts, (tx + K - 1) / K,
+                                     (ty + K - 1) / K, K, K, P);
                     if (bar) bar->finish();
                     phase = what;
                     bar = std::make_unique<Progress>(phase);
@@ -338,14 +342,24 @@ int cmd_build(int argc, char **argv)
         if (tile_posts < 2 || tile_posts > CT_MAX_POSTS) usage("--tile-size must be auto or 2..32768 posts");
     }
     std::string resampled;
-    if (!dem_needs_warp(a.pos[0], utm)) {
+    {
         // the size from the header first: a DEM beyond one package is refused
         // (or streamed into a mosaic of tile sets) before its pixels are read
-        DemRows rows(a.pos[0]);
-        const DemRaster &hd = rows.header();
-        if (hd.width > kMaxPackagePosts || hd.height > kMaxPackagePosts) {
-            if (tile_posts == 0) throw Error(a.pos[0] + ": " + too_wide_for_package(hd.width, hd.height));
-            return build_mosaic(a.pos[0], rows, to_double(a, "--posting", 0), to_double(a, "--height-scale", 0),
+        const bool warp = dem_needs_warp(a.pos[0], utm);
+        std::unique_ptr<DemRows> rows;
+        try {
+            rows = std::make_unique<DemRows>(a.pos[0]);
+        } catch (const Error &) {
+            if (!warp) throw;  // GDAL may read what OpenImageIO does not: the warper says
+        }
+        const int w = rows ? rows->header().width : 0, h = rows ? rows->header().height : 0;
+        if (w > kMaxPackagePosts || h > kMaxPackagePosts) {
+            if (warp)
+                throw Error(a.pos[0] + ": DEM of " + std::to_string(w) + "x" + std::to_string(h) +
+                            " posts: resampling onto UTM holds the whole DEM and takes at most " +
+                            std::to_string(kMaxPackagePosts) + " posts per side (resample it in pieces, e.g. gdalwarp)");
+            if (tile_posts == 0) throw Error(a.pos[0] + ": " + too_wide_for_package(w, h));
+            return build_mosaic(a.pos[0], *rows, to_double(a, "--posting", 0), to_double(a, "--height-scale", 0),
                                 vdatum, o, tile_posts, out, t0);
         }
     }

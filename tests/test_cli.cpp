@@ -879,6 +879,8 @@ static void test_bad_inputs(void)
         {"hscale_nan", {"build", "@ok.tif", "-o", "X.ctp", "--height-scale", "nan"}, "", "--height-scale|ok.tif", true, ""},
         {"posting_nan", {"build", "@ok.tif", "-o", "X.ctp", "--posting", "nan"}, "", "--posting|ok.tif", true, ""},
         {"toolarge", {"build", "@wide.tif", "-o", "X.ctp"}, "wide.tif", "exceeds the package limit", false, ""},
+        {"wide_vdatum", {"build", "@wide.tif", "-o", "T", "--tile-size", "17", "--vdatum", "egm96"}, "wide.tif", "--vdatum",
+         false, ""},
         {"builder", {"build", "@ok.tif", "-o", "X.ctp", "--builder", "magic"}, "", "--builder", true, ""},
         {"window0", {"build", "@ok.tif", "-o", "X.ctp", "--window", "0"}, "", "--window", true, ""},
     };
@@ -1212,6 +1214,9 @@ static void test_big_dem(void)
     Run r = run_cli(d, {"build", "big.tif", "-o", "X.ctp", "--sectors", "1", "--reduce", "8"});
     CHECK_FAILURE(r, d, before, "big.tif", "exceeds the package limit of 32768");
     TEST_ASSERT_MSG(contains(r.err, "--tile-size"), "the refusal suggests --tile-size: %s", r.err.c_str());
+    // more memory than any machine has (a band of 32,768 rows, 64 tiles of 32,768^2 at once): refused first
+    r = run_cli(d, {"build", "big.tif", "-o", "mosaic", "--tile-size", "32768", "--threads", "64"});
+    CHECK_FAILURE(r, d, before, "big.tif", "available");
     // tiles of 4,097 posts: 10 x 10 of them, in 2 x 2 tile sets of at most 7 x 7
     t0 = std::chrono::steady_clock::now();
     r = run_cli(d, {"build", "big.tif", "-o", "mosaic", "--tile-size", "4097", "--sectors", "1", "--reduce", "8",
