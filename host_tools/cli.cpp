@@ -220,9 +220,6 @@ int build_mosaic(const std::string &path, DemRows &rows, double posting, double 
                  const BuildOptions &o, int P, const std::string &out, std::chrono::steady_clock::time_point t0)
 {
     const DemRaster &hd = rows.header();
-    if (vdatum != CT_VDATUM_UNKNOWN)
-        throw Error(path + ": --vdatum on a DEM wider than " + std::to_string(kMaxPackagePosts) +
-                    " posts (a mosaic of tile sets) is not supported: give --vdatum unknown");
     Georef g = hd.geo;
     if (!hd.has_georef) {
         if (posting <= 0) throw Error(path + ": no georeference in the file; give --posting METRES");
@@ -232,6 +229,12 @@ int build_mosaic(const std::string &path, DemRows &rows, double posting, double 
     } else if (posting > 0) {
         g.posting_e = std::copysign(posting, g.posting_e);
         g.posting_n = std::copysign(posting, g.posting_n);
+    }
+    GeoidGrid geoid;  // over the whole DEM, in every tile, as load_terrain makes it
+    try {
+        geoid = vdatum_grid(g, hd.width, hd.height, vdatum);
+    } catch (const Error &e) {
+        throw Error(path + ": " + e.what());
     }
     // read in chunks of whole TIFF tiles or strips, about 4 M posts each
     const int block = std::max(1, hd.block_rows);
@@ -243,8 +246,11 @@ int build_mosaic(const std::string &path, DemRows &rows, double posting, double 
     StreamedSetSummary sum;
     try {
         build_mosaic_dir(
-            hd.width, hd.height, g, hscale, vdatum,
-            [&](int y0, int n, std::vector<double> &h, std::vector<uint8_t> &valid) { rows.read(y0, n, h, valid); },
+            hd.width, hd.height, g, hscale, vdatum, geoid,
+            [&](int y0, int n, std::vector<double> &h, std::vector<uint8_t> &valid) {
+                rows.read(y0, n, h, valid);
+                apply_vdatum_rows(h, valid, hd.width, y0, n, g, vdatum, geoid);  // heights -> ellipsoidal
+            },
             chunk, o, P, out, o.threads,
             [&](const char *what, size_t d, size_t n) {
                 if (phase != what) {

@@ -332,7 +332,8 @@ std::string gib(size_t b)
 
 }  // namespace
 
-void build_mosaic_dir(int width, int height, const Georef &geo, double scale_m, int vdatum, const RowReader &read,
+void build_mosaic_dir(int width, int height, const Georef &geo, double scale_m, int vdatum, const GeoidGrid &geoid,
+                      const RowReader &read,
                       int chunk_rows, const BuildOptions &opt, int P, const std::string &dir, int threads,
                       const std::function<void(const char *, size_t, size_t)> &progress,
                       StreamedSetSummary *summary)
@@ -465,6 +466,7 @@ void build_mosaic_dir(int width, int height, const Georef &geo, double scale_m, 
                         s.height_offset_m = lo;
                         s.height_scale_m = scale_m;
                         s.vdatum = vdatum;
+                        s.geoid = geoid;
                         const std::vector<uint8_t> pkg = build_package(s, o);
                         const int bx = col / K, by = row / K;
                         write_file_atomic((fs::path(tmp) / mosaic_set_name(bx, by) /

@@ -96,7 +96,9 @@ struct StreamedSetSummary {
 size_t streamed_memory_estimate(int width, int height, int P, int chunk_rows, int threads, int reduce, int sectors);
 
 // Build a W x H DEM (W or H beyond kMaxPackagePosts, at most
-// kMaxTileSetDemPosts) read by `read` in chunks of `chunk_rows` rows into a
+// kMaxTileSetDemPosts; vdatum and geoid as the whole DEM's Terrain has
+// them, `read` giving heights already in that datum) read by `read` in
+// chunks of `chunk_rows` rows into a
 // mosaic of tile sets at `dir`, holding one band of tiles (P rows) at a
 // time: a first pass finds the heights' range (the height coding,
 // choose_height_scale(lo, hi, scale_m)), the second reads each band,
@@ -105,7 +107,8 @@ size_t streamed_memory_estimate(int width, int height, int P, int chunk_rows, in
 // existing tile set or mosaic at dir replaced, anything else refused).
 // Refuses with Error when the memory estimate exceeds what the machine has
 // available.  progress(phase, done, total) from the calling thread.
-void build_mosaic_dir(int width, int height, const Georef &geo, double scale_m, int vdatum, const RowReader &read,
+void build_mosaic_dir(int width, int height, const Georef &geo, double scale_m, int vdatum, const GeoidGrid &geoid,
+                      const RowReader &read,
                       int chunk_rows, const BuildOptions &opt, int P, const std::string &dir, int threads,
                       const std::function<void(const char *phase, size_t, size_t)> &progress,
                       StreamedSetSummary *summary);

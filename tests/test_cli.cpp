@@ -879,8 +879,6 @@ static void test_bad_inputs(void)
         {"hscale_nan", {"build", "@ok.tif", "-o", "X.ctp", "--height-scale", "nan"}, "", "--height-scale|ok.tif", true, ""},
         {"posting_nan", {"build", "@ok.tif", "-o", "X.ctp", "--posting", "nan"}, "", "--posting|ok.tif", true, ""},
         {"toolarge", {"build", "@wide.tif", "-o", "X.ctp"}, "wide.tif", "exceeds the package limit", false, ""},
-        {"wide_vdatum", {"build", "@wide.tif", "-o", "T", "--tile-size", "17", "--vdatum", "egm96"}, "wide.tif", "--vdatum",
-         false, ""},
         {"builder", {"build", "@ok.tif", "-o", "X.ctp", "--builder", "magic"}, "", "--builder", true, ""},
         {"window0", {"build", "@ok.tif", "-o", "X.ctp", "--window", "0"}, "", "--window", true, ""},
     };

@@ -35,6 +35,7 @@
 #include "le.hpp"
 #include "terrain.hpp"
 #include "tileset.hpp"
+#include "vdatum.hpp"
 
 namespace {
 
@@ -793,19 +794,30 @@ static void test_streamed_build(void)
     char tmpl[] = "/tmp/ct_test_tiles_XXXXXX";
     TEST_ASSERT(mkdtemp(tmpl) != nullptr);
     const std::string root = tmpl;
-    const ct_host::Terrain t = ct_host::terrain_from_heights(W, H, h, valid, g, 0.0);
-    for (int P : {17, 64}) {
+    // P = 17 and 64; P = 33 with heights above EGM96 (turned ellipsoidal
+    // band by band, the whole DEM's geoid grid in every tile)
+    for (int P : {17, 64, 33}) {
+        const int vd = P == 33 ? CT_VDATUM_EGM96 : CT_VDATUM_UNKNOWN;
+        std::vector<double> hw = h;
+        ct_host::GeoidGrid gw;
+        ct_host::apply_vdatum(hw, valid, W, H, g, vd, gw);
+        ct_host::Terrain t = ct_host::terrain_from_heights(W, H, hw, valid, g, 0.0);
+        t.vdatum = vd;
+        t.geoid = gw;
         const std::string whole = root + "/whole" + std::to_string(P), mosaic = root + "/mosaic" + std::to_string(P);
         ct_host::build_tileset_dir(t, o, P, whole, 2, nullptr, nullptr);
         int reads = 0;
+        const ct_host::GeoidGrid gs = ct_host::vdatum_grid(g, W, H, vd);
+        TEST_ASSERT(gs.w == gw.w && gs.h == gw.h && gs.um == gw.um && (vd == CT_VDATUM_UNKNOWN || gs.w > 1));
         ct_host::RowReader read = [&](int y0, int n, std::vector<double> &hh, std::vector<uint8_t> &vv) {
             TEST_ASSERT(y0 >= 0 && n >= 1 && y0 + n <= H);
             hh.assign(h.begin() + (ptrdiff_t)y0 * W, h.begin() + (ptrdiff_t)(y0 + n) * W);
             vv.assign(valid.begin() + (ptrdiff_t)y0 * W, valid.begin() + (ptrdiff_t)(y0 + n) * W);
+            ct_host::apply_vdatum_rows(hh, vv, W, y0, n, g, vd, gs);
             reads++;
         };
         ct_host::StreamedSetSummary sum;
-        ct_host::build_mosaic_dir(W, H, g, 0.0, 0, read, 7, o, P, mosaic, 2, nullptr, &sum);
+        ct_host::build_mosaic_dir(W, H, g, 0.0, vd, gs, read, 7, o, P, mosaic, 2, nullptr, &sum);
         TEST_ASSERT_EQUAL_INT(1, sum.sets_x * sum.sets_y);
         TEST_ASSERT_MSG(reads == 2 * ((H + 6) / 7), "P %d: %d chunks read (two passes of %d)", P, reads, (H + 6) / 7);
         const ct_host::TileGrid tg = ct_host::tile_grid(W, H, P);
