@@ -278,10 +278,12 @@ int build_mosaic(const std::string &path, DemRows &rows, double posting, double 
     const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     std::printf("%s/: %dx%d posts in a mosaic of %d x %d tile sets (set_<x>_<y>/, edge posts shared) of %d x %d tiles "
                 "of %d posts in all, %d sectors, r=%d, %zu bytes in all (%.2fx the 16-bit DEM), largest tile %zu bytes; "
-                "heights %.4f m + code x %.6g m; built in %.2f s (%.2f s scanning heights), memory estimate %.1f MB\n",
+                "heights %.4f m + code x %.6g m; built in %.2f s (%.2f s scanning heights), peak resident %.1f MB "
+                "(estimate %.1f MB)\n",
                 out.c_str(), hd.width, hd.height, sum.sets_x, sum.sets_y, sum.tiles_x, sum.tiles_y, P, o.sectors,
                 o.reduce, sum.bytes, (double)sum.bytes / (2.0 * hd.width * hd.height), sum.largest, sum.lo_m,
-                sum.scale_m, secs, sum.seconds_scan, sum.memory_estimate / 1e6);
+                sum.scale_m, secs, sum.seconds_scan, proc_status_kib("VmHWM") * 1024.0 / 1e6,
+                sum.memory_estimate / 1e6);
     return 0;
 }
 
