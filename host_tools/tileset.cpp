@@ -363,6 +363,25 @@ void build_mosaic_dir(int width, int height, const Georef &geo, double scale_m, 
                     std::to_string(P) + " rows, " + std::to_string(nthreads) + " tiles at once) but " + gib(avail) +
                     " are available: use a smaller --tile-size or fewer --threads");
     check_replaceable(dir);
+    std::error_code ec;
+    {
+        // the tiles' bytes (without voids and geoid, a lower bound) against
+        // the free space where they are written
+        uint64_t need = 0;
+        for (int r = 0; r < g.tiles_y; ++r)
+            for (int c = 0; c < g.tiles_x; ++c) {
+                uint32_t b = 0;
+                ct_package_size((uint32_t)std::min(P, width - g.first_col(c)),
+                                (uint32_t)std::min(P, height - g.first_row(r)), (uint32_t)opt.reduce,
+                                (uint32_t)opt.sectors, 0u, &b);
+                need += b;
+            }
+        fs::path parent = fs::absolute(fs::path(dir), ec).parent_path();
+        const fs::space_info sp = fs::space(parent, ec);
+        if (!ec && sp.available < need)
+            throw Error(dir + ": the tiles need about " + gib(need) + " but " + parent.string() + " has " +
+                        gib(sp.available) + " free");
+    }
     const int64_t oe = geo.origin_nm_set ? geo.origin_e_nm : metres_to_nm(geo.origin_e);
     const int64_t on = geo.origin_nm_set ? geo.origin_n_nm : metres_to_nm(geo.origin_n);
     const int64_t pe = metres_to_nm(geo.posting_e), pn = metres_to_nm(geo.posting_n);
@@ -394,7 +413,6 @@ void build_mosaic_dir(int width, int height, const Georef &geo, double scale_m, 
     // pass 2: band by band (tile row by tile row), each tile written as made
     const std::string pid = std::to_string((long)getpid());
     const std::string tmp = dir + ".tmp." + pid, old = dir + ".old." + pid;
-    std::error_code ec;
     fs::remove_all(tmp, ec);
     if (!fs::create_directories(tmp, ec)) throw Error(tmp + ": cannot create (" + ec.message() + ")");
     std::vector<TileEntry> entries((size_t)g.tiles_x * g.tiles_y);

@@ -1215,6 +1215,9 @@ static void test_big_dem(void)
     // more memory than any machine has (a band of 32,768 rows, 64 tiles of 32,768^2 at once): refused first
     r = run_cli(d, {"build", "big.tif", "-o", "mosaic", "--tile-size", "32768", "--threads", "64"});
     CHECK_FAILURE(r, d, before, "big.tif", "available");
+    // more disk than the output's file system has (none: /proc): refused first too
+    r = run_cli(d, {"build", "big.tif", "-o", "/proc/ct_mosaic", "--tile-size", "4097", "--sectors", "1", "--reduce", "8"});
+    CHECK_FAILURE(r, d, before, "/proc/ct_mosaic", "free");
     // tiles of 4,097 posts: 10 x 10 of them, in 2 x 2 tile sets of at most 7 x 7
     t0 = std::chrono::steady_clock::now();
     r = run_cli(d, {"build", "big.tif", "-o", "mosaic", "--tile-size", "4097", "--sectors", "1", "--reduce", "8",
