@@ -15,11 +15,18 @@
 #include "dem_io.hpp"
 #include "harness.h"
 
+#include <geotiffio.h>
+#include <geovalues.h>
+#include <tiffio.h>
+#include <xtiffio.h>
+#include <zlib.h>
+
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -1134,10 +1141,176 @@ static void test_tile_sets(void)
 }
 
 // ---------------------------------------------------------------------------
+// 7. a DEM beyond one tile set's frame (40,000 x 40,000 posts, 3.2 GB of
+// int16 heights): a plain build refuses it from the header; build
+// --tile-size streams it into a mosaic of tile sets, read to its end, whose
+// manifests and posts are checked
 
-int main(void)
+// The generated heights: TIFF tile (I, J) of 512 x 512 posts holds
+// 100 + (u + 2 v) % 97 + 10 ((I + 3 J) % 7) at (u, v) in it -- seven
+// distinct tiles, each deflated once and written as often as it occurs.
+static const int kBigW = 40000, kBigTile = 512;
+static int big_height(int i, int j)
 {
-    TEST_BEGIN("test_cli");
+    const int u = i % kBigTile, v = j % kBigTile, I = i / kBigTile, J = j / kBigTile;
+    return 100 + (u + 2 * v) % 97 + 10 * ((I + 3 * J) % 7);
+}
+
+static std::string write_big_tiff(const std::string &path)
+{
+    TIFF *t = XTIFFOpen(path.c_str(), "w");
+    if (!t) return "cannot open " + path;
+    const double scale[3] = {30.0, 30.0, 0.0}, tie[6] = {0, 0, 0, sOE, sON, 0};
+    bool ok = TIFFSetField(t, TIFFTAG_IMAGEWIDTH, (uint32_t)kBigW) && TIFFSetField(t, TIFFTAG_IMAGELENGTH, (uint32_t)kBigW) &&
+              TIFFSetField(t, TIFFTAG_SAMPLESPERPIXEL, (uint16_t)1) && TIFFSetField(t, TIFFTAG_BITSPERSAMPLE, (uint16_t)16) &&
+              TIFFSetField(t, TIFFTAG_SAMPLEFORMAT, (uint16_t)SAMPLEFORMAT_INT) &&
+              TIFFSetField(t, TIFFTAG_PHOTOMETRIC, (uint16_t)PHOTOMETRIC_MINISBLACK) &&
+              TIFFSetField(t, TIFFTAG_PLANARCONFIG, (uint16_t)PLANARCONFIG_CONTIG) &&
+              TIFFSetField(t, TIFFTAG_COMPRESSION, (uint16_t)COMPRESSION_ADOBE_DEFLATE) &&
+              TIFFSetField(t, TIFFTAG_TILEWIDTH, (uint32_t)kBigTile) && TIFFSetField(t, TIFFTAG_TILELENGTH, (uint32_t)kBigTile) &&
+              TIFFSetField(t, TIFFTAG_GEOPIXELSCALE, (uint16_t)3, scale) && TIFFSetField(t, TIFFTAG_GEOTIEPOINTS, (uint16_t)6, tie);
+    GTIF *gt = ok ? GTIFNew(t) : nullptr;
+    ok = gt && GTIFKeySet(gt, GTModelTypeGeoKey, TYPE_SHORT, 1, (int)ModelTypeProjected) &&
+         GTIFKeySet(gt, GTRasterTypeGeoKey, TYPE_SHORT, 1, (int)RasterPixelIsArea) &&
+         GTIFKeySet(gt, ProjectedCSTypeGeoKey, TYPE_SHORT, 1, 32617) && GTIFWriteKeys(gt);
+    if (gt) GTIFFree(gt);
+    // the seven tiles, deflated
+    std::vector<std::vector<unsigned char>> z(7);
+    for (int k = 0; k < 7 && ok; ++k) {
+        std::vector<int16_t> px((size_t)kBigTile * kBigTile);
+        for (int v = 0; v < kBigTile; ++v)
+            for (int u = 0; u < kBigTile; ++u) px[(size_t)v * kBigTile + u] = (int16_t)(100 + (u + 2 * v) % 97 + 10 * k);
+        uLongf n = compressBound((uLong)(px.size() * 2));
+        z[k].resize(n);
+        ok = compress2(z[k].data(), &n, (const Bytef *)px.data(), (uLong)(px.size() * 2), 6) == Z_OK;
+        z[k].resize(n);
+    }
+    const int nt = (kBigW + kBigTile - 1) / kBigTile;
+    for (int J = 0; J < nt && ok; ++J)
+        for (int I = 0; I < nt && ok; ++I) {
+            const std::vector<unsigned char> &b = z[(I + 3 * J) % 7];
+            ok = TIFFWriteRawTile(t, TIFFComputeTile(t, (uint32_t)(I * kBigTile), (uint32_t)(J * kBigTile), 0, 0),
+                                  (void *)b.data(), (tmsize_t)b.size()) == (tmsize_t)b.size();
+        }
+    XTIFFClose(t);
+    return ok ? "" : "libtiff failed writing " + path;
+}
+
+static uint32_t le16(const std::string &b, size_t o) { return (uint8_t)b[o] | (uint32_t)(uint8_t)b[o + 1] << 8; }
+
+static void test_big_dem(void)
+{
+    std::string d = new_dir("bigdem");
+    auto t0 = std::chrono::steady_clock::now();
+    const std::string w = write_big_tiff(d + "/big.tif");
+    TEST_ASSERT_MSG(w.empty(), "%s", w.c_str());
+    auto secs = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
+    printf("  big.tif: %d x %d posts, %.1f MB, written in %.1f s\n", kBigW, kBigW, fs::file_size(d + "/big.tif") / 1e6,
+           secs());
+    // one package: refused from the header, naming the DEM and the way out
+    std::set<std::string> before = listing(d);
+    Run r = run_cli(d, {"build", "big.tif", "-o", "X.ctp", "--sectors", "1", "--reduce", "8"});
+    CHECK_FAILURE(r, d, before, "big.tif", "exceeds the package limit of 32768");
+    TEST_ASSERT_MSG(contains(r.err, "--tile-size"), "the refusal suggests --tile-size: %s", r.err.c_str());
+    // more memory than any machine has (a band of 32,768 rows, 64 tiles of 32,768^2 at once): refused first
+    r = run_cli(d, {"build", "big.tif", "-o", "mosaic", "--tile-size", "32768", "--threads", "64"});
+    CHECK_FAILURE(r, d, before, "big.tif", "available");
+    // more disk than the output's file system has (none: /proc): refused first too
+    r = run_cli(d, {"build", "big.tif", "-o", "/proc/ct_mosaic", "--tile-size", "4097", "--sectors", "1", "--reduce", "8"});
+    CHECK_FAILURE(r, d, before, "/proc/ct_mosaic", "free");
+    // tiles of 4,097 posts: 10 x 10 of them, in 2 x 2 tile sets of at most 7 x 7
+    t0 = std::chrono::steady_clock::now();
+    r = run_cli(d, {"build", "big.tif", "-o", "mosaic", "--tile-size", "4097", "--sectors", "1", "--reduce", "8",
+                    "--slices", "2", "--window", "1"});
+    printf("  build --tile-size 4097: %.1f s; %s", secs(), r.out.c_str());
+    TEST_ASSERT_MSG(r.code == 0, "build: %s", r.err.c_str());
+    TEST_ASSERT_MSG(contains(r.out, "mosaic of 2 x 2 tile sets") && contains(r.out, "10 x 10 tiles of 4097 posts"),
+                    "summary: %s", r.out.c_str());
+    TEST_ASSERT_MSG(listing(d) == (std::set<std::string>{"big.tif", "mosaic"}), "left beside: {%s}", join(listing(d)).c_str());
+    TEST_ASSERT_MSG(listing(d + "/mosaic") == (std::set<std::string>{"set_0_0", "set_0_1", "set_1_0", "set_1_1"}),
+                    "mosaic: {%s}", join(listing(d + "/mosaic")).c_str());
+    // each set's manifest: its grid and merged size (7 tiles of 4,096 cells, then 3 for the last 11,327)
+    const int tiles[2] = {7, 3}, posts[2] = {7 * 4096 + 1, kBigW - 7 * 4096};
+    for (int by = 0; by < 2; ++by)
+        for (int bx = 0; bx < 2; ++bx) {
+            const std::string sd = d + "/mosaic/set_" + std::to_string(bx) + "_" + std::to_string(by);
+            const std::string m = slurp(sd + "/manifest.ctm");
+            TEST_ASSERT_MSG(m.size() >= 96 && m.compare(0, 4, "CTTS") == 0, "%s: not a manifest", sd.c_str());
+            TEST_ASSERT_EQUAL_INT(tiles[bx], (int)le16(m, 16));
+            TEST_ASSERT_EQUAL_INT(tiles[by], (int)le16(m, 18));
+            TEST_ASSERT_EQUAL_INT(4097, (int)le16(m, 20));
+            TEST_ASSERT_EQUAL_INT(posts[bx], (int)le16(m, 24));
+            TEST_ASSERT_EQUAL_INT(posts[by], (int)le16(m, 26));
+            TEST_ASSERT_EQUAL_INT(tiles[bx] * tiles[by] + 1, (int)listing(sd).size());
+        }
+    // posts: vertical rays onto posts of every set (corners, seams, the
+    // DEM's last row and column) hit the generated heights exactly
+    ct_rng rng;
+    ct_rng_seed(&rng, 40000);
+    std::vector<std::pair<int, int>> pts = {{0, 0},         {39999, 39999}, {28672, 28672}, {28672, 0},
+                                            {39999, 0},     {0, 39999},     {28671, 28673}, {4096, 4096},
+                                            {12345, 33333}, {33333, 12345}};
+    for (int k = 0; k < 30; ++k)
+        pts.push_back({(int)(ct_rng_unit(&rng) * (kBigW - 1)), (int)(ct_rng_unit(&rng) * (kBigW - 1))});
+    std::string rays[2][2];
+    std::vector<std::pair<int, int>> in_set[2][2];
+    for (const auto &p : pts) {
+        const int bx = p.first > 28672 ? 1 : 0, by = p.second > 28672 ? 1 : 0;
+        char line[200];
+        snprintf(line, sizeof line, "%.3f,%.3f,2000,0,0,-1\n", sOE + (p.first + 0.5) * 30.0, sON - (p.second + 0.5) * 30.0);
+        rays[bx][by] += line;
+        in_set[bx][by].push_back(p);
+    }
+    std::vector<Job> jobs;
+    for (int by = 0; by < 2; ++by)
+        for (int bx = 0; bx < 2; ++bx) {
+            const std::string n = std::to_string(bx) + "_" + std::to_string(by);
+            spit(d + "/rays_" + n + ".csv", "E,N,h,dE,dN,dh\n" + rays[bx][by]);
+            jobs.push_back(Job{d, {"trace", "mosaic/set_" + n, "--rays", "rays_" + n + ".csv", "-o", "hits_" + n + ".csv"}});
+        }
+    jobs.push_back(Job{d, {"info", "mosaic"}});
+    jobs.push_back(Job{d, {"trace", "mosaic", "--rays", "rays_0_0.csv", "-o", "hits.csv"}});
+    std::vector<Run> runs = run_all(jobs);
+    size_t checked = 0;
+    for (int by = 0; by < 2; ++by)
+        for (int bx = 0; bx < 2; ++bx) {
+            const Run &tr = runs[(size_t)by * 2 + bx];
+            TEST_ASSERT_MSG(tr.code == 0, "`%s`: %s", tr.cmd.c_str(), tr.err.c_str());
+            const std::string n = std::to_string(bx) + "_" + std::to_string(by);
+            const std::vector<std::string> hl = lines_of(slurp(d + "/hits_" + n + ".csv"));
+            TEST_ASSERT_EQUAL_INT((int)in_set[bx][by].size() + 1, (int)hl.size());
+            for (size_t k = 0; k < in_set[bx][by].size(); ++k) {
+                const auto &p = in_set[bx][by][k];
+                double e = 0, nn = 0, h = 0;
+                char status[32] = "";
+                TEST_ASSERT_MSG(sscanf(hl[k + 1].c_str(), "%31[^,],%lf,%lf,%lf", status, &e, &nn, &h) == 4 &&
+                                    std::string(status) == "hit" && std::fabs(h - big_height(p.first, p.second)) < 1e-6,
+                                "post (%d, %d) in set %s: '%s', expected h %d", p.first, p.second, n.c_str(),
+                                hl[k + 1].c_str(), big_height(p.first, p.second));
+                checked++;
+            }
+        }
+    TEST_ASSERT_EQUAL_INT((int)pts.size(), (int)checked);
+    const Run &info = runs[4];
+    TEST_ASSERT_MSG(info.code == 0 && contains(info.out, "2 x 2 tile sets"), "info: %d %s %s", info.code,
+                    info.out.c_str(), info.err.c_str());
+    size_t ok = 0, pos = 0;
+    while ((pos = info.out.find("verify        ok", pos)) != std::string::npos) ok++, pos++;
+    TEST_ASSERT_MSG(ok == 4, "info verifies every set: %s", info.out.c_str());
+    TEST_ASSERT_MSG(runs[5].code != 0 && runs[5].err_lines.size() == 1 && contains(runs[5].err, "mosaic") &&
+                        contains(runs[5].err, "set_0_0") && !fs::exists(d + "/hits.csv"),
+                    "trace over the whole mosaic: %d %s", runs[5].code, runs[5].err.c_str());
+    fs::remove_all(d);  // ~4.5 GB
+}
+
+// ---------------------------------------------------------------------------
+
+// `test_cli`: every test but the big DEM's; `test_cli bigdem`: that one
+// (its own CTest entry, label "bigdem").
+int main(int argc, char **argv)
+{
+    const bool big = argc > 1 && std::strcmp(argv[1], "bigdem") == 0;
+    TEST_BEGIN(big ? "test_cli bigdem" : "test_cli");
     char tmpl[] = "/tmp/ct_test_cli_XXXXXX";
     if (!mkdtemp(tmpl)) {
         printf("test_cli: mkdtemp failed\n");
@@ -1149,6 +1322,15 @@ int main(void)
         return 1;
     }
     load_fixture();
+    if (big) {
+        RUN_TEST(test_big_dem);
+        int rc = TEST_END();
+        if (getenv("CT_TEST_KEEP"))
+            printf("scratch directory kept: %s\n", g_root.c_str());
+        else
+            fs::remove_all(g_root);
+        return rc;
+    }
     RUN_TEST(test_light_start);
     RUN_TEST(test_help);
     RUN_TEST(test_build_info_fixture);

@@ -19,10 +19,14 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <map>
 #include <string>
 #include <vector>
+
+#include <unistd.h>
 
 #include "conetrace.h"
 #include "dem_cases.hpp"
@@ -31,6 +35,7 @@
 #include "le.hpp"
 #include "terrain.hpp"
 #include "tileset.hpp"
+#include "vdatum.hpp"
 
 namespace {
 
@@ -749,6 +754,87 @@ void test_los()
 
 }  // namespace
 
+// ---------------------------------------------------------------------------
+// The streamed build (build_mosaic_dir: a band of tiles at a time, the rows
+// read in chunks) makes the very files the whole-DEM build makes: a DEM
+// that fits one set becomes set_0_0/ of its mosaic, byte for byte -- voids,
+// the narrower last tiles, chunks that straddle bands, the height coding.
+
+static std::vector<uint8_t> file_bytes(const std::string &p)
+{
+    std::vector<uint8_t> b;
+    FILE *f = fopen(p.c_str(), "rb");
+    if (!f) return b;
+    int c;
+    while ((c = fgetc(f)) != EOF) b.push_back((uint8_t)c);
+    fclose(f);
+    return b;
+}
+
+static void test_streamed_build(void)
+{
+    const int W = 203, H = 150;
+    std::vector<double> h((size_t)W * H);
+    std::vector<uint8_t> valid((size_t)W * H, 1);
+    for (int j = 0; j < H; ++j)
+        for (int i = 0; i < W; ++i) {
+            const size_t k = (size_t)j * W + i;
+            h[k] = 250.0 + 80.0 * std::sin(i * 0.07) * std::cos(j * 0.05) + 0.37 * ((i * 7 + j * 13) % 11);
+            if ((i - 60) * (i - 60) + (j - 70) * (j - 70) < 30) valid[k] = 0;  // a void
+        }
+    ct_host::Georef g;
+    g.origin_e = 500000.0;
+    g.origin_n = 4000000.0;
+    g.posting_e = 30.0;
+    g.posting_n = -30.0;
+    g.epsg = 32617;
+    ct_host::BuildOptions o;
+    o.sectors = 8;
+    o.reduce = 3;
+    char tmpl[] = "/tmp/ct_test_tiles_XXXXXX";
+    TEST_ASSERT(mkdtemp(tmpl) != nullptr);
+    const std::string root = tmpl;
+    // P = 17 and 64; P = 33 with heights above EGM96 (turned ellipsoidal
+    // band by band, the whole DEM's geoid grid in every tile)
+    for (int P : {17, 64, 33}) {
+        const int vd = P == 33 ? CT_VDATUM_EGM96 : CT_VDATUM_UNKNOWN;
+        std::vector<double> hw = h;
+        ct_host::GeoidGrid gw;
+        ct_host::apply_vdatum(hw, valid, W, H, g, vd, gw);
+        ct_host::Terrain t = ct_host::terrain_from_heights(W, H, hw, valid, g, 0.0);
+        t.vdatum = vd;
+        t.geoid = gw;
+        const std::string whole = root + "/whole" + std::to_string(P), mosaic = root + "/mosaic" + std::to_string(P);
+        ct_host::build_tileset_dir(t, o, P, whole, 2, nullptr, nullptr);
+        int reads = 0;
+        const ct_host::GeoidGrid gs = ct_host::vdatum_grid(g, W, H, vd);
+        TEST_ASSERT(gs.w == gw.w && gs.h == gw.h && gs.um == gw.um && (vd == CT_VDATUM_UNKNOWN || gs.w > 1));
+        ct_host::RowReader read = [&](int y0, int n, std::vector<double> &hh, std::vector<uint8_t> &vv) {
+            TEST_ASSERT(y0 >= 0 && n >= 1 && y0 + n <= H);
+            hh.assign(h.begin() + (ptrdiff_t)y0 * W, h.begin() + (ptrdiff_t)(y0 + n) * W);
+            vv.assign(valid.begin() + (ptrdiff_t)y0 * W, valid.begin() + (ptrdiff_t)(y0 + n) * W);
+            ct_host::apply_vdatum_rows(hh, vv, W, y0, n, g, vd, gs);
+            reads++;
+        };
+        ct_host::StreamedSetSummary sum;
+        ct_host::build_mosaic_dir(W, H, g, 0.0, vd, gs, read, 7, o, P, mosaic, 2, nullptr, &sum);
+        TEST_ASSERT_EQUAL_INT(1, sum.sets_x * sum.sets_y);
+        TEST_ASSERT_MSG(reads == 2 * ((H + 6) / 7), "P %d: %d chunks read (two passes of %d)", P, reads, (H + 6) / 7);
+        const ct_host::TileGrid tg = ct_host::tile_grid(W, H, P);
+        for (int r = 0; r < tg.tiles_y; ++r)
+            for (int c = 0; c < tg.tiles_x; ++c) {
+                const std::string n = ct_host::tile_file_name(c, r);
+                const std::vector<uint8_t> a = file_bytes(whole + "/" + n), b = file_bytes(mosaic + "/set_0_0/" + n);
+                TEST_ASSERT_MSG(!a.empty() && a == b, "P %d: %s differs (%zu vs %zu bytes)", P, n.c_str(), a.size(),
+                                b.size());
+            }
+        TEST_ASSERT_MSG(file_bytes(whole + "/manifest.ctm") == file_bytes(mosaic + "/set_0_0/manifest.ctm"),
+                        "P %d: the manifests differ", P);
+    }
+    std::string cmd = "rm -rf '" + root + "'";
+    TEST_ASSERT(system(cmd.c_str()) == 0);
+}
+
 int main()
 {
     TEST_BEGIN("test_tiles");
@@ -759,5 +845,6 @@ int main()
     RUN_TEST(test_manifest_checks);
     RUN_TEST(test_geolocation);
     RUN_TEST(test_los);
+    RUN_TEST(test_streamed_build);
     return TEST_END();
 }

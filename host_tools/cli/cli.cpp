@@ -14,6 +14,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <map>
@@ -33,6 +34,8 @@
 #include "tileset.hpp"
 #include "vdatum.hpp"
 #include "warp.hpp"
+
+namespace fs = std::filesystem;
 
 using namespace ct_host;
 
@@ -56,7 +59,8 @@ const UsageBlock kUsage[] = {
      "                [--emit-c NAME] [--vdatum egm96|ellipsoid|unknown]\n"
      "                [--utm ZONE{N|S}]   (geographic DEMs: resampled onto UTM at --posting M)\n"
      "                [--tile-size P|auto]  (a tile set: -o names a directory of tiles of P posts\n"
-     "                and their manifest; auto: tiles of at most 4 MB)\n"},
+     "                and their manifest; auto: tiles of at most 4 MB; a DEM over 32768 posts\n"
+     "                per side: a mosaic of tile sets DIR/set_<x>_<y>)\n"},
     {"info", "conetrace info PKG_or_TILESET\n"},
     {"trace", "conetrace trace PKG_or_TILESET --rays rays.csv [--method M] [--threads T] [--cache-tiles K]\n"
               "                -o hits.csv\n"},
@@ -210,6 +214,79 @@ int build_tiles(const Terrain &t, const BuildOptions &o, int P, const std::strin
     return 0;
 }
 
+// `build --tile-size P` of a DEM beyond one tile set's frame: a mosaic of
+// tile sets, read and built one band of tiles at a time.
+int build_mosaic(const std::string &path, DemRows &rows, double posting, double hscale, int vdatum,
+                 const BuildOptions &o, int P, const std::string &out, std::chrono::steady_clock::time_point t0)
+{
+    const DemRaster &hd = rows.header();
+    Georef g = hd.geo;
+    if (!hd.has_georef) {
+        if (posting <= 0) throw Error(path + ": no georeference in the file; give --posting METRES");
+        g = Georef{};
+        g.posting_e = posting;
+        g.posting_n = -posting;
+    } else if (posting > 0) {
+        g.posting_e = std::copysign(posting, g.posting_e);
+        g.posting_n = std::copysign(posting, g.posting_n);
+    }
+    GeoidGrid geoid;  // over the whole DEM, in every tile, as load_terrain makes it
+    try {
+        geoid = vdatum_grid(g, hd.width, hd.height, vdatum);
+    } catch (const Error &e) {
+        throw Error(path + ": " + e.what());
+    }
+    // read in chunks of whole TIFF tiles or strips, about 4 M posts each
+    const int block = std::max(1, hd.block_rows);
+    const int chunk = block * std::max(1, (int)std::min<size_t>(1u << 20, (4u << 20) / ((size_t)block * hd.width)));
+    const int K = mosaic_set_tiles(P);
+    const int tx = (hd.width - 1 + P - 2) / (P - 1), ty = (hd.height - 1 + P - 2) / (P - 1);
+    std::unique_ptr<Progress> bar;
+    std::string phase;
+    StreamedSetSummary sum;
+    try {
+        build_mosaic_dir(
+            hd.width, hd.height, g, hscale, vdatum, geoid,
+            [&](int y0, int n, std::vector<double> &h, std::vector<uint8_t> &valid) {
+                rows.read(y0, n, h, valid);
+                apply_vdatum_rows(h, valid, hd.width, y0, n, g, vdatum, geoid);  // heights -> ellipsoidal
+            },
+            chunk, o, P, out, o.threads,
+            [&](const char *what, size_t d, size_t n) {
+                if (phase != what) {
+                    if (phase.empty())  // the checks passed: what is built, then the progress
+                        std::fprintf(stderr,
+                                     "%s: %dx%d posts, more than a tile set's frame holds (%d per side): a mosaic of "
+                                     "%d x %d tile sets of up to %d x %d tiles of %d posts, one band of tiles at a "
+                                     "time\n",
+                                     path.c_str(), hd.width, hd.height, kMaxPackagePosts, (tx + K - 1) / K,
+                                     (ty + K - 1) / K, K, K, P);
+                    if (bar) bar->finish();
+                    phase = what;
+                    bar = std::make_unique<Progress>(phase);
+                }
+                bar->update(d, n);
+            },
+            &sum);
+    } catch (const Error &e) {
+        const std::string w = e.what();
+        // the reader's errors name the DEM already; the builder's name the output
+        if (w.compare(0, path.size(), path) == 0 || w.compare(0, out.size(), out) == 0) throw;
+        throw Error(path + ": " + w);
+    }
+    if (bar) bar->finish();
+    const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    std::printf("%s/: %dx%d posts in a mosaic of %d x %d tile sets (set_<x>_<y>/, edge posts shared) of %d x %d tiles "
+                "of %d posts in all, %d sectors, r=%d, %zu bytes in all (%.2fx the 16-bit DEM), largest tile %zu bytes; "
+                "heights %.4f m + code x %.6g m; built in %.2f s (%.2f s scanning heights), peak resident %.1f MB "
+                "(estimate %.1f MB)\n",
+                out.c_str(), hd.width, hd.height, sum.sets_x, sum.sets_y, sum.tiles_x, sum.tiles_y, P, o.sectors,
+                o.reduce, sum.bytes, (double)sum.bytes / (2.0 * hd.width * hd.height), sum.largest, sum.lo_m,
+                sum.scale_m, secs, sum.seconds_scan, proc_status_kib("VmHWM") * 1024.0 / 1e6,
+                sum.memory_estimate / 1e6);
+    return 0;
+}
+
 int cmd_build(int argc, char **argv)
 {
     Args a = parse(argc, argv, 2,
@@ -273,6 +350,27 @@ int cmd_build(int argc, char **argv)
         if (tile_posts < 2 || tile_posts > CT_MAX_POSTS) usage("--tile-size must be auto or 2..32768 posts");
     }
     std::string resampled;
+    {
+        // the size from the header first: a DEM beyond one package is refused
+        // (or streamed into a mosaic of tile sets) before its pixels are read
+        const bool warp = dem_needs_warp(a.pos[0], utm);
+        std::unique_ptr<DemRows> rows;
+        try {
+            rows = std::make_unique<DemRows>(a.pos[0]);
+        } catch (const Error &) {
+            if (!warp) throw;  // GDAL may read what OpenImageIO does not: the warper says
+        }
+        const int w = rows ? rows->header().width : 0, h = rows ? rows->header().height : 0;
+        if (w > kMaxPackagePosts || h > kMaxPackagePosts) {
+            if (warp)
+                throw Error(a.pos[0] + ": DEM of " + std::to_string(w) + "x" + std::to_string(h) +
+                            " posts: resampling onto UTM holds the whole DEM and takes at most " +
+                            std::to_string(kMaxPackagePosts) + " posts per side (resample it in pieces, e.g. gdalwarp)");
+            if (tile_posts == 0) throw Error(a.pos[0] + ": " + too_wide_for_package(w, h));
+            return build_mosaic(a.pos[0], *rows, to_double(a, "--posting", 0), to_double(a, "--height-scale", 0),
+                                vdatum, o, tile_posts, out, t0);
+        }
+    }
     Terrain t = load_terrain(a.pos[0], to_double(a, "--posting", 0), to_double(a, "--height-scale", 0), vdatum, utm,
                              &resampled);
     if (tile_posts > 0) return build_tiles(t, o, tile_posts, out, t0, resampled);
@@ -377,6 +475,20 @@ int cmd_info(int argc, char **argv)
 {
     Args a = parse(argc, argv, 2, {});
     if (a.pos.size() != 1) usage("info needs exactly one package file");
+    int sets_x = 0, sets_y = 0;
+    if (is_mosaic_path(a.pos[0], &sets_x, &sets_y)) {
+        // a mosaic: each of its tile sets as `info` on it would show it
+        std::printf("mosaic        %s: %d x %d tile sets set_<x>_<y>/ (edge posts shared)\n", a.pos[0].c_str(), sets_x,
+                    sets_y);
+        int rc = 0;
+        for (int by = 0; by < sets_y; ++by)
+            for (int bx = 0; bx < sets_x; ++bx) {
+                std::printf("\n");
+                std::fflush(stdout);
+                rc = std::max(rc, info_tiles((fs::path(a.pos[0]) / mosaic_set_name(bx, by)).string()));
+            }
+        return rc;
+    }
     if (is_tileset_path(a.pos[0])) return info_tiles(a.pos[0]);
     std::vector<uint8_t> bytes;
     ct_package p;

@@ -1,6 +1,6 @@
 // heavy_door.cpp -- the `conetrace` binary's side of heavy_door.hpp: loads
 // conetrace_heavy.so from the binary's own directory on first use and
-// forwards read_dem_pixels, dem_needs_warp and warp_dem to it.  Linked into
+// forwards read_dem_pixels, the row reader, dem_needs_warp and warp_dem to it.  Linked into
 // the binary only (in place of dem_pixels.cpp and warp.cpp).
 #include "heavy_door.hpp"
 
@@ -65,6 +65,25 @@ void read_dem_pixels(const std::string &path, DemRaster &r, bool &is_tiff)
 {
     std::string why;
     rethrow(door().read_pixels(path, &r, &is_tiff, &why), why);
+}
+
+void *open_dem_pixel_rows(const std::string &path, DemRaster &r, bool &is_tiff)
+{
+    std::string why;
+    void *h = nullptr;
+    rethrow(door().open_rows(path, &r, &is_tiff, &h, &why), why);
+    return h;
+}
+
+void read_dem_pixel_rows(void *handle, int y0, int n, std::vector<double> &h)
+{
+    std::string why;
+    rethrow(door().read_rows(handle, y0, n, &h, &why), why);
+}
+
+void close_dem_pixel_rows(void *handle)
+{
+    if (handle) door().close_rows(handle);
 }
 
 bool dem_needs_warp(const std::string &path, const WarpOptions &o)

@@ -37,7 +37,20 @@ int warp(const std::string &path, const ct_host::WarpOptions &o, ct_host::DemRas
     return guarded(why, [&] { *r = ct_host::warp_dem(path, o); });
 }
 
-const ct_host::HeavyDoor kDoor = {ct_host::kHeavyDoorVersion, read_pixels, needs_warp, warp};
+int open_rows(const std::string &path, ct_host::DemRaster *r, bool *is_tiff, void **handle, std::string *why)
+{
+    return guarded(why, [&] { *handle = ct_host::open_dem_pixel_rows(path, *r, *is_tiff); });
+}
+
+int read_rows(void *handle, int y0, int n, std::vector<double> *h, std::string *why)
+{
+    return guarded(why, [&] { ct_host::read_dem_pixel_rows(handle, y0, n, *h); });
+}
+
+void close_rows(void *handle) { ct_host::close_dem_pixel_rows(handle); }
+
+const ct_host::HeavyDoor kDoor = {ct_host::kHeavyDoorVersion, read_pixels, needs_warp, warp, open_rows, read_rows,
+                                  close_rows};
 
 }  // namespace
 

@@ -15,17 +15,40 @@ int64_t metres_to_nm(double m)
     return (int64_t)std::llround(m * 1e9);
 }
 
+double choose_height_scale(double lo, double hi, double scale_m)
+{
+    const double range = hi - lo;
+    if (scale_m <= 0.0) {
+        // finest power-of-two LSB (at most 1/16 m) that keeps the range
+        // within 60000 codes
+        scale_m = 1.0 / 16.0;
+        while (range / scale_m > 60000.0) {
+            scale_m *= 2.0;
+        }
+    }
+    if (range / scale_m > 65535.0) {
+        std::ostringstream os;
+        os << "height range " << range << " m does not fit 16 bits at " << scale_m << " m per LSB";
+        throw Error(os.str());
+    }
+    return scale_m;
+}
+
+std::string too_wide_for_package(int width, int height)
+{
+    std::ostringstream os;
+    os << "DEM of " << width << "x" << height << " posts exceeds the package limit of " << kMaxPackagePosts
+       << " per side (a tile set, build --tile-size P|auto, holds up to " << kMaxTileSetDemPosts << ")";
+    return os.str();
+}
+
 Terrain terrain_from_heights(int width, int height, const std::vector<double> &h_m,
                              const std::vector<uint8_t> &valid, const Georef &geo, double scale_m)
 {
     if (width < 2 || height < 2) {
         throw Error("DEM must have at least 2x2 posts");
     }
-    if (width > 32768 || height > 32768) {
-        std::ostringstream os;
-        os << "DEM of " << width << "x" << height << " posts exceeds the package limit of 32768 per side";
-        throw Error(os.str());
-    }
+    if (width > kMaxPackagePosts || height > kMaxPackagePosts) throw Error(too_wide_for_package(width, height));
     size_t n = (size_t)width * (size_t)height;
     if (h_m.size() != n || (!valid.empty() && valid.size() != n)) {
         throw Error("height array size does not match the dimensions");
@@ -43,20 +66,7 @@ Terrain terrain_from_heights(int width, int height, const std::vector<double> &h
     if (nvalid == 0) {
         throw Error("every sample is nodata");
     }
-    double range = hi - lo;
-    if (scale_m <= 0.0) {
-        // finest power-of-two LSB (at most 1/16 m) that keeps the range
-        // within 60000 codes
-        scale_m = 1.0 / 16.0;
-        while (range / scale_m > 60000.0) {
-            scale_m *= 2.0;
-        }
-    }
-    if (range / scale_m > 65535.0) {
-        std::ostringstream os;
-        os << "height range " << range << " m does not fit 16 bits at " << scale_m << " m per LSB";
-        throw Error(os.str());
-    }
+    scale_m = choose_height_scale(lo, hi, scale_m);
     Terrain t;
     t.width = width;
     t.height = height;

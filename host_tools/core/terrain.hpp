@@ -95,6 +95,21 @@ struct Error : std::runtime_error {
     using std::runtime_error::runtime_error;
 };
 
+// Posts per side: of one package (CT_MAX_POSTS; also the most a tile set's
+// merged frame holds, ct_tileset_open), and of a DEM that `build
+// --tile-size` takes (beyond kMaxPackagePosts: a mosaic of tile sets).
+constexpr int kMaxPackagePosts = 32768;
+constexpr int kMaxTileSetDemPosts = 1 << 20;
+// "DEM of WxH posts exceeds the package limit ..." (and what holds it).
+std::string too_wide_for_package(int width, int height);
+
+// The height scale (metres per LSB) for heights lo..hi: scale_m <= 0
+// chooses the finest power-of-two fraction of a metre (at most 1/16 m) that
+// keeps the range within 60000 codes; throws Error when the range does not
+// fit 16 bits at the scale.  Codes are lround((h - lo) / scale) clamped to
+// 0..65535, voids 0.
+double choose_height_scale(double lo, double hi, double scale_m);
+
 // Quantise metres to codes.  scale_m <= 0 chooses the finest power-of-two
 // fraction of a metre that fits the range (at most 1/16 m ... up to 2^k m).
 // NaN / nodata entries (valid[k] == 0) become void posts.

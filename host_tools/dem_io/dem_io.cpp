@@ -228,6 +228,12 @@ void read_georef(const std::string &path, DemRaster &r)
     TiffPtr tif(open_tiff(path, "r", sink));
     if (!tif) throw fail("cannot open as TIFF: " + sink.text("unknown libtiff error"));
 
+    {
+        uint32_t rows = 0;
+        if (TIFFIsTiled(tif.get()) ? TIFFGetField(tif.get(), TIFFTAG_TILELENGTH, &rows) == 1
+                                   : TIFFGetField(tif.get(), TIFFTAG_ROWSPERSTRIP, &rows) == 1)
+            r.block_rows = (int)std::min<uint32_t>(rows, 1u << 20);
+    }
     // GDAL_NODATA
     char *nd = nullptr;
     if (TIFFGetField(tif.get(), kTagGdalNodata, &nd) == 1 && nd) {
@@ -309,40 +315,48 @@ void read_georef(const std::string &path, DemRaster &r)
     r.geo.posting_n = pn;
 }
 
-void mark_valid(DemRaster &r)
-{
+// The nodata rule of read_dem: NaN, or equal to GDAL_NODATA compared in the
+// sample type (as GDAL does).
+struct NodataRule {
     bool can_match = false;
     double cmp = 0.0;
-    if (r.has_nodata && !std::isnan(r.nodata)) {
-        const double nd = r.nodata;
-        const std::string &t = r.sample_type;
-        if (t == "float64") {
-            can_match = true;
-            cmp = nd;
-        } else if (t == "float32") {
-            // compare in the sample type, as GDAL does
-            if (std::isinf(nd) || std::fabs(nd) <= (double)FLT_MAX) {
+    explicit NodataRule(const DemRaster &r)
+    {
+        if (r.has_nodata && !std::isnan(r.nodata)) {
+            const double nd = r.nodata;
+            const std::string &t = r.sample_type;
+            if (t == "float64") {
                 can_match = true;
-                cmp = (double)(float)nd;
+                cmp = nd;
+            } else if (t == "float32") {
+                if (std::isinf(nd) || std::fabs(nd) <= (double)FLT_MAX) {
+                    can_match = true;
+                    cmp = (double)(float)nd;
+                }
+            } else if (std::isfinite(nd) && nd == std::floor(nd)) {
+                double lo = 0, hi = 0;
+                if (t == "int8") lo = INT8_MIN, hi = INT8_MAX;
+                else if (t == "uint8") lo = 0, hi = UINT8_MAX;
+                else if (t == "int16") lo = INT16_MIN, hi = INT16_MAX;
+                else if (t == "uint16") lo = 0, hi = UINT16_MAX;
+                else if (t == "int32") lo = INT32_MIN, hi = INT32_MAX;
+                else if (t == "uint32") lo = 0, hi = UINT32_MAX;
+                can_match = nd >= lo && nd <= hi;
+                cmp = nd;
             }
-        } else if (std::isfinite(nd) && nd == std::floor(nd)) {
-            double lo = 0, hi = 0;
-            if (t == "int8") lo = INT8_MIN, hi = INT8_MAX;
-            else if (t == "uint8") lo = 0, hi = UINT8_MAX;
-            else if (t == "int16") lo = INT16_MIN, hi = INT16_MAX;
-            else if (t == "uint16") lo = 0, hi = UINT16_MAX;
-            else if (t == "int32") lo = INT32_MIN, hi = INT32_MAX;
-            else if (t == "uint32") lo = 0, hi = UINT32_MAX;
-            can_match = nd >= lo && nd <= hi;
-            cmp = nd;
         }
     }
-    r.valid.assign(r.h.size(), 1);
-    for (size_t k = 0; k < r.h.size(); k++) {
-        const double v = r.h[k];
-        if (std::isnan(v) || (can_match && v == cmp)) r.valid[k] = 0;
+    void apply(const std::vector<double> &h, std::vector<uint8_t> &valid) const
+    {
+        valid.assign(h.size(), 1);
+        for (size_t k = 0; k < h.size(); k++) {
+            const double v = h[k];
+            if (std::isnan(v) || (can_match && v == cmp)) valid[k] = 0;
+        }
     }
-}
+};
+
+void mark_valid(DemRaster &r) { NodataRule(r).apply(r.h, r.valid); }
 
 // ---------------------------------------------------------------------------
 // writing
@@ -494,6 +508,36 @@ DemRaster read_dem(const std::string &path)
     if (is_tiff) read_georef(path, r);
     mark_valid(r);
     return r;
+}
+
+DemRows::DemRows(const std::string &path)
+{
+    struct stat st;
+    if (::stat(path.c_str(), &st) != 0) throw Error(path + ": cannot open: " + std::strerror(errno));
+    if (S_ISDIR(st.st_mode)) throw Error(path + ": cannot open: is a directory");
+    if (::access(path.c_str(), R_OK) != 0) throw Error(path + ": cannot open: " + std::strerror(errno));
+    bool is_tiff = false;
+    try {
+        handle_ = open_dem_pixel_rows(path, hdr_, is_tiff);
+        if (is_tiff) read_georef(path, hdr_);
+    } catch (const Error &) {
+        if (handle_) close_dem_pixel_rows(handle_);
+        throw;
+    } catch (const std::exception &e) {
+        if (handle_) close_dem_pixel_rows(handle_);
+        throw Error(path + ": cannot read image (" + e.what() + ")");
+    }
+}
+
+DemRows::~DemRows()
+{
+    if (handle_) close_dem_pixel_rows(handle_);
+}
+
+void DemRows::read(int y0, int n, std::vector<double> &h, std::vector<uint8_t> &valid)
+{
+    read_dem_pixel_rows(handle_, y0, n, h);
+    NodataRule(hdr_).apply(h, valid);
 }
 
 void write_geotiff(const std::string &path, int width, int height,

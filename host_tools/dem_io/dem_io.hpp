@@ -20,6 +20,7 @@ struct DemRaster {
     Georef geo;                   // GDAL-convention corner origin and posting
     bool has_nodata = false;
     double nodata = 0.0;
+    int block_rows = 0;           // a TIFF's rows per tile or strip (0: not known)
 };
 
 // Read a single-band raster.  Throws ct_host::Error("<path>: <reason>") for
@@ -48,6 +49,32 @@ void write_float_tiff(const std::string &path, int width, int height, const std:
 // read_dem looks for GeoTIFF tags).  The `conetrace` binary links a door to
 // the plugin in its place (heavy_door.hpp).
 void read_dem_pixels(const std::string &path, DemRaster &r, bool &is_tiff);
+
+// The same a band of rows at a time (dem_pixels.cpp; the door in the
+// binary): open checks the header as read_dem_pixels does and sets r's size
+// and sample type; read puts rows y0 .. y0 + n - 1 in h (metres as stored);
+// close ends it (also after an error).  Throw Error("<path>: ...").
+void *open_dem_pixel_rows(const std::string &path, DemRaster &r, bool &is_tiff);
+void read_dem_pixel_rows(void *handle, int y0, int n, std::vector<double> &h);
+void close_dem_pixel_rows(void *handle);
+
+// A DEM read by bands of rows, for DEMs too large to hold whole: header()
+// is read_dem's result without the pixels (size, sample type,
+// georeference, nodata); read() gives rows y0 .. y0 + n - 1 and their
+// valid flags by read_dem's rules.  Throws Error("<path>: <reason>").
+class DemRows {
+public:
+    explicit DemRows(const std::string &path);
+    ~DemRows();
+    DemRows(const DemRows &) = delete;
+    DemRows &operator=(const DemRows &) = delete;
+    const DemRaster &header() const { return hdr_; }
+    void read(int y0, int n, std::vector<double> &h, std::vector<uint8_t> &valid);
+
+private:
+    DemRaster hdr_;
+    void *handle_ = nullptr;
+};
 
 // A library's message on one line (line breaks as spaces, ends trimmed).
 inline std::string one_line(std::string s)

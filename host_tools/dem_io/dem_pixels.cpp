@@ -9,7 +9,9 @@
 
 #include <sys/stat.h>
 
+#include <algorithm>
 #include <cstring>
+#include <memory>
 
 namespace ct_host {
 namespace {
@@ -25,9 +27,10 @@ void convert_samples(const std::vector<unsigned char> &buf, size_t n, std::vecto
     }
 }
 
-}  // namespace
 
-void read_dem_pixels(const std::string &path, DemRaster &r, bool &is_tiff)
+// Open `path` and check what read_dem needs of it (one channel, a plain
+// sample type at its full bit depth); r's size and sample type set.
+std::unique_ptr<OIIO::ImageInput> open_checked(const std::string &path, DemRaster &r, bool &is_tiff)
 {
     auto fail = [&](const std::string &why) { return Error(path + ": " + why); };
 
@@ -66,10 +69,7 @@ void read_dem_pixels(const std::string &path, DemRaster &r, bool &is_tiff)
     if (bits != 0 && bits != (int)(fmt.size() * 8))
         throw fail("unsupported bit depth " + std::to_string(bits) + " (stored as " +
                    fmt.c_str() + ")");
-
     const size_t n = (size_t)spec.width * (size_t)spec.height;
-    if (n / (size_t)spec.width != (size_t)spec.height || n > ((size_t)1 << 34))
-        throw fail("image too large");
     {
         // uncompressed pixels must be in the file: a header that promises
         // more is refused before the buffer is allocated
@@ -81,6 +81,87 @@ void read_dem_pixels(const std::string &path, DemRaster &r, bool &is_tiff)
                        " uncompressed posts (" + std::to_string(n * fmt.size()) + " bytes) but the file has " +
                        std::to_string((unsigned long long)st.st_size));
     }
+    r.width = spec.width;
+    r.height = spec.height;
+    r.sample_type = name;
+    return in;
+}
+
+void convert_any(OIIO::TypeDesc fmt, const std::vector<unsigned char> &buf, size_t n, std::vector<double> &out)
+{
+    switch (fmt.basetype) {
+    case OIIO::TypeDesc::INT8: convert_samples<int8_t>(buf, n, out); break;
+    case OIIO::TypeDesc::UINT8: convert_samples<uint8_t>(buf, n, out); break;
+    case OIIO::TypeDesc::INT16: convert_samples<int16_t>(buf, n, out); break;
+    case OIIO::TypeDesc::UINT16: convert_samples<uint16_t>(buf, n, out); break;
+    case OIIO::TypeDesc::INT32: convert_samples<int32_t>(buf, n, out); break;
+    case OIIO::TypeDesc::UINT32: convert_samples<uint32_t>(buf, n, out); break;
+    case OIIO::TypeDesc::FLOAT: convert_samples<float>(buf, n, out); break;
+    default: convert_samples<double>(buf, n, out); break;
+    }
+}
+
+struct RowInput {
+    std::string path;
+    std::unique_ptr<OIIO::ImageInput> in;
+    std::vector<unsigned char> buf;
+};
+
+}  // namespace
+
+void *open_dem_pixel_rows(const std::string &path, DemRaster &r, bool &is_tiff)
+{
+    auto ri = std::make_unique<RowInput>();
+    ri->path = path;
+    ri->in = open_checked(path, r, is_tiff);
+    return ri.release();
+}
+
+void read_dem_pixel_rows(void *handle, int y0, int n, std::vector<double> &h)
+{
+    RowInput &ri = *static_cast<RowInput *>(handle);
+    const OIIO::ImageSpec &spec = ri.in->spec();
+    if (y0 < 0 || n < 1 || y0 + n > spec.height) throw Error(ri.path + ": rows out of range");
+    const size_t count = (size_t)spec.width * (size_t)n, px = spec.format.size();
+    bool ok;
+    if (spec.tile_width > 0 && spec.tile_height > 0) {
+        // a tiled file: whole rows of tiles (read_scanlines is not for
+        // tiled files in OpenImageIO 2.4), the rows wanted copied out
+        const int th = spec.tile_height, t0 = y0 / th * th, t1 = std::min(spec.height, (y0 + n + th - 1) / th * th);
+        ri.buf.resize((size_t)spec.width * (size_t)(t1 - t0) * px);
+        ok = ri.in->read_tiles(0, 0, spec.x, spec.x + spec.width, spec.y + t0, spec.y + t1, spec.z,
+                               spec.z + std::max(1, spec.depth), 0, 1, spec.format, ri.buf.data());
+        if (t0 != y0)
+            std::memmove(ri.buf.data(), ri.buf.data() + (size_t)(y0 - t0) * spec.width * px, count * px);
+    } else {
+        ri.buf.resize(count * px);
+        ok = ri.in->read_scanlines(0, 0, spec.y + y0, spec.y + y0 + n, spec.z, 0, 1, spec.format, ri.buf.data());
+    }
+    if (!ok || ri.in->has_error()) {
+        std::string e = clipped(one_line(ri.in->geterror()));
+        throw Error(ri.path + ": cannot read rows " + std::to_string(y0) + ".." + std::to_string(y0 + n - 1) +
+                    (e.empty() ? std::string() : ": " + e));
+    }
+    convert_any(spec.format, ri.buf, count, h);
+}
+
+void close_dem_pixel_rows(void *handle)
+{
+    RowInput *ri = static_cast<RowInput *>(handle);
+    if (ri && ri->in) ri->in->close();
+    delete ri;
+}
+
+void read_dem_pixels(const std::string &path, DemRaster &r, bool &is_tiff)
+{
+    auto fail = [&](const std::string &why) { return Error(path + ": " + why); };
+    auto in = open_checked(path, r, is_tiff);
+    const OIIO::ImageSpec spec = in->spec();
+    const OIIO::TypeDesc fmt = spec.format;
+
+    const size_t n = (size_t)spec.width * (size_t)spec.height;
+    if (n / (size_t)spec.width != (size_t)spec.height || n > ((size_t)1 << 34))
+        throw fail("image too large");
     std::vector<unsigned char> buf(n * fmt.size());
     // OIIO 2.4 can return true from read_image() although a strip failed to
     // decode (the error is only recorded), so check has_error() as well.
@@ -91,19 +172,7 @@ void read_dem_pixels(const std::string &path, DemRaster &r, bool &is_tiff)
     }
     in->close();
 
-    switch (fmt.basetype) {
-    case OIIO::TypeDesc::INT8: convert_samples<int8_t>(buf, n, r.h); break;
-    case OIIO::TypeDesc::UINT8: convert_samples<uint8_t>(buf, n, r.h); break;
-    case OIIO::TypeDesc::INT16: convert_samples<int16_t>(buf, n, r.h); break;
-    case OIIO::TypeDesc::UINT16: convert_samples<uint16_t>(buf, n, r.h); break;
-    case OIIO::TypeDesc::INT32: convert_samples<int32_t>(buf, n, r.h); break;
-    case OIIO::TypeDesc::UINT32: convert_samples<uint32_t>(buf, n, r.h); break;
-    case OIIO::TypeDesc::FLOAT: convert_samples<float>(buf, n, r.h); break;
-    default: convert_samples<double>(buf, n, r.h); break;
-    }
-    r.width = spec.width;
-    r.height = spec.height;
-    r.sample_type = name;
+    convert_any(fmt, buf, n, r.h);
 }
 
 }  // namespace ct_host

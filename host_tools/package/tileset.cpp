@@ -2,6 +2,9 @@
 #include "tileset.hpp"
 
 #include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -87,11 +90,35 @@ Terrain tile_terrain(const Terrain &t, const TileGrid &g, int col, int row)
     return s;
 }
 
-std::vector<uint8_t> make_manifest(const Terrain &t, const TileGrid &g, int reduce, int sectors,
-                                   const std::vector<std::vector<uint8_t>> &tiles)
+namespace {
+
+// A tile's manifest entry (package size, its CRC field, its codes' range).
+struct TileEntry {
+    bool present = false;
+    uint32_t size = 0, crc = 0;
+    uint16_t hmin = 0, hmax = 0;
+};
+
+TileEntry entry_of(const std::vector<uint8_t> &p)
+{
+    TileEntry e;
+    if (p.empty()) return e;  // no tile: present = 0
+    if (p.size() < CT_PKG_HEADER_SIZE) throw Error("manifest: a tile is shorter than a header");
+    e.present = true;
+    e.size = (uint32_t)p.size();
+    e.crc = get32(p, CT_HDR_CRC);
+    e.hmin = get16(&p[CT_HDR_HMIN]);
+    e.hmax = get16(&p[CT_HDR_HMAX]);
+    return e;
+}
+
+// The manifest of a set whose merged grid is t's (size, georeference,
+// height coding, datum; t's codes are not used): codes lo..hi, the entries.
+std::vector<uint8_t> manifest_bytes(const Terrain &t, uint16_t lo, uint16_t hi, const TileGrid &g, int reduce,
+                                    int sectors, const std::vector<TileEntry> &entries)
 {
     const size_t n = (size_t)g.tiles_x * g.tiles_y;
-    if (tiles.size() != n) throw Error("manifest: tile count mismatch");
+    if (entries.size() != n) throw Error("manifest: tile count mismatch");
     std::vector<uint8_t> m(CT_SET_HEADER_SIZE + n * CT_SET_ENTRY_SIZE, 0);
     std::memcpy(&m[0], CT_SET_MAGIC, 4);
     put16(m, CT_HDR_VERSION, CT_SET_VERSION);
@@ -104,11 +131,6 @@ std::vector<uint8_t> make_manifest(const Terrain &t, const TileGrid &g, int redu
     m[CT_SET_HDR_SECTORS] = (uint8_t)sectors;
     put16(m, CT_SET_HDR_WIDTH, (uint32_t)t.width);
     put16(m, CT_SET_HDR_HEIGHT, (uint32_t)t.height);
-    uint16_t lo = 65535, hi = 0;
-    for (uint16_t v : t.codes) {
-        lo = std::min(lo, v);
-        hi = std::max(hi, v);
-    }
     put16(m, CT_SET_HDR_HMIN, lo);
     put16(m, CT_SET_HDR_HMAX, hi);
     const int64_t geo[6] = {t.geo.origin_nm_set ? t.geo.origin_e_nm : metres_to_nm(t.geo.origin_e),
@@ -121,20 +143,69 @@ std::vector<uint8_t> make_manifest(const Terrain &t, const TileGrid &g, int redu
     put32(m, CT_SET_HDR_EPSG, (uint32_t)std::max(0, t.geo.epsg));
     put16(m, CT_SET_HDR_VDATUM, (uint32_t)t.vdatum);
     for (size_t k = 0; k < n; ++k) {
-        const std::vector<uint8_t> &p = tiles[k];
+        const TileEntry &te = entries[k];
         uint8_t *e = &m[CT_SET_HEADER_SIZE + k * CT_SET_ENTRY_SIZE];
-        if (p.empty()) continue;  // no tile: present = 0
-        if (p.size() < CT_PKG_HEADER_SIZE) throw Error("manifest: a tile is shorter than a header");
-        put32(e, (uint32_t)p.size());
-        put32(e + 4, get32(p, CT_HDR_CRC));
-        put16(e + 8, get16(&p[CT_HDR_HMIN]));
-        put16(e + 10, get16(&p[CT_HDR_HMAX]));
+        if (!te.present) continue;  // no tile: present = 0
+        put32(e, te.size);
+        put32(e + 4, te.crc);
+        put16(e + 8, te.hmin);
+        put16(e + 10, te.hmax);
         e[12] = 1;
     }
     uint32_t crc = 0;
     ct_crc32(0u, m.data(), m.size(), &crc);  // the CRC field is still 0
     put32(m, CT_HDR_CRC, crc);
     return m;
+}
+
+// A directory that `build --tile-size` may replace: missing, empty, a tile
+// set or a mosaic of them.
+void check_replaceable(const std::string &dir)
+{
+    std::error_code ec;
+    if (fs::exists(dir, ec) && !fs::is_directory(dir, ec)) throw Error(dir + ": exists and is not a directory");
+    if (fs::is_directory(dir, ec) && !fs::is_empty(dir, ec) && !fs::exists(fs::path(dir) / kManifestName, ec) &&
+        !is_mosaic_path(dir))
+        throw Error(dir + ": a non-empty directory that is not a tile set (refusing to replace it)");
+}
+
+// The finished directory tmp moved to dir (an existing one replaced only
+// now); tmp removed on failure.
+void install_dir(const std::string &tmp, const std::string &dir, const std::string &old)
+{
+    std::error_code ec;
+    try {
+        if (fs::exists(dir, ec)) {
+            fs::rename(dir, old, ec);
+            if (ec) throw Error(dir + ": cannot replace (" + ec.message() + ")");
+        }
+        fs::rename(tmp, dir, ec);
+        if (ec) {
+            std::error_code ec2;
+            if (fs::exists(old, ec2)) fs::rename(old, dir, ec2);
+            throw Error(dir + ": cannot create (" + ec.message() + ")");
+        }
+    } catch (...) {
+        fs::remove_all(tmp, ec);
+        throw;
+    }
+    fs::remove_all(old, ec);
+}
+
+}  // namespace
+
+std::vector<uint8_t> make_manifest(const Terrain &t, const TileGrid &g, int reduce, int sectors,
+                                   const std::vector<std::vector<uint8_t>> &tiles)
+{
+    uint16_t lo = 65535, hi = 0;
+    for (uint16_t v : t.codes) {
+        lo = std::min(lo, v);
+        hi = std::max(hi, v);
+    }
+    std::vector<TileEntry> entries;
+    entries.reserve(tiles.size());
+    for (const std::vector<uint8_t> &p : tiles) entries.push_back(entry_of(p));
+    return manifest_bytes(t, lo, hi, g, reduce, sectors, entries);
 }
 
 TileSetBytes build_tileset(const Terrain &t, const BuildOptions &opt, int P, int threads,
@@ -191,9 +262,7 @@ void build_tileset_dir(const Terrain &t, const BuildOptions &opt, int P, const s
     const std::string pid = std::to_string((long)getpid());
     const std::string tmp = dir + ".tmp." + pid, old = dir + ".old." + pid;
     std::error_code ec;
-    if (fs::exists(dir, ec) && !fs::is_directory(dir, ec)) throw Error(dir + ": exists and is not a directory");
-    if (fs::is_directory(dir, ec) && !fs::is_empty(dir, ec) && !fs::exists(fs::path(dir) / kManifestName, ec))
-        throw Error(dir + ": a non-empty directory that is not a tile set (refusing to replace it)");
+    check_replaceable(dir);
     TileSetBytes b = build_tileset(t, opt, P, threads, nullptr, progress);
     fs::remove_all(tmp, ec);
     if (!fs::create_directories(tmp, ec)) throw Error(tmp + ": cannot create (" + ec.message() + ")");
@@ -203,21 +272,11 @@ void build_tileset_dir(const Terrain &t, const BuildOptions &opt, int P, const s
                 write_file_atomic((fs::path(tmp) / tile_file_name(col, row)).string(),
                                   b.tiles[(size_t)row * b.grid.tiles_x + col]);
         write_file_atomic((fs::path(tmp) / kManifestName).string(), b.manifest);
-        if (fs::exists(dir, ec)) {
-            fs::rename(dir, old, ec);
-            if (ec) throw Error(dir + ": cannot replace (" + ec.message() + ")");
-        }
-        fs::rename(tmp, dir, ec);
-        if (ec) {
-            std::error_code ec2;
-            if (fs::exists(old, ec2)) fs::rename(old, dir, ec2);
-            throw Error(dir + ": cannot create (" + ec.message() + ")");
-        }
     } catch (...) {
         fs::remove_all(tmp, ec);
         throw;
     }
-    fs::remove_all(old, ec);
+    install_dir(tmp, dir, old);
     if (summary) {
         summary->grid = b.grid;
         summary->manifest = b.manifest;
@@ -225,9 +284,306 @@ void build_tileset_dir(const Terrain &t, const BuildOptions &opt, int P, const s
     }
 }
 
+std::string mosaic_set_name(int bx, int by) { return "set_" + std::to_string(bx) + "_" + std::to_string(by); }
+
+int mosaic_set_tiles(int P)
+{
+    if (P < 2 || P > CT_MAX_POSTS) throw Error("tile size must be in 2..32768 posts");
+    return std::min(64, (CT_MAX_POSTS - 1) / (P - 1));  // K^2 <= CT_SET_MAX_TILES, K (P - 1) + 1 <= CT_MAX_POSTS
+}
+
+size_t streamed_memory_estimate(int width, int height, int P, int chunk_rows, int threads, int reduce, int sectors)
+{
+    (void)height;
+    uint32_t pkg = 0;
+    if (ct_package_size((uint32_t)P, (uint32_t)P, (uint32_t)reduce, (uint32_t)sectors, 0u, &pkg) != CT_OK)
+        pkg = (uint32_t)((size_t)P * P * 4);
+    const size_t band = (size_t)width * (size_t)P * 3;                     // codes and void flags
+    const size_t chunk = (size_t)width * (size_t)chunk_rows * (8 + 1 + 8);  // doubles, flags, raw samples
+    // per tile being built: its codes and voids (3 B/post), the builder's
+    // working memory (~3.3 B/post at r = 3: 1.62x the 16-bit DEM) and the
+    // package (held until written)
+    const size_t tile = (size_t)P * P * 7 + pkg;
+    return band + chunk + (size_t)std::max(1, threads) * tile + (64u << 20);
+}
+
+namespace {
+
+// MemAvailable from /proc/meminfo, bytes (0: unknown).
+size_t memory_available()
+{
+    std::ifstream f("/proc/meminfo");
+    std::string key;
+    size_t kib = 0;
+    std::string unit;
+    while (f >> key >> kib) {
+        std::getline(f, unit);
+        if (key == "MemAvailable:") return kib * 1024;
+    }
+    return 0;
+}
+
+std::string gib(size_t b)
+{
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.1f GB", (double)b / 1e9);
+    return buf;
+}
+
+}  // namespace
+
+void build_mosaic_dir(int width, int height, const Georef &geo, double scale_m, int vdatum, const GeoidGrid &geoid,
+                      const RowReader &read,
+                      int chunk_rows, const BuildOptions &opt, int P, const std::string &dir, int threads,
+                      const std::function<void(const char *, size_t, size_t)> &progress,
+                      StreamedSetSummary *summary)
+{
+    if (width < 2 || height < 2) throw Error("DEM must have at least 2x2 posts");
+    if (width > kMaxTileSetDemPosts || height > kMaxTileSetDemPosts)
+        throw Error("DEM of " + std::to_string(width) + "x" + std::to_string(height) +
+                    " posts exceeds the tile-set limit of " + std::to_string(kMaxTileSetDemPosts) + " per side");
+    const int K = mosaic_set_tiles(P);
+    TileGrid g;  // the DEM's global tile grid
+    g.P = P;
+    g.tiles_x = (width - 1 + P - 2) / (P - 1);
+    g.tiles_y = (height - 1 + P - 2) / (P - 1);
+    const int sets_x = (g.tiles_x + K - 1) / K, sets_y = (g.tiles_y + K - 1) / K;
+    const int nthreads = threads > 0 ? threads : (int)std::max(1u, std::thread::hardware_concurrency());
+    chunk_rows = std::max(1, std::min(chunk_rows, height));
+    StreamedSetSummary sum;
+    sum.sets_x = sets_x;
+    sum.sets_y = sets_y;
+    sum.tiles_x = g.tiles_x;
+    sum.tiles_y = g.tiles_y;
+    sum.memory_estimate = streamed_memory_estimate(width, height, P, chunk_rows, nthreads, opt.reduce, opt.sectors);
+    const size_t avail = memory_available();
+    if (avail != 0 && sum.memory_estimate > avail)
+        throw Error("building tiles of " + std::to_string(P) + " posts from a " + std::to_string(width) + "x" +
+                    std::to_string(height) + " DEM needs about " + gib(sum.memory_estimate) + " (a band of " +
+                    std::to_string(P) + " rows, " + std::to_string(nthreads) + " tiles at once) but " + gib(avail) +
+                    " are available: use a smaller --tile-size or fewer --threads");
+    check_replaceable(dir);
+    std::error_code ec;
+    {
+        // the tiles' bytes (without voids and geoid, a lower bound) against
+        // the free space where they are written
+        uint64_t need = 0;
+        for (int r = 0; r < g.tiles_y; ++r)
+            for (int c = 0; c < g.tiles_x; ++c) {
+                uint32_t b = 0;
+                ct_package_size((uint32_t)std::min(P, width - g.first_col(c)),
+                                (uint32_t)std::min(P, height - g.first_row(r)), (uint32_t)opt.reduce,
+                                (uint32_t)opt.sectors, 0u, &b);
+                need += b;
+            }
+        fs::path parent = fs::absolute(fs::path(dir), ec).parent_path();
+        const fs::space_info sp = fs::space(parent, ec);
+        if (!ec && sp.available < need)
+            throw Error(dir + ": the tiles need about " + gib(need) + " but " + parent.string() + " has " +
+                        gib(sp.available) + " free");
+    }
+    const int64_t oe = geo.origin_nm_set ? geo.origin_e_nm : metres_to_nm(geo.origin_e);
+    const int64_t on = geo.origin_nm_set ? geo.origin_n_nm : metres_to_nm(geo.origin_n);
+    const int64_t pe = metres_to_nm(geo.posting_e), pn = metres_to_nm(geo.posting_n);
+
+    // pass 1: the heights' range
+    auto t0 = std::chrono::steady_clock::now();
+    std::vector<double> h;
+    std::vector<uint8_t> valid;
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    size_t nvalid = 0;
+    for (int y = 0; y < height; y += chunk_rows) {
+        const int n = std::min(chunk_rows, height - y);
+        read(y, n, h, valid);
+        for (size_t k = 0; k < h.size(); ++k)
+            if (valid[k] && std::isfinite(h[k])) {
+                lo = std::min(lo, h[k]);
+                hi = std::max(hi, h[k]);
+                nvalid++;
+            }
+        if (progress) progress("scanning heights", (size_t)(y + n), (size_t)height);
+    }
+    if (nvalid == 0) throw Error("every sample is nodata");
+    scale_m = choose_height_scale(lo, hi, scale_m);
+    sum.lo_m = lo;
+    sum.scale_m = scale_m;
+    auto t1 = std::chrono::steady_clock::now();
+    sum.seconds_scan = std::chrono::duration<double>(t1 - t0).count();
+
+    // pass 2: band by band (tile row by tile row), each tile written as made
+    const std::string pid = std::to_string((long)getpid());
+    const std::string tmp = dir + ".tmp." + pid, old = dir + ".old." + pid;
+    fs::remove_all(tmp, ec);
+    if (!fs::create_directories(tmp, ec)) throw Error(tmp + ": cannot create (" + ec.message() + ")");
+    std::vector<TileEntry> entries((size_t)g.tiles_x * g.tiles_y);
+    try {
+        for (int by = 0; by < sets_y; ++by)
+            for (int bx = 0; bx < sets_x; ++bx)
+                if (!fs::create_directory(fs::path(tmp) / mosaic_set_name(bx, by), ec))
+                    throw Error(tmp + ": cannot create (" + ec.message() + ")");
+        BuildOptions o = opt;
+        o.threads = 1;
+        o.progress = nullptr;
+        std::vector<uint16_t> codes((size_t)width * P);
+        std::vector<uint8_t> voids((size_t)width * P);
+        int have = 0;        // rows of the band already filled (the shared edge row)
+        int next_row = 0;    // the next DEM row to read
+        int chunk_y = 0;     // rows chunk_y .. chunk_y + chunk_n - 1 are in h / valid
+        int chunk_n = 0;
+        const size_t ntiles = entries.size();
+        std::atomic<size_t> done{0};
+        for (int row = 0; row < g.tiles_y; ++row) {
+            const int y0 = g.first_row(row), rows = std::min(P, height - y0);
+            // the band's rows: the previous band's last row is this one's first
+            for (int j = have; j < rows; ++j) {
+                const int y = y0 + j;
+                if (y >= chunk_y + chunk_n) {
+                    chunk_y = next_row;
+                    chunk_n = std::min(chunk_rows, height - chunk_y);
+                    read(chunk_y, chunk_n, h, valid);
+                    next_row = chunk_y + chunk_n;
+                }
+                const size_t src = (size_t)(y - chunk_y) * width, dst = (size_t)j * width;
+                for (int i = 0; i < width; ++i) {
+                    const double v = h[src + i];
+                    const bool ok = valid[src + i] && std::isfinite(v);
+                    long c = ok ? std::lround((v - lo) / scale_m) : 0L;  // voids: the lowest height
+                    codes[dst + i] = (uint16_t)std::min(65535L, std::max(0L, c));
+                    voids[dst + i] = ok ? 0 : 1;
+                }
+            }
+            // this band's tiles, `nthreads` at a time
+            std::atomic<int> next_col{0};
+            std::mutex err_mu;
+            std::string err;
+            std::atomic<bool> failed{false};
+            auto work = [&]() {
+                for (;;) {
+                    const int col = next_col++;
+                    if (col >= g.tiles_x) return;
+                    try {
+                        const int x0 = g.first_col(col), w = std::min(P, width - x0);
+                        Terrain s;
+                        s.width = w;
+                        s.height = rows;
+                        s.codes.resize((size_t)w * rows);
+                        s.void_post.resize((size_t)w * rows);
+                        bool any = false;
+                        for (int j = 0; j < rows; ++j) {
+                            std::copy_n(&codes[(size_t)j * width + x0], w, &s.codes[(size_t)j * w]);
+                            std::copy_n(&voids[(size_t)j * width + x0], w, &s.void_post[(size_t)j * w]);
+                            for (int i = 0; i < w; ++i) any = any || s.void_post[(size_t)j * w + i];
+                        }
+                        if (!any) s.void_post.clear();
+                        s.geo = geo;
+                        s.geo.origin_e = geo.origin_e + x0 * geo.posting_e;
+                        s.geo.origin_n = geo.origin_n + y0 * geo.posting_n;
+                        s.geo.origin_nm_set = true;
+                        s.geo.origin_e_nm = oe + (int64_t)x0 * pe;
+                        s.geo.origin_n_nm = on + (int64_t)y0 * pn;
+                        s.height_offset_m = lo;
+                        s.height_scale_m = scale_m;
+                        s.vdatum = vdatum;
+                        s.geoid = geoid;
+                        const std::vector<uint8_t> pkg = build_package(s, o);
+                        const int bx = col / K, by = row / K;
+                        write_file_atomic((fs::path(tmp) / mosaic_set_name(bx, by) /
+                                           tile_file_name(col - bx * K, row - by * K))
+                                              .string(),
+                                          pkg);
+                        entries[(size_t)row * g.tiles_x + col] = entry_of(pkg);
+                    } catch (const std::exception &e) {
+                        std::lock_guard<std::mutex> lk(err_mu);
+                        if (err.empty()) err = "tile " + std::to_string(col) + "," + std::to_string(row) + ": " + e.what();
+                        failed = true;
+                        next_col = g.tiles_x;  // stop the others
+                    }
+                    done++;
+                }
+            };
+            std::vector<std::thread> pool;
+            const int nw = std::max(1, std::min(nthreads, g.tiles_x));
+            for (int k = 0; k < nw; ++k) pool.emplace_back(work);
+            const size_t target = (size_t)(row + 1) * g.tiles_x;
+            while (progress && done.load() < target && !failed.load()) {
+                progress("building tiles", done.load(), ntiles);
+                std::this_thread::sleep_for(std::chrono::milliseconds(100));
+            }
+            for (std::thread &th : pool) th.join();
+            if (!err.empty()) throw Error(err);
+            if (progress) progress("building tiles", done.load(), ntiles);
+            // the band's last row is the next band's first
+            if (row + 1 < g.tiles_y) {
+                std::copy_n(&codes[(size_t)(rows - 1) * width], width, &codes[0]);
+                std::copy_n(&voids[(size_t)(rows - 1) * width], width, &voids[0]);
+                have = 1;
+            }
+        }
+        // each set's manifest: its grid, origin and codes' range
+        for (int by = 0; by < sets_y; ++by)
+            for (int bx = 0; bx < sets_x; ++bx) {
+                const int c0 = bx * K, r0 = by * K;
+                TileGrid sg;
+                sg.P = P;
+                sg.tiles_x = std::min(K, g.tiles_x - c0);
+                sg.tiles_y = std::min(K, g.tiles_y - r0);
+                const int x0 = g.first_col(c0), y0 = g.first_row(r0);
+                Terrain f;
+                f.width = std::min(sg.tiles_x * (P - 1) + 1, width - x0);
+                f.height = std::min(sg.tiles_y * (P - 1) + 1, height - y0);
+                f.geo = geo;
+                f.geo.origin_nm_set = true;
+                f.geo.origin_e_nm = oe + (int64_t)x0 * pe;
+                f.geo.origin_n_nm = on + (int64_t)y0 * pn;
+                f.height_offset_m = lo;
+                f.height_scale_m = scale_m;
+                f.vdatum = vdatum;
+                std::vector<TileEntry> se;
+                uint16_t clo = 65535, chi = 0;
+                for (int r = 0; r < sg.tiles_y; ++r)
+                    for (int c = 0; c < sg.tiles_x; ++c) {
+                        const TileEntry &e = entries[(size_t)(r0 + r) * g.tiles_x + c0 + c];
+                        se.push_back(e);
+                        clo = std::min(clo, e.hmin);
+                        chi = std::max(chi, e.hmax);
+                        sum.bytes += e.size;
+                        sum.largest = std::max<size_t>(sum.largest, e.size);
+                    }
+                const std::vector<uint8_t> m = manifest_bytes(f, clo, chi, sg, opt.reduce, opt.sectors, se);
+                write_file_atomic((fs::path(tmp) / mosaic_set_name(bx, by) / kManifestName).string(), m);
+                sum.bytes += m.size();
+            }
+    } catch (...) {
+        fs::remove_all(tmp, ec);
+        throw;
+    }
+    install_dir(tmp, dir, old);
+    sum.seconds_build = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
+    if (summary) *summary = sum;
+}
+
+bool is_mosaic_path(const std::string &path, int *sets_x, int *sets_y)
+{
+    std::error_code ec;
+    if (!fs::is_directory(path, ec) || fs::exists(fs::path(path) / kManifestName, ec) ||
+        !fs::exists(fs::path(path) / kMosaicFirstSet / kManifestName, ec))
+        return false;
+    int nx = 1, ny = 1;
+    while (fs::is_directory(fs::path(path) / mosaic_set_name(nx, 0), ec)) nx++;
+    while (fs::is_directory(fs::path(path) / mosaic_set_name(0, ny), ec)) ny++;
+    if (sets_x) *sets_x = nx;
+    if (sets_y) *sets_y = ny;
+    return true;
+}
+
 bool is_tileset_path(const std::string &path)
 {
     std::error_code ec;
+    int sx = 0, sy = 0;
+    if (is_mosaic_path(path, &sx, &sy))
+        throw Error(path + ": a mosaic of " + std::to_string(sx) + " x " + std::to_string(sy) +
+                    " tile sets (one set's frame holds at most " + std::to_string(kMaxPackagePosts) +
+                    " posts per side): give one of them, e.g. " + (fs::path(path) / kMosaicFirstSet).string());
     if (fs::is_directory(path, ec)) return fs::exists(fs::path(path) / kManifestName, ec);
     std::ifstream f(path, std::ios::binary);
     char m[4] = {0, 0, 0, 0};

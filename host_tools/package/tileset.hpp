@@ -64,9 +64,63 @@ void build_tileset_dir(const Terrain &t, const BuildOptions &opt, int P, const s
 std::vector<uint8_t> make_manifest(const Terrain &t, const TileGrid &g, int reduce, int sectors,
                                    const std::vector<std::vector<uint8_t>> &tiles);
 
+// A DEM wider or taller than a tile set's merged frame holds (CT_MAX_POSTS
+// = 32,768 posts per side; ct_tileset_open refuses more) is built into a
+// *mosaic*: a directory of tile sets set_<bx>_<by>/, each an ordinary tile
+// set of at most 32,768 posts and 64 x 64 tiles per side, neighbours
+// sharing their edge posts, all cut from one global tile grid (tile
+// (col, row) of the DEM is tile (col - bx K, row - by K) of set (bx, by),
+// K tiles per set side) and with the whole DEM's height coding.
+constexpr const char *kMosaicFirstSet = "set_0_0";
+std::string mosaic_set_name(int bx, int by);
+// The tile sets of a mosaic per side: K tiles of P posts, K = min(64,
+// 32767 / (P - 1)).
+int mosaic_set_tiles(int P);
+
+// One row of the DEM's rows y0 .. y0 + n - 1 (metres as stored) and valid
+// flags (1 valid, 0 nodata), n <= the reader's wish.
+using RowReader = std::function<void(int y0, int n, std::vector<double> &h, std::vector<uint8_t> &valid)>;
+
+struct StreamedSetSummary {
+    int sets_x = 0, sets_y = 0;      // tile sets of the mosaic
+    int tiles_x = 0, tiles_y = 0;    // the DEM's tile grid
+    size_t bytes = 0, largest = 0;   // tiles and manifests; largest tile
+    double lo_m = 0.0, scale_m = 0.0;
+    double seconds_scan = 0.0, seconds_build = 0.0;
+    size_t memory_estimate = 0;      // bytes, checked before the build
+};
+
+// The bytes a streamed build of a W x H DEM in tiles of P posts holds at
+// once (a band of P rows of codes and voids, a chunk of read rows, and
+// `threads` tiles being built), by the estimate checked before it starts.
+size_t streamed_memory_estimate(int width, int height, int P, int chunk_rows, int threads, int reduce, int sectors);
+
+// Build a W x H DEM (W or H beyond kMaxPackagePosts, at most
+// kMaxTileSetDemPosts; vdatum and geoid as the whole DEM's Terrain has
+// them, `read` giving heights already in that datum) read by `read` in
+// chunks of `chunk_rows` rows into a
+// mosaic of tile sets at `dir`, holding one band of tiles (P rows) at a
+// time: a first pass finds the heights' range (the height coding,
+// choose_height_scale(lo, hi, scale_m)), the second reads each band,
+// quantises it and builds its tiles `threads` at a time, writing each to
+// "<dir>.tmp.<pid>" as it is made; renamed into place on success (an
+// existing tile set or mosaic at dir replaced, anything else refused).
+// Refuses with Error when the memory estimate exceeds what the machine has
+// available.  progress(phase, done, total) from the calling thread.
+void build_mosaic_dir(int width, int height, const Georef &geo, double scale_m, int vdatum, const GeoidGrid &geoid,
+                      const RowReader &read,
+                      int chunk_rows, const BuildOptions &opt, int P, const std::string &dir, int threads,
+                      const std::function<void(const char *phase, size_t, size_t)> &progress,
+                      StreamedSetSummary *summary);
+
 // True when `path` is a tile set: a directory holding manifest.ctm, or a
-// file starting with the manifest's magic.
+// file starting with the manifest's magic.  Throws Error for a mosaic of
+// tile sets (is_mosaic_path), which no command but `info` reads whole.
 bool is_tileset_path(const std::string &path);
+// True when `path` is a directory holding a mosaic of tile sets
+// (set_0_0/manifest.ctm and no manifest.ctm of its own); *sets_x, *sets_y
+// (optional): how many sets per side it holds.
+bool is_mosaic_path(const std::string &path, int *sets_x = nullptr, int *sets_y = nullptr);
 
 // A tile set on disk, read on demand.  loader() is a ct_tile_loader (user:
 // this object): it reads tile_<col>_<row>.ctp into the slot's buffer.

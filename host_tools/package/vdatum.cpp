@@ -145,27 +145,39 @@ double geoid_at(const GeoidGrid &grid, int epsg, double e_m, double n_m)
     return GridView(grid).at(z, metres_to_nm(e_m), metres_to_nm(n_m), &n) ? (double)n * 1e-9 : NAN;
 }
 
-void apply_vdatum(std::vector<double> &h_m, const std::vector<uint8_t> &valid, int width, int height,
-                  const Georef &geo, int vdatum, GeoidGrid &geoid)
+GeoidGrid vdatum_grid(const Georef &geo, int width, int height, int vdatum)
 {
-    geoid = GeoidGrid();
-    if (vdatum == CT_VDATUM_UNKNOWN) return;
-    const ct_utm z = utm_of(geo.epsg);
+    if (vdatum == CT_VDATUM_UNKNOWN) return GeoidGrid();
+    (void)utm_of(geo.epsg);  // a UTM CRS, or Error
     Egm96 egm;
-    geoid = make_geoid_grid(egm, geo, width, height);
-    if (vdatum != CT_VDATUM_EGM96) return;  // ellipsoidal heights pass through
+    return make_geoid_grid(egm, geo, width, height);
+}
+
+void apply_vdatum_rows(std::vector<double> &h_m, const std::vector<uint8_t> &valid, int width, int y0, int n,
+                       const Georef &geo, int vdatum, const GeoidGrid &geoid)
+{
+    if (vdatum != CT_VDATUM_EGM96) return;  // unknown, or ellipsoidal heights: as they are
+    const ct_utm z = utm_of(geo.epsg);
     GridView v(geoid);
     const int64_t oe = metres_to_nm(geo.origin_e), on = metres_to_nm(geo.origin_n);
     const int64_t pe = metres_to_nm(geo.posting_e), pn = metres_to_nm(geo.posting_n);
-    for (int j = 0; j < height; ++j)
+    for (int jj = 0; jj < n; ++jj)
         for (int i = 0; i < width; ++i) {
-            const size_t k = (size_t)j * width + i;
+            const size_t k = (size_t)jj * width + i;
+            const int64_t j = (int64_t)y0 + jj;
             if (!valid.empty() && !valid[k]) continue;
-            int64_t n = 0;
-            if (!v.at(z, oe + pe / 2 + i * pe, on + pn / 2 + j * pn, &n))
+            int64_t u = 0;
+            if (!v.at(z, oe + pe / 2 + i * pe, on + pn / 2 + j * pn, &u))
                 throw Error("a post lies outside its own geoid grid");
-            h_m[k] += (double)n * 1e-9;
+            h_m[k] += (double)u * 1e-9;
         }
+}
+
+void apply_vdatum(std::vector<double> &h_m, const std::vector<uint8_t> &valid, int width, int height,
+                  const Georef &geo, int vdatum, GeoidGrid &geoid)
+{
+    geoid = vdatum_grid(geo, width, height, vdatum);
+    apply_vdatum_rows(h_m, valid, width, 0, height, geo, vdatum, geoid);
 }
 
 }  // namespace ct_host

@@ -47,4 +47,12 @@ double geoid_at(const GeoidGrid &grid, int epsg, double e_m, double n_m);
 void apply_vdatum(std::vector<double> &h_m, const std::vector<uint8_t> &valid, int width,
                   int height, const Georef &g, int vdatum, GeoidGrid &geoid);
 
+// apply_vdatum in two halves, for a DEM read by bands of rows: the grid
+// over the whole DEM (empty for unknown), then the heights of rows y0 ..
+// y0 + n - 1 (h_m and valid hold those rows) turned as apply_vdatum turns
+// them -- the same sums, post by post.
+GeoidGrid vdatum_grid(const Georef &g, int width, int height, int vdatum);
+void apply_vdatum_rows(std::vector<double> &h_m, const std::vector<uint8_t> &valid, int width, int y0, int n,
+                       const Georef &g, int vdatum, const GeoidGrid &geoid);
+
 }  // namespace ct_host
