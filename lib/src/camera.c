@@ -492,10 +492,10 @@ static void cr_weights(int64_t t, int64_t w[4])
     int64_t t3 = t * t * t;            /* t^3, Q60 */
     int64_t t1 = t << 40;              /* t, Q60   */
     const int64_t half = INT64_C(1) << 29;
-    w[0] = (-t3 + 2 * t2 - t1 + half) >> 30;
-    w[1] = (3 * t3 - 5 * t2 + (INT64_C(2) << 60) + half) >> 30;
-    w[2] = (-3 * t3 + 4 * t2 + t1 + half) >> 30;
-    w[3] = (t3 - t2 + half) >> 30;
+    w[0] = ct_floor_shr(-t3 + 2 * t2 - t1 + half, 30u);
+    w[1] = ct_floor_shr(3 * t3 - 5 * t2 + (INT64_C(2) << 60) + half, 30u);
+    w[2] = ct_floor_shr(-3 * t3 + 4 * t2 + t1 + half, 30u);
+    w[3] = ct_floor_shr(t3 - t2 + half, 30u);
 }
 
 /* Node index and fraction (Q20) along one axis: the pixel lies in
@@ -549,7 +549,7 @@ static ct_status grid_unproject(const ct_camera *c, int64_t u, int64_t v, int32_
             acc[2] += wu[a] * r[2];
         }
         for (k = 0u; k < 3u; ++k) { /* bound: 3 components */
-            row[b][k] = (acc[k] + (INT64_C(1) << 29)) >> 30;
+            row[b][k] = ct_floor_shr(acc[k] + (INT64_C(1) << 29), 30u);
         }
     }
     /* along v, then V' = V / 2^32 rounded.  bound: 3 x 4 */
@@ -558,7 +558,7 @@ static ct_status grid_unproject(const ct_camera *c, int64_t u, int64_t v, int32_
         for (b = 0u; b < 4u; ++b) {
             acc += wv[b] * row[b][k];
         }
-        V[k] = (acc + (INT64_C(1) << 31)) >> 32;
+        V[k] = ct_floor_shr(acc + (INT64_C(1) << 31), 32u);
         l2 += (uint64_t)(V[k] * V[k]);
     }
     L = ct_isqrt64(l2);

@@ -57,6 +57,13 @@ static inline int64_t ct_floor_div(int64_t a, int64_t b)
     return q;
 }
 
+/* floor(a / 2^n), n < 63, without relying on the implementation-defined
+ * right shift of negative values (|a| < 2^63 - 2^n). */
+static inline int64_t ct_floor_shr(int64_t a, unsigned n)
+{
+    return a >= 0 ? a >> n : -(int64_t)(((uint64_t)(-a) + (((uint64_t)1 << n) - 1u)) >> n);
+}
+
 /* ceil(a / b) for b > 0. */
 static inline int64_t ct_ceil_div(int64_t a, int64_t b)
 {

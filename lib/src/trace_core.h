@@ -20,12 +20,8 @@ typedef struct {
 } rt;
 
 
-/* floor(a / 2^n) without relying on the implementation-defined right shift
- * of negative values. */
-static inline int64_t floor_shr(int64_t a, unsigned n)
-{
-    return a >= 0 ? a >> n : -(int64_t)(((uint64_t)(-a) + (((uint64_t)1 << n) - 1u)) >> n);
-}
+/* floor(a / 2^n) (fixed.h's ct_floor_shr, under the tracer's short name). */
+static inline int64_t floor_shr(int64_t a, unsigned n) { return ct_floor_shr(a, n); }
 
 /* a < b for rationals: n <= 2^34, d <= 2^26 -> products < 2^60 */
 static inline int rt_lt(rt a, rt b) { return a.n * b.d < b.n * a.d; }
