@@ -1324,22 +1324,17 @@ int main(int argc, char **argv)
     load_fixture();
     if (big) {
         RUN_TEST(test_big_dem);
-        int rc = TEST_END();
-        if (getenv("CT_TEST_KEEP"))
-            printf("scratch directory kept: %s\n", g_root.c_str());
-        else
-            fs::remove_all(g_root);
-        return rc;
+    } else {
+        RUN_TEST(test_light_start);
+        RUN_TEST(test_help);
+        RUN_TEST(test_build_info_fixture);
+        RUN_TEST(test_trace_methods);
+        RUN_TEST(test_nodata_policy);
+        RUN_TEST(test_bad_inputs);
+        RUN_TEST(test_bad_rows);
+        RUN_TEST(test_failed_run_keeps_output);
+        RUN_TEST(test_tile_sets);
     }
-    RUN_TEST(test_light_start);
-    RUN_TEST(test_help);
-    RUN_TEST(test_build_info_fixture);
-    RUN_TEST(test_trace_methods);
-    RUN_TEST(test_nodata_policy);
-    RUN_TEST(test_bad_inputs);
-    RUN_TEST(test_bad_rows);
-    RUN_TEST(test_failed_run_keeps_output);
-    RUN_TEST(test_tile_sets);
     int rc = TEST_END();
     if (getenv("CT_TEST_KEEP"))
         printf("scratch directory kept: %s\n", g_root.c_str());

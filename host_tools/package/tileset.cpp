@@ -54,6 +54,24 @@ TileGrid tile_grid(int width, int height, int P)
     return g;
 }
 
+namespace {
+
+// geo moved by (x0, y0) posts: the origin in metres and, exactly, in nm.
+Georef shifted_georef(const Georef &geo, int x0, int y0)
+{
+    Georef s = geo;
+    const int64_t oe = geo.origin_nm_set ? geo.origin_e_nm : metres_to_nm(geo.origin_e);
+    const int64_t on = geo.origin_nm_set ? geo.origin_n_nm : metres_to_nm(geo.origin_n);
+    s.origin_e = geo.origin_e + x0 * geo.posting_e;
+    s.origin_n = geo.origin_n + y0 * geo.posting_n;
+    s.origin_nm_set = true;
+    s.origin_e_nm = oe + (int64_t)x0 * metres_to_nm(geo.posting_e);
+    s.origin_n_nm = on + (int64_t)y0 * metres_to_nm(geo.posting_n);
+    return s;
+}
+
+}  // namespace
+
 Terrain tile_terrain(const Terrain &t, const TileGrid &g, int col, int row)
 {
     const int x0 = g.first_col(col), y0 = g.first_row(row);
@@ -75,14 +93,7 @@ Terrain tile_terrain(const Terrain &t, const TileGrid &g, int col, int row)
             }
         if (!any) s.void_post.clear();
     }
-    s.geo = t.geo;
-    s.geo.origin_e = t.geo.origin_e + x0 * t.geo.posting_e;
-    s.geo.origin_n = t.geo.origin_n + y0 * t.geo.posting_n;
-    s.geo.origin_nm_set = true;
-    const int64_t oe = t.geo.origin_nm_set ? t.geo.origin_e_nm : metres_to_nm(t.geo.origin_e);
-    const int64_t on = t.geo.origin_nm_set ? t.geo.origin_n_nm : metres_to_nm(t.geo.origin_n);
-    s.geo.origin_e_nm = oe + (int64_t)x0 * metres_to_nm(t.geo.posting_e);
-    s.geo.origin_n_nm = on + (int64_t)y0 * metres_to_nm(t.geo.posting_n);
+    s.geo = shifted_georef(t.geo, x0, y0);
     s.height_offset_m = t.height_offset_m;
     s.height_scale_m = t.height_scale_m;
     s.vdatum = t.vdatum;
@@ -382,9 +393,6 @@ void build_mosaic_dir(int width, int height, const Georef &geo, double scale_m, 
             throw Error(dir + ": the tiles need about " + gib(need) + " but " + parent.string() + " has " +
                         gib(sp.available) + " free");
     }
-    const int64_t oe = geo.origin_nm_set ? geo.origin_e_nm : metres_to_nm(geo.origin_e);
-    const int64_t on = geo.origin_nm_set ? geo.origin_n_nm : metres_to_nm(geo.origin_n);
-    const int64_t pe = metres_to_nm(geo.posting_e), pn = metres_to_nm(geo.posting_n);
 
     // pass 1: the heights' range
     auto t0 = std::chrono::steady_clock::now();
@@ -475,12 +483,7 @@ void build_mosaic_dir(int width, int height, const Georef &geo, double scale_m, 
                             for (int i = 0; i < w; ++i) any = any || s.void_post[(size_t)j * w + i];
                         }
                         if (!any) s.void_post.clear();
-                        s.geo = geo;
-                        s.geo.origin_e = geo.origin_e + x0 * geo.posting_e;
-                        s.geo.origin_n = geo.origin_n + y0 * geo.posting_n;
-                        s.geo.origin_nm_set = true;
-                        s.geo.origin_e_nm = oe + (int64_t)x0 * pe;
-                        s.geo.origin_n_nm = on + (int64_t)y0 * pn;
+                        s.geo = shifted_georef(geo, x0, y0);
                         s.height_offset_m = lo;
                         s.height_scale_m = scale_m;
                         s.vdatum = vdatum;
@@ -531,10 +534,7 @@ void build_mosaic_dir(int width, int height, const Georef &geo, double scale_m, 
                 Terrain f;
                 f.width = std::min(sg.tiles_x * (P - 1) + 1, width - x0);
                 f.height = std::min(sg.tiles_y * (P - 1) + 1, height - y0);
-                f.geo = geo;
-                f.geo.origin_nm_set = true;
-                f.geo.origin_e_nm = oe + (int64_t)x0 * pe;
-                f.geo.origin_n_nm = on + (int64_t)y0 * pn;
+                f.geo = shifted_georef(geo, x0, y0);
                 f.height_offset_m = lo;
                 f.height_scale_m = scale_m;
                 f.vdatum = vdatum;
