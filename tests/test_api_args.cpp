@@ -436,6 +436,160 @@ std::vector<Case> cases()
         ct_hit h;
         return ct_los_tiles(nullptr, w.a, w.b, nullptr, 0, CT_METHOD_DIRECTIONAL, &h);
     });
+    // ---- each part of a range check of several parts on its own (the
+    // other parts in range), so that every part is seen to refuse
+    add("package_size: height 1", CT_ERR_DIMS, [](World &) {
+        uint32_t s;
+        return ct_package_size(16, 1, 1, 8, 0, &s);
+    });
+    add("package_size: width CT_MAX_POSTS + 1", CT_ERR_DIMS, [](World &) {
+        uint32_t s;
+        return ct_package_size(CT_MAX_POSTS + 1u, 16, 1, 8, 0, &s);
+    });
+    add("package_size: height CT_MAX_POSTS + 1", CT_ERR_DIMS, [](World &) {
+        uint32_t s;
+        return ct_package_size(16, CT_MAX_POSTS + 1u, 1, 8, 0, &s);
+    });
+    add("package_size: CT_MAX_SECTORS + 1 sectors", CT_ERR_SECTORS, [](World &) {
+        uint32_t s;
+        return ct_package_size(16, 16, 1, CT_MAX_SECTORS + 1u, 0, &s);
+    });
+    add("package_size: r CT_MAX_REDUCE + 1", CT_ERR_REDUCE, [](World &) {
+        uint32_t s;
+        return ct_package_size(16, 16, CT_MAX_REDUCE + 1u, 8, 0, &s);
+    });
+    // the largest grid, r = 1, 64 sectors: 32767^2 cells x 65 angle planes
+    // alone are 2^36 bytes, beyond a 32-bit package size
+    add("package_size: CT_MAX_POSTS^2, r 1, 64 sectors (over 4 GB)", CT_ERR_SIZE, [](World &) {
+        uint32_t s;
+        return ct_package_size(CT_MAX_POSTS, CT_MAX_POSTS, 1, CT_MAX_SECTORS, 1, &s);
+    });
+    add("crc32: data NULL, len 0 (nothing to read)", CT_OK, [](World &) {
+        uint32_t c = 1;
+        const ct_status st = ct_crc32(0, nullptr, 0, &c);
+        return st == CT_OK && c == 0u ? CT_OK : CT_ERR_INTERNAL;  // the CRC of no bytes from 0 is 0
+    });
+    add("package_verify: a package never opened (no bytes)", CT_ERR_ARG, [](World &) {
+        static const ct_package q{};
+        return ct_package_verify(&q);
+    });
+    add("cot_table: height scale 0", CT_ERR_GEOREF, [](World &) {
+        static int64_t out[256];
+        static uint8_t ok[256];
+        return ct_cot_table(30000000000, 0, out, ok);
+    });
+    add("cot_table: posting beyond 2^50", CT_ERR_GEOREF, [](World &) {
+        static int64_t out[256];
+        static uint8_t ok[256];
+        return ct_cot_table((INT64_C(1) << 50) + 1, 62500000, out, ok);
+    });
+    add("cot_table: height scale beyond 2^46", CT_ERR_GEOREF, [](World &) {
+        static int64_t out[256];
+        static uint8_t ok[256];
+        return ct_cot_table(30000000000, (INT64_C(1) << 46) + 1, out, ok);
+    });
+    add("in_wedge: 0 sectors", CT_ERR_SECTORS, [](World &w) {
+        uint32_t in;
+        return ct_in_wedge(w.p.bound_x, w.p.bound_y, 0, 0, 1, 0, &in);
+    });
+    add("in_wedge: CT_MAX_SECTORS + 1 sectors", CT_ERR_SECTORS, [](World &w) {
+        uint32_t in;
+        return ct_in_wedge(w.p.bound_x, w.p.bound_y, CT_MAX_SECTORS + 1u, 0, 1, 0, &in);
+    });
+    add("in_wedge: dy beyond 2^30", CT_ERR_ARG, [](World &w) {
+        uint32_t in;
+        return ct_in_wedge(w.p.bound_x, w.p.bound_y, 8, 0, 1, -(INT64_C(1) << 30) - 1, &in);
+    });
+    add("sector_of: dx beyond 2^30", CT_ERR_ARG, [](World &w) {
+        uint32_t s;
+        return ct_sector_of(&w.p, -(INT64_C(1) << 30) - 1, 0, &s);
+    });
+    add("sector_of: dy beyond 2^30", CT_ERR_ARG, [](World &w) {
+        uint32_t s;
+        return ct_sector_of(&w.p, 0, (INT64_C(1) << 30) + 1, &s);
+    });
+    add("status_name: one past CT_NO_DATA", CT_ERR_ARG, [](World &) {
+        const char *n = nullptr;
+        return ct_status_name((ct_status)(CT_NO_DATA + 1), &n);
+    });
+    add("status_name: one below CT_ERR_CRS", CT_ERR_ARG, [](World &) {
+        const char *n = nullptr;
+        return ct_status_name((ct_status)(CT_ERR_CRS - 1), &n);
+    });
+    add("utm_zone_of_epsg: 32761 (one past the southern zones)", CT_ERR_CRS, [](World &) {
+        ct_utm z;
+        return ct_utm_zone_of_epsg(32761, &z);
+    });
+    add("utm_inverse: zone 0", CT_ERR_ARG, [](World &) {
+        const ct_utm z = {0, 0};
+        int64_t lat, lon;
+        return ct_utm_inverse(&z, 500000000000000, 0, &lat, &lon);
+    });
+    add("utm_inverse: zone 61", CT_ERR_ARG, [](World &) {
+        const ct_utm z = {61, 0};
+        int64_t lat, lon;
+        return ct_utm_inverse(&z, 500000000000000, 0, &lat, &lon);
+    });
+    add("utm_inverse: northing beyond 2^60 nm", CT_ERR_RANGE, [](World &) {
+        const ct_utm z = {17, 0};
+        int64_t lat, lon;
+        return ct_utm_inverse(&z, 500000000000000, (INT64_C(1) << 60) + 1, &lat, &lon);
+    });
+    add("utm_inverse: 9,600 km north of the equator (beyond 84.5 deg)", CT_ERR_RANGE, [](World &) {
+        const ct_utm z = {17, 0};
+        int64_t lat, lon;
+        return ct_utm_inverse(&z, 500000000000000, 9600000000000000, &lat, &lon);
+    });
+    // 1,000 km east of the meridian at 6,600 km north (about 59 deg): some
+    // 17 deg of longitude away, beyond the zone's 9 deg
+    add("utm_inverse: 17 deg from the central meridian", CT_ERR_RANGE, [](World &) {
+        const ct_utm z = {17, 0};
+        int64_t lat, lon;
+        return ct_utm_inverse(&z, 1500000000000000, 6600000000000000, &lat, &lon);
+    });
+    add("package_geoid: a package on no UTM zone (EPSG 0)", CT_ERR_CRS, [](World &w) {
+        ct_package q = w.p;
+        int64_t n;
+        q.epsg = 0;
+        return ct_package_geoid(&q, w.a[0], w.a[1], &n);
+    });
+    add("package_geoid: an EPSG code beyond INT32_MAX", CT_ERR_CRS, [](World &w) {
+        ct_package q = w.p;
+        int64_t n;
+        q.epsg = 0x80000000u + 32617u;
+        return ct_package_geoid(&q, w.a[0], w.a[1], &n);
+    });
+    add("package_geoid: a point far off the zone", CT_ERR_RANGE, [](World &w) {
+        int64_t n;
+        return ct_package_geoid(&w.p, INT64_C(1) << 61, w.a[1], &n);
+    });
+    // a 2 x 2 geoid grid with its north-west node at 0.5 rad, 0.1 rad
+    // apart, but one dimension or the point out of range
+    static const uint8_t geoid_vals[16 * 4097] = {0};
+    auto geoid = [](uint32_t gw, uint32_t gh) {
+        return ct_geoid_grid{gw, gh, CT_PI_Q61 / 6, 0, CT_PI_Q61 / 31, geoid_vals};
+    };
+    add("geoid_at: a grid of one row", CT_ERR_RANGE, [geoid](World &) {
+        const ct_geoid_grid g = geoid(2, 1);
+        int64_t n;
+        return ct_geoid_at(&g, CT_PI_Q61 / 7, CT_PI_Q61 / 64, &n);
+    });
+    add("geoid_at: a grid of CT_GEOID_MAX_NODES + 1 rows", CT_ERR_RANGE, [geoid](World &) {
+        const ct_geoid_grid g = geoid(2, CT_GEOID_MAX_NODES + 1u);
+        int64_t n;
+        return ct_geoid_at(&g, CT_PI_Q61 / 7, CT_PI_Q61 / 64, &n);
+    });
+    add("geoid_at: a point north of the grid's first row", CT_ERR_RANGE, [geoid](World &) {
+        const ct_geoid_grid g = geoid(2, 2);
+        int64_t n;
+        return ct_geoid_at(&g, CT_PI_Q61 / 5, CT_PI_Q61 / 64, &n);
+    });
+    add("geoid_at: the same grid, a point inside it", CT_OK, [geoid](World &) {
+        const ct_geoid_grid g = geoid(2, 2);
+        int64_t n = 1;
+        const ct_status st = ct_geoid_at(&g, CT_PI_Q61 / 6 - CT_PI_Q61 / 64, CT_PI_Q61 / 64, &n);
+        return st == CT_OK && n == 0 ? CT_OK : CT_ERR_INTERNAL;  // all nodes 0
+    });
     // ---- every other pointer argument NULL: CT_ERR_ARG, the rule of the header
     auto null_arg = [&](const char *name, std::function<ct_status(World &)> f) { add(name, CT_ERR_ARG, std::move(f)); };
     null_arg("package_layout: sec_size NULL", [](World &) {
