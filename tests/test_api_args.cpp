@@ -319,6 +319,50 @@ std::vector<Case> cases()
         ct_geo g;
         return ct_geolocate(&w.p, &w.cam, &w.pose, CT_METHOD_DIRECTIONAL, &fx, 32 << 16, 24 << 16, &g);
     });
+    // a map fitted for w.p, used with a package whose georeference differs
+    // in one field, or with one of its own fields out of range: "a map
+    // fitted for this package, else CT_ERR_EFFECTS"; the map as fitted gives
+    // the status of the exact conversions
+    static ct_earth_map fitted;
+    static ct_status fitted_st = CT_ERR_INTERNAL;
+    auto with_map = [](World &w, void (*edit)(ct_package &, ct_earth_map &)) -> ct_status {
+        if (fitted_st == CT_ERR_INTERNAL) fitted_st = ct_earth_map_init(&w.p, w.a[0], w.a[1], w.a[2], INT64_C(10000000000000), &fitted);
+        if (fitted_st != CT_OK) return fitted_st;
+        ct_package q = w.p;
+        ct_earth_map m = fitted;
+        edit(q, m);
+        const ct_effects fx = {CT_EFFECT_CURVATURE, 0, 0, 0, &m};
+        ct_geo g;
+        const ct_status st = ct_geolocate(&q, &w.cam, &w.pose, CT_METHOD_DIRECTIONAL, &fx, 32 << 16, 24 << 16, &g);
+        if (st < 0) return st;
+        // accepted: the status of the exact conversions (no map)
+        const ct_effects exact = {CT_EFFECT_CURVATURE, 0, 0, 0, nullptr};
+        ct_geo g2;
+        return ct_geolocate(&q, &w.cam, &w.pose, CT_METHOD_DIRECTIONAL, &exact, 32 << 16, 24 << 16, &g2) == st ? CT_OK : CT_ERR_INTERNAL;
+    };
+    struct MapEdit {
+        const char *name;
+        ct_status want;
+        void (*edit)(ct_package &, ct_earth_map &);
+    };
+    static const MapEdit map_edits[] = {
+        {"geolocate: the earth map as fitted (the exact status)", CT_OK, [](ct_package &, ct_earth_map &) {}},
+        {"geolocate: earth map of degree 3", CT_ERR_EFFECTS, [](ct_package &, ct_earth_map &m) { m.deg = 3; }},
+        {"geolocate: earth map of degree 7", CT_ERR_EFFECTS, [](ct_package &, ct_earth_map &m) { m.deg = CT_EARTH_MAP_DEG + 1; }},
+        {"geolocate: earth map cube 2^43 nm", CT_ERR_EFFECTS, [](ct_package &, ct_earth_map &m) { m.qrho = 43u; }},
+        {"geolocate: earth map cube 2^48 nm", CT_ERR_EFFECTS, [](ct_package &, ct_earth_map &m) { m.qrho = 48u; }},
+        {"geolocate: earth map of another origin (east)", CT_ERR_EFFECTS, [](ct_package &q, ct_earth_map &) { q.origin_e_nm += 1; }},
+        {"geolocate: earth map of another origin (north)", CT_ERR_EFFECTS, [](ct_package &q, ct_earth_map &) { q.origin_n_nm += 1; }},
+        {"geolocate: earth map of another posting (east)", CT_ERR_EFFECTS, [](ct_package &q, ct_earth_map &) { q.posting_e_nm += 1; }},
+        {"geolocate: earth map of another posting (north)", CT_ERR_EFFECTS, [](ct_package &q, ct_earth_map &) { q.posting_n_nm -= 1; }},
+        {"geolocate: earth map of another height offset", CT_ERR_EFFECTS, [](ct_package &q, ct_earth_map &) { q.height_offset_nm += 1; }},
+        {"geolocate: earth map of another height scale", CT_ERR_EFFECTS, [](ct_package &q, ct_earth_map &) { q.height_scale_nm += 1; }},
+        {"geolocate: earth map of another zone", CT_ERR_EFFECTS, [](ct_package &q, ct_earth_map &) { q.epsg = 32618u; }},
+    };
+    for (const MapEdit &e : map_edits) {
+        const MapEdit *ep = &e;
+        add(e.name, e.want, [with_map, ep](World &w) { return with_map(w, ep->edit); });
+    }
     add("geolocate_batch: pixels NULL, count 1", CT_ERR_ARG, [](World &w) {
         ct_geo g;
         return ct_geolocate_batch(&w.p, &w.cam, &w.pose, CT_METHOD_DIRECTIONAL, nullptr, nullptr, 1, &g, 1);
