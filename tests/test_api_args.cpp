@@ -467,6 +467,20 @@ std::vector<Case> cases()
         ct_hit h;
         return ct_tileset_trace(nullptr, &w.ray, CT_METHOD_DIRECTIONAL, &h);
     });
+    add("tileset_trace: ray NULL", CT_ERR_ARG, [](World &) {
+        static ct_tileset ts{};
+        ct_hit h;
+        return ct_tileset_trace(&ts, nullptr, CT_METHOD_DIRECTIONAL, &h);
+    });
+    add("tileset_trace: hit NULL", CT_ERR_ARG, [](World &w) {
+        static ct_tileset ts{};
+        return ct_tileset_trace(&ts, &w.ray, CT_METHOD_DIRECTIONAL, nullptr);
+    });
+    add("tileset_trace: unknown method", CT_ERR_METHOD, [](World &w) {
+        static ct_tileset ts{};
+        ct_hit h;
+        return ct_tileset_trace(&ts, &w.ray, kBadMethod, &h);
+    });
     add("geolocate_tiles: ts NULL", CT_ERR_ARG, [](World &w) {
         ct_geo g;
         return ct_geolocate_tiles(nullptr, &w.cam, &w.pose, CT_METHOD_DIRECTIONAL, nullptr, 0, 0, &g);
