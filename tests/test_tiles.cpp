@@ -41,6 +41,7 @@ struct Mem {
     const TileSetBytes *b = nullptr;
     std::map<size_t, std::vector<uint8_t>> replace;  // tile k served as these bytes
     long fail = -1;                                  // tile the loader refuses
+    long no_bytes = -1;                              // tile it says CT_OK for but gives no bytes
     bool copy = true;                                // into the slot (else zero copy)
     std::vector<long> calls;                         // per tile
 };
@@ -52,6 +53,11 @@ ct_status mem_loader(void *user, uint32_t col, uint32_t row, uint8_t *buf, size_
     const size_t k = (size_t)row * m->b->grid.tiles_x + col;
     m->calls[k]++;
     if ((long)k == m->fail) return CT_ERR_ARG;
+    if ((long)k == m->no_bytes) {
+        *bytes = nullptr;
+        *len = 0;
+        return CT_OK;
+    }
     auto it = m->replace.find(k);
     const std::vector<uint8_t> &v = it != m->replace.end() ? it->second : m->b->tiles[k];
     if (m->copy) {
@@ -389,8 +395,9 @@ void test_missing_and_corrupt()
     // differs from the set's), 15 tile (0, 0) served in its place (the
     // manifest unchanged: another CRC), 16 its entry's lowest code raised
     // by one, 17 the tallest code of the first tile's entry below the set's
-    // tallest post raised by one
-    for (int variant = 0; variant < 18; ++variant) {
+    // tallest post raised by one, 18 the origin one post east, 19 the
+    // loader says CT_OK but gives no bytes
+    for (int variant = 0; variant < 20; ++variant) {
         TileSetBytes tb = full;
         Set set;
         size_t centre = centre_tile;
@@ -417,9 +424,11 @@ void test_missing_and_corrupt()
             std::vector<uint8_t> bad = full.tiles[centre];
             bad.resize(bad.size() - 64);
             set.mem.replace[centre] = bad;
+        } else if (variant == 19) {
+            set.mem.no_bytes = (long)centre;
         } else if (variant == 15) {
             set.mem.replace[centre] = full.tiles[0];
-        } else if (variant >= 16) {
+        } else if (variant == 16 || variant == 17) {
             std::vector<uint8_t> &m = tb.manifest;
             const size_t e = CT_SET_HEADER_SIZE + centre * CT_SET_ENTRY_SIZE + (variant == 16 ? 8 : 10);
             const uint16_t code = (uint16_t)(m[e] | m[e + 1] << 8);
@@ -444,6 +453,9 @@ void test_missing_and_corrupt()
                 } else if (variant == 7) {
                     tt.geo.origin_n_nm += (int64_t)(tt.geo.posting_n * 1e9);  // one post north
                     tt.geo.origin_n += tt.geo.posting_n;
+                } else if (variant == 18) {
+                    tt.geo.origin_e_nm += (int64_t)(tt.geo.posting_e * 1e9);  // one post east
+                    tt.geo.origin_e += tt.geo.posting_e;
                 } else if (variant == 8) {
                     oo.reduce = o.reduce == 1 ? 2 : 1;
                 } else if (variant == 9) {
