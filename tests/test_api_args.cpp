@@ -174,6 +174,87 @@ std::vector<Case> cases()
         ct_hit h;
         return ct_trace_prepared(&w.p, nullptr, CT_METHOD_DIRECTIONAL, &h);
     });
+    // a prepared ray with one field edited out of its documented range or
+    // out of agreement with the others: CT_ERR_RAY (ct_trace_prepared
+    // checks every field of the caller's object); the unedited ray traces
+    struct PrepEdit {
+        const char *name;
+        ct_status want;
+        void (*edit)(ct_prepared &, const ct_package &);
+    };
+    static const PrepEdit prep_edits[] = {
+        {"trace_prepared: as prepared", CT_OK, [](ct_prepared &, const ct_package &) {}},
+        {"trace_prepared: |d| beyond 2^26", CT_ERR_RAY, [](ct_prepared &r, const ct_package &) { r.dz = (1 << 26) + 1; }},
+        {"trace_prepared: |d| below 2^25", CT_ERR_RAY, [](ct_prepared &r, const ct_package &) { r.dx = r.dy = r.dz = 1; }},
+        {"trace_prepared: ox < 0", CT_ERR_RAY, [](ct_prepared &r, const ct_package &) { r.ox = -1; }},
+        {"trace_prepared: oy < 0", CT_ERR_RAY, [](ct_prepared &r, const ct_package &) { r.oy = -1; }},
+        {"trace_prepared: ox past the tile", CT_ERR_RAY,
+         [](ct_prepared &r, const ct_package &p) { r.ox = (int64_t)p.cells_x * 65536 + 1; }},
+        {"trace_prepared: oy past the tile", CT_ERR_RAY,
+         [](ct_prepared &r, const ct_package &p) { r.oy = (int64_t)p.cells_y * 65536 + 1; }},
+        {"trace_prepared: oz above the box", CT_ERR_RAY,
+         [](ct_prepared &r, const ct_package &p) { r.oz = ((int64_t)p.hmax + 2) * (65536 >> r.zshift); }},
+        {"trace_prepared: oz below -2^(46 - zshift)", CT_ERR_RAY,
+         [](ct_prepared &r, const ct_package &) { r.oz = -(INT64_C(1) << (46 - r.zshift)) - 1; }},
+        {"trace_prepared: oz on the floor, start ok", CT_ERR_RAY,
+         [](ct_prepared &r, const ct_package &p) { r.oz = ((int64_t)p.hmin - 1) * (65536 >> r.zshift); }},
+        {"trace_prepared: len_lo < 0", CT_ERR_RAY, [](ct_prepared &r, const ct_package &) { r.len_lo = -1; }},
+        {"trace_prepared: len_hi < len_lo", CT_ERR_RAY, [](ct_prepared &r, const ct_package &) { r.len_hi = r.len_lo - 1; }},
+        {"trace_prepared: len_hi > len_lo + 1", CT_ERR_RAY, [](ct_prepared &r, const ct_package &) { r.len_hi = r.len_lo + 2; }},
+        {"trace_prepared: len_lo above the length", CT_ERR_RAY,
+         [](ct_prepared &r, const ct_package &) { r.len_lo = r.len_hi = r.len_hi + 1; }},
+        {"trace_prepared: len_hi below the length", CT_ERR_RAY,
+         [](ct_prepared &r, const ct_package &) { r.len_hi = r.len_lo = r.len_lo - 1; }},
+        {"trace_prepared: tend_d 0", CT_ERR_RAY, [](ct_prepared &r, const ct_package &) { r.tend_d = 0; }},
+        {"trace_prepared: tend_d beyond 2^26", CT_ERR_RAY,
+         [](ct_prepared &r, const ct_package &) { r.tend_d = (INT64_C(1) << 26) + 1; }},
+        {"trace_prepared: tend_n < 0", CT_ERR_RAY, [](ct_prepared &r, const ct_package &) { r.tend_n = -1; }},
+        {"trace_prepared: tend_n beyond 2^34", CT_ERR_RAY,
+         [](ct_prepared &r, const ct_package &) { r.tend_n = (INT64_C(1) << 34) + 1; }},
+        {"trace_prepared: tend past the box exit", CT_ERR_RAY,
+         [](ct_prepared &r, const ct_package &) { r.tend_n = INT64_C(1) << 34, r.tend_d = 1; }},
+        {"trace_prepared: sector -1 for a slanted ray", CT_ERR_RAY, [](ct_prepared &r, const ct_package &) { r.sector = -1; }},
+        {"trace_prepared: sector N", CT_ERR_RAY,
+         [](ct_prepared &r, const ct_package &p) { r.sector = (int32_t)p.sectors; }},
+        {"trace_prepared: the opposite sector", CT_ERR_RAY,
+         [](ct_prepared &r, const ct_package &p) { r.sector = (int32_t)((r.sector + p.sectors / 2) % p.sectors); }},
+    };
+    for (const PrepEdit &e : prep_edits) {
+        const PrepEdit *ep = &e;
+        add(e.name, e.want, [ep](World &w) -> ct_status {
+            ct_prepared r = w.pr;
+            ep->edit(r, w.p);
+            ct_hit h;
+            const ct_status st = ct_trace_prepared(&w.p, &r, CT_METHOD_DIRECTIONAL, &h);
+            return st >= 0 ? CT_OK : st;
+        });
+    }
+    add("trace_prepared: a vertical ray with a sector", CT_ERR_RAY, [](World &w) -> ct_status {
+        ct_ray ray = w.ray;
+        ray.dx = ray.dy = 0;
+        ct_prepared r;
+        if (ct_ray_prepare(&w.p, &ray, &r) != CT_OK || r.sector != -1) return CT_ERR_INTERNAL;
+        ct_hit h;
+        if (ct_trace_prepared(&w.p, &r, CT_METHOD_DIRECTIONAL, &h) < 0) return CT_ERR_INTERNAL;
+        r.sector = 0;
+        return ct_trace_prepared(&w.p, &r, CT_METHOD_DIRECTIONAL, &h);
+    });
+    add("surface_height: x < 0", CT_ERR_RANGE, [](World &w) {
+        int64_t z;
+        return ct_surface_height(&w.p, -1, 0, &z);
+    });
+    add("surface_height: y < 0", CT_ERR_RANGE, [](World &w) {
+        int64_t z;
+        return ct_surface_height(&w.p, 0, -1, &z);
+    });
+    add("surface_height: x past the tile", CT_ERR_RANGE, [](World &w) {
+        int64_t z;
+        return ct_surface_height(&w.p, (int64_t)w.p.cells_x * 65536 + 1, 0, &z);
+    });
+    add("surface_height: y past the tile", CT_ERR_RANGE, [](World &w) {
+        int64_t z;
+        return ct_surface_height(&w.p, 0, (int64_t)w.p.cells_y * 65536 + 1, &z);
+    });
     add("trace_prepared: unknown method", CT_ERR_METHOD, [](World &w) {
         ct_hit h;
         return ct_trace_prepared(&w.p, &w.pr, kBadMethod, &h);
