@@ -318,6 +318,172 @@ std::vector<Case> cases()
         ct_camera c;
         return ct_camera_init(&c, &lens);
     });
+    // each of the lens's ranges alone
+    struct LensEdit {
+        const char *name;
+        void (*edit)(ct_lens &);
+    };
+    static const LensEdit lens_edits[] = {
+        {"camera_init: fy beyond 2^20 px", [](ct_lens &l) { l.fy_q32 = ((int64_t)CT_CAM_MAX_PIXEL << 32) + 1; }},
+        {"camera_init: fx beyond 2^20 px", [](ct_lens &l) { l.fx_q32 = ((int64_t)CT_CAM_MAX_PIXEL << 32) + 1; }},
+        {"camera_init: fy below 1 px", [](ct_lens &l) { l.fy_q32 = (INT64_C(1) << 32) - 1; }},
+        {"camera_init: cx beyond 2^20 px", [](ct_lens &l) { l.cx_q32 = ((int64_t)CT_CAM_MAX_PIXEL << 32) + 1; }},
+        {"camera_init: cx below -2^20 px", [](ct_lens &l) { l.cx_q32 = -((int64_t)CT_CAM_MAX_PIXEL << 32) - 1; }},
+        {"camera_init: cy beyond 2^20 px", [](ct_lens &l) { l.cy_q32 = ((int64_t)CT_CAM_MAX_PIXEL << 32) + 1; }},
+        {"camera_init: cy below -2^20 px", [](ct_lens &l) { l.cy_q32 = -((int64_t)CT_CAM_MAX_PIXEL << 32) - 1; }},
+    };
+    for (const LensEdit &e : lens_edits) {
+        const LensEdit *ep = &e;
+        add(e.name, CT_ERR_LENS, [ep](World &) {
+            ct_lens lens = dem_cases::centred_pinhole(64, 48, 60);
+            ep->edit(lens);
+            ct_camera c;
+            return ct_camera_init(&c, &lens);
+        });
+    }
+    // a pixel whose normalised coordinate passes 2^16 (|u - cx| / fx): a
+    // 1 px focal length and the centre at the far edge of the range
+    add("camera_unproject: (u - cx) / fx beyond 2^16", CT_ERR_UNPROJECT, [](World &) -> ct_status {
+        ct_lens lens = dem_cases::centred_pinhole(64, 48, 1);
+        lens.cx_q32 = -((int64_t)CT_CAM_MAX_PIXEL << 32);
+        ct_camera c;
+        int32_t r[3];
+        if (ct_camera_init(&c, &lens) != CT_OK) return CT_ERR_INTERNAL;
+        return ct_camera_unproject(&c, (int64_t)CT_CAM_MAX_PIXEL << 16, 0, r, nullptr);
+    });
+    add("camera_unproject: (v - cy) / fy beyond 2^16", CT_ERR_UNPROJECT, [](World &) -> ct_status {
+        ct_lens lens = dem_cases::centred_pinhole(64, 48, 1);
+        lens.cy_q32 = (int64_t)CT_CAM_MAX_PIXEL << 32;
+        ct_camera c;
+        int32_t r[3];
+        if (ct_camera_init(&c, &lens) != CT_OK) return CT_ERR_INTERNAL;
+        return ct_camera_unproject(&c, 0, -((int64_t)CT_CAM_MAX_PIXEL << 16), r, nullptr);
+    });
+    // rational lenses with one denominator coefficient (k4, k5 or k6)
+    // alone: the pixel unprojected and projected back lands within 1e-3 px
+    for (int kk = 5; kk <= 7; ++kk) {
+        static const char *const names[] = {"camera_init: OPENCV8 with k4 alone, round trip",
+                                            "camera_init: OPENCV8 with k5 alone, round trip",
+                                            "camera_init: OPENCV8 with k6 alone, round trip"};
+        add(names[kk - 5], CT_OK, [kk](World &) -> ct_status {
+            ct_lens lens = dem_cases::centred_pinhole(640, 480, 500);
+            lens.model = CT_LENS_OPENCV8;
+            lens.dist_q48[0] = -(INT64_C(1) << 46);  // k1 -0.25
+            lens.dist_q48[kk] = INT64_C(1) << 45;    // 0.125
+            ct_camera c;
+            const ct_status st = ct_camera_init(&c, &lens);
+            if (st != CT_OK) return st;
+            for (int64_t u : {INT64_C(150), INT64_C(320), INT64_C(450)}) {
+                const int64_t uq = u << 16, vq = (u / 2 + 90) << 16;
+                int32_t r[3];
+                int64_t u2, v2;
+                if (ct_camera_unproject(&c, uq, vq, r, nullptr) != CT_OK ||
+                    ct_camera_project(&c, r, &u2, &v2) != CT_OK)
+                    return CT_ERR_INTERNAL;
+                if (std::llabs(u2 - uq) > 66 || std::llabs(v2 - vq) > 66) return CT_ERR_INTERNAL;
+            }
+            return CT_OK;
+        });
+    }
+    // unprojection grids: a 4 x 4 grid of the optical axis (0, 0, 1), one
+    // field out of range or one node edited
+    struct GridEdit {
+        const char *name;
+        ct_status want;
+        void (*edit)(ct_unproject_grid &, int32_t *rays);
+    };
+    static const GridEdit grid_edits[] = {
+        {"camera_init_grid: the axis everywhere (ok)", CT_OK, [](ct_unproject_grid &, int32_t *) {}},
+        {"camera_init_grid: nv 3", CT_ERR_LENS, [](ct_unproject_grid &g, int32_t *) { g.nv = 3; }},
+        {"camera_init_grid: nu beyond CT_GRID_MAX_NODES", CT_ERR_LENS,
+         [](ct_unproject_grid &g, int32_t *) { g.nu = CT_GRID_MAX_NODES + 1u; }},
+        {"camera_init_grid: nv beyond CT_GRID_MAX_NODES", CT_ERR_LENS,
+         [](ct_unproject_grid &g, int32_t *) { g.nv = CT_GRID_MAX_NODES + 1u; }},
+        {"camera_init_grid: step below 1 px", CT_ERR_LENS, [](ct_unproject_grid &g, int32_t *) { g.step_q16 = 65535; }},
+        {"camera_init_grid: step beyond 4096 px", CT_ERR_LENS,
+         [](ct_unproject_grid &g, int32_t *) { g.step_q16 = (INT64_C(4096) << 16) + 1; }},
+        {"camera_init_grid: u0 beyond 2^20 px", CT_ERR_LENS,
+         [](ct_unproject_grid &g, int32_t *) { g.u0_q16 = ((int64_t)CT_CAM_MAX_PIXEL << 16) + 1; }},
+        {"camera_init_grid: v0 beyond 2^20 px", CT_ERR_LENS,
+         [](ct_unproject_grid &g, int32_t *) { g.v0_q16 = -((int64_t)CT_CAM_MAX_PIXEL << 16) - 1; }},
+        {"camera_init_grid: fewer rays than nodes", CT_ERR_LENS, [](ct_unproject_grid &g, int32_t *) { g.rays_len = 47; }},
+        {"camera_init_grid: a node (0, 1, 0) (ok)", CT_OK,
+         [](ct_unproject_grid &, int32_t *r) { r[3 * 5 + 1] = 1 << 30, r[3 * 5 + 2] = 0; }},
+        {"camera_init_grid: a node (0, 0, 0) (no ray, ok)", CT_OK, [](ct_unproject_grid &, int32_t *r) { r[3 * 5 + 2] = 0; }},
+        {"camera_init_grid: x beyond 1", CT_ERR_LENS, [](ct_unproject_grid &, int32_t *r) { r[3 * 5] = (1 << 30) + (1 << 13); }},
+        {"camera_init_grid: x below -1", CT_ERR_LENS, [](ct_unproject_grid &, int32_t *r) { r[3 * 5] = -(1 << 30) - (1 << 13); }},
+        {"camera_init_grid: y beyond 1", CT_ERR_LENS, [](ct_unproject_grid &, int32_t *r) { r[3 * 5 + 1] = (1 << 30) + (1 << 13); }},
+        {"camera_init_grid: y below -1", CT_ERR_LENS,
+         [](ct_unproject_grid &, int32_t *r) { r[3 * 5 + 1] = -(1 << 30) - (1 << 13); }},
+        {"camera_init_grid: z beyond 1", CT_ERR_LENS, [](ct_unproject_grid &, int32_t *r) { r[3 * 5 + 2] = (1 << 30) + (1 << 13); }},
+        {"camera_init_grid: z below -1", CT_ERR_LENS,
+         [](ct_unproject_grid &, int32_t *r) { r[3 * 5 + 2] = -(1 << 30) - (1 << 13); }},
+        {"camera_init_grid: a node not of unit length", CT_ERR_LENS, [](ct_unproject_grid &, int32_t *r) { r[3 * 5 + 2] = 1 << 29; }},
+    };
+    for (const GridEdit &e : grid_edits) {
+        const GridEdit *ep = &e;
+        add(e.name, e.want, [ep](World &) {
+            static int32_t rays[48];
+            for (int k = 0; k < 16; ++k) rays[3 * k] = rays[3 * k + 1] = 0, rays[3 * k + 2] = 1 << 30;
+            ct_unproject_grid g{4u, 4u, 0, 0, INT64_C(16) << 16, rays, 48};
+            ep->edit(g, rays);
+            ct_camera c;
+            return ct_camera_init_grid(&c, &g);
+        });
+    }
+    // unprojecting through a grid: the centre cell of the 4 x 4 grid
+    // (pixels 16..32) is the one cell with a node on every side
+    struct GridPixel {
+        const char *name;
+        ct_status want;
+        void (*edit)(int32_t *rays);
+    };
+    static const GridPixel grid_pixels[] = {
+        {"camera_unproject (grid): the axis (ok)", CT_OK, [](int32_t *) {}},
+        {"camera_unproject (grid): a node without a ray (x, y, z all 0)", CT_ERR_UNPROJECT,
+         [](int32_t *r) { r[3 * 5 + 2] = 0; }},
+        {"camera_unproject (grid): a node (0, 1, 0), 90 deg from its neighbours", CT_ERR_UNPROJECT,
+         [](int32_t *r) { r[3 * 5 + 1] = 1 << 30, r[3 * 5 + 2] = 0; }},
+        {"camera_unproject (grid): rows of opposite rays (they cancel)", CT_ERR_UNPROJECT,
+         [](int32_t *r) {
+             for (int k = 8; k < 16; ++k) r[3 * k + 2] = -(1 << 30);
+         }},
+    };
+    for (const GridPixel &e : grid_pixels) {
+        const GridPixel *ep = &e;
+        add(e.name, e.want, [ep](World &) -> ct_status {
+            static int32_t rays[48];
+            for (int k = 0; k < 16; ++k) rays[3 * k] = rays[3 * k + 1] = 0, rays[3 * k + 2] = 1 << 30;
+            ep->edit(rays);
+            const ct_unproject_grid g{4u, 4u, 0, 0, INT64_C(16) << 16, rays, 48};
+            ct_camera c;
+            if (ct_camera_init_grid(&c, &g) != CT_OK) return CT_ERR_INTERNAL;
+            int32_t r[3] = {0, 0, 0};
+            const ct_status st = ct_camera_unproject(&c, INT64_C(20) << 16, INT64_C(21) << 16, r, nullptr);
+            if (st == CT_OK && (r[0] != 0 || r[1] != 0 || r[2] != 1 << 30)) return CT_ERR_INTERNAL;  // the axis
+            return st;
+        });
+    }
+    add("pose_init: east beyond 2^61 nm", CT_ERR_POSE, [](World &) {
+        const int32_t R[9] = {1 << 30, 0, 0, 0, 1 << 30, 0, 0, 0, 1 << 30};
+        ct_pose q;
+        return ct_pose_init(&q, R, (INT64_C(1) << 61) + 1, 0, 0);
+    });
+    add("pose_init: north beyond 2^61 nm", CT_ERR_POSE, [](World &) {
+        const int32_t R[9] = {1 << 30, 0, 0, 0, 1 << 30, 0, 0, 0, 1 << 30};
+        ct_pose q;
+        return ct_pose_init(&q, R, 0, -(INT64_C(1) << 61) - 1, 0);
+    });
+    add("pose_init: height beyond 2^61 nm", CT_ERR_POSE, [](World &) {
+        const int32_t R[9] = {1 << 30, 0, 0, 0, 1 << 30, 0, 0, 0, 1 << 30};
+        ct_pose q;
+        return ct_pose_init(&q, R, 0, 0, (INT64_C(1) << 61) + 1);
+    });
+    add("pose_init: an entry of the second column beyond 1", CT_ERR_POSE, [](World &) {
+        const int32_t R[9] = {1 << 30, (1 << 30) + (1 << 13), 0, 0, 1 << 30, 0, 0, 0, 1 << 30};
+        ct_pose q;
+        return ct_pose_init(&q, R, 0, 0, 0);
+    });
     add("camera_init_grid: grid NULL", CT_ERR_ARG, [](World &) {
         ct_camera c;
         return ct_camera_init_grid(&c, nullptr);
