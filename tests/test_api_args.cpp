@@ -7,6 +7,7 @@
 // prints every case.
 #include <cstdlib>
 #include <cstring>
+#include <deque>
 #include <functional>
 #include <string>
 #include <vector>
@@ -25,6 +26,12 @@ struct World {
     ct_ray ray{};
     ct_prepared pr{};
     int64_t a[3] = {0, 0, 0}, b[3] = {0, 0, 0};  // two map points over the tile
+    // the same heights on a 1 um grid with 1 um height codes (a legal
+    // georeference whose grid range a point a few km away already passes),
+    // and on a grid whose axes run west and north (posting_e < 0 < posting_n)
+    dem_cases::Case fine_c, west_c;
+    ct_package fine{}, west{};
+    int64_t fa[3] = {0, 0, 0};  // a map point over the fine tile
 };
 
 World *world()
@@ -48,6 +55,18 @@ World *world()
     (void)ct_grid_to_map(&w->p, 3 << 16, 4 << 16, (int64_t)w->p.hmin << 16, &w->b[0], &w->b[1], &w->b[2]);
     if (ct_ray_from_map(&w->p, e, n, h + 100000000000, 1 << 20, 1 << 19, -(1 << 20), &w->ray) != CT_OK) return nullptr;
     if (ct_ray_prepare(&w->p, &w->ray, &w->pr) != CT_OK) return nullptr;
+    ct_host::Terrain tf = t;
+    tf.geo.posting_e = 1e-6;
+    tf.geo.posting_n = -1e-6;
+    tf.height_scale_m = 1e-6;
+    w->fine_c = dem_cases::make_case("fine", tf, 8, 2);
+    if (ct_package_open(&w->fine, w->fine_c.pkg.data(), w->fine_c.pkg.size()) != CT_OK) return nullptr;
+    (void)ct_grid_to_map(&w->fine, 12 << 16, 10 << 16, (int64_t)w->fine.hmax << 16, &w->fa[0], &w->fa[1], &w->fa[2]);
+    ct_host::Terrain tw = t;
+    tw.geo.posting_e = -30.0;
+    tw.geo.posting_n = 30.0;
+    w->west_c = dem_cases::make_case("west", tw, 8, 2);
+    if (ct_package_open(&w->west, w->west_c.pkg.data(), w->west_c.pkg.size()) != CT_OK) return nullptr;
     return w;
 }
 
@@ -894,6 +913,110 @@ std::vector<Case> cases()
         int64_t n = 1;
         const ct_status st = ct_geoid_at(&g, CT_PI_Q61 / 6 - CT_PI_Q61 / 64, CT_PI_Q61 / 64, &n);
         return st == CT_OK && n == 0 ? CT_OK : CT_ERR_INTERNAL;  // all nodes 0
+    });
+    // ---- the grid's range: on the 1 um grid a point 10 km away is beyond
+    // CT_MAX_ORIGIN_Q16 (2^46 Q16) and one 2^57 nm away beyond what
+    // ct_map_to_grid can express (2^62)
+    const int64_t km10 = INT64_C(10000000000000), far57 = INT64_C(1) << 57;
+    add("map_to_grid (1 um grid): 2^57 nm east", CT_ERR_RANGE, [far57](World &w) {
+        int64_t x, y, z;
+        return ct_map_to_grid(&w.fine, w.fa[0] + far57, w.fa[1], w.fa[2], &x, &y, &z);
+    });
+    add("map_to_grid (1 um grid): 2^57 nm north", CT_ERR_RANGE, [far57](World &w) {
+        int64_t x, y, z;
+        return ct_map_to_grid(&w.fine, w.fa[0], w.fa[1] - far57, w.fa[2], &x, &y, &z);
+    });
+    add("map_to_grid (1 um grid): 2^57 nm up", CT_ERR_RANGE, [far57](World &w) {
+        int64_t x, y, z;
+        return ct_map_to_grid(&w.fine, w.fa[0], w.fa[1], w.fa[2] + far57, &x, &y, &z);
+    });
+    // a camera looking down 60 deg at (de, dn, dh) from the fine tile's point
+    auto fine_geo = [](World &w, int64_t de, int64_t dn, int64_t dh, const ct_effects *fx) -> ct_status {
+        int32_t q[4];
+        ct_pose pose;
+        if (ct_quat_from_ypr(0, dem_cases::deg_q61(-60), 0, q) != CT_OK ||
+            ct_pose_from_map(&pose, w.fa[0] + de, w.fa[1] + dn, w.fa[2] + dh, q) != CT_OK)
+            return CT_ERR_INTERNAL;
+        ct_geo g;
+        return ct_geolocate(&w.fine, &w.cam, &pose, CT_METHOD_DIRECTIONAL, fx, 32 << 16, 24 << 16, &g);
+    };
+    static const ct_effects earth = {CT_EFFECT_CURVATURE | CT_EFFECT_REFRACTION, CT_REFRACTION_K_STD_Q16, 0, 0, nullptr};
+    static const ct_effects sphere = {CT_EFFECT_CURVATURE, 0, CT_EARTH_RADIUS_NM, 0, nullptr};
+    for (const ct_effects *fx : {(const ct_effects *)nullptr, &earth, &sphere}) {
+        const std::string tag = fx == nullptr ? "" : (fx == &earth ? ", true Earth" : ", sphere");
+        static std::deque<std::string> names;  // push_back keeps earlier elements in place
+        auto name = [&](const char *what) {
+            names.push_back(std::string("geolocate (1 um grid): camera ") + what + tag);
+            return names.back().c_str();
+        };
+        add(name("10 km east"), CT_ERR_RAY, [fine_geo, fx, km10](World &w) { return fine_geo(w, km10, 0, 0, fx); });
+        add(name("10 km south"), CT_ERR_RAY, [fine_geo, fx, km10](World &w) { return fine_geo(w, 0, -km10, 0, fx); });
+        add(name("10 km up"), CT_ERR_RAY, [fine_geo, fx, km10](World &w) { return fine_geo(w, 0, 0, km10, fx); });
+        add(name("2^57 nm west"), CT_ERR_RAY, [fine_geo, fx, far57](World &w) { return fine_geo(w, -far57, 0, 0, fx); });
+    }
+    // line of sight with one end beyond the grid's range on one axis
+    struct LosEnd {
+        const char *name;
+        int end, axis;
+        int64_t d;
+    };
+    static const LosEnd los_ends[] = {
+        {"los (1 um grid): A 10 km east", 0, 0, INT64_C(10000000000000)},
+        {"los (1 um grid): A 10 km north", 0, 1, INT64_C(10000000000000)},
+        {"los (1 um grid): A 10 km up", 0, 2, INT64_C(10000000000000)},
+        {"los (1 um grid): B 10 km west", 1, 0, -INT64_C(10000000000000)},
+        {"los (1 um grid): B 10 km south", 1, 1, -INT64_C(10000000000000)},
+        {"los (1 um grid): B 10 km up", 1, 2, INT64_C(10000000000000)},
+        {"los (1 um grid): A 2^57 nm east", 0, 0, INT64_C(1) << 57},
+        {"los (1 um grid): B 2^57 nm north", 1, 1, INT64_C(1) << 57},
+    };
+    for (const LosEnd &e : los_ends) {
+        const LosEnd *ep = &e;
+        add(e.name, CT_ERR_RAY, [ep](World &w) {
+            int64_t a[3] = {w.fa[0], w.fa[1], w.fa[2]}, b[3] = {w.fa[0] + 3000, w.fa[1] - 4000, w.fa[2] - 1000};
+            (ep->end == 0 ? a : b)[ep->axis] += ep->d;
+            ct_hit h;
+            return ct_los(&w.fine, a, b, nullptr, 0, CT_METHOD_DIRECTIONAL, &h);
+        });
+    }
+    add("earth_map_init (1 um grid): centre 10 km east", CT_ERR_RANGE, [km10](World &w) {
+        static ct_earth_map m;
+        return ct_earth_map_init(&w.fine, w.fa[0] + km10, w.fa[1], w.fa[2], INT64_C(10000000000000), &m);
+    });
+    add("earth_map_init (1 um grid): centre 10 km north", CT_ERR_RANGE, [km10](World &w) {
+        static ct_earth_map m;
+        return ct_earth_map_init(&w.fine, w.fa[0], w.fa[1] + km10, w.fa[2], INT64_C(10000000000000), &m);
+    });
+    add("earth_map_init (1 um grid): centre 10 km up", CT_ERR_RANGE, [km10](World &w) {
+        static ct_earth_map m;
+        return ct_earth_map_init(&w.fine, w.fa[0], w.fa[1], w.fa[2] + km10, INT64_C(10000000000000), &m);
+    });
+    // ---- a grid whose axes run west and north: ct_map_to_grid is
+    // ct_grid_to_map's inverse, x grows westwards and y northwards, and a
+    // camera straight above a point sees that point
+    add("map_to_grid (axes west and north): inverse of grid_to_map, x west, y north", CT_OK, [](World &w) -> ct_status {
+        int64_t e, n, h, x, y, z, x2, y2, z2;
+        if (ct_grid_to_map(&w.west, 7 << 16, 5 << 16, 1000 << 16, &e, &n, &h) != CT_OK ||
+            ct_map_to_grid(&w.west, e, n, h, &x, &y, &z) != CT_OK ||
+            ct_map_to_grid(&w.west, e - 30000000000, n + 30000000000, h, &x2, &y2, &z2) != CT_OK)
+            return CT_ERR_INTERNAL;
+        return x == 7 << 16 && y == 5 << 16 && z == 1000 << 16 && x2 == x + 65536 && y2 == y + 65536 && z2 == z
+                   ? CT_OK
+                   : CT_ERR_INTERNAL;
+    });
+    add("geolocate (axes west and north): nadir pixel hits below the camera", CT_HIT, [](World &w) -> ct_status {
+        int64_t e, n, h;
+        int32_t q[4];
+        ct_pose pose;
+        if (ct_grid_to_map(&w.west, (11 << 16) + 12345, (9 << 16) + 23456, (int64_t)w.west.hmax << 16, &e, &n, &h) != CT_OK ||
+            ct_quat_from_ypr(0, dem_cases::deg_q61(-90), 0, q) != CT_OK ||
+            ct_pose_from_map(&pose, e, n, h + 200000000000, q) != CT_OK)
+            return CT_ERR_INTERNAL;
+        ct_geo g;
+        // the centred pinhole's principal point: (63/2, 47/2) px
+        const ct_status st = ct_geolocate(&w.west, &w.cam, &pose, CT_METHOD_DIRECTIONAL, nullptr, 63 << 15, 47 << 15, &g);
+        if (st == CT_HIT && (std::llabs(g.hit.e_nm - e) > 1000000 || std::llabs(g.hit.n_nm - n) > 1000000)) return CT_ERR_INTERNAL;
+        return st;
     });
     // ---- every other pointer argument NULL: CT_ERR_ARG, the rule of the header
     auto null_arg = [&](const char *name, std::function<ct_status(World &)> f) { add(name, CT_ERR_ARG, std::move(f)); };
