@@ -629,6 +629,15 @@ std::vector<Case> cases()
         const MapEdit *ep = &e;
         add(e.name, e.want, [with_map, ep](World &w) { return with_map(w, ep->edit); });
     }
+    // the true Earth with the camera 2,000 km east of the package's zone
+    // (still inside the grid's range): its projection cannot take the pose
+    add("geolocate: true Earth, camera 2,000 km east of the zone", CT_ERR_POSE, [](World &w) {
+        const ct_effects fx = {CT_EFFECT_CURVATURE, 0, 0, 0, nullptr};
+        ct_pose pose = w.pose;
+        pose.e_nm += INT64_C(2000000000000000);
+        ct_geo g;
+        return ct_geolocate(&w.p, &w.cam, &pose, CT_METHOD_DIRECTIONAL, &fx, 32 << 16, 24 << 16, &g);
+    });
     add("geolocate_batch: pixels NULL, count 1", CT_ERR_ARG, [](World &w) {
         ct_geo g;
         return ct_geolocate_batch(&w.p, &w.cam, &w.pose, CT_METHOD_DIRECTIONAL, nullptr, nullptr, 1, &g, 1);
