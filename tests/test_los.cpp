@@ -192,6 +192,96 @@ void test_los_arguments()
     for (int m = 1; m < CT_METHOD_COUNT; ++m) TEST_ASSERT_EQUAL_INT(s0, ct_los(&p, a, b, nullptr, 0, (ct_method)m, &h));
 }
 
+// ct_locate_inverse (the pixel where a map point appears, and whether it
+// is visible) as the inverse of ct_geolocate: from a map pose and from a
+// geodetic pose (map metres per ground metre undone), with no effects and
+// with an effects record of no flags (the same answer), a point below the
+// surface (hidden), the camera centre itself (CT_ERR_RAY), a point behind
+// the camera (CT_ERR_UNPROJECT), a point 3,000 km away straight ahead in
+// azimuth (its direction scaled down first: the centre column), and a
+// camera under the surface (CT_BELOW, as ct_los).
+void test_locate_inverse_cases()
+{
+    ct_host::Terrain t = dem_cases::make_terrain(64, 64, dem_cases::smooth(64, 64, 5, 1000, 4000), 0.25);
+    t.geo.epsg = 32617;
+    const dem_cases::Case cs = dem_cases::make_case("inverse", t, 8, 2);
+    ct_package p;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_package_open(&p, cs.pkg.data(), cs.pkg.size()));
+    const ct_lens lens = dem_cases::centred_pinhole(640, 480, 500);
+    ct_camera cam;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_camera_init(&cam, &lens));
+    int64_t e, n, h;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_grid_to_map(&p, 32 << 16, 40 << 16, (int64_t)p.hmax << 16, &e, &n, &h));
+    int32_t q[4];
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_quat_from_ypr(0, dem_cases::deg_q61(-60), 0, q));
+    ct_pose poses[2];
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_pose_from_map(&poses[0], e, n, h + 1000000000000, q));
+    {
+        const ct_utm zone = {17, 0};
+        int64_t lat, lon;
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_utm_inverse(&zone, e, n, &lat, &lon));
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_pose_from_wgs84(&poses[1], &zone, lat, lon, h + 1000000000000, q));
+        TEST_ASSERT(poses[1].hscale_q30 != (1 << 30));
+    }
+    const ct_effects none = {0u, 0, 0, 0, nullptr};
+    for (int pk = 0; pk < 2; ++pk) {
+        const ct_pose &pose = poses[pk];
+        int hits = 0;
+        for (int64_t u : {100, 320, 555})
+            for (int64_t v : {60, 240, 420}) {
+                ct_geo g;
+                if (ct_geolocate(&p, &cam, &pose, CT_METHOD_DIRECTIONAL, nullptr, u << 16, v << 16, &g) != CT_HIT) continue;
+                hits++;
+                const int64_t gp[3] = {g.hit.e_nm, g.hit.n_nm, g.hit.h_nm};
+                for (const ct_effects *fx : {(const ct_effects *)nullptr, &none}) {
+                    int64_t uu, vv;
+                    uint32_t vis = 7;
+                    ct_hit b;
+                    TEST_ASSERT_EQUAL_INT(CT_OK, ct_locate_inverse(&p, &cam, &pose, fx, gp, 500000000, &uu, &vv, &vis, &b));
+                    TEST_ASSERT_MSG(vis == 1u, "pose %d pixel (%lld, %lld): the hit not visible", pk, (long long)u,
+                                    (long long)v);
+                    // the hit is within 2 mm of the pixel's ray: 1 km away,
+                    // a few thousandths of a pixel
+                    TEST_ASSERT_MSG(std::llabs(uu - (u << 16)) < 656 && std::llabs(vv - (v << 16)) < 656,
+                                    "pose %d pixel (%lld, %lld): back at (%.4f, %.4f)", pk, (long long)u, (long long)v,
+                                    uu / 65536.0, vv / 65536.0);
+                }
+                // 50 m below the surface there: hidden (the surface is met first)
+                const int64_t under[3] = {gp[0], gp[1], gp[2] - 50000000000};
+                int64_t uu, vv;
+                uint32_t vis = 7;
+                ct_hit b;
+                TEST_ASSERT_EQUAL_INT(CT_OK, ct_locate_inverse(&p, &cam, &pose, nullptr, under, 500000000, &uu, &vv, &vis, &b));
+                TEST_ASSERT_EQUAL_INT(0, (int)vis);
+            }
+        TEST_ASSERT(hits >= 5);
+        int64_t uu, vv;
+        uint32_t vis;
+        ct_hit b;
+        const int64_t centre[3] = {pose.e_nm, pose.n_nm, pose.h_nm};
+        TEST_ASSERT_EQUAL_INT(CT_ERR_RAY, ct_locate_inverse(&p, &cam, &pose, nullptr, centre, 0, &uu, &vv, &vis, &b));
+        const int64_t behind[3] = {pose.e_nm, pose.n_nm - 1000000000000, pose.h_nm};
+        TEST_ASSERT_EQUAL_INT(CT_ERR_UNPROJECT, ct_locate_inverse(&p, &cam, &pose, nullptr, behind, 0, &uu, &vv, &vis, &b));
+        const int64_t ahead[3] = {pose.e_nm, pose.n_nm + INT64_C(3000000000000000), pose.h_nm};
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_locate_inverse(&p, &cam, &pose, nullptr, ahead, 0, &uu, &vv, &vis, &b));
+        TEST_ASSERT_MSG(std::llabs(uu - (INT64_C(639) << 15)) < 65536, "ahead: u %.3f", uu / 65536.0);
+        TEST_ASSERT(vv < 0);  // above the image's top: 60 deg up from its axis
+    }
+    // a camera under the surface: ct_los's CT_BELOW, and not visible
+    {
+        ct_pose under;
+        int64_t zs, uu, vv, gx, gy, gz;
+        uint32_t vis = 7;
+        ct_hit b;
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_surface_height(&p, 32 << 16, 40 << 16, &zs));
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_grid_to_map(&p, 32 << 16, 40 << 16, zs - (200 << 16), &gx, &gy, &gz));
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_pose_from_map(&under, gx, gy, gz, q));
+        const int64_t ahead[3] = {gx, gy + 300000000000, gz - 200000000000};
+        TEST_ASSERT_EQUAL_INT(CT_BELOW, ct_locate_inverse(&p, &cam, &under, nullptr, ahead, 0, &uu, &vv, &vis, &b));
+        TEST_ASSERT_EQUAL_INT(0, (int)vis);
+    }
+}
+
 }  // namespace
 
 int main()
@@ -199,5 +289,6 @@ int main()
     TEST_BEGIN("test_los");
     RUN_TEST(test_los_vs_reference);
     RUN_TEST(test_los_arguments);
+    RUN_TEST(test_locate_inverse_cases);
     return TEST_END();
 }
