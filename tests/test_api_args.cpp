@@ -638,6 +638,38 @@ std::vector<Case> cases()
         ct_geo g;
         return ct_geolocate(&w.p, &w.cam, &pose, CT_METHOD_DIRECTIONAL, &fx, 32 << 16, 24 << 16, &g);
     });
+    // a package whose EPSG code is beyond INT32_MAX (the header field is 32
+    // bits unsigned): no UTM zone, so the true Earth falls back to the
+    // sphere of 6371 km (the same hit as asking for it), and no earth map
+    add("geolocate: true Earth, EPSG beyond INT32_MAX: the sphere's hit", CT_OK, [](World &w) -> ct_status {
+        ct_package q = w.p;
+        q.epsg = 0x80000000u + 32617u;
+        const ct_effects earth = {CT_EFFECT_CURVATURE, 0, 0, 0, nullptr};
+        const ct_effects sphere = {CT_EFFECT_CURVATURE, 0, CT_EARTH_RADIUS_NM, 0, nullptr};
+        ct_geo g1, g2;
+        const ct_status s1 = ct_geolocate(&q, &w.cam, &w.pose, CT_METHOD_DIRECTIONAL, &earth, 32 << 16, 24 << 16, &g1);
+        const ct_status s2 = ct_geolocate(&q, &w.cam, &w.pose, CT_METHOD_DIRECTIONAL, &sphere, 32 << 16, 24 << 16, &g2);
+        if (s1 != s2 || s1 < 0) return CT_ERR_INTERNAL;
+        return s1 != CT_HIT || (g1.hit.e_nm == g2.hit.e_nm && g1.hit.n_nm == g2.hit.n_nm && g1.hit.h_nm == g2.hit.h_nm)
+                   ? CT_OK
+                   : CT_ERR_INTERNAL;
+    });
+    add("los: true Earth, EPSG beyond INT32_MAX: the sphere's answer", CT_OK, [](World &w) -> ct_status {
+        ct_package q = w.p;
+        q.epsg = 0x80000000u + 32617u;
+        const ct_effects earth = {CT_EFFECT_CURVATURE, 0, 0, 0, nullptr};
+        const ct_effects sphere = {CT_EFFECT_CURVATURE, 0, CT_EARTH_RADIUS_NM, 0, nullptr};
+        ct_hit h1, h2;
+        const ct_status s1 = ct_los(&q, w.a, w.b, &earth, 0, CT_METHOD_DIRECTIONAL, &h1);
+        const ct_status s2 = ct_los(&q, w.a, w.b, &sphere, 0, CT_METHOD_DIRECTIONAL, &h2);
+        return s1 == s2 && s1 >= 0 ? CT_OK : CT_ERR_INTERNAL;
+    });
+    add("earth_map_init: EPSG beyond INT32_MAX", CT_ERR_CRS, [](World &w) {
+        ct_package q = w.p;
+        q.epsg = 0x80000000u + 32617u;
+        static ct_earth_map m;
+        return ct_earth_map_init(&q, w.a[0], w.a[1], w.a[2], INT64_C(10000000000000), &m);
+    });
     add("geolocate_batch: pixels NULL, count 1", CT_ERR_ARG, [](World &w) {
         ct_geo g;
         return ct_geolocate_batch(&w.p, &w.cam, &w.pose, CT_METHOD_DIRECTIONAL, nullptr, nullptr, 1, &g, 1);

@@ -282,6 +282,60 @@ void test_locate_inverse_cases()
     }
 }
 
+// ct_los's rarer paths: a vertical line of sight (A straight above B on the
+// surface: visible; B under the surface: hidden), A = B under the true
+// Earth (CT_ERR_RAY, as straight), B off the zone's projection (CT_ERR_RAY),
+// and the true Earth asked of a package on no UTM zone: the sphere of
+// CT_EARTH_RADIUS_NM, the same answer and block as asking for it.
+void test_los_cases()
+{
+    ct_host::Terrain t = dem_cases::make_terrain(48, 40, dem_cases::smooth(48, 40, 9, 1000, 30000), 0.25);
+    t.geo.epsg = 32617;
+    const dem_cases::Case utm = dem_cases::make_case("utm", t, 8, 2);
+    t.geo.epsg = 0;
+    const dem_cases::Case plain = dem_cases::make_case("no crs", t, 8, 2);
+    ct_package p, q;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_package_open(&p, utm.pkg.data(), utm.pkg.size()));
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_package_open(&q, plain.pkg.data(), plain.pkg.size()));
+    int64_t zs, g[3], a[3];
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_surface_height(&p, (20 << 16) + 999, (17 << 16) + 4321, &zs));
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_grid_to_map(&p, (20 << 16) + 999, (17 << 16) + 4321, zs, &g[0], &g[1], &g[2]));
+    a[0] = g[0], a[1] = g[1], a[2] = g[2] + 800000000000;  // 800 m above
+    const ct_effects earth = {CT_EFFECT_CURVATURE | CT_EFFECT_REFRACTION, CT_REFRACTION_K_STD_Q16, 0, 0, nullptr};
+    ct_hit h;
+    for (const ct_effects *fx : {(const ct_effects *)nullptr, &earth}) {
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_los(&p, a, g, fx, 1000000, CT_METHOD_DIRECTIONAL, &h));
+        const int64_t under[3] = {g[0], g[1], g[2] - 5000000000};
+        TEST_ASSERT_EQUAL_INT(CT_HIT, ct_los(&p, a, under, fx, 1000000, CT_METHOD_DIRECTIONAL, &h));
+        TEST_ASSERT(std::llabs(h.h_nm - g[2]) < 2000000);  // blocked at the surface, within 2 mm
+        TEST_ASSERT_EQUAL_INT(CT_ERR_RAY, ct_los(&p, a, a, fx, 0, CT_METHOD_DIRECTIONAL, &h));
+    }
+    const int64_t off_zone[3] = {a[0] + INT64_C(2000000000000000), a[1], a[2]};
+    TEST_ASSERT_EQUAL_INT(CT_ERR_RAY, ct_los(&p, a, off_zone, &earth, 0, CT_METHOD_DIRECTIONAL, &h));
+    // no CRS: the true Earth is the sphere of 6371 km
+    const ct_effects sphere = {CT_EFFECT_CURVATURE | CT_EFFECT_REFRACTION, CT_REFRACTION_K_STD_Q16, CT_EARTH_RADIUS_NM,
+                               0, nullptr};
+    ct_rng rng;
+    ct_rng_seed(&rng, 77);
+    int hidden = 0;
+    for (int k = 0; k < 200; ++k) {
+        int64_t b[3], zb;
+        const int64_t xb = ct_rng_range(&rng, 0, 47 << 16), yb = ct_rng_range(&rng, 0, 39 << 16);
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_surface_height(&q, xb, yb, &zb));
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_grid_to_map(&q, xb, yb, zb, &b[0], &b[1], &b[2]));
+        ct_hit h1, h2;
+        const ct_status s1 = ct_los(&q, a, b, &earth, 500000000, CT_METHOD_DIRECTIONAL, &h1);
+        const ct_status s2 = ct_los(&q, a, b, &sphere, 500000000, CT_METHOD_DIRECTIONAL, &h2);
+        TEST_ASSERT_EQUAL_INT(s2, s1);
+        if (s1 == CT_HIT) {
+            hidden++;
+            TEST_ASSERT(h1.x_q16 == h2.x_q16 && h1.y_q16 == h2.y_q16 && h1.z_q16 == h2.z_q16 && h1.e_nm == h2.e_nm);
+        }
+        if (ct_harness_g.current_failed) return;
+    }
+    TEST_ASSERT(hidden > 0);
+}
+
 }  // namespace
 
 int main()
@@ -290,5 +344,6 @@ int main()
     RUN_TEST(test_los_vs_reference);
     RUN_TEST(test_los_arguments);
     RUN_TEST(test_locate_inverse_cases);
+    RUN_TEST(test_los_cases);
     return TEST_END();
 }
