@@ -128,6 +128,8 @@ void test_evil_packages()
         {"non-square posting", CT_ERR_GEOREF, true, [](std::vector<uint8_t> &b) { put64(b, 56, -31000000000ll); }},
         {"negative height scale", CT_ERR_GEOREF, true, [](std::vector<uint8_t> &b) { put64(b, 72, -1); }},
         {"reserved field set", CT_ERR_FLAGS, true, [](std::vector<uint8_t> &b) { put32(b, 84, 7); }},
+        {"32768 x 32768 posts, r 1, N 64: over 4 GB", CT_ERR_SIZE, true,
+         [](std::vector<uint8_t> &b) { put16(b, 16, 32768); put16(b, 18, 32768); b[20] = 1; b[21] = 64; }},
         {"total size below the header", CT_ERR_TRUNCATED, false, [](std::vector<uint8_t> &b) { put32(b, 8, 64); }},
         {"zero posting north", CT_ERR_GEOREF, true, [](std::vector<uint8_t> &b) { put64(b, 56, 0); }},
         {"posting beyond 2^50 nm", CT_ERR_GEOREF, true,
