@@ -8,16 +8,16 @@ listed in tests/coverage_exceptions.txt, with its reason.
 A branch is keyed so that the key survives line shifts: the file (relative to
 lib/src), the function around it, the line's source text with its spaces
 squeezed (and a `#k` when the same text occurs k > 1 times in the function),
-and the branch's gcov index on that line (-O0: 0/1 for the first condition,
-2/3 for the second, ...).  Exception lines:
+and the branch's index among the line's branches as gcov numbers them (at -O0
+one pair per condition, in the compiler's order).  Exception lines:
 
-  file | function | source text[#k] | branches | reason
+  file | function | branches | reason | source text[#k]
 
-where branches is a comma-separated list of indices.  The check fails (exit 1)
-when an uncovered branch is not listed, or a listed entry names a line or
-branch that no longer exists; a listed branch the suite now takes is reported
-(it should be removed from the list) and also fails, unless
---allow-covered is given.
+branches a comma-separated list of indices; the source text last, so that it
+may hold any character.  The check fails (exit 1) when an uncovered branch is
+not listed, or a listed entry names a line or branch that no longer exists; a
+listed branch the suite now takes is reported (it should be removed from the
+list) and also fails, unless --allow-covered is given.
 """
 import json
 import os
@@ -71,11 +71,11 @@ def load_exceptions(path):
             line = raw.rstrip("\n")
             if not line.strip() or line.lstrip().startswith("#"):
                 continue
-            parts = [p.strip() for p in line.split(" | ")]
-            if len(parts) != 5 or not parts[4]:
-                problems.append("%s:%d: want 'file | function | text | branches | reason'" % (path, n))
+            parts = [p.strip() for p in line.split(" | ", 4)]
+            if len(parts) != 5 or not parts[3] or not parts[4]:
+                problems.append("%s:%d: want 'file | function | branches | reason | source text'" % (path, n))
                 continue
-            rel, func, text, idx, reason = parts
+            rel, func, idx, reason, text = parts
             try:
                 indices = [int(x) for x in idx.split(",")]
             except ValueError:
@@ -90,7 +90,7 @@ def load_exceptions(path):
 
 
 def fmt(key):
-    return "%s | %s | %s | %d" % key
+    return "%s | %s | %d | %s" % (key[0], key[1], key[3], key[2])
 
 
 def main(argv):
@@ -99,7 +99,7 @@ def main(argv):
     if len(argv) == 4 and argv[1] == "--list":
         branches = load_report(argv[2], argv[3])
         for key in sorted(k for k, c in branches.items() if c == 0):
-            print(fmt(key) + " | ?")
+            print("%s | %s | %d | ? | %s" % (key[0], key[1], key[3], key[2]))
         return 0
     if len(argv) != 4:
         print(__doc__.strip().split("\n\n")[1])

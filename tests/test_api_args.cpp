@@ -1511,6 +1511,37 @@ std::vector<Case> cases()
         ct_hit h;
         return ct_los(&w.p, far, w.b, &fx, 0, CT_METHOD_DIRECTIONAL, &h);
     });
+    add("los: the sphere from 2,000 km north of the tile (no lowered model)", CT_ERR_EFFECTS, [](World &w) {
+        const ct_effects fx = {CT_EFFECT_CURVATURE, 0, CT_EARTH_RADIUS_NM, 0, nullptr};
+        const int64_t far[3] = {w.a[0], w.a[1] + INT64_C(2000000000000000), w.a[2]};
+        ct_hit h;
+        return ct_los(&w.p, far, w.b, &fx, 0, CT_METHOD_DIRECTIONAL, &h);
+    });
+    add("los: the sphere from 2,000 km south of the tile (no lowered model)", CT_ERR_EFFECTS, [](World &w) {
+        const ct_effects fx = {CT_EFFECT_CURVATURE, 0, CT_EARTH_RADIUS_NM, 0, nullptr};
+        const int64_t far[3] = {w.a[0], w.a[1] - INT64_C(2000000000000000), w.a[2]};
+        ct_hit h;
+        return ct_los(&w.p, far, w.b, &fx, 0, CT_METHOD_DIRECTIONAL, &h);
+    });
+    // posts 2 km apart (2^40 nm and more): beyond the lowered model's range
+    add("los: the sphere over 2 km posts (no lowered model)", CT_ERR_EFFECTS, [](World &w) -> ct_status {
+        static dem_cases::Case coarse;
+        static ct_package q;
+        if (coarse.pkg.empty()) {
+            ct_host::Terrain t = w.c.t;
+            t.geo.posting_e = 2000.0;
+            t.geo.posting_n = -2000.0;
+            coarse = dem_cases::make_case("coarse", t, 8, 2);
+            if (ct_package_open(&q, coarse.pkg.data(), coarse.pkg.size()) != CT_OK) return CT_ERR_INTERNAL;
+        }
+        int64_t a[3], b[3];
+        (void)ct_grid_to_map(&q, 12 << 16, 10 << 16, ((int64_t)q.hmax + 100) << 16, &a[0], &a[1], &a[2]);
+        (void)ct_grid_to_map(&q, 3 << 16, 4 << 16, (int64_t)q.hmin << 16, &b[0], &b[1], &b[2]);
+        const ct_effects fx = {CT_EFFECT_CURVATURE, 0, CT_EARTH_RADIUS_NM, 0, nullptr};
+        ct_hit h;
+        if (ct_los(&q, a, b, nullptr, 0, CT_METHOD_DIRECTIONAL, &h) < 0) return CT_ERR_INTERNAL;  // straight: fine
+        return ct_los(&q, a, b, &fx, 0, CT_METHOD_DIRECTIONAL, &h);
+    });
     add("los: the true Earth from beyond the zone", CT_ERR_EFFECTS, [](World &w) {
         const ct_effects fx = {CT_EFFECT_CURVATURE, 0, 0, 0, nullptr};
         const int64_t far[3] = {w.a[0] + INT64_C(3000000000000000), w.a[1], w.a[2]};
