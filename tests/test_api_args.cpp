@@ -232,6 +232,8 @@ std::vector<Case> cases()
          [](ct_prepared &r, const ct_package &) { r.tend_n = (INT64_C(1) << 34) + 1; }},
         {"trace_prepared: tend past the box exit", CT_ERR_RAY,
          [](ct_prepared &r, const ct_package &) { r.tend_n = INT64_C(1) << 34, r.tend_d = 1; }},
+        {"trace_prepared: start CT_HIT_VOID (no preparation's outcome)", CT_ERR_RAY,
+         [](ct_prepared &r, const ct_package &) { r.start = CT_HIT_VOID; }},
         {"trace_prepared: sector -1 for a slanted ray", CT_ERR_RAY, [](ct_prepared &r, const ct_package &) { r.sector = -1; }},
         {"trace_prepared: sector N", CT_ERR_RAY,
          [](ct_prepared &r, const ct_package &p) { r.sector = (int32_t)p.sectors; }},
