@@ -672,6 +672,47 @@ std::vector<Case> cases()
         static ct_earth_map m;
         return ct_earth_map_init(&q, w.a[0], w.a[1], w.a[2], INT64_C(10000000000000), &m);
     });
+    // heights in 0.1 mm codes: a cube of 2^47 nm leaves too few fraction
+    // bits for the fit (CT_ERR_RANGE), one of 2^44 nm fits; the per-call fit
+    // of CT_EFFECT_EARTH_FIT falls back to the exact conversions there (the
+    // same hit as without it, bit for bit)
+    static dem_cases::Case fine_h;
+    static ct_package pfh;
+    auto fine_heights = [](World &w) -> const ct_package * {
+        if (fine_h.pkg.empty()) {
+            ct_host::Terrain t = w.c.t;
+            t.height_scale_m = 1e-4;
+            fine_h = dem_cases::make_case("0.1 mm codes", t, 8, 2);
+            if (ct_package_open(&pfh, fine_h.pkg.data(), fine_h.pkg.size()) != CT_OK) return nullptr;
+        }
+        return &pfh;
+    };
+    add("earth_map_init (0.1 mm height codes): a cube of 2^47 nm", CT_ERR_RANGE, [fine_heights](World &w) -> ct_status {
+        const ct_package *q = fine_heights(w);
+        if (q == nullptr) return CT_ERR_INTERNAL;
+        static ct_earth_map m;
+        if (ct_earth_map_init(q, w.a[0], w.a[1], w.a[2], INT64_C(1) << 44, &m) != CT_OK) return CT_ERR_INTERNAL;
+        return ct_earth_map_init(q, w.a[0], w.a[1], w.a[2], INT64_C(1) << 47, &m);
+    });
+    add("geolocate (0.1 mm height codes): EARTH_FIT from 50 km up falls back to exact", CT_HIT, [fine_heights](World &w) -> ct_status {
+        const ct_package *q = fine_heights(w);
+        if (q == nullptr) return CT_ERR_INTERNAL;
+        int32_t qq[4];
+        ct_pose pose;
+        if (ct_quat_from_ypr(0, dem_cases::deg_q61(-90), 0, qq) != CT_OK ||
+            ct_pose_from_map(&pose, w.a[0], w.a[1], w.a[2] + INT64_C(50000000000000), qq) != CT_OK)
+            return CT_ERR_INTERNAL;
+        const ct_effects fit = {CT_EFFECT_CURVATURE | CT_EFFECT_EARTH_FIT, 0, 0, 0, nullptr};
+        const ct_effects exact = {CT_EFFECT_CURVATURE, 0, 0, 0, nullptr};
+        ct_geo g1, g2;
+        // the principal point (63/2, 47/2) px: straight down
+        const ct_status s1 = ct_geolocate(q, &w.cam, &pose, CT_METHOD_DIRECTIONAL, &fit, 63 << 15, 47 << 15, &g1);
+        const ct_status s2 = ct_geolocate(q, &w.cam, &pose, CT_METHOD_DIRECTIONAL, &exact, 63 << 15, 47 << 15, &g2);
+        if (s1 != s2 || s1 < 0) return CT_ERR_INTERNAL;
+        return s1 != CT_HIT || (g1.hit.x_q16 == g2.hit.x_q16 && g1.hit.y_q16 == g2.hit.y_q16 && g1.hit.z_q16 == g2.hit.z_q16)
+                   ? s1
+                   : CT_ERR_INTERNAL;
+    });
     add("geolocate_batch: pixels NULL, count 1", CT_ERR_ARG, [](World &w) {
         ct_geo g;
         return ct_geolocate_batch(&w.p, &w.cam, &w.pose, CT_METHOD_DIRECTIONAL, nullptr, nullptr, 1, &g, 1);
