@@ -238,6 +238,13 @@ void test_bent_arguments()
     b2.coeff_q16 = 5 << 16;
     TEST_ASSERT_EQUAL_INT(CT_ERR_ARG, ct_trace_bent(&p, &ray, &b2, CT_METHOD_DIRECTIONAL, &h));
     TEST_ASSERT_EQUAL_INT(CT_ERR_METHOD, ct_trace_bent(&p, &ray, &bd, (ct_method)7, &h));
+    // the ray's ranges (checked here first for a bent ray): each alone
+    for (int k = 0; k < 6; ++k) {
+        ct_ray bad = ray;
+        int64_t *f[6] = {&bad.x_q16, &bad.y_q16, &bad.z_q16, &bad.dx, &bad.dy, &bad.dz};
+        *f[k] = k < 3 ? CT_MAX_ORIGIN_Q16 + 1 : -(INT64_C(1) << 62) - 1;
+        TEST_ASSERT_EQUAL_INT(CT_ERR_RAY, ct_trace_bent(&p, &bad, &bd, CT_METHOD_DIRECTIONAL, &h));
+    }
     // c = 0 and vertical rays are the straight trace
     b2 = bd;
     b2.coeff_q16 = 0;
