@@ -283,7 +283,8 @@ void test_locate_inverse_cases()
 }
 
 // ct_los's rarer paths: a vertical line of sight (A straight above B on the
-// surface: visible; B under the surface: hidden), A = B under the true
+// surface: visible; B under the surface: hidden; straight, on the true
+// Earth and on the sphere's lowered walk), A = B under the true
 // Earth (CT_ERR_RAY, as straight), B off the zone's projection (CT_ERR_RAY),
 // and the true Earth asked of a package on no UTM zone: the sphere of
 // CT_EARTH_RADIUS_NM, the same answer and block as asking for it.
@@ -302,8 +303,10 @@ void test_los_cases()
     TEST_ASSERT_EQUAL_INT(CT_OK, ct_grid_to_map(&p, (20 << 16) + 999, (17 << 16) + 4321, zs, &g[0], &g[1], &g[2]));
     a[0] = g[0], a[1] = g[1], a[2] = g[2] + 800000000000;  // 800 m above
     const ct_effects earth = {CT_EFFECT_CURVATURE | CT_EFFECT_REFRACTION, CT_REFRACTION_K_STD_Q16, 0, 0, nullptr};
+    const ct_effects ball = {CT_EFFECT_CURVATURE | CT_EFFECT_REFRACTION, CT_REFRACTION_K_STD_Q16, CT_EARTH_RADIUS_NM, 0,
+                             nullptr};
     ct_hit h;
-    for (const ct_effects *fx : {(const ct_effects *)nullptr, &earth}) {
+    for (const ct_effects *fx : {(const ct_effects *)nullptr, &earth, &ball}) {
         TEST_ASSERT_EQUAL_INT(CT_OK, ct_los(&p, a, g, fx, 1000000, CT_METHOD_DIRECTIONAL, &h));
         const int64_t under[3] = {g[0], g[1], g[2] - 5000000000};
         TEST_ASSERT_EQUAL_INT(CT_HIT, ct_los(&p, a, under, fx, 1000000, CT_METHOD_DIRECTIONAL, &h));
@@ -336,6 +339,61 @@ void test_los_cases()
     TEST_ASSERT(hidden > 0);
 }
 
+// A DEM with a patch of voids: ct_los decides as its definition says -- the
+// segment A -> B (as ct_map_to_grid rounds them) prepared and traced, hidden
+// when the first hit, void or not, lies more than the margin before B, the
+// block that hit bit for bit -- straight and on the true Earth (blocked by a
+// void cell there as well).
+void test_los_voids()
+{
+    ct_host::Terrain t = dem_cases::make_terrain(40, 40, dem_cases::smooth(40, 40, 13, 1000, 20000), 0.25);
+    t.geo.epsg = 32617;
+    t.void_post.assign(1600, 0);
+    for (int j = 12; j < 28; ++j)
+        for (int i = 14; i < 26; ++i) t.void_post[(size_t)j * 40 + i] = 1;
+    const dem_cases::Case cs = dem_cases::make_case("voids", t, 8, 2);
+    ct_package p;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_package_open(&p, cs.pkg.data(), cs.pkg.size()));
+    ct_rng rng;
+    ct_rng_seed(&rng, 4242);
+    const int64_t margin = 500000000;
+    long void_blocks = 0, checked = 0;
+    for (int k = 0; k < 400; ++k) {
+        int64_t a[3], b[3], za, zb;
+        const int64_t xa = ct_rng_range(&rng, 0, 39 << 16), ya = ct_rng_range(&rng, 0, 39 << 16);
+        const int64_t xb = ct_rng_range(&rng, 15 << 16, 25 << 16), yb = ct_rng_range(&rng, 13 << 16, 27 << 16);
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_surface_height(&p, xa, ya, &za));
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_surface_height(&p, xb, yb, &zb));
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_grid_to_map(&p, xa, ya, za + ct_rng_range(&rng, 1 << 16, 4000 << 16), &a[0], &a[1], &a[2]));
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_grid_to_map(&p, xb, yb, zb - (2000 << 16), &b[0], &b[1], &b[2]));  // 500 m under
+        // the definition: the segment in the grid, prepared and traced
+        int64_t g[6];
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_map_to_grid(&p, a[0], a[1], a[2], &g[0], &g[1], &g[2]));
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_map_to_grid(&p, b[0], b[1], b[2], &g[3], &g[4], &g[5]));
+        const ct_ray seg = {g[0], g[1], g[2], g[3] - g[0], g[4] - g[1], g[5] - g[2]};
+        ct_prepared pr;
+        ct_hit ht, hl;
+        ct_status st = ct_ray_prepare_segment(&p, &seg, &pr);
+        if (st == CT_OK || st == CT_HIT) st = ct_trace_prepared(&p, &pr, CT_METHOD_DIRECTIONAL, &ht);
+        const ct_status sl = ct_los(&p, a, b, nullptr, margin, CT_METHOD_DIRECTIONAL, &hl);
+        TEST_ASSERT(st == CT_HIT || st == CT_HIT_VOID || st == CT_BELOW);  // B is under the surface
+        if (st == CT_BELOW) {
+            TEST_ASSERT_EQUAL_INT(CT_BELOW, sl);
+            continue;
+        }
+        checked++;
+        void_blocks += st == CT_HIT_VOID;
+        TEST_ASSERT_EQUAL_INT(CT_HIT, sl);  // met 500 m or more before B
+        TEST_ASSERT(hl.x_q16 == ht.x_q16 && hl.y_q16 == ht.y_q16 && hl.z_q16 == ht.z_q16 && hl.e_nm == ht.e_nm);
+        // the true Earth: hidden as well (B is 500 m under the surface)
+        const ct_effects earth = {CT_EFFECT_CURVATURE, 0, 0, 0, nullptr};
+        TEST_ASSERT_EQUAL_INT(CT_HIT, ct_los(&p, a, b, &earth, margin, CT_METHOD_DIRECTIONAL, &hl));
+        if (ct_harness_g.current_failed) return;
+    }
+    std::printf("  voids: %ld pairs blocked, %ld of them in a void cell\n", checked, void_blocks);
+    TEST_ASSERT(void_blocks > 0 && checked > void_blocks);
+}
+
 }  // namespace
 
 int main()
@@ -345,5 +403,6 @@ int main()
     RUN_TEST(test_los_arguments);
     RUN_TEST(test_locate_inverse_cases);
     RUN_TEST(test_los_cases);
+    RUN_TEST(test_los_voids);
     return TEST_END();
 }

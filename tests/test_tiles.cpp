@@ -527,6 +527,43 @@ void test_missing_and_corrupt()
     }
 }
 
+// A DEM with a patch of voids cut into 3 x 3 tiles: every ray's result as
+// the merged package's, CT_HIT_VOID included (walked in a later tile too).
+void test_voids()
+{
+    ct_host::Terrain t = dem_cases::make_terrain(43, 43, dem_cases::smooth(43, 43, 21, 1000, 20000), 0.25);
+    t.void_post.assign(43 * 43, 0);
+    for (int j = 10; j < 33; ++j)
+        for (int i = 10; i < 33; ++i) t.void_post[(size_t)j * 43 + i] = (i + j) % 5 != 0;
+    ct_host::BuildOptions o;
+    o.sectors = 8;
+    o.reduce = 2;
+    const TileSetBytes tb = ct_host::build_tileset(t, o, 15, 0);
+    const std::vector<uint8_t> merged = ct_host::build_package(t, o);
+    ct_package mp;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_package_open(&mp, merged.data(), merged.size()));
+    Set set;
+    TEST_ASSERT_EQUAL_INT(CT_OK, set.open(tb, 2));
+    ct_rng rng;
+    ct_rng_seed(&rng, 99);
+    double lo, hi;
+    dem_cases::minmax(t, &lo, &hi);
+    long voids = 0;
+    for (int k = 0; k < 6000; ++k) {
+        const ct_ray ray = dem_cases::make_ray(t, (dem_cases::Family)(k % dem_cases::FAMILY_COUNT), &rng, lo, hi);
+        for (int m = 0; m < CT_METHOD_COUNT; ++m) {
+            ct_hit hm, hs;
+            const ct_status sm = ct_trace(&mp, &ray, (ct_method)m, &hm);
+            const ct_status ss = ct_tileset_trace(&set.ts, &ray, (ct_method)m, &hs);
+            TEST_ASSERT_MSG(same_hit(sm, hm, ss, hs), "ray %d method %d: %d vs merged %d", k, m, ss, sm);
+            voids += m == 0 && sm == CT_HIT_VOID;
+        }
+        if (ct_harness_g.current_failed) return;
+    }
+    std::printf("  voids: %ld of 6000 rays hit a void cell, as merged\n", voids);
+    TEST_ASSERT(voids > 0);
+}
+
 void test_manifest_checks()
 {
     const ct_host::Terrain t = dem_cases::adversarial_cases()[3].t;  // flat 40 x 33
@@ -824,6 +861,7 @@ int main()
     RUN_TEST(test_skips_tiles_above);
     RUN_TEST(test_missing_and_corrupt);
     RUN_TEST(test_manifest_checks);
+    RUN_TEST(test_voids);
     RUN_TEST(test_geolocation);
     RUN_TEST(test_los);
     return TEST_END();
