@@ -713,6 +713,11 @@ std::vector<Case> cases()
                    ? s1
                    : CT_ERR_INTERNAL;
     });
+    add("geolocate: chord beyond 2^50 nm", CT_ERR_EFFECTS, [](World &w) {
+        const ct_effects fx = {CT_EFFECT_CURVATURE, 0, 0, (INT64_C(1) << 50) + 1, nullptr};
+        ct_geo g;
+        return ct_geolocate(&w.p, &w.cam, &w.pose, CT_METHOD_DIRECTIONAL, &fx, 32 << 16, 24 << 16, &g);
+    });
     add("geolocate_batch: pixels NULL, count 1", CT_ERR_ARG, [](World &w) {
         ct_geo g;
         return ct_geolocate_batch(&w.p, &w.cam, &w.pose, CT_METHOD_DIRECTIONAL, nullptr, nullptr, 1, &g, 1);

@@ -260,8 +260,9 @@ void test_bent_arguments()
 // a ray whose horizontal part vanishes once reduced (the straight trace, bit
 // for bit), horizontal paths that never cross the tile -- along an axis
 // beside it, or past a corner -- (CT_MISS, as straight), a start far under
-// the tile's floor (CT_BELOW, as straight), and a path needing more than
-// CT_BEND_MAX_SEGMENTS segments (CT_ERR_RANGE, as documented).
+// the tile's floor (CT_BELOW, as straight), an observer beyond 2^52 nm and a
+// path needing more than CT_BEND_MAX_SEGMENTS segments (CT_ERR_RANGE, as
+// documented).
 void test_bent_polyline_edges()
 {
     auto cs = dem_cases::make_case("hills", dem_cases::make_terrain(40, 36, dem_cases::smooth(40, 36, 4, 1000, 9000)), 8, 2);
@@ -289,6 +290,14 @@ void test_bent_polyline_edges()
         const ct_status ss = ct_trace(&p, &r.ray, CT_METHOD_DIRECTIONAL, &hs);
         TEST_ASSERT_MSG(sb == r.want && ss == r.want, "%s: bent %d, straight %d, expected %d", r.name, sb, ss, r.want);
         if (sb == CT_HIT) TEST_ASSERT(hb.x_q16 == hs.x_q16 && hb.y_q16 == hs.y_q16 && hb.z_q16 == hs.z_q16);
+    }
+    // an observer 4,600 km west of the tile (beyond RHO_MAX, 2^52 nm), and
+    // one 2^45.5 Q16 cells west (its range times the posting passes 2^80):
+    // CT_ERR_RANGE, "the observer beyond 2^52 nm of the tile"
+    for (int64_t x0 : {-(INT64_C(153333) << 16), -(INT64_C(46000000000000))}) {
+        const ct_ray far = {x0, H / 2, top, 1 << 20, 0, 0};
+        ct_hit hf;
+        TEST_ASSERT_EQUAL_INT(CT_ERR_RANGE, ct_trace_bent(&p, &far, &up, CT_METHOD_DIRECTIONAL, &hf));
     }
     // 2000 x 3 posts of 30 m and a chord that makes the segment just over
     // 1/64 cell: about 120,000 segments across the tile
