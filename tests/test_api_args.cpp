@@ -666,6 +666,10 @@ std::vector<Case> cases()
         const ct_status s2 = ct_los(&q, w.a, w.b, &sphere, 0, CT_METHOD_DIRECTIONAL, &h2);
         return s1 == s2 && s1 >= 0 ? CT_OK : CT_ERR_INTERNAL;
     });
+    add("earth_map_init: centre 2,000 km east of the zone's meridian", CT_ERR_RANGE, [](World &w) {
+        static ct_earth_map m;
+        return ct_earth_map_init(&w.p, w.a[0] + INT64_C(2000000000000000), w.a[1], w.a[2], INT64_C(10000000000000), &m);
+    });
     add("earth_map_init: EPSG beyond INT32_MAX", CT_ERR_CRS, [](World &w) {
         ct_package q = w.p;
         q.epsg = 0x80000000u + 32617u;
