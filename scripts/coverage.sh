@@ -3,7 +3,9 @@
 # gcovr).  A separate build in <dir> with the flight library instrumented
 # (-O0 --coverage; everything else as usual), the suite run on it (the heavy
 # sweeps at their default sizes; the benchmarks' and the cross tests' own
-# builds do not count), then gcovr's table per file and its summary.
+# builds do not count), then gcovr's table per file, the check that every
+# branch never taken is listed in tests/coverage_exceptions.txt with its
+# reason (scripts/coverage_check.py; exit 1 otherwise), and the summary.
 #   scripts/coverage.sh <dir>
 set -eu
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
@@ -17,5 +19,15 @@ find "$DIR" -name '*.gcda' -delete
 (cd "$DIR" && ctest -j"$(nproc 2>/dev/null || echo 2)" -E 'mcu_|lib_clang|fuzz_|install_example|_san$' \
     --output-on-failure >"$DIR/coverage_ctest.log" 2>&1) || { tail -30 "$DIR/coverage_ctest.log"; echo "coverage: a test failed"; exit 1; }
 cd "$DIR"
-gcovr -r "$ROOT" --filter "$ROOT/lib/src/" --object-directory "$DIR/lib" --txt --print-summary \
-    --exclude-unreachable-branches --exclude-throw-branches
+# one gcovr run: the table (coverage.txt), every line and branch
+# (coverage.json), the summary (printed last)
+gcovr -r "$ROOT" --filter "$ROOT/lib/src/" --object-directory "$DIR/lib" \
+    --exclude-unreachable-branches --exclude-throw-branches \
+    --txt "$DIR/coverage.txt" --json "$DIR/coverage.json" --print-summary >"$DIR/coverage_summary.txt"
+cat "$DIR/coverage.txt"
+# every branch the suite never takes must be listed, with its reason, in
+# tests/coverage_exceptions.txt (and every entry must still exist)
+ok=0
+/usr/bin/python3 "$ROOT/scripts/coverage_check.py" "$DIR/coverage.json" "$ROOT/tests/coverage_exceptions.txt" "$ROOT" || ok=1
+cat "$DIR/coverage_summary.txt"
+exit $ok

@@ -7,6 +7,7 @@
 // prints every case.
 #include <cstdlib>
 #include <cstring>
+#include <deque>
 #include <functional>
 #include <string>
 #include <vector>
@@ -25,6 +26,12 @@ struct World {
     ct_ray ray{};
     ct_prepared pr{};
     int64_t a[3] = {0, 0, 0}, b[3] = {0, 0, 0};  // two map points over the tile
+    // the same heights on a 1 um grid with 1 um height codes (a legal
+    // georeference whose grid range a point a few km away already passes),
+    // and on a grid whose axes run west and north (posting_e < 0 < posting_n)
+    dem_cases::Case fine_c, west_c;
+    ct_package fine{}, west{};
+    int64_t fa[3] = {0, 0, 0};  // a map point over the fine tile
 };
 
 World *world()
@@ -48,6 +55,18 @@ World *world()
     (void)ct_grid_to_map(&w->p, 3 << 16, 4 << 16, (int64_t)w->p.hmin << 16, &w->b[0], &w->b[1], &w->b[2]);
     if (ct_ray_from_map(&w->p, e, n, h + 100000000000, 1 << 20, 1 << 19, -(1 << 20), &w->ray) != CT_OK) return nullptr;
     if (ct_ray_prepare(&w->p, &w->ray, &w->pr) != CT_OK) return nullptr;
+    ct_host::Terrain tf = t;
+    tf.geo.posting_e = 1e-6;
+    tf.geo.posting_n = -1e-6;
+    tf.height_scale_m = 1e-6;
+    w->fine_c = dem_cases::make_case("fine", tf, 8, 2);
+    if (ct_package_open(&w->fine, w->fine_c.pkg.data(), w->fine_c.pkg.size()) != CT_OK) return nullptr;
+    (void)ct_grid_to_map(&w->fine, 12 << 16, 10 << 16, (int64_t)w->fine.hmax << 16, &w->fa[0], &w->fa[1], &w->fa[2]);
+    ct_host::Terrain tw = t;
+    tw.geo.posting_e = -30.0;
+    tw.geo.posting_n = 30.0;
+    w->west_c = dem_cases::make_case("west", tw, 8, 2);
+    if (ct_package_open(&w->west, w->west_c.pkg.data(), w->west_c.pkg.size()) != CT_OK) return nullptr;
     return w;
 }
 
@@ -174,6 +193,89 @@ std::vector<Case> cases()
         ct_hit h;
         return ct_trace_prepared(&w.p, nullptr, CT_METHOD_DIRECTIONAL, &h);
     });
+    // a prepared ray with one field edited out of its documented range or
+    // out of agreement with the others: CT_ERR_RAY (ct_trace_prepared
+    // checks every field of the caller's object); the unedited ray traces
+    struct PrepEdit {
+        const char *name;
+        ct_status want;
+        void (*edit)(ct_prepared &, const ct_package &);
+    };
+    static const PrepEdit prep_edits[] = {
+        {"trace_prepared: as prepared", CT_OK, [](ct_prepared &, const ct_package &) {}},
+        {"trace_prepared: |d| beyond 2^26", CT_ERR_RAY, [](ct_prepared &r, const ct_package &) { r.dz = (1 << 26) + 1; }},
+        {"trace_prepared: |d| below 2^25", CT_ERR_RAY, [](ct_prepared &r, const ct_package &) { r.dx = r.dy = r.dz = 1; }},
+        {"trace_prepared: ox < 0", CT_ERR_RAY, [](ct_prepared &r, const ct_package &) { r.ox = -1; }},
+        {"trace_prepared: oy < 0", CT_ERR_RAY, [](ct_prepared &r, const ct_package &) { r.oy = -1; }},
+        {"trace_prepared: ox past the tile", CT_ERR_RAY,
+         [](ct_prepared &r, const ct_package &p) { r.ox = (int64_t)p.cells_x * 65536 + 1; }},
+        {"trace_prepared: oy past the tile", CT_ERR_RAY,
+         [](ct_prepared &r, const ct_package &p) { r.oy = (int64_t)p.cells_y * 65536 + 1; }},
+        {"trace_prepared: oz above the box", CT_ERR_RAY,
+         [](ct_prepared &r, const ct_package &p) { r.oz = ((int64_t)p.hmax + 2) * (65536 >> r.zshift); }},
+        {"trace_prepared: oz below -2^(46 - zshift)", CT_ERR_RAY,
+         [](ct_prepared &r, const ct_package &) { r.oz = -(INT64_C(1) << (46 - r.zshift)) - 1; }},
+        {"trace_prepared: oz on the floor, start ok", CT_ERR_RAY,
+         [](ct_prepared &r, const ct_package &p) { r.oz = ((int64_t)p.hmin - 1) * (65536 >> r.zshift); }},
+        {"trace_prepared: len_lo < 0", CT_ERR_RAY, [](ct_prepared &r, const ct_package &) { r.len_lo = -1; }},
+        {"trace_prepared: len_hi < len_lo", CT_ERR_RAY, [](ct_prepared &r, const ct_package &) { r.len_hi = r.len_lo - 1; }},
+        {"trace_prepared: len_hi > len_lo + 1", CT_ERR_RAY, [](ct_prepared &r, const ct_package &) { r.len_hi = r.len_lo + 2; }},
+        {"trace_prepared: len_lo above the length", CT_ERR_RAY,
+         [](ct_prepared &r, const ct_package &) { r.len_lo = r.len_hi = r.len_hi + 1; }},
+        {"trace_prepared: len_hi below the length", CT_ERR_RAY,
+         [](ct_prepared &r, const ct_package &) { r.len_hi = r.len_lo = r.len_lo - 1; }},
+        {"trace_prepared: tend_d 0", CT_ERR_RAY, [](ct_prepared &r, const ct_package &) { r.tend_d = 0; }},
+        {"trace_prepared: tend_d beyond 2^26", CT_ERR_RAY,
+         [](ct_prepared &r, const ct_package &) { r.tend_d = (INT64_C(1) << 26) + 1; }},
+        {"trace_prepared: tend_n < 0", CT_ERR_RAY, [](ct_prepared &r, const ct_package &) { r.tend_n = -1; }},
+        {"trace_prepared: tend_n beyond 2^34", CT_ERR_RAY,
+         [](ct_prepared &r, const ct_package &) { r.tend_n = (INT64_C(1) << 34) + 1; }},
+        {"trace_prepared: tend past the box exit", CT_ERR_RAY,
+         [](ct_prepared &r, const ct_package &) { r.tend_n = INT64_C(1) << 34, r.tend_d = 1; }},
+        {"trace_prepared: start CT_HIT_VOID (no preparation's outcome)", CT_ERR_RAY,
+         [](ct_prepared &r, const ct_package &) { r.start = CT_HIT_VOID; }},
+        {"trace_prepared: sector -1 for a slanted ray", CT_ERR_RAY, [](ct_prepared &r, const ct_package &) { r.sector = -1; }},
+        {"trace_prepared: sector N", CT_ERR_RAY,
+         [](ct_prepared &r, const ct_package &p) { r.sector = (int32_t)p.sectors; }},
+        {"trace_prepared: the opposite sector", CT_ERR_RAY,
+         [](ct_prepared &r, const ct_package &p) { r.sector = (int32_t)((r.sector + p.sectors / 2) % p.sectors); }},
+    };
+    for (const PrepEdit &e : prep_edits) {
+        const PrepEdit *ep = &e;
+        add(e.name, e.want, [ep](World &w) -> ct_status {
+            ct_prepared r = w.pr;
+            ep->edit(r, w.p);
+            ct_hit h;
+            const ct_status st = ct_trace_prepared(&w.p, &r, CT_METHOD_DIRECTIONAL, &h);
+            return st >= 0 ? CT_OK : st;
+        });
+    }
+    add("trace_prepared: a vertical ray with a sector", CT_ERR_RAY, [](World &w) -> ct_status {
+        ct_ray ray = w.ray;
+        ray.dx = ray.dy = 0;
+        ct_prepared r;
+        if (ct_ray_prepare(&w.p, &ray, &r) != CT_OK || r.sector != -1) return CT_ERR_INTERNAL;
+        ct_hit h;
+        if (ct_trace_prepared(&w.p, &r, CT_METHOD_DIRECTIONAL, &h) < 0) return CT_ERR_INTERNAL;
+        r.sector = 0;
+        return ct_trace_prepared(&w.p, &r, CT_METHOD_DIRECTIONAL, &h);
+    });
+    add("surface_height: x < 0", CT_ERR_RANGE, [](World &w) {
+        int64_t z;
+        return ct_surface_height(&w.p, -1, 0, &z);
+    });
+    add("surface_height: y < 0", CT_ERR_RANGE, [](World &w) {
+        int64_t z;
+        return ct_surface_height(&w.p, 0, -1, &z);
+    });
+    add("surface_height: x past the tile", CT_ERR_RANGE, [](World &w) {
+        int64_t z;
+        return ct_surface_height(&w.p, (int64_t)w.p.cells_x * 65536 + 1, 0, &z);
+    });
+    add("surface_height: y past the tile", CT_ERR_RANGE, [](World &w) {
+        int64_t z;
+        return ct_surface_height(&w.p, 0, (int64_t)w.p.cells_y * 65536 + 1, &z);
+    });
     add("trace_prepared: unknown method", CT_ERR_METHOD, [](World &w) {
         ct_hit h;
         return ct_trace_prepared(&w.p, &w.pr, kBadMethod, &h);
@@ -236,6 +338,172 @@ std::vector<Case> cases()
         lens.fx_q32 = 0;
         ct_camera c;
         return ct_camera_init(&c, &lens);
+    });
+    // each of the lens's ranges alone
+    struct LensEdit {
+        const char *name;
+        void (*edit)(ct_lens &);
+    };
+    static const LensEdit lens_edits[] = {
+        {"camera_init: fy beyond 2^20 px", [](ct_lens &l) { l.fy_q32 = ((int64_t)CT_CAM_MAX_PIXEL << 32) + 1; }},
+        {"camera_init: fx beyond 2^20 px", [](ct_lens &l) { l.fx_q32 = ((int64_t)CT_CAM_MAX_PIXEL << 32) + 1; }},
+        {"camera_init: fy below 1 px", [](ct_lens &l) { l.fy_q32 = (INT64_C(1) << 32) - 1; }},
+        {"camera_init: cx beyond 2^20 px", [](ct_lens &l) { l.cx_q32 = ((int64_t)CT_CAM_MAX_PIXEL << 32) + 1; }},
+        {"camera_init: cx below -2^20 px", [](ct_lens &l) { l.cx_q32 = -((int64_t)CT_CAM_MAX_PIXEL << 32) - 1; }},
+        {"camera_init: cy beyond 2^20 px", [](ct_lens &l) { l.cy_q32 = ((int64_t)CT_CAM_MAX_PIXEL << 32) + 1; }},
+        {"camera_init: cy below -2^20 px", [](ct_lens &l) { l.cy_q32 = -((int64_t)CT_CAM_MAX_PIXEL << 32) - 1; }},
+    };
+    for (const LensEdit &e : lens_edits) {
+        const LensEdit *ep = &e;
+        add(e.name, CT_ERR_LENS, [ep](World &) {
+            ct_lens lens = dem_cases::centred_pinhole(64, 48, 60);
+            ep->edit(lens);
+            ct_camera c;
+            return ct_camera_init(&c, &lens);
+        });
+    }
+    // a pixel whose normalised coordinate passes 2^16 (|u - cx| / fx): a
+    // 1 px focal length and the centre at the far edge of the range
+    add("camera_unproject: (u - cx) / fx beyond 2^16", CT_ERR_UNPROJECT, [](World &) -> ct_status {
+        ct_lens lens = dem_cases::centred_pinhole(64, 48, 1);
+        lens.cx_q32 = -((int64_t)CT_CAM_MAX_PIXEL << 32);
+        ct_camera c;
+        int32_t r[3];
+        if (ct_camera_init(&c, &lens) != CT_OK) return CT_ERR_INTERNAL;
+        return ct_camera_unproject(&c, (int64_t)CT_CAM_MAX_PIXEL << 16, 0, r, nullptr);
+    });
+    add("camera_unproject: (v - cy) / fy beyond 2^16", CT_ERR_UNPROJECT, [](World &) -> ct_status {
+        ct_lens lens = dem_cases::centred_pinhole(64, 48, 1);
+        lens.cy_q32 = (int64_t)CT_CAM_MAX_PIXEL << 32;
+        ct_camera c;
+        int32_t r[3];
+        if (ct_camera_init(&c, &lens) != CT_OK) return CT_ERR_INTERNAL;
+        return ct_camera_unproject(&c, 0, -((int64_t)CT_CAM_MAX_PIXEL << 16), r, nullptr);
+    });
+    // rational lenses with one denominator coefficient (k4, k5 or k6)
+    // alone: the pixel unprojected and projected back lands within 1e-3 px
+    for (int kk = 5; kk <= 7; ++kk) {
+        static const char *const names[] = {"camera_init: OPENCV8 with k4 alone, round trip",
+                                            "camera_init: OPENCV8 with k5 alone, round trip",
+                                            "camera_init: OPENCV8 with k6 alone, round trip"};
+        add(names[kk - 5], CT_OK, [kk](World &) -> ct_status {
+            ct_lens lens = dem_cases::centred_pinhole(640, 480, 500);
+            lens.model = CT_LENS_OPENCV8;
+            lens.dist_q48[0] = -(INT64_C(1) << 46);  // k1 -0.25
+            lens.dist_q48[kk] = INT64_C(1) << 45;    // 0.125
+            ct_camera c;
+            const ct_status st = ct_camera_init(&c, &lens);
+            if (st != CT_OK) return st;
+            for (int64_t u : {INT64_C(150), INT64_C(320), INT64_C(450)}) {
+                const int64_t uq = u << 16, vq = (u / 2 + 90) << 16;
+                int32_t r[3];
+                int64_t u2, v2;
+                if (ct_camera_unproject(&c, uq, vq, r, nullptr) != CT_OK ||
+                    ct_camera_project(&c, r, &u2, &v2) != CT_OK)
+                    return CT_ERR_INTERNAL;
+                if (std::llabs(u2 - uq) > 66 || std::llabs(v2 - vq) > 66) return CT_ERR_INTERNAL;
+            }
+            return CT_OK;
+        });
+    }
+    // unprojection grids: a 4 x 4 grid of the optical axis (0, 0, 1), one
+    // field out of range or one node edited
+    struct GridEdit {
+        const char *name;
+        ct_status want;
+        void (*edit)(ct_unproject_grid &, int32_t *rays);
+    };
+    static const GridEdit grid_edits[] = {
+        {"camera_init_grid: the axis everywhere (ok)", CT_OK, [](ct_unproject_grid &, int32_t *) {}},
+        {"camera_init_grid: nv 3", CT_ERR_LENS, [](ct_unproject_grid &g, int32_t *) { g.nv = 3; }},
+        {"camera_init_grid: nu beyond CT_GRID_MAX_NODES", CT_ERR_LENS,
+         [](ct_unproject_grid &g, int32_t *) { g.nu = CT_GRID_MAX_NODES + 1u; }},
+        {"camera_init_grid: nv beyond CT_GRID_MAX_NODES", CT_ERR_LENS,
+         [](ct_unproject_grid &g, int32_t *) { g.nv = CT_GRID_MAX_NODES + 1u; }},
+        {"camera_init_grid: step below 1 px", CT_ERR_LENS, [](ct_unproject_grid &g, int32_t *) { g.step_q16 = 65535; }},
+        {"camera_init_grid: step beyond 4096 px", CT_ERR_LENS,
+         [](ct_unproject_grid &g, int32_t *) { g.step_q16 = (INT64_C(4096) << 16) + 1; }},
+        {"camera_init_grid: u0 beyond 2^20 px", CT_ERR_LENS,
+         [](ct_unproject_grid &g, int32_t *) { g.u0_q16 = ((int64_t)CT_CAM_MAX_PIXEL << 16) + 1; }},
+        {"camera_init_grid: v0 beyond 2^20 px", CT_ERR_LENS,
+         [](ct_unproject_grid &g, int32_t *) { g.v0_q16 = -((int64_t)CT_CAM_MAX_PIXEL << 16) - 1; }},
+        {"camera_init_grid: fewer rays than nodes", CT_ERR_LENS, [](ct_unproject_grid &g, int32_t *) { g.rays_len = 47; }},
+        {"camera_init_grid: a node (0, 1, 0) (ok)", CT_OK,
+         [](ct_unproject_grid &, int32_t *r) { r[3 * 5 + 1] = 1 << 30, r[3 * 5 + 2] = 0; }},
+        {"camera_init_grid: a node (0, 0, 0) (no ray, ok)", CT_OK, [](ct_unproject_grid &, int32_t *r) { r[3 * 5 + 2] = 0; }},
+        {"camera_init_grid: x beyond 1", CT_ERR_LENS, [](ct_unproject_grid &, int32_t *r) { r[3 * 5] = (1 << 30) + (1 << 13); }},
+        {"camera_init_grid: x below -1", CT_ERR_LENS, [](ct_unproject_grid &, int32_t *r) { r[3 * 5] = -(1 << 30) - (1 << 13); }},
+        {"camera_init_grid: y beyond 1", CT_ERR_LENS, [](ct_unproject_grid &, int32_t *r) { r[3 * 5 + 1] = (1 << 30) + (1 << 13); }},
+        {"camera_init_grid: y below -1", CT_ERR_LENS,
+         [](ct_unproject_grid &, int32_t *r) { r[3 * 5 + 1] = -(1 << 30) - (1 << 13); }},
+        {"camera_init_grid: z beyond 1", CT_ERR_LENS, [](ct_unproject_grid &, int32_t *r) { r[3 * 5 + 2] = (1 << 30) + (1 << 13); }},
+        {"camera_init_grid: z below -1", CT_ERR_LENS,
+         [](ct_unproject_grid &, int32_t *r) { r[3 * 5 + 2] = -(1 << 30) - (1 << 13); }},
+        {"camera_init_grid: a node not of unit length", CT_ERR_LENS, [](ct_unproject_grid &, int32_t *r) { r[3 * 5 + 2] = 1 << 29; }},
+    };
+    for (const GridEdit &e : grid_edits) {
+        const GridEdit *ep = &e;
+        add(e.name, e.want, [ep](World &) {
+            static int32_t rays[48];
+            for (int k = 0; k < 16; ++k) rays[3 * k] = rays[3 * k + 1] = 0, rays[3 * k + 2] = 1 << 30;
+            ct_unproject_grid g{4u, 4u, 0, 0, INT64_C(16) << 16, rays, 48};
+            ep->edit(g, rays);
+            ct_camera c;
+            return ct_camera_init_grid(&c, &g);
+        });
+    }
+    // unprojecting through a grid: the centre cell of the 4 x 4 grid
+    // (pixels 16..32) is the one cell with a node on every side
+    struct GridPixel {
+        const char *name;
+        ct_status want;
+        void (*edit)(int32_t *rays);
+    };
+    static const GridPixel grid_pixels[] = {
+        {"camera_unproject (grid): the axis (ok)", CT_OK, [](int32_t *) {}},
+        {"camera_unproject (grid): a node without a ray (x, y, z all 0)", CT_ERR_UNPROJECT,
+         [](int32_t *r) { r[3 * 5 + 2] = 0; }},
+        {"camera_unproject (grid): a node (0, 1, 0), 90 deg from its neighbours", CT_ERR_UNPROJECT,
+         [](int32_t *r) { r[3 * 5 + 1] = 1 << 30, r[3 * 5 + 2] = 0; }},
+        {"camera_unproject (grid): rows of opposite rays (they cancel)", CT_ERR_UNPROJECT,
+         [](int32_t *r) {
+             for (int k = 8; k < 16; ++k) r[3 * k + 2] = -(1 << 30);
+         }},
+    };
+    for (const GridPixel &e : grid_pixels) {
+        const GridPixel *ep = &e;
+        add(e.name, e.want, [ep](World &) -> ct_status {
+            static int32_t rays[48];
+            for (int k = 0; k < 16; ++k) rays[3 * k] = rays[3 * k + 1] = 0, rays[3 * k + 2] = 1 << 30;
+            ep->edit(rays);
+            const ct_unproject_grid g{4u, 4u, 0, 0, INT64_C(16) << 16, rays, 48};
+            ct_camera c;
+            if (ct_camera_init_grid(&c, &g) != CT_OK) return CT_ERR_INTERNAL;
+            int32_t r[3] = {0, 0, 0};
+            const ct_status st = ct_camera_unproject(&c, INT64_C(20) << 16, INT64_C(21) << 16, r, nullptr);
+            if (st == CT_OK && (r[0] != 0 || r[1] != 0 || r[2] != 1 << 30)) return CT_ERR_INTERNAL;  // the axis
+            return st;
+        });
+    }
+    add("pose_init: east beyond 2^61 nm", CT_ERR_POSE, [](World &) {
+        const int32_t R[9] = {1 << 30, 0, 0, 0, 1 << 30, 0, 0, 0, 1 << 30};
+        ct_pose q;
+        return ct_pose_init(&q, R, (INT64_C(1) << 61) + 1, 0, 0);
+    });
+    add("pose_init: north beyond 2^61 nm", CT_ERR_POSE, [](World &) {
+        const int32_t R[9] = {1 << 30, 0, 0, 0, 1 << 30, 0, 0, 0, 1 << 30};
+        ct_pose q;
+        return ct_pose_init(&q, R, 0, -(INT64_C(1) << 61) - 1, 0);
+    });
+    add("pose_init: height beyond 2^61 nm", CT_ERR_POSE, [](World &) {
+        const int32_t R[9] = {1 << 30, 0, 0, 0, 1 << 30, 0, 0, 0, 1 << 30};
+        ct_pose q;
+        return ct_pose_init(&q, R, 0, 0, (INT64_C(1) << 61) + 1);
+    });
+    add("pose_init: an entry of the second column beyond 1", CT_ERR_POSE, [](World &) {
+        const int32_t R[9] = {1 << 30, (1 << 30) + (1 << 13), 0, 0, 1 << 30, 0, 0, 0, 1 << 30};
+        ct_pose q;
+        return ct_pose_init(&q, R, 0, 0, 0);
     });
     add("camera_init_grid: grid NULL", CT_ERR_ARG, [](World &) {
         ct_camera c;
@@ -316,6 +584,141 @@ std::vector<Case> cases()
         ct_earth_map m;
         std::memset(&m, 0, sizeof m);
         const ct_effects fx = {CT_EFFECT_CURVATURE, 0, 0, 0, &m};
+        ct_geo g;
+        return ct_geolocate(&w.p, &w.cam, &w.pose, CT_METHOD_DIRECTIONAL, &fx, 32 << 16, 24 << 16, &g);
+    });
+    // a map fitted for w.p, used with a package whose georeference differs
+    // in one field, or with one of its own fields out of range: "a map
+    // fitted for this package, else CT_ERR_EFFECTS"; the map as fitted gives
+    // the status of the exact conversions
+    static ct_earth_map fitted;
+    static ct_status fitted_st = CT_ERR_INTERNAL;
+    auto with_map = [](World &w, void (*edit)(ct_package &, ct_earth_map &)) -> ct_status {
+        if (fitted_st == CT_ERR_INTERNAL) fitted_st = ct_earth_map_init(&w.p, w.a[0], w.a[1], w.a[2], INT64_C(10000000000000), &fitted);
+        if (fitted_st != CT_OK) return fitted_st;
+        ct_package q = w.p;
+        ct_earth_map m = fitted;
+        edit(q, m);
+        const ct_effects fx = {CT_EFFECT_CURVATURE, 0, 0, 0, &m};
+        ct_geo g;
+        const ct_status st = ct_geolocate(&q, &w.cam, &w.pose, CT_METHOD_DIRECTIONAL, &fx, 32 << 16, 24 << 16, &g);
+        if (st < 0) return st;
+        // accepted: the status of the exact conversions (no map)
+        const ct_effects exact = {CT_EFFECT_CURVATURE, 0, 0, 0, nullptr};
+        ct_geo g2;
+        return ct_geolocate(&q, &w.cam, &w.pose, CT_METHOD_DIRECTIONAL, &exact, 32 << 16, 24 << 16, &g2) == st ? CT_OK : CT_ERR_INTERNAL;
+    };
+    struct MapEdit {
+        const char *name;
+        ct_status want;
+        void (*edit)(ct_package &, ct_earth_map &);
+    };
+    static const MapEdit map_edits[] = {
+        {"geolocate: the earth map as fitted (the exact status)", CT_OK, [](ct_package &, ct_earth_map &) {}},
+        {"geolocate: earth map of degree 3", CT_ERR_EFFECTS, [](ct_package &, ct_earth_map &m) { m.deg = 3; }},
+        {"geolocate: earth map of degree 7", CT_ERR_EFFECTS, [](ct_package &, ct_earth_map &m) { m.deg = CT_EARTH_MAP_DEG + 1; }},
+        {"geolocate: earth map cube 2^43 nm", CT_ERR_EFFECTS, [](ct_package &, ct_earth_map &m) { m.qrho = 43u; }},
+        {"geolocate: earth map cube 2^48 nm", CT_ERR_EFFECTS, [](ct_package &, ct_earth_map &m) { m.qrho = 48u; }},
+        {"geolocate: earth map of another origin (east)", CT_ERR_EFFECTS, [](ct_package &q, ct_earth_map &) { q.origin_e_nm += 1; }},
+        {"geolocate: earth map of another origin (north)", CT_ERR_EFFECTS, [](ct_package &q, ct_earth_map &) { q.origin_n_nm += 1; }},
+        {"geolocate: earth map of another posting (east)", CT_ERR_EFFECTS, [](ct_package &q, ct_earth_map &) { q.posting_e_nm += 1; }},
+        {"geolocate: earth map of another posting (north)", CT_ERR_EFFECTS, [](ct_package &q, ct_earth_map &) { q.posting_n_nm -= 1; }},
+        {"geolocate: earth map of another height offset", CT_ERR_EFFECTS, [](ct_package &q, ct_earth_map &) { q.height_offset_nm += 1; }},
+        {"geolocate: earth map of another height scale", CT_ERR_EFFECTS, [](ct_package &q, ct_earth_map &) { q.height_scale_nm += 1; }},
+        {"geolocate: earth map of another zone", CT_ERR_EFFECTS, [](ct_package &q, ct_earth_map &) { q.epsg = 32618u; }},
+    };
+    for (const MapEdit &e : map_edits) {
+        const MapEdit *ep = &e;
+        add(e.name, e.want, [with_map, ep](World &w) { return with_map(w, ep->edit); });
+    }
+    // the true Earth with the camera 2,000 km east of the package's zone
+    // (still inside the grid's range): its projection cannot take the pose
+    add("geolocate: true Earth, camera 2,000 km east of the zone", CT_ERR_POSE, [](World &w) {
+        const ct_effects fx = {CT_EFFECT_CURVATURE, 0, 0, 0, nullptr};
+        ct_pose pose = w.pose;
+        pose.e_nm += INT64_C(2000000000000000);
+        ct_geo g;
+        return ct_geolocate(&w.p, &w.cam, &pose, CT_METHOD_DIRECTIONAL, &fx, 32 << 16, 24 << 16, &g);
+    });
+    // a package whose EPSG code is beyond INT32_MAX (the header field is 32
+    // bits unsigned): no UTM zone, so the true Earth falls back to the
+    // sphere of 6371 km (the same hit as asking for it), and no earth map
+    add("geolocate: true Earth, EPSG beyond INT32_MAX: the sphere's hit", CT_OK, [](World &w) -> ct_status {
+        ct_package q = w.p;
+        q.epsg = 0x80000000u + 32617u;
+        const ct_effects earth = {CT_EFFECT_CURVATURE, 0, 0, 0, nullptr};
+        const ct_effects sphere = {CT_EFFECT_CURVATURE, 0, CT_EARTH_RADIUS_NM, 0, nullptr};
+        ct_geo g1, g2;
+        const ct_status s1 = ct_geolocate(&q, &w.cam, &w.pose, CT_METHOD_DIRECTIONAL, &earth, 32 << 16, 24 << 16, &g1);
+        const ct_status s2 = ct_geolocate(&q, &w.cam, &w.pose, CT_METHOD_DIRECTIONAL, &sphere, 32 << 16, 24 << 16, &g2);
+        if (s1 != s2 || s1 < 0) return CT_ERR_INTERNAL;
+        return s1 != CT_HIT || (g1.hit.e_nm == g2.hit.e_nm && g1.hit.n_nm == g2.hit.n_nm && g1.hit.h_nm == g2.hit.h_nm)
+                   ? CT_OK
+                   : CT_ERR_INTERNAL;
+    });
+    add("los: true Earth, EPSG beyond INT32_MAX: the sphere's answer", CT_OK, [](World &w) -> ct_status {
+        ct_package q = w.p;
+        q.epsg = 0x80000000u + 32617u;
+        const ct_effects earth = {CT_EFFECT_CURVATURE, 0, 0, 0, nullptr};
+        const ct_effects sphere = {CT_EFFECT_CURVATURE, 0, CT_EARTH_RADIUS_NM, 0, nullptr};
+        ct_hit h1, h2;
+        const ct_status s1 = ct_los(&q, w.a, w.b, &earth, 0, CT_METHOD_DIRECTIONAL, &h1);
+        const ct_status s2 = ct_los(&q, w.a, w.b, &sphere, 0, CT_METHOD_DIRECTIONAL, &h2);
+        return s1 == s2 && s1 >= 0 ? CT_OK : CT_ERR_INTERNAL;
+    });
+    add("earth_map_init: centre 2,000 km east of the zone's meridian", CT_ERR_RANGE, [](World &w) {
+        static ct_earth_map m;
+        return ct_earth_map_init(&w.p, w.a[0] + INT64_C(2000000000000000), w.a[1], w.a[2], INT64_C(10000000000000), &m);
+    });
+    add("earth_map_init: EPSG beyond INT32_MAX", CT_ERR_CRS, [](World &w) {
+        ct_package q = w.p;
+        q.epsg = 0x80000000u + 32617u;
+        static ct_earth_map m;
+        return ct_earth_map_init(&q, w.a[0], w.a[1], w.a[2], INT64_C(10000000000000), &m);
+    });
+    // heights in 0.1 mm codes: a cube of 2^47 nm leaves too few fraction
+    // bits for the fit (CT_ERR_RANGE), one of 2^44 nm fits; the per-call fit
+    // of CT_EFFECT_EARTH_FIT falls back to the exact conversions there (the
+    // same hit as without it, bit for bit)
+    static dem_cases::Case fine_h;
+    static ct_package pfh;
+    auto fine_heights = [](World &w) -> const ct_package * {
+        if (fine_h.pkg.empty()) {
+            ct_host::Terrain t = w.c.t;
+            t.height_scale_m = 1e-4;
+            fine_h = dem_cases::make_case("0.1 mm codes", t, 8, 2);
+            if (ct_package_open(&pfh, fine_h.pkg.data(), fine_h.pkg.size()) != CT_OK) return nullptr;
+        }
+        return &pfh;
+    };
+    add("earth_map_init (0.1 mm height codes): a cube of 2^47 nm", CT_ERR_RANGE, [fine_heights](World &w) -> ct_status {
+        const ct_package *q = fine_heights(w);
+        if (q == nullptr) return CT_ERR_INTERNAL;
+        static ct_earth_map m;
+        if (ct_earth_map_init(q, w.a[0], w.a[1], w.a[2], INT64_C(1) << 44, &m) != CT_OK) return CT_ERR_INTERNAL;
+        return ct_earth_map_init(q, w.a[0], w.a[1], w.a[2], INT64_C(1) << 47, &m);
+    });
+    add("geolocate (0.1 mm height codes): EARTH_FIT from 50 km up falls back to exact", CT_HIT, [fine_heights](World &w) -> ct_status {
+        const ct_package *q = fine_heights(w);
+        if (q == nullptr) return CT_ERR_INTERNAL;
+        int32_t qq[4];
+        ct_pose pose;
+        if (ct_quat_from_ypr(0, dem_cases::deg_q61(-90), 0, qq) != CT_OK ||
+            ct_pose_from_map(&pose, w.a[0], w.a[1], w.a[2] + INT64_C(50000000000000), qq) != CT_OK)
+            return CT_ERR_INTERNAL;
+        const ct_effects fit = {CT_EFFECT_CURVATURE | CT_EFFECT_EARTH_FIT, 0, 0, 0, nullptr};
+        const ct_effects exact = {CT_EFFECT_CURVATURE, 0, 0, 0, nullptr};
+        ct_geo g1, g2;
+        // the principal point (63/2, 47/2) px: straight down
+        const ct_status s1 = ct_geolocate(q, &w.cam, &pose, CT_METHOD_DIRECTIONAL, &fit, 63 << 15, 47 << 15, &g1);
+        const ct_status s2 = ct_geolocate(q, &w.cam, &pose, CT_METHOD_DIRECTIONAL, &exact, 63 << 15, 47 << 15, &g2);
+        if (s1 != s2 || s1 < 0) return CT_ERR_INTERNAL;
+        return s1 != CT_HIT || (g1.hit.x_q16 == g2.hit.x_q16 && g1.hit.y_q16 == g2.hit.y_q16 && g1.hit.z_q16 == g2.hit.z_q16)
+                   ? s1
+                   : CT_ERR_INTERNAL;
+    });
+    add("geolocate: chord beyond 2^50 nm", CT_ERR_EFFECTS, [](World &w) {
+        const ct_effects fx = {CT_EFFECT_CURVATURE, 0, 0, (INT64_C(1) << 50) + 1, nullptr};
         ct_geo g;
         return ct_geolocate(&w.p, &w.cam, &w.pose, CT_METHOD_DIRECTIONAL, &fx, 32 << 16, 24 << 16, &g);
     });
@@ -423,6 +826,20 @@ std::vector<Case> cases()
         ct_hit h;
         return ct_tileset_trace(nullptr, &w.ray, CT_METHOD_DIRECTIONAL, &h);
     });
+    add("tileset_trace: ray NULL", CT_ERR_ARG, [](World &) {
+        static ct_tileset ts{};
+        ct_hit h;
+        return ct_tileset_trace(&ts, nullptr, CT_METHOD_DIRECTIONAL, &h);
+    });
+    add("tileset_trace: hit NULL", CT_ERR_ARG, [](World &w) {
+        static ct_tileset ts{};
+        return ct_tileset_trace(&ts, &w.ray, CT_METHOD_DIRECTIONAL, nullptr);
+    });
+    add("tileset_trace: unknown method", CT_ERR_METHOD, [](World &w) {
+        static ct_tileset ts{};
+        ct_hit h;
+        return ct_tileset_trace(&ts, &w.ray, kBadMethod, &h);
+    });
     add("geolocate_tiles: ts NULL", CT_ERR_ARG, [](World &w) {
         ct_geo g;
         return ct_geolocate_tiles(nullptr, &w.cam, &w.pose, CT_METHOD_DIRECTIONAL, nullptr, 0, 0, &g);
@@ -435,6 +852,277 @@ std::vector<Case> cases()
     add("los_tiles: ts NULL", CT_ERR_ARG, [](World &w) {
         ct_hit h;
         return ct_los_tiles(nullptr, w.a, w.b, nullptr, 0, CT_METHOD_DIRECTIONAL, &h);
+    });
+    // ---- each part of a range check of several parts on its own (the
+    // other parts in range), so that every part is seen to refuse
+    add("package_size: height 1", CT_ERR_DIMS, [](World &) {
+        uint32_t s;
+        return ct_package_size(16, 1, 1, 8, 0, &s);
+    });
+    add("package_size: width CT_MAX_POSTS + 1", CT_ERR_DIMS, [](World &) {
+        uint32_t s;
+        return ct_package_size(CT_MAX_POSTS + 1u, 16, 1, 8, 0, &s);
+    });
+    add("package_size: height CT_MAX_POSTS + 1", CT_ERR_DIMS, [](World &) {
+        uint32_t s;
+        return ct_package_size(16, CT_MAX_POSTS + 1u, 1, 8, 0, &s);
+    });
+    add("package_size: CT_MAX_SECTORS + 1 sectors", CT_ERR_SECTORS, [](World &) {
+        uint32_t s;
+        return ct_package_size(16, 16, 1, CT_MAX_SECTORS + 1u, 0, &s);
+    });
+    add("package_size: r CT_MAX_REDUCE + 1", CT_ERR_REDUCE, [](World &) {
+        uint32_t s;
+        return ct_package_size(16, 16, CT_MAX_REDUCE + 1u, 8, 0, &s);
+    });
+    // the largest grid, r = 1, 64 sectors: 32767^2 cells x 65 angle planes
+    // alone are 2^36 bytes, beyond a 32-bit package size
+    add("package_size: CT_MAX_POSTS^2, r 1, 64 sectors (over 4 GB)", CT_ERR_SIZE, [](World &) {
+        uint32_t s;
+        return ct_package_size(CT_MAX_POSTS, CT_MAX_POSTS, 1, CT_MAX_SECTORS, 1, &s);
+    });
+    add("crc32: data NULL, len 0 (nothing to read)", CT_OK, [](World &) {
+        uint32_t c = 1;
+        const ct_status st = ct_crc32(0, nullptr, 0, &c);
+        return st == CT_OK && c == 0u ? CT_OK : CT_ERR_INTERNAL;  // the CRC of no bytes from 0 is 0
+    });
+    add("package_verify: a package never opened (no bytes)", CT_ERR_ARG, [](World &) {
+        static const ct_package q{};
+        return ct_package_verify(&q);
+    });
+    add("cot_table: height scale 0", CT_ERR_GEOREF, [](World &) {
+        static int64_t out[256];
+        static uint8_t ok[256];
+        return ct_cot_table(30000000000, 0, out, ok);
+    });
+    add("cot_table: posting beyond 2^50", CT_ERR_GEOREF, [](World &) {
+        static int64_t out[256];
+        static uint8_t ok[256];
+        return ct_cot_table((INT64_C(1) << 50) + 1, 62500000, out, ok);
+    });
+    add("cot_table: height scale beyond 2^46", CT_ERR_GEOREF, [](World &) {
+        static int64_t out[256];
+        static uint8_t ok[256];
+        return ct_cot_table(30000000000, (INT64_C(1) << 46) + 1, out, ok);
+    });
+    add("in_wedge: 0 sectors", CT_ERR_SECTORS, [](World &w) {
+        uint32_t in;
+        return ct_in_wedge(w.p.bound_x, w.p.bound_y, 0, 0, 1, 0, &in);
+    });
+    add("in_wedge: CT_MAX_SECTORS + 1 sectors", CT_ERR_SECTORS, [](World &w) {
+        uint32_t in;
+        return ct_in_wedge(w.p.bound_x, w.p.bound_y, CT_MAX_SECTORS + 1u, 0, 1, 0, &in);
+    });
+    add("in_wedge: dy beyond 2^30", CT_ERR_ARG, [](World &w) {
+        uint32_t in;
+        return ct_in_wedge(w.p.bound_x, w.p.bound_y, 8, 0, 1, -(INT64_C(1) << 30) - 1, &in);
+    });
+    add("sector_of: dx beyond 2^30", CT_ERR_ARG, [](World &w) {
+        uint32_t s;
+        return ct_sector_of(&w.p, -(INT64_C(1) << 30) - 1, 0, &s);
+    });
+    add("sector_of: dy beyond 2^30", CT_ERR_ARG, [](World &w) {
+        uint32_t s;
+        return ct_sector_of(&w.p, 0, (INT64_C(1) << 30) + 1, &s);
+    });
+    add("status_name: one past CT_NO_DATA", CT_ERR_ARG, [](World &) {
+        const char *n = nullptr;
+        return ct_status_name((ct_status)(CT_NO_DATA + 1), &n);
+    });
+    add("status_name: one below CT_ERR_CRS", CT_ERR_ARG, [](World &) {
+        const char *n = nullptr;
+        return ct_status_name((ct_status)(CT_ERR_CRS - 1), &n);
+    });
+    add("utm_zone_of_epsg: 32761 (one past the southern zones)", CT_ERR_CRS, [](World &) {
+        ct_utm z;
+        return ct_utm_zone_of_epsg(32761, &z);
+    });
+    add("utm_inverse: zone 0", CT_ERR_ARG, [](World &) {
+        const ct_utm z = {0, 0};
+        int64_t lat, lon;
+        return ct_utm_inverse(&z, 500000000000000, 0, &lat, &lon);
+    });
+    add("utm_inverse: zone 61", CT_ERR_ARG, [](World &) {
+        const ct_utm z = {61, 0};
+        int64_t lat, lon;
+        return ct_utm_inverse(&z, 500000000000000, 0, &lat, &lon);
+    });
+    add("utm_inverse: northing beyond 2^60 nm", CT_ERR_RANGE, [](World &) {
+        const ct_utm z = {17, 0};
+        int64_t lat, lon;
+        return ct_utm_inverse(&z, 500000000000000, (INT64_C(1) << 60) + 1, &lat, &lon);
+    });
+    add("utm_inverse: 9,600 km north of the equator (beyond 84.5 deg)", CT_ERR_RANGE, [](World &) {
+        const ct_utm z = {17, 0};
+        int64_t lat, lon;
+        return ct_utm_inverse(&z, 500000000000000, 9600000000000000, &lat, &lon);
+    });
+    // 1,000 km east of the meridian at 6,600 km north (about 59 deg): some
+    // 17 deg of longitude away, beyond the zone's 9 deg
+    add("utm_inverse: 17 deg from the central meridian", CT_ERR_RANGE, [](World &) {
+        const ct_utm z = {17, 0};
+        int64_t lat, lon;
+        return ct_utm_inverse(&z, 1500000000000000, 6600000000000000, &lat, &lon);
+    });
+    add("package_geoid: a package on no UTM zone (EPSG 0)", CT_ERR_CRS, [](World &w) {
+        ct_package q = w.p;
+        int64_t n;
+        q.epsg = 0;
+        return ct_package_geoid(&q, w.a[0], w.a[1], &n);
+    });
+    add("package_geoid: an EPSG code beyond INT32_MAX", CT_ERR_CRS, [](World &w) {
+        ct_package q = w.p;
+        int64_t n;
+        q.epsg = 0x80000000u + 32617u;
+        return ct_package_geoid(&q, w.a[0], w.a[1], &n);
+    });
+    add("package_geoid: a point far off the zone", CT_ERR_RANGE, [](World &w) {
+        int64_t n;
+        return ct_package_geoid(&w.p, INT64_C(1) << 61, w.a[1], &n);
+    });
+    // a 2 x 2 geoid grid with its north-west node at 0.5 rad, 0.1 rad
+    // apart, but one dimension or the point out of range
+    static const uint8_t geoid_vals[16 * 4097] = {0};
+    auto geoid = [](uint32_t gw, uint32_t gh) {
+        return ct_geoid_grid{gw, gh, CT_PI_Q61 / 6, 0, CT_PI_Q61 / 31, geoid_vals};
+    };
+    add("geoid_at: a grid of one row", CT_ERR_RANGE, [geoid](World &) {
+        const ct_geoid_grid g = geoid(2, 1);
+        int64_t n;
+        return ct_geoid_at(&g, CT_PI_Q61 / 7, CT_PI_Q61 / 64, &n);
+    });
+    add("geoid_at: a grid of CT_GEOID_MAX_NODES + 1 rows", CT_ERR_RANGE, [geoid](World &) {
+        const ct_geoid_grid g = geoid(2, CT_GEOID_MAX_NODES + 1u);
+        int64_t n;
+        return ct_geoid_at(&g, CT_PI_Q61 / 7, CT_PI_Q61 / 64, &n);
+    });
+    add("geoid_at: a point north of the grid's first row", CT_ERR_RANGE, [geoid](World &) {
+        const ct_geoid_grid g = geoid(2, 2);
+        int64_t n;
+        return ct_geoid_at(&g, CT_PI_Q61 / 5, CT_PI_Q61 / 64, &n);
+    });
+    add("geoid_at: the same grid, a point inside it", CT_OK, [geoid](World &) {
+        const ct_geoid_grid g = geoid(2, 2);
+        int64_t n = 1;
+        const ct_status st = ct_geoid_at(&g, CT_PI_Q61 / 6 - CT_PI_Q61 / 64, CT_PI_Q61 / 64, &n);
+        return st == CT_OK && n == 0 ? CT_OK : CT_ERR_INTERNAL;  // all nodes 0
+    });
+    // ---- the grid's range: on the 1 um grid a point 10 km away is beyond
+    // CT_MAX_ORIGIN_Q16 (2^46 Q16) and one 2^57 nm away beyond what
+    // ct_map_to_grid can express (2^62)
+    const int64_t km10 = INT64_C(10000000000000), far57 = INT64_C(1) << 57;
+    add("map_to_grid (1 um grid): 2^57 nm east", CT_ERR_RANGE, [far57](World &w) {
+        int64_t x, y, z;
+        return ct_map_to_grid(&w.fine, w.fa[0] + far57, w.fa[1], w.fa[2], &x, &y, &z);
+    });
+    add("map_to_grid (1 um grid): 2^57 nm north", CT_ERR_RANGE, [far57](World &w) {
+        int64_t x, y, z;
+        return ct_map_to_grid(&w.fine, w.fa[0], w.fa[1] - far57, w.fa[2], &x, &y, &z);
+    });
+    add("map_to_grid (1 um grid): 2^57 nm up", CT_ERR_RANGE, [far57](World &w) {
+        int64_t x, y, z;
+        return ct_map_to_grid(&w.fine, w.fa[0], w.fa[1], w.fa[2] + far57, &x, &y, &z);
+    });
+    // a camera looking down 60 deg at (de, dn, dh) from the fine tile's point
+    auto fine_geo = [](World &w, int64_t de, int64_t dn, int64_t dh, const ct_effects *fx) -> ct_status {
+        int32_t q[4];
+        ct_pose pose;
+        if (ct_quat_from_ypr(0, dem_cases::deg_q61(-60), 0, q) != CT_OK ||
+            ct_pose_from_map(&pose, w.fa[0] + de, w.fa[1] + dn, w.fa[2] + dh, q) != CT_OK)
+            return CT_ERR_INTERNAL;
+        ct_geo g;
+        return ct_geolocate(&w.fine, &w.cam, &pose, CT_METHOD_DIRECTIONAL, fx, 32 << 16, 24 << 16, &g);
+    };
+    static const ct_effects earth = {CT_EFFECT_CURVATURE | CT_EFFECT_REFRACTION, CT_REFRACTION_K_STD_Q16, 0, 0, nullptr};
+    static const ct_effects sphere = {CT_EFFECT_CURVATURE, 0, CT_EARTH_RADIUS_NM, 0, nullptr};
+    for (const ct_effects *fx : {(const ct_effects *)nullptr, &earth, &sphere}) {
+        const std::string tag = fx == nullptr ? "" : (fx == &earth ? ", true Earth" : ", sphere");
+        static std::deque<std::string> names;  // push_back keeps earlier elements in place
+        auto name = [&](const char *what) {
+            names.push_back(std::string("geolocate (1 um grid): camera ") + what + tag);
+            return names.back().c_str();
+        };
+        add(name("10 km east"), CT_ERR_RAY, [fine_geo, fx, km10](World &w) { return fine_geo(w, km10, 0, 0, fx); });
+        add(name("10 km south"), CT_ERR_RAY, [fine_geo, fx, km10](World &w) { return fine_geo(w, 0, -km10, 0, fx); });
+        add(name("10 km up"), CT_ERR_RAY, [fine_geo, fx, km10](World &w) { return fine_geo(w, 0, 0, km10, fx); });
+        add(name("2^57 nm west"), CT_ERR_RAY, [fine_geo, fx, far57](World &w) { return fine_geo(w, -far57, 0, 0, fx); });
+    }
+    // line of sight with one end beyond the grid's range on one axis
+    struct LosEnd {
+        const char *name;
+        int end, axis;
+        int64_t d;
+    };
+    static const LosEnd los_ends[] = {
+        {"los (1 um grid): A 10 km east", 0, 0, INT64_C(10000000000000)},
+        {"los (1 um grid): A 10 km north", 0, 1, INT64_C(10000000000000)},
+        {"los (1 um grid): A 10 km up", 0, 2, INT64_C(10000000000000)},
+        {"los (1 um grid): B 10 km west", 1, 0, -INT64_C(10000000000000)},
+        {"los (1 um grid): B 10 km south", 1, 1, -INT64_C(10000000000000)},
+        {"los (1 um grid): B 10 km up", 1, 2, INT64_C(10000000000000)},
+        {"los (1 um grid): A 2^57 nm east", 0, 0, INT64_C(1) << 57},
+        {"los (1 um grid): B 2^57 nm north", 1, 1, INT64_C(1) << 57},
+    };
+    for (const LosEnd &e : los_ends) {
+        const LosEnd *ep = &e;
+        add(e.name, CT_ERR_RAY, [ep](World &w) {
+            int64_t a[3] = {w.fa[0], w.fa[1], w.fa[2]}, b[3] = {w.fa[0] + 3000, w.fa[1] - 4000, w.fa[2] - 1000};
+            (ep->end == 0 ? a : b)[ep->axis] += ep->d;
+            ct_hit h;
+            return ct_los(&w.fine, a, b, nullptr, 0, CT_METHOD_DIRECTIONAL, &h);
+        });
+    }
+    // the sphere on the 1 um grid (its lowering's constants from the far
+    // end of their normalisation): over 23 um the bend is far below a
+    // height code, so the answer is the straight line's
+    add("los (1 um grid): the sphere, as straight", CT_OK, [](World &w) -> ct_status {
+        const ct_effects fx = {CT_EFFECT_CURVATURE, 0, CT_EARTH_RADIUS_NM, 0, nullptr};
+        ct_hit h;
+        for (int64_t dz : {INT64_C(-1000), INT64_C(-100000), INT64_C(-3000000)}) {
+            const int64_t b[3] = {w.fa[0] + 3000, w.fa[1] - 4000, w.fa[2] + dz};
+            const ct_status s1 = ct_los(&w.fine, w.fa, b, &fx, 0, CT_METHOD_DIRECTIONAL, &h);
+            if (s1 < 0 || s1 != ct_los(&w.fine, w.fa, b, nullptr, 0, CT_METHOD_DIRECTIONAL, &h)) return CT_ERR_INTERNAL;
+        }
+        return CT_OK;
+    });
+    add("earth_map_init (1 um grid): centre 10 km east", CT_ERR_RANGE, [km10](World &w) {
+        static ct_earth_map m;
+        return ct_earth_map_init(&w.fine, w.fa[0] + km10, w.fa[1], w.fa[2], INT64_C(10000000000000), &m);
+    });
+    add("earth_map_init (1 um grid): centre 10 km north", CT_ERR_RANGE, [km10](World &w) {
+        static ct_earth_map m;
+        return ct_earth_map_init(&w.fine, w.fa[0], w.fa[1] + km10, w.fa[2], INT64_C(10000000000000), &m);
+    });
+    add("earth_map_init (1 um grid): centre 10 km up", CT_ERR_RANGE, [km10](World &w) {
+        static ct_earth_map m;
+        return ct_earth_map_init(&w.fine, w.fa[0], w.fa[1], w.fa[2] + km10, INT64_C(10000000000000), &m);
+    });
+    // ---- a grid whose axes run west and north: ct_map_to_grid is
+    // ct_grid_to_map's inverse, x grows westwards and y northwards, and a
+    // camera straight above a point sees that point
+    add("map_to_grid (axes west and north): inverse of grid_to_map, x west, y north", CT_OK, [](World &w) -> ct_status {
+        int64_t e, n, h, x, y, z, x2, y2, z2;
+        if (ct_grid_to_map(&w.west, 7 << 16, 5 << 16, 1000 << 16, &e, &n, &h) != CT_OK ||
+            ct_map_to_grid(&w.west, e, n, h, &x, &y, &z) != CT_OK ||
+            ct_map_to_grid(&w.west, e - 30000000000, n + 30000000000, h, &x2, &y2, &z2) != CT_OK)
+            return CT_ERR_INTERNAL;
+        return x == 7 << 16 && y == 5 << 16 && z == 1000 << 16 && x2 == x + 65536 && y2 == y + 65536 && z2 == z
+                   ? CT_OK
+                   : CT_ERR_INTERNAL;
+    });
+    add("geolocate (axes west and north): nadir pixel hits below the camera", CT_HIT, [](World &w) -> ct_status {
+        int64_t e, n, h;
+        int32_t q[4];
+        ct_pose pose;
+        if (ct_grid_to_map(&w.west, (11 << 16) + 12345, (9 << 16) + 23456, (int64_t)w.west.hmax << 16, &e, &n, &h) != CT_OK ||
+            ct_quat_from_ypr(0, dem_cases::deg_q61(-90), 0, q) != CT_OK ||
+            ct_pose_from_map(&pose, e, n, h + 200000000000, q) != CT_OK)
+            return CT_ERR_INTERNAL;
+        ct_geo g;
+        // the centred pinhole's principal point: (63/2, 47/2) px
+        const ct_status st = ct_geolocate(&w.west, &w.cam, &pose, CT_METHOD_DIRECTIONAL, nullptr, 63 << 15, 47 << 15, &g);
+        if (st == CT_HIT && (std::llabs(g.hit.e_nm - e) > 1000000 || std::llabs(g.hit.n_nm - n) > 1000000)) return CT_ERR_INTERNAL;
+        return st;
     });
     // ---- every other pointer argument NULL: CT_ERR_ARG, the rule of the header
     auto null_arg = [&](const char *name, std::function<ct_status(World &)> f) { add(name, CT_ERR_ARG, std::move(f)); };
@@ -887,6 +1575,37 @@ std::vector<Case> cases()
         const int64_t far[3] = {w.a[0] + INT64_C(2000000000000000), w.a[1], w.a[2]};
         ct_hit h;
         return ct_los(&w.p, far, w.b, &fx, 0, CT_METHOD_DIRECTIONAL, &h);
+    });
+    add("los: the sphere from 2,000 km north of the tile (no lowered model)", CT_ERR_EFFECTS, [](World &w) {
+        const ct_effects fx = {CT_EFFECT_CURVATURE, 0, CT_EARTH_RADIUS_NM, 0, nullptr};
+        const int64_t far[3] = {w.a[0], w.a[1] + INT64_C(2000000000000000), w.a[2]};
+        ct_hit h;
+        return ct_los(&w.p, far, w.b, &fx, 0, CT_METHOD_DIRECTIONAL, &h);
+    });
+    add("los: the sphere from 2,000 km south of the tile (no lowered model)", CT_ERR_EFFECTS, [](World &w) {
+        const ct_effects fx = {CT_EFFECT_CURVATURE, 0, CT_EARTH_RADIUS_NM, 0, nullptr};
+        const int64_t far[3] = {w.a[0], w.a[1] - INT64_C(2000000000000000), w.a[2]};
+        ct_hit h;
+        return ct_los(&w.p, far, w.b, &fx, 0, CT_METHOD_DIRECTIONAL, &h);
+    });
+    // posts 2 km apart (2^40 nm and more): beyond the lowered model's range
+    add("los: the sphere over 2 km posts (no lowered model)", CT_ERR_EFFECTS, [](World &w) -> ct_status {
+        static dem_cases::Case coarse;
+        static ct_package q;
+        if (coarse.pkg.empty()) {
+            ct_host::Terrain t = w.c.t;
+            t.geo.posting_e = 2000.0;
+            t.geo.posting_n = -2000.0;
+            coarse = dem_cases::make_case("coarse", t, 8, 2);
+            if (ct_package_open(&q, coarse.pkg.data(), coarse.pkg.size()) != CT_OK) return CT_ERR_INTERNAL;
+        }
+        int64_t a[3], b[3];
+        (void)ct_grid_to_map(&q, 12 << 16, 10 << 16, ((int64_t)q.hmax + 100) << 16, &a[0], &a[1], &a[2]);
+        (void)ct_grid_to_map(&q, 3 << 16, 4 << 16, (int64_t)q.hmin << 16, &b[0], &b[1], &b[2]);
+        const ct_effects fx = {CT_EFFECT_CURVATURE, 0, CT_EARTH_RADIUS_NM, 0, nullptr};
+        ct_hit h;
+        if (ct_los(&q, a, b, nullptr, 0, CT_METHOD_DIRECTIONAL, &h) < 0) return CT_ERR_INTERNAL;  // straight: fine
+        return ct_los(&q, a, b, &fx, 0, CT_METHOD_DIRECTIONAL, &h);
     });
     add("los: the true Earth from beyond the zone", CT_ERR_EFFECTS, [](World &w) {
         const ct_effects fx = {CT_EFFECT_CURVATURE, 0, 0, 0, nullptr};

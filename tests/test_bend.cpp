@@ -238,6 +238,13 @@ void test_bent_arguments()
     b2.coeff_q16 = 5 << 16;
     TEST_ASSERT_EQUAL_INT(CT_ERR_ARG, ct_trace_bent(&p, &ray, &b2, CT_METHOD_DIRECTIONAL, &h));
     TEST_ASSERT_EQUAL_INT(CT_ERR_METHOD, ct_trace_bent(&p, &ray, &bd, (ct_method)7, &h));
+    // the ray's ranges (checked here first for a bent ray): each alone
+    for (int k = 0; k < 6; ++k) {
+        ct_ray bad = ray;
+        int64_t *f[6] = {&bad.x_q16, &bad.y_q16, &bad.z_q16, &bad.dx, &bad.dy, &bad.dz};
+        *f[k] = k < 3 ? CT_MAX_ORIGIN_Q16 + 1 : -(INT64_C(1) << 62) - 1;
+        TEST_ASSERT_EQUAL_INT(CT_ERR_RAY, ct_trace_bent(&p, &bad, &bd, CT_METHOD_DIRECTIONAL, &h));
+    }
     // c = 0 and vertical rays are the straight trace
     b2 = bd;
     b2.coeff_q16 = 0;
@@ -247,6 +254,60 @@ void test_bent_arguments()
     ct_ray v = {3 << 16, 3 << 16, 500 << 16, 0, 0, -1};
     TEST_ASSERT_EQUAL_INT(ct_trace(&p, &v, CT_METHOD_CONE, &hs), ct_trace_bent(&p, &v, &bd, CT_METHOD_CONE, &h));
     TEST_ASSERT(h.z_q16 == hs.z_q16);
+}
+
+// The polyline (c < 0) where the curve does not matter or cannot be traced:
+// a ray whose horizontal part vanishes once reduced (the straight trace, bit
+// for bit), horizontal paths that never cross the tile -- along an axis
+// beside it, or past a corner -- (CT_MISS, as straight), a start far under
+// the tile's floor (CT_BELOW, as straight), an observer beyond 2^52 nm and a
+// path needing more than CT_BEND_MAX_SEGMENTS segments (CT_ERR_RANGE, as
+// documented).
+void test_bent_polyline_edges()
+{
+    auto cs = dem_cases::make_case("hills", dem_cases::make_terrain(40, 36, dem_cases::smooth(40, 36, 4, 1000, 9000)), 8, 2);
+    ct_package p;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_package_open(&p, cs.pkg.data(), cs.pkg.size()));
+    const ct_bend up = {-2 * 65536, INT64_C(6371000000000000), 1000000, 0u};  // k = 3: bends upwards
+    const int64_t W = (int64_t)p.cells_x << 16, H = (int64_t)p.cells_y << 16, top = ((int64_t)p.hmax + 5) << 16;
+    struct Ray {
+        const char *name;
+        ct_ray ray;
+        ct_status want;  // also the straight trace's
+    };
+    const Ray rays[] = {
+        {"nearly vertical", {W / 2, H / 3, top, 1, 0, -(INT64_C(1) << 62)}, CT_HIT},
+        {"along x, beside the tile (y < 0)", {-W, -(5 << 16), top, 1 << 20, 0, -(1 << 10)}, CT_MISS},
+        {"along x, beside the tile (y > top)", {-W, H + (5 << 16), top, 1 << 20, 0, -(1 << 10)}, CT_MISS},
+        {"along y, beside the tile (x < 0)", {-(5 << 16), -H, top, 0, 1 << 20, -(1 << 10)}, CT_MISS},
+        {"along y, beside the tile (x > top)", {W + (5 << 16), -H, top, 0, 1 << 20, -(1 << 10)}, CT_MISS},
+        {"past the corner", {-(5 << 16), H + (5 << 16), top, 1 << 20, 1 << 20, -(1 << 10)}, CT_MISS},
+        {"far under the floor", {-(100 << 16), H / 2, -(INT64_C(1) << 46) + (1 << 20), 1 << 16, 0, -(1 << 20)}, CT_BELOW},
+    };
+    for (const Ray &r : rays) {
+        ct_hit hb, hs;
+        const ct_status sb = ct_trace_bent(&p, &r.ray, &up, CT_METHOD_DIRECTIONAL, &hb);
+        const ct_status ss = ct_trace(&p, &r.ray, CT_METHOD_DIRECTIONAL, &hs);
+        TEST_ASSERT_MSG(sb == r.want && ss == r.want, "%s: bent %d, straight %d, expected %d", r.name, sb, ss, r.want);
+        if (sb == CT_HIT) TEST_ASSERT(hb.x_q16 == hs.x_q16 && hb.y_q16 == hs.y_q16 && hb.z_q16 == hs.z_q16);
+    }
+    // an observer 4,600 km west of the tile (beyond RHO_MAX, 2^52 nm), and
+    // one 2^45.5 Q16 cells west (its range times the posting passes 2^80):
+    // CT_ERR_RANGE, "the observer beyond 2^52 nm of the tile"
+    for (int64_t x0 : {-(INT64_C(153333) << 16), -(INT64_C(46000000000000))}) {
+        const ct_ray far = {x0, H / 2, top, 1 << 20, 0, 0};
+        ct_hit hf;
+        TEST_ASSERT_EQUAL_INT(CT_ERR_RANGE, ct_trace_bent(&p, &far, &up, CT_METHOD_DIRECTIONAL, &hf));
+    }
+    // 2000 x 3 posts of 30 m and a chord that makes the segment just over
+    // 1/64 cell: about 120,000 segments across the tile
+    auto wide = dem_cases::make_case("wide", dem_cases::make_terrain(2000, 3, std::vector<uint16_t>(6000, 100)), 1, 1);
+    ct_package q;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_package_open(&q, wide.pkg.data(), wide.pkg.size()));
+    const ct_bend fine = {-4 * 65536, INT64_C(1) << 40, 120000, 0u};
+    const ct_ray across = {0, 1 << 16, 200 << 16, 1 << 20, 0, 0};
+    ct_hit h;
+    TEST_ASSERT_EQUAL_INT(CT_ERR_RANGE, ct_trace_bent(&q, &across, &fine, CT_METHOD_DIRECTIONAL, &h));
 }
 
 // Regression: the segment length Delta = sqrt(8 chord R / |c|) was formed
@@ -323,6 +384,7 @@ int main()
 {
     TEST_BEGIN("test_bend");
     RUN_TEST(test_bent_arguments);
+    RUN_TEST(test_bent_polyline_edges);
     RUN_TEST(test_bent_segment_length_regression);
     RUN_TEST(test_bent_chord_check_agrees);
     RUN_TEST(test_bent_vs_reference);

@@ -493,6 +493,116 @@ void test_statuses_and_errors()
     TEST_ASSERT_EQUAL_INT(0, two[1].hit.steps);
 }
 
+// ct_effects_for_tolerance's cases (conetrace.h): a camera below every
+// post is unbounded, a level ray from below the tallest post reaches the
+// tile with no flat-ground bound (the default chord), rays rising from
+// above the tile bound nothing (the coarsest chord), a grid camera samples
+// its supported extent, a camera that unprojects nothing is
+// CT_ERR_UNPROJECT; and the choice is the smallest set whose bound is within
+// the tolerance (each bound just met, or just missed, by tol).
+void test_effects_choice()
+{
+    World *wd = world();
+    TEST_ASSERT(wd != nullptr);
+    const ct_package &p = wd->p;
+    const int64_t lo = p.height_offset_nm + (int64_t)p.hmin * p.height_scale_nm;
+    const int64_t hi = p.height_offset_nm + (int64_t)(p.hmax + 1) * p.height_scale_nm;
+    int64_t e, n, h;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_grid_to_map(&p, 64 << 16, 56 << 16, 0, &e, &n, &h));
+    ct_camera pin;
+    const ct_lens lens = dem_cases::centred_pinhole(640, 480, 500);
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_camera_init(&pin, &lens));
+    static int32_t axis[48], none[48];
+    for (int k = 0; k < 16; ++k) axis[3 * k] = axis[3 * k + 1] = 0, axis[3 * k + 2] = 1 << 30;
+    ct_camera grid, empty;
+    const ct_unproject_grid ga{4u, 4u, 0, 0, INT64_C(16) << 16, axis, 48}, gn{4u, 4u, 0, 0, INT64_C(16) << 16, none, 48};
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_camera_init_grid(&grid, &ga));
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_camera_init_grid(&empty, &gn));
+    const int64_t UNB = INT64_C(1) << 62;
+    struct Case {
+        const char *name;
+        const ct_camera *cam;
+        int64_t h_nm, pitch_deg;
+        int32_t k_q16;
+        ct_status want;
+        void (*check)(const ct_effects_choice &);
+    };
+    const Case cases[] = {
+        {"below every post", &pin, lo - 1000000000, -30, CT_REFRACTION_K_STD_Q16, CT_OK,
+         [](const ct_effects_choice &c) {
+             for (int k = 0; k < 3; ++k) TEST_ASSERT(c.bound_nm[k] == INT64_C(1) << 62);
+             TEST_ASSERT_EQUAL_INT(CT_EFFECT_ALL, (int)c.flags);
+         }},
+        {"level, below the tallest post", &pin, (lo + hi) / 2, 0, CT_REFRACTION_K_STD_Q16, CT_OK,
+         [](const ct_effects_choice &c) {
+             TEST_ASSERT(c.tan_min_q30 == 0);
+             TEST_ASSERT(c.chord_nm == CT_EFFECTS_CHORD_NM);
+             TEST_ASSERT(c.bound_nm[0] == INT64_C(1) << 62);
+         }},
+        {"level, below the tallest post, k = 0", &pin, (lo + hi) / 2, 0, 0, CT_OK,
+         [](const ct_effects_choice &c) {
+             TEST_ASSERT(c.bound_nm[0] == INT64_C(1) << 62 && c.bound_nm[2] == INT64_C(1) << 62);
+             TEST_ASSERT(c.bound_nm[1] == 0);  // curvature alone is exact with no refraction
+             TEST_ASSERT_EQUAL_INT(CT_EFFECT_CURVATURE, (int)c.flags);
+         }},
+        {"rising, above the tile", &pin, hi + 1000000000000, 60, CT_REFRACTION_K_STD_Q16, CT_OK,
+         [](const ct_effects_choice &c) {
+             TEST_ASSERT(c.bound_nm[0] == 0 && c.bound_nm[1] == 0 && c.bound_nm[2] == 0);
+             TEST_ASSERT(c.range_nm == 0 && c.tan_min_q30 == INT64_C(1) << 62);
+             TEST_ASSERT_EQUAL_INT(0, (int)c.flags);
+             TEST_ASSERT(c.chord_nm == INT64_C(1) << 50);
+         }},
+        {"a grid camera, the axis 30 deg down", &grid, hi + 1000000000000, -30, CT_REFRACTION_K_STD_Q16, CT_OK,
+         [](const ct_effects_choice &c) { TEST_ASSERT(c.samples > 0u && c.bound_nm[0] > 0); }},
+        {"a grid camera with no rays", &empty, hi + 1000000000000, -30, CT_REFRACTION_K_STD_Q16, CT_ERR_UNPROJECT,
+         nullptr},
+        {"k = -2, 30 deg down", &pin, hi + 1000000000000, -30, -2 * 65536, CT_OK, nullptr},
+        {"k = 0.13, 5 deg down", &pin, hi + 1000000000000, -5, CT_REFRACTION_K_STD_Q16, CT_OK, nullptr},
+    };
+    for (const Case &c : cases) {
+        int32_t q[4];
+        ct_pose pose;
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_quat_from_ypr(0, dem_cases::deg_q61((double)c.pitch_deg), 0, q));
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_pose_from_map(&pose, e, n, c.h_nm, q));
+        ct_effects_choice ch;
+        const ct_status st = ct_effects_for_tolerance(&p, c.cam, &pose, c.k_q16, 0, 0, &ch);
+        TEST_ASSERT_MSG(st == c.want, "%s: %d, expected %d", c.name, st, c.want);
+        if (st != CT_OK) continue;
+        if (c.check) c.check(ch);
+        // the choice against each bound: a tolerance equal to a bound
+        // admits it, one nm less does not (the sets in the header's order)
+        for (int b = 0; b < 3; ++b) {
+            if (ch.bound_nm[b] >= UNB) continue;
+            for (int64_t tol : {ch.bound_nm[b], ch.bound_nm[b] - 1}) {
+                if (tol < 0) continue;
+                ct_effects_choice c2;
+                TEST_ASSERT_EQUAL_INT(CT_OK, ct_effects_for_tolerance(&p, c.cam, &pose, c.k_q16, 0, tol, &c2));
+                const uint32_t want = ch.bound_nm[0] <= tol   ? 0u
+                                      : ch.bound_nm[1] <= tol ? (uint32_t)CT_EFFECT_CURVATURE
+                                      : ch.bound_nm[2] <= tol ? (uint32_t)CT_EFFECT_REFRACTION
+                                                              : (uint32_t)CT_EFFECT_ALL;
+                TEST_ASSERT_MSG(c2.flags == want, "%s, tol %lld: flags %u, expected %u", c.name, (long long)tol,
+                                c2.flags, want);
+                if (b == 2 && tol == ch.bound_nm[2] && c.k_q16 == -2 * 65536)
+                    TEST_ASSERT_EQUAL_INT(CT_EFFECT_REFRACTION, (int)c2.flags);  // |1 - k| = 3 > |k| = 2 > 1
+                // the chord: at least 2^10 nm, at most 2^50
+                TEST_ASSERT(c2.chord_nm >= 1024 && c2.chord_nm <= INT64_C(1) << 50);
+            }
+        }
+    }
+    // a camera 2^50 nm (1,126 km) east of the tile: each corner's offset
+    // capped at 2^49 nm, so the range is at most 2^49.5 nm
+    {
+        int32_t q[4];
+        ct_pose pose;
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_quat_from_ypr(0, dem_cases::deg_q61(-30), 0, q));
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_pose_from_map(&pose, e + (INT64_C(1) << 50), n - (INT64_C(1) << 50), hi + 1000000000000, q));
+        ct_effects_choice ch;
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_effects_for_tolerance(&p, &pin, &pose, CT_REFRACTION_K_STD_Q16, 0, 1000000, &ch));
+        TEST_ASSERT(ch.range_nm <= (int64_t)(std::sqrt(2.0) * (double)(INT64_C(1) << 49)) + 1);
+    }
+}
+
 }  // namespace
 
 int main()
@@ -501,5 +611,6 @@ int main()
     RUN_TEST(test_geolocate_vs_mrcal);
     RUN_TEST(test_occluded_by_wall);
     RUN_TEST(test_statuses_and_errors);
+    RUN_TEST(test_effects_choice);
     return TEST_END();
 }

@@ -192,6 +192,208 @@ void test_los_arguments()
     for (int m = 1; m < CT_METHOD_COUNT; ++m) TEST_ASSERT_EQUAL_INT(s0, ct_los(&p, a, b, nullptr, 0, (ct_method)m, &h));
 }
 
+// ct_locate_inverse (the pixel where a map point appears, and whether it
+// is visible) as the inverse of ct_geolocate: from a map pose and from a
+// geodetic pose (map metres per ground metre undone), with no effects and
+// with an effects record of no flags (the same answer), a point below the
+// surface (hidden), the camera centre itself (CT_ERR_RAY), a point behind
+// the camera (CT_ERR_UNPROJECT), a point 3,000 km away straight ahead in
+// azimuth (its direction scaled down first: the centre column), and a
+// camera under the surface (CT_BELOW, as ct_los).
+void test_locate_inverse_cases()
+{
+    ct_host::Terrain t = dem_cases::make_terrain(64, 64, dem_cases::smooth(64, 64, 5, 1000, 4000), 0.25);
+    t.geo.epsg = 32617;
+    const dem_cases::Case cs = dem_cases::make_case("inverse", t, 8, 2);
+    ct_package p;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_package_open(&p, cs.pkg.data(), cs.pkg.size()));
+    const ct_lens lens = dem_cases::centred_pinhole(640, 480, 500);
+    ct_camera cam;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_camera_init(&cam, &lens));
+    int64_t e, n, h;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_grid_to_map(&p, 32 << 16, 40 << 16, (int64_t)p.hmax << 16, &e, &n, &h));
+    int32_t q[4];
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_quat_from_ypr(0, dem_cases::deg_q61(-60), 0, q));
+    ct_pose poses[2];
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_pose_from_map(&poses[0], e, n, h + 1000000000000, q));
+    {
+        const ct_utm zone = {17, 0};
+        int64_t lat, lon;
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_utm_inverse(&zone, e, n, &lat, &lon));
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_pose_from_wgs84(&poses[1], &zone, lat, lon, h + 1000000000000, q));
+        TEST_ASSERT(poses[1].hscale_q30 != (1 << 30));
+    }
+    const ct_effects none = {0u, 0, 0, 0, nullptr};
+    for (int pk = 0; pk < 2; ++pk) {
+        const ct_pose &pose = poses[pk];
+        int hits = 0;
+        for (int64_t u : {100, 320, 555})
+            for (int64_t v : {60, 240, 420}) {
+                ct_geo g;
+                if (ct_geolocate(&p, &cam, &pose, CT_METHOD_DIRECTIONAL, nullptr, u << 16, v << 16, &g) != CT_HIT) continue;
+                hits++;
+                const int64_t gp[3] = {g.hit.e_nm, g.hit.n_nm, g.hit.h_nm};
+                for (const ct_effects *fx : {(const ct_effects *)nullptr, &none}) {
+                    int64_t uu, vv;
+                    uint32_t vis = 7;
+                    ct_hit b;
+                    TEST_ASSERT_EQUAL_INT(CT_OK, ct_locate_inverse(&p, &cam, &pose, fx, gp, 500000000, &uu, &vv, &vis, &b));
+                    TEST_ASSERT_MSG(vis == 1u, "pose %d pixel (%lld, %lld): the hit not visible", pk, (long long)u,
+                                    (long long)v);
+                    // the hit is within 2 mm of the pixel's ray: 1 km away,
+                    // a few thousandths of a pixel
+                    TEST_ASSERT_MSG(std::llabs(uu - (u << 16)) < 656 && std::llabs(vv - (v << 16)) < 656,
+                                    "pose %d pixel (%lld, %lld): back at (%.4f, %.4f)", pk, (long long)u, (long long)v,
+                                    uu / 65536.0, vv / 65536.0);
+                }
+                // 50 m below the surface there: hidden (the surface is met first)
+                const int64_t under[3] = {gp[0], gp[1], gp[2] - 50000000000};
+                int64_t uu, vv;
+                uint32_t vis = 7;
+                ct_hit b;
+                TEST_ASSERT_EQUAL_INT(CT_OK, ct_locate_inverse(&p, &cam, &pose, nullptr, under, 500000000, &uu, &vv, &vis, &b));
+                TEST_ASSERT_EQUAL_INT(0, (int)vis);
+            }
+        TEST_ASSERT(hits >= 5);
+        int64_t uu, vv;
+        uint32_t vis;
+        ct_hit b;
+        const int64_t centre[3] = {pose.e_nm, pose.n_nm, pose.h_nm};
+        TEST_ASSERT_EQUAL_INT(CT_ERR_RAY, ct_locate_inverse(&p, &cam, &pose, nullptr, centre, 0, &uu, &vv, &vis, &b));
+        const int64_t behind[3] = {pose.e_nm, pose.n_nm - 1000000000000, pose.h_nm};
+        TEST_ASSERT_EQUAL_INT(CT_ERR_UNPROJECT, ct_locate_inverse(&p, &cam, &pose, nullptr, behind, 0, &uu, &vv, &vis, &b));
+        const int64_t ahead[3] = {pose.e_nm, pose.n_nm + INT64_C(3000000000000000), pose.h_nm};
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_locate_inverse(&p, &cam, &pose, nullptr, ahead, 0, &uu, &vv, &vis, &b));
+        TEST_ASSERT_MSG(std::llabs(uu - (INT64_C(639) << 15)) < 65536, "ahead: u %.3f", uu / 65536.0);
+        TEST_ASSERT(vv < 0);  // above the image's top: 60 deg up from its axis
+    }
+    // a camera under the surface: ct_los's CT_BELOW, and not visible
+    {
+        ct_pose under;
+        int64_t zs, uu, vv, gx, gy, gz;
+        uint32_t vis = 7;
+        ct_hit b;
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_surface_height(&p, 32 << 16, 40 << 16, &zs));
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_grid_to_map(&p, 32 << 16, 40 << 16, zs - (200 << 16), &gx, &gy, &gz));
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_pose_from_map(&under, gx, gy, gz, q));
+        const int64_t ahead[3] = {gx, gy + 300000000000, gz - 200000000000};
+        TEST_ASSERT_EQUAL_INT(CT_BELOW, ct_locate_inverse(&p, &cam, &under, nullptr, ahead, 0, &uu, &vv, &vis, &b));
+        TEST_ASSERT_EQUAL_INT(0, (int)vis);
+    }
+}
+
+// ct_los's rarer paths: a vertical line of sight (A straight above B on the
+// surface: visible; B under the surface: hidden; straight, on the true
+// Earth and on the sphere's lowered walk), A = B under the true
+// Earth (CT_ERR_RAY, as straight), B off the zone's projection (CT_ERR_RAY),
+// and the true Earth asked of a package on no UTM zone: the sphere of
+// CT_EARTH_RADIUS_NM, the same answer and block as asking for it.
+void test_los_cases()
+{
+    ct_host::Terrain t = dem_cases::make_terrain(48, 40, dem_cases::smooth(48, 40, 9, 1000, 30000), 0.25);
+    t.geo.epsg = 32617;
+    const dem_cases::Case utm = dem_cases::make_case("utm", t, 8, 2);
+    t.geo.epsg = 0;
+    const dem_cases::Case plain = dem_cases::make_case("no crs", t, 8, 2);
+    ct_package p, q;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_package_open(&p, utm.pkg.data(), utm.pkg.size()));
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_package_open(&q, plain.pkg.data(), plain.pkg.size()));
+    int64_t zs, g[3], a[3];
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_surface_height(&p, (20 << 16) + 999, (17 << 16) + 4321, &zs));
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_grid_to_map(&p, (20 << 16) + 999, (17 << 16) + 4321, zs, &g[0], &g[1], &g[2]));
+    a[0] = g[0], a[1] = g[1], a[2] = g[2] + 800000000000;  // 800 m above
+    const ct_effects earth = {CT_EFFECT_CURVATURE | CT_EFFECT_REFRACTION, CT_REFRACTION_K_STD_Q16, 0, 0, nullptr};
+    const ct_effects ball = {CT_EFFECT_CURVATURE | CT_EFFECT_REFRACTION, CT_REFRACTION_K_STD_Q16, CT_EARTH_RADIUS_NM, 0,
+                             nullptr};
+    ct_hit h;
+    for (const ct_effects *fx : {(const ct_effects *)nullptr, &earth, &ball}) {
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_los(&p, a, g, fx, 1000000, CT_METHOD_DIRECTIONAL, &h));
+        const int64_t under[3] = {g[0], g[1], g[2] - 5000000000};
+        TEST_ASSERT_EQUAL_INT(CT_HIT, ct_los(&p, a, under, fx, 1000000, CT_METHOD_DIRECTIONAL, &h));
+        TEST_ASSERT(std::llabs(h.h_nm - g[2]) < 2000000);  // blocked at the surface, within 2 mm
+        TEST_ASSERT_EQUAL_INT(CT_ERR_RAY, ct_los(&p, a, a, fx, 0, CT_METHOD_DIRECTIONAL, &h));
+    }
+    const int64_t off_zone[3] = {a[0] + INT64_C(2000000000000000), a[1], a[2]};
+    TEST_ASSERT_EQUAL_INT(CT_ERR_RAY, ct_los(&p, a, off_zone, &earth, 0, CT_METHOD_DIRECTIONAL, &h));
+    // no CRS: the true Earth is the sphere of 6371 km
+    const ct_effects sphere = {CT_EFFECT_CURVATURE | CT_EFFECT_REFRACTION, CT_REFRACTION_K_STD_Q16, CT_EARTH_RADIUS_NM,
+                               0, nullptr};
+    ct_rng rng;
+    ct_rng_seed(&rng, 77);
+    int hidden = 0;
+    for (int k = 0; k < 200; ++k) {
+        int64_t b[3], zb;
+        const int64_t xb = ct_rng_range(&rng, 0, 47 << 16), yb = ct_rng_range(&rng, 0, 39 << 16);
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_surface_height(&q, xb, yb, &zb));
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_grid_to_map(&q, xb, yb, zb, &b[0], &b[1], &b[2]));
+        ct_hit h1, h2;
+        const ct_status s1 = ct_los(&q, a, b, &earth, 500000000, CT_METHOD_DIRECTIONAL, &h1);
+        const ct_status s2 = ct_los(&q, a, b, &sphere, 500000000, CT_METHOD_DIRECTIONAL, &h2);
+        TEST_ASSERT_EQUAL_INT(s2, s1);
+        if (s1 == CT_HIT) {
+            hidden++;
+            TEST_ASSERT(h1.x_q16 == h2.x_q16 && h1.y_q16 == h2.y_q16 && h1.z_q16 == h2.z_q16 && h1.e_nm == h2.e_nm);
+        }
+        if (ct_harness_g.current_failed) return;
+    }
+    TEST_ASSERT(hidden > 0);
+}
+
+// A DEM with a patch of voids: ct_los decides as its definition says -- the
+// segment A -> B (as ct_map_to_grid rounds them) prepared and traced, hidden
+// when the first hit, void or not, lies more than the margin before B, the
+// block that hit bit for bit -- straight and on the true Earth (blocked by a
+// void cell there as well).
+void test_los_voids()
+{
+    ct_host::Terrain t = dem_cases::make_terrain(40, 40, dem_cases::smooth(40, 40, 13, 1000, 20000), 0.25);
+    t.geo.epsg = 32617;
+    t.void_post.assign(1600, 0);
+    for (int j = 12; j < 28; ++j)
+        for (int i = 14; i < 26; ++i) t.void_post[(size_t)j * 40 + i] = 1;
+    const dem_cases::Case cs = dem_cases::make_case("voids", t, 8, 2);
+    ct_package p;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_package_open(&p, cs.pkg.data(), cs.pkg.size()));
+    ct_rng rng;
+    ct_rng_seed(&rng, 4242);
+    const int64_t margin = 500000000;
+    long void_blocks = 0, checked = 0;
+    for (int k = 0; k < 400; ++k) {
+        int64_t a[3], b[3], za, zb;
+        const int64_t xa = ct_rng_range(&rng, 0, 39 << 16), ya = ct_rng_range(&rng, 0, 39 << 16);
+        const int64_t xb = ct_rng_range(&rng, 15 << 16, 25 << 16), yb = ct_rng_range(&rng, 13 << 16, 27 << 16);
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_surface_height(&p, xa, ya, &za));
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_surface_height(&p, xb, yb, &zb));
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_grid_to_map(&p, xa, ya, za + ct_rng_range(&rng, 1 << 16, 4000 << 16), &a[0], &a[1], &a[2]));
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_grid_to_map(&p, xb, yb, zb - (2000 << 16), &b[0], &b[1], &b[2]));  // 500 m under
+        // the definition: the segment in the grid, prepared and traced
+        int64_t g[6];
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_map_to_grid(&p, a[0], a[1], a[2], &g[0], &g[1], &g[2]));
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_map_to_grid(&p, b[0], b[1], b[2], &g[3], &g[4], &g[5]));
+        const ct_ray seg = {g[0], g[1], g[2], g[3] - g[0], g[4] - g[1], g[5] - g[2]};
+        ct_prepared pr;
+        ct_hit ht, hl;
+        ct_status st = ct_ray_prepare_segment(&p, &seg, &pr);
+        if (st == CT_OK || st == CT_HIT) st = ct_trace_prepared(&p, &pr, CT_METHOD_DIRECTIONAL, &ht);
+        const ct_status sl = ct_los(&p, a, b, nullptr, margin, CT_METHOD_DIRECTIONAL, &hl);
+        TEST_ASSERT(st == CT_HIT || st == CT_HIT_VOID || st == CT_BELOW);  // B is under the surface
+        if (st == CT_BELOW) {
+            TEST_ASSERT_EQUAL_INT(CT_BELOW, sl);
+            continue;
+        }
+        checked++;
+        void_blocks += st == CT_HIT_VOID;
+        TEST_ASSERT_EQUAL_INT(CT_HIT, sl);  // met 500 m or more before B
+        TEST_ASSERT(hl.x_q16 == ht.x_q16 && hl.y_q16 == ht.y_q16 && hl.z_q16 == ht.z_q16 && hl.e_nm == ht.e_nm);
+        // the true Earth: hidden as well (B is 500 m under the surface)
+        const ct_effects earth = {CT_EFFECT_CURVATURE, 0, 0, 0, nullptr};
+        TEST_ASSERT_EQUAL_INT(CT_HIT, ct_los(&p, a, b, &earth, margin, CT_METHOD_DIRECTIONAL, &hl));
+        if (ct_harness_g.current_failed) return;
+    }
+    std::printf("  voids: %ld pairs blocked, %ld of them in a void cell\n", checked, void_blocks);
+    TEST_ASSERT(void_blocks > 0 && checked > void_blocks);
+}
+
 }  // namespace
 
 int main()
@@ -199,5 +401,8 @@ int main()
     TEST_BEGIN("test_los");
     RUN_TEST(test_los_vs_reference);
     RUN_TEST(test_los_arguments);
+    RUN_TEST(test_locate_inverse_cases);
+    RUN_TEST(test_los_cases);
+    RUN_TEST(test_los_voids);
     return TEST_END();
 }

@@ -128,6 +128,17 @@ void test_evil_packages()
         {"non-square posting", CT_ERR_GEOREF, true, [](std::vector<uint8_t> &b) { put64(b, 56, -31000000000ll); }},
         {"negative height scale", CT_ERR_GEOREF, true, [](std::vector<uint8_t> &b) { put64(b, 72, -1); }},
         {"reserved field set", CT_ERR_FLAGS, true, [](std::vector<uint8_t> &b) { put32(b, 84, 7); }},
+        {"32768 x 32768 posts, r 1, N 64: over 4 GB", CT_ERR_SIZE, true,
+         [](std::vector<uint8_t> &b) { put16(b, 16, 32768); put16(b, 18, 32768); b[20] = 1; b[21] = 64; }},
+        {"total size below the header", CT_ERR_TRUNCATED, false, [](std::vector<uint8_t> &b) { put32(b, 8, 64); }},
+        {"zero posting north", CT_ERR_GEOREF, true, [](std::vector<uint8_t> &b) { put64(b, 56, 0); }},
+        {"posting beyond 2^50 nm", CT_ERR_GEOREF, true,
+         [](std::vector<uint8_t> &b) { put64(b, 48, (1ll << 50) + 1); put64(b, 56, -(1ll << 50) - 1); }},
+        {"height scale beyond 2^46 nm", CT_ERR_GEOREF, true, [](std::vector<uint8_t> &b) { put64(b, 72, (1ll << 46) + 1); }},
+        {"height scale 0", CT_ERR_GEOREF, true, [](std::vector<uint8_t> &b) { put64(b, 72, 0); }},
+        {"origin east beyond 2^61 nm", CT_ERR_GEOREF, true, [](std::vector<uint8_t> &b) { put64(b, 32, (1ll << 61) + 1); }},
+        {"origin north beyond 2^61 nm", CT_ERR_GEOREF, true, [](std::vector<uint8_t> &b) { put64(b, 40, -(1ll << 61) - 1); }},
+        {"height offset beyond 2^61 nm", CT_ERR_GEOREF, true, [](std::vector<uint8_t> &b) { put64(b, 64, (1ll << 61) + 1); }},
     };
     for (auto &c : cases) {
         std::vector<uint8_t> b = good;
@@ -136,6 +147,20 @@ void test_evil_packages()
         size_t len = c.len ? c.len : b.size();
         ct_status st = open_bytes(b, len);
         TEST_ASSERT_MSG(st == c.expect, "%s: expected %d, got %d", c.name, c.expect, st);
+    }
+    // a height scale so fine against the posting (0.1 mm codes, 30 m
+    // posts) that the prepared z unit reaches its coarsest, 2^CT_ZSHIFT_MAX
+    // Q16 LSB; the package opens and traces as ever (a hit from above)
+    {
+        std::vector<uint8_t> b = good;
+        put64(b, 72, 100000);
+        fix_crc(b);
+        ct_package q;
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_package_open(&q, b.data(), b.size()));
+        TEST_ASSERT_EQUAL_INT(CT_ZSHIFT_MAX, (int)q.zshift_max);
+        const ct_ray down = {(int64_t)q.cells_x << 15, (int64_t)q.cells_y << 15, ((int64_t)q.hmax + 10) << 16, 3, 1, -(1 << 20)};
+        ct_hit h;
+        TEST_ASSERT_EQUAL_INT(CT_HIT, ct_trace(&q, &down, CT_METHOD_DIRECTIONAL, &h));
     }
     // NULL arguments
     ct_package p;

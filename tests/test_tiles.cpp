@@ -46,6 +46,7 @@ struct Mem {
     const TileSetBytes *b = nullptr;
     std::map<size_t, std::vector<uint8_t>> replace;  // tile k served as these bytes
     long fail = -1;                                  // tile the loader refuses
+    long no_bytes = -1;                              // tile it says CT_OK for but gives no bytes
     bool copy = true;                                // into the slot (else zero copy)
     std::vector<long> calls;                         // per tile
 };
@@ -57,6 +58,11 @@ ct_status mem_loader(void *user, uint32_t col, uint32_t row, uint8_t *buf, size_
     const size_t k = (size_t)row * m->b->grid.tiles_x + col;
     m->calls[k]++;
     if ((long)k == m->fail) return CT_ERR_ARG;
+    if ((long)k == m->no_bytes) {
+        *bytes = nullptr;
+        *len = 0;
+        return CT_OK;
+    }
     auto it = m->replace.find(k);
     const std::vector<uint8_t> &v = it != m->replace.end() ? it->second : m->b->tiles[k];
     if (m->copy) {
@@ -383,14 +389,34 @@ void test_missing_and_corrupt()
     const std::vector<uint8_t> merged = ct_host::build_package(t, o);
     ct_package mp;
     TEST_ASSERT_EQUAL_INT(CT_OK, ct_package_open(&mp, merged.data(), merged.size()));
-    const size_t centre = 4;  // tile (1, 1)
+    const size_t centre_tile = 4;  // tile (1, 1): the bad tile but in variant 17
     const ct_host::TileGrid &g = full.grid;
     // variants: 0 absent from the manifest, 1 the loader fails, 2 a flipped
     // byte, 3 truncated, 4 tile (0, 0) swapped in with its entry, 5 another
-    // CRS, 6 another posting (each vouched for by its entry)
-    for (int variant = 0; variant < 7; ++variant) {
+    // CRS, 6 another posting, 7 the origin one post north, 8 another r, 9
+    // another N, 10 the posting north negated, 11 another height offset, 12
+    // another height scale, 13 one post narrower, 14 one post shorter (each
+    // vouched for by its entry: one field of the tile's place or values
+    // differs from the set's), 15 tile (0, 0) served in its place (the
+    // manifest unchanged: another CRC), 16 its entry's lowest code raised
+    // by one, 17 the tallest code of the first tile's entry below the set's
+    // tallest post raised by one, 18 the origin one post east, 19 the
+    // loader says CT_OK but gives no bytes
+    for (int variant = 0; variant < 20; ++variant) {
         TileSetBytes tb = full;
         Set set;
+        size_t centre = centre_tile;
+        if (variant == 17) {
+            // the first tile below the set's tallest post (raising the
+            // tallest entry would change the set's frame)
+            const std::vector<uint8_t> &m = full.manifest;
+            auto code = [&m](size_t at) { return (unsigned)(m[at] | m[at + 1] << 8); };
+            for (centre = 0; centre + 1 < full.tiles.size() &&
+                             code(CT_SET_HEADER_SIZE + centre * CT_SET_ENTRY_SIZE + 10) >= code(CT_SET_HDR_HMAX);
+                 ++centre) {
+            }
+            TEST_ASSERT(code(CT_SET_HEADER_SIZE + centre * CT_SET_ENTRY_SIZE + 10) < code(CT_SET_HDR_HMAX));
+        }
         if (variant == 0) {
             tb = ct_host::build_tileset(t, o, P, 0, [](int c, int r) { return c == 1 && r == 1; });
         } else if (variant == 1) {
@@ -403,6 +429,19 @@ void test_missing_and_corrupt()
             std::vector<uint8_t> bad = full.tiles[centre];
             bad.resize(bad.size() - 64);
             set.mem.replace[centre] = bad;
+        } else if (variant == 19) {
+            set.mem.no_bytes = (long)centre;
+        } else if (variant == 15) {
+            set.mem.replace[centre] = full.tiles[0];
+        } else if (variant == 16 || variant == 17) {
+            std::vector<uint8_t> &m = tb.manifest;
+            const size_t e = CT_SET_HEADER_SIZE + centre * CT_SET_ENTRY_SIZE + (variant == 16 ? 8 : 10);
+            const uint16_t code = (uint16_t)(m[e] | m[e + 1] << 8);
+            ct_host::put16(m, e, code + 1);
+            ct_host::put32(m, CT_HDR_CRC, 0);
+            uint32_t crc = 0;
+            ct_crc32(0, m.data(), m.size(), &crc);
+            ct_host::put32(m, CT_HDR_CRC, crc);
         } else {
             // a valid package with the manifest rewritten to vouch for it
             std::vector<uint8_t> other;
@@ -410,13 +449,40 @@ void test_missing_and_corrupt()
                 other = full.tiles[0];
             } else {
                 ct_host::Terrain tt = ct_host::tile_terrain(t, g, 1, 1);
+                ct_host::BuildOptions oo = o;
                 if (variant == 5) {
                     tt.geo.epsg = 32616;
-                } else {
+                } else if (variant == 6) {
                     tt.geo.posting_e = 20.0;
                     tt.geo.posting_n = -20.0;
+                } else if (variant == 7) {
+                    tt.geo.origin_n_nm += (int64_t)(tt.geo.posting_n * 1e9);  // one post north
+                    tt.geo.origin_n += tt.geo.posting_n;
+                } else if (variant == 18) {
+                    tt.geo.origin_e_nm += (int64_t)(tt.geo.posting_e * 1e9);  // one post east
+                    tt.geo.origin_e += tt.geo.posting_e;
+                } else if (variant == 8) {
+                    oo.reduce = o.reduce == 1 ? 2 : 1;
+                } else if (variant == 9) {
+                    oo.sectors = o.sectors == 8 ? 4 : 8;
+                } else if (variant == 10) {
+                    tt.geo.posting_n = -tt.geo.posting_n;
+                } else if (variant == 11) {
+                    tt.height_offset_m += 1.0;
+                } else if (variant == 12) {
+                    tt.height_scale_m *= 2.0;
+                } else {
+                    // drop the last column (13) or row (14)
+                    const int w = tt.width - (variant == 13), h = tt.height - (variant == 14);
+                    std::vector<uint16_t> codes;
+                    for (int j = 0; j < h; ++j)
+                        for (int i = 0; i < w; ++i) codes.push_back(tt.at(i, j));
+                    tt.codes = codes;
+                    tt.width = w;
+                    tt.height = h;
+                    tt.void_post.clear();
                 }
-                other = ct_host::build_package(tt, o);
+                other = ct_host::build_package(tt, oo);
             }
             set.mem.replace[centre] = other;
             std::vector<std::vector<uint8_t>> tiles = full.tiles;
@@ -427,7 +493,8 @@ void test_missing_and_corrupt()
         ct_rng rng;
         ct_rng_seed(&rng, 500 + variant);
         long nodata = 0, same = 0, inside = 0;
-        const double x0 = g.first_col(1), x1 = g.first_col(2), y0 = g.first_row(1), y1 = g.first_row(2);
+        const int col = (int)(centre % (size_t)g.tiles_x), row = (int)(centre / (size_t)g.tiles_x);
+        const double x0 = g.first_col(col), x1 = g.first_col(col + 1), y0 = g.first_row(row), y1 = g.first_row(row + 1);
         double lo, hi;
         dem_cases::minmax(t, &lo, &hi);
         for (int k = 0; k < 4000; ++k) {
@@ -463,6 +530,43 @@ void test_missing_and_corrupt()
                     variant, nodata, same, inside);
         TEST_ASSERT(nodata >= inside && inside > 0);
     }
+}
+
+// A DEM with a patch of voids cut into 3 x 3 tiles: every ray's result as
+// the merged package's, CT_HIT_VOID included (walked in a later tile too).
+void test_voids()
+{
+    ct_host::Terrain t = dem_cases::make_terrain(43, 43, dem_cases::smooth(43, 43, 21, 1000, 20000), 0.25);
+    t.void_post.assign(43 * 43, 0);
+    for (int j = 10; j < 33; ++j)
+        for (int i = 10; i < 33; ++i) t.void_post[(size_t)j * 43 + i] = (i + j) % 5 != 0;
+    ct_host::BuildOptions o;
+    o.sectors = 8;
+    o.reduce = 2;
+    const TileSetBytes tb = ct_host::build_tileset(t, o, 15, 0);
+    const std::vector<uint8_t> merged = ct_host::build_package(t, o);
+    ct_package mp;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_package_open(&mp, merged.data(), merged.size()));
+    Set set;
+    TEST_ASSERT_EQUAL_INT(CT_OK, set.open(tb, 2));
+    ct_rng rng;
+    ct_rng_seed(&rng, 99);
+    double lo, hi;
+    dem_cases::minmax(t, &lo, &hi);
+    long voids = 0;
+    for (int k = 0; k < 6000; ++k) {
+        const ct_ray ray = dem_cases::make_ray(t, (dem_cases::Family)(k % dem_cases::FAMILY_COUNT), &rng, lo, hi);
+        for (int m = 0; m < CT_METHOD_COUNT; ++m) {
+            ct_hit hm, hs;
+            const ct_status sm = ct_trace(&mp, &ray, (ct_method)m, &hm);
+            const ct_status ss = ct_tileset_trace(&set.ts, &ray, (ct_method)m, &hs);
+            TEST_ASSERT_MSG(same_hit(sm, hm, ss, hs), "ray %d method %d: %d vs merged %d", k, m, ss, sm);
+            voids += m == 0 && sm == CT_HIT_VOID;
+        }
+        if (ct_harness_g.current_failed) return;
+    }
+    std::printf("  voids: %ld of 6000 rays hit a void cell, as merged\n", voids);
+    TEST_ASSERT(voids > 0);
 }
 
 void test_manifest_checks()
@@ -843,6 +947,7 @@ int main()
     RUN_TEST(test_skips_tiles_above);
     RUN_TEST(test_missing_and_corrupt);
     RUN_TEST(test_manifest_checks);
+    RUN_TEST(test_voids);
     RUN_TEST(test_geolocation);
     RUN_TEST(test_los);
     RUN_TEST(test_streamed_build);

@@ -222,6 +222,8 @@ void test_geoid_at_grid()
     TEST_ASSERT_EQUAL_INT(CT_ERR_RANGE, ct_geoid_at(&g, lat0 + 1, lon0, &n));
     TEST_ASSERT_EQUAL_INT(CT_ERR_RANGE, ct_geoid_at(&g, lat0 - s - 1, lon0, &n));
     TEST_ASSERT_EQUAL_INT(CT_ERR_RANGE, ct_geoid_at(&g, INT64_MIN, INT64_MAX, &n));
+    TEST_ASSERT_EQUAL_INT(CT_ERR_RANGE, ct_geoid_at(&g, lat0, CT_PI_Q61 + 1, &n));      // longitude beyond pi
+    TEST_ASSERT_EQUAL_INT(CT_ERR_RANGE, ct_geoid_at(&g, -CT_PI_Q61 / 2 - 1, lon0, &n)); // latitude beyond -pi/2
     TEST_ASSERT_EQUAL_INT(CT_ERR_ARG, ct_geoid_at(nullptr, 0, 0, &n));
     TEST_ASSERT_EQUAL_INT(CT_ERR_ARG, ct_geoid_at(&g, 0, 0, nullptr));
     ct_geoid_grid bad = g;
@@ -259,6 +261,7 @@ void test_datum_section_evil()
         {"offset past the end", [](std::vector<uint8_t> &p, size_t) { put32(p, CT_HDR_DATUM, (get32(p, 8) - 32) & ~7u); }, CT_ERR_OFFSET},
         {"unknown datum code", [](std::vector<uint8_t> &p, size_t o) { p[o] = CT_VDATUM_COUNT; }, CT_ERR_RANGE},
         {"reserved word set", [](std::vector<uint8_t> &p, size_t o) { p[o + 12] = 1; }, CT_ERR_RANGE},
+        {"reserved half-word set", [](std::vector<uint8_t> &p, size_t o) { p[o + 6] = 1; }, CT_ERR_RANGE},
         {"one node per row", [](std::vector<uint8_t> &p, size_t o) { p[o + 2] = 1; p[o + 3] = 0; }, CT_ERR_DIMS},
         {"rows without a row width", [](std::vector<uint8_t> &p, size_t o) { p[o + 2] = 0; p[o + 3] = 0; }, CT_ERR_DIMS},
         {"grid beyond the package", [](std::vector<uint8_t> &p, size_t o) { p[o + 4] = 200; p[o + 5] = 0; }, CT_ERR_SIZE},
