@@ -879,7 +879,8 @@ ct_status ct_effects_for_tolerance(const ct_package *pkg, const ct_camera *cam, 
  * first point, as ct_trace's hit -- so a target on the ground, met at
  * itself, is visible; CT_BELOW: A under the surface.  Errors: CT_ERR_ARG
  * (NULL, margin < 0), CT_ERR_METHOD, CT_ERR_RAY (a point beyond
- * CT_MAX_ORIGIN_Q16 of the tile, or A = B), CT_ERR_EFFECTS (effects that
+ * CT_MAX_ORIGIN_Q16 of the tile, A = B, or for the true Earth B where the
+ * zone's projection cannot take it), CT_ERR_EFFECTS (effects that
  * ct_geolocate refuses -- unknown flags, |k| > 2, R or chord out of range,
  * another package's earth_map -- or, on the sphere, c < 0 or a bend the
  * lowered walk cannot take from A; for the true Earth, A where the zone's

@@ -162,12 +162,6 @@ int ct_earth_map_fits(const ct_package *pkg, const ct_earth_map *map);
  * its cube) or exact (for tests of the fit).                              */
 ct_status ct_earth_image24(const ct_package *pkg, const ct_earth *es, const int64_t D[3], int fitted, int64_t g[3]);
 
-/* The first hit of the line of sight of a unit map-frame direction
- * (grid east, grid north, up at the camera; Q39, without the pose's
- * horizontal scale).  hit.steps / iters add up over the pieces.           */
-ct_status ct_trace_earth(const ct_package *pkg, const ct_earth *es, const int64_t dir_grid_q39[3], ct_method method,
-                         ct_hit *hit);
-
 /* ct_trace_prepared for a ray this library prepared itself (skips the
  * re-validation of the caller-visible struct). */
 ct_status ct_trace_prepared_own(const ct_package *pkg, const ct_prepared *ray, ct_method method, ct_hit *hit);

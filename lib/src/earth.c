@@ -1171,11 +1171,6 @@ static int64_t next_length(const ct_earth *es, const piece *pc)
     return ct_min64(PIECE_MAX_NM, ct_max64(PIECE_MIN_NM, ct_mul_shr(pc->Lc, fr, 15u)));
 }
 
-ct_status ct_trace_earth(const ct_package *p, const ct_earth *es, const int64_t dg[3], ct_method m, ct_hit *h)
-{
-    return ct_trace_earth_set(p, NULL, es, dg, m, h);
-}
-
 /* The line of sight as pieces of lowered walks from the camera: each piece
  * chosen (next_piece), traced unless off the tile (trace_piece), until a
  * hit, an error, the path's end or a path gone from the tile. */

@@ -76,7 +76,10 @@ ct_status ct_tileset_trace_segment(ct_tileset *ts, const ct_ray *ray, const ct_l
 ct_status ct_trace_bent_set_ts(const ct_package *p, ct_tileset *ts, const ct_ray *ray, const ct_bent_setup *bs,
                                ct_method method, ct_hit *hit);
 
-/* ct_trace_earth over a tile set (p: its frame; ts NULL: one package p). */
+/* The first hit of the line of sight of a unit map-frame direction (grid
+ * east, grid north, up at the camera; Q39, without the pose's horizontal
+ * scale), over a tile set (p: its frame) or, ts NULL, on one package p.
+ * hit.steps / iters add up over the pieces.                               */
 ct_status ct_trace_earth_set(const ct_package *p, ct_tileset *ts, const ct_earth *es, const int64_t dir_grid_q39[3],
                              ct_method method, ct_hit *hit);
 
