@@ -9,7 +9,8 @@
  * camera over the same package, straight and with curvature + refraction on
  * the sphere and on the true Earth; each pixel's status, steps and hit must
  * equal the host's, and ct_geolocate_batch over the same pixels gives the
- * per-call set-up.
+ * per-call set-up; last, straight again with the lens baked into an 8 px
+ * unprojection grid (grid_row).
  * Flight software budgets in cycles: on a Cortex-M4 most instructions take
  * one cycle (loads two, taken branches 1-3, divisions 2-12), so cycles are
  * roughly 1.2-1.5x these counts at zero-wait-state memory.
@@ -102,6 +103,72 @@ static void spin(uint32_t n)
 }
 
 static ct_geo g_geo[64];
+
+/* The straight row again with the lens baked into an 8 px unprojection
+ * grid (m4_geo_grid); 0 on a mismatch with the host. */
+static int grid_row(const ct_package *p, const ct_pose *pose, const int64_t *uv, uint32_t n, uint32_t empty,
+                    uint64_t ipt_q16)
+{
+    ct_camera cam;
+    uint64_t sum = 0u, steps = 0u, batch;
+    uint32_t lo = 0xFFFFFFFFu, hi = 0u, hits = 0u, k, t0, dt, in;
+    int ok = 1;
+    if (ct_camera_init_grid(&cam, &m4_geo_grid) != CT_OK) {
+        ct_plat_puts("bench_m4: FAIL: the unprojection grid is refused\n");
+        return 0;
+    }
+    /* bound: n <= 64 pixels */
+    for (k = 0u; k < n; ++k) {
+        ct_geo g;
+        ct_status st;
+        t0 = SYST_CVR;
+        st = ct_geolocate(p, &cam, pose, CT_METHOD_DIRECTIONAL, (const ct_effects *)0, uv[2u * k], uv[2u * k + 1u], &g);
+        dt = ticks_since(t0);
+        dt = dt > empty ? dt - empty : 0u;
+        in = (uint32_t)(((uint64_t)dt * ipt_q16) >> 16);
+        sum += dt;
+        lo = in < lo ? in : lo;
+        hi = in > hi ? in : hi;
+        steps += g.hit.steps;
+        if ((int32_t)st != m4_geo_grid_px[k].status || g.hit.steps != m4_geo_grid_px[k].steps) {
+            ok = 0;
+        }
+        if (st == CT_HIT || st == CT_HIT_VOID) {
+            hits++;
+            if (g.hit.e_nm != m4_geo_grid_px[k].enh[0] || g.hit.n_nm != m4_geo_grid_px[k].enh[1] ||
+                g.hit.h_nm != m4_geo_grid_px[k].enh[2]) {
+                ok = 0;
+            }
+        }
+    }
+    t0 = SYST_CVR;
+    if (ct_geolocate_batch(p, &cam, pose, CT_METHOD_DIRECTIONAL, (const ct_effects *)0, uv, n, g_geo, 64u) != CT_OK) {
+        ok = 0;
+    }
+    dt = ticks_since(t0);
+    batch = dt > empty ? dt - empty : 0u;
+    /* bound: n <= 64 pixels */
+    for (k = 0u; k < n; ++k) {
+        if ((int32_t)g_geo[k].status != m4_geo_grid_px[k].status || g_geo[k].hit.steps != m4_geo_grid_px[k].steps) {
+            ok = 0;
+        }
+    }
+    put_pad("straight, 8 px grid", 26u);
+    put_u(n, 7u);
+    put_u(hits, 5u);
+    put_u(n > 0u ? (steps * 10u / n) / 10u : 0u, 4u);
+    put(".");
+    put_u(n > 0u ? (steps * 10u / n) % 10u : 0u, 0u);
+    put(" | ");
+    put_u(n > 0u ? ((sum * ipt_q16) >> 16) / n : 0u, 24u);
+    put("  ");
+    put_u(lo, 8u);
+    put("-");
+    put_u(hi, 0u);
+    put_u(n > 0u ? ((batch * ipt_q16) >> 16) / n : 0u, 14u);
+    flush();
+    return ok;
+}
 
 /* Geolocation per pixel (see the head comment); 0 on a mismatch with the
  * host or a set-up failure. */
@@ -209,7 +276,7 @@ static int geo_bench(const ct_package *p, uint32_t empty, uint64_t ipt_q16)
         }
         flush();
     }
-    return ok;
+    return grid_row(p, &pose, uv, n, empty, ipt_q16) && ok;
 }
 
 int main(void)

@@ -63,4 +63,14 @@ extern const int64_t m4_geo_centre_nm[3]; /* camera centre E, N, h          */
 extern const int32_t m4_geo_q30[4];       /* ct_pose_from_map's quaternion  */
 extern const uint32_t m4_geo_count;
 extern const m4_pixel m4_geo_px[];
+/* The same lens baked into an 8 px unprojection grid (nodes from the
+ * library's own closed-form unprojection), and the host's straight
+ * geolocation of the same pixels through it. */
+extern const ct_unproject_grid m4_geo_grid;
+typedef struct {
+    int32_t status;
+    uint32_t steps;
+    int64_t enh[3];
+} m4_grid_pixel;
+extern const m4_grid_pixel m4_geo_grid_px[];
 #endif

@@ -120,6 +120,46 @@ bool geo_data(FILE *f, const ct_package &p)
         }
     }
     std::fprintf(f, "};\n");
+    // the lens as an 8 px unprojection grid: nodes at (-0.5 - 8 + 8 i, ...)
+    // from ct_camera_unproject (a node it refuses stays (0, 0, 0))
+    const int64_t step = INT64_C(8) << 16, u0 = -(INT64_C(17) << 15), v0 = u0;
+    const uint32_t nu = (uint32_t)((((int64_t)lens.width << 16) - u0) / step) + 3u,
+                   nv = (uint32_t)((((int64_t)lens.height << 16) - v0) / step) + 3u;
+    std::vector<int32_t> nodes(3u * nu * nv, 0);
+    for (uint32_t j = 0; j < nv; ++j)
+        for (uint32_t i = 0; i < nu; ++i) {
+            int32_t r[3];
+            if (ct_camera_unproject(&cam, u0 + (int64_t)i * step, v0 + (int64_t)j * step, r, nullptr) == CT_OK)
+                for (int c = 0; c < 3; ++c) nodes[3u * (j * nu + i) + (uint32_t)c] = r[c];
+        }
+    ct_unproject_grid grid;
+    grid.nu = nu;
+    grid.nv = nv;
+    grid.u0_q16 = u0;
+    grid.v0_q16 = v0;
+    grid.step_q16 = step;
+    grid.rays_q30 = nodes.data();
+    grid.rays_len = nodes.size();
+    ct_camera gcam;
+    if (ct_camera_init_grid(&gcam, &grid) != CT_OK) {
+        std::fprintf(stderr, "ct_gen_m4_data: the unprojection grid is refused\n");
+        return false;
+    }
+    std::fprintf(f, "static const int32_t m4_grid_nodes[%zu] = {", nodes.size());
+    for (size_t k = 0; k < nodes.size(); ++k) std::fprintf(f, "%s%d,", k % 12 == 0 ? "\n" : "", nodes[k]);
+    std::fprintf(f, "\n};\nconst ct_unproject_grid m4_geo_grid = {%uu, %uu, INT64_C(%lld), INT64_C(%lld), INT64_C(%lld), "
+                    "m4_grid_nodes, %zuu};\n",
+                 nu, nv, (long long)u0, (long long)v0, (long long)step, nodes.size());
+    std::fprintf(f, "const m4_grid_pixel m4_geo_grid_px[%zu] = {\n", n);
+    for (size_t k = 0; k < n; ++k) {
+        ct_geo x;
+        ct_geolocate(&p, &gcam, &pose, CT_METHOD_DIRECTIONAL, nullptr, uv[2 * k], uv[2 * k + 1], &x);
+        const bool hit = x.status == CT_HIT || x.status == CT_HIT_VOID;
+        std::fprintf(f, "  {%d, %uu, {INT64_C(%lld), INT64_C(%lld), INT64_C(%lld)}},\n", (int)x.status, x.hit.steps,
+                     hit ? (long long)x.hit.e_nm : 0LL, hit ? (long long)x.hit.n_nm : 0LL,
+                     hit ? (long long)x.hit.h_nm : 0LL);
+    }
+    std::fprintf(f, "};\n");
     return true;
 }
 
