@@ -566,11 +566,10 @@ static ct_status grid_unproject(const ct_camera *c, int64_t u, int64_t v, int32_
         return CT_ERR_UNPROJECT;
     }
     f = (UINT64_C(1) << 62) / L;
-    /* bound: 3 components; a quotient just above 2^30 (V' along an axis,
-     * L rounded down) is clamped to the unit */
+    /* bound: 3 components.  |V'_k| is an integer <= |V'|, so <= L, and
+     * L f <= 2^62: the quotient is at most 2^30 */
     for (k = 0u; k < 3u; ++k) {
-        uint64_t q = ((uint64_t)ct_abs64(V[k]) * f + (UINT64_C(1) << 31)) >> 32;
-        int32_t m = q > (UINT64_C(1) << 30) ? (INT32_C(1) << 30) : (int32_t)q;
+        int32_t m = (int32_t)(((uint64_t)ct_abs64(V[k]) * f + (UINT64_C(1) << 31)) >> 32);
         out[k] = V[k] < 0 ? -m : m;
     }
     /* the result must lie within 60 deg of each of its 16 nodes (cos >=
