@@ -10,7 +10,7 @@
  * the sphere and on the true Earth; each pixel's status, steps and hit must
  * equal the host's, and ct_geolocate_batch over the same pixels gives the
  * per-call set-up; last, straight again with the lens baked into an 8 px
- * unprojection grid (grid_row).
+ * unprojection grid (the last row, pixel_row as the others).
  * Flight software budgets in cycles: on a Cortex-M4 most instructions take
  * one cycle (loads two, taken branches 1-3, divisions 2-12), so cycles are
  * roughly 1.2-1.5x these counts at zero-wait-state memory.
@@ -102,27 +102,37 @@ static void spin(uint32_t n)
     __asm__ volatile("1: subs %0, %0, #1\n\tbne 1b" : "+r"(n) : : "cc");
 }
 
-static ct_geo g_geo[64];
-
-/* The straight row again with the lens baked into an 8 px unprojection
- * grid (m4_geo_grid); 0 on a mismatch with the host. */
-static int grid_row(const ct_package *p, const ct_pose *pose, const int64_t *uv, uint32_t n, uint32_t empty,
-                    uint64_t ipt_q16)
+/* g's status, steps and (for a hit) map position equal the host's. */
+static int same_geo(const ct_geo *g, const m4_grid_pixel *w)
 {
-    ct_camera cam;
+    if ((int32_t)g->status != w->status || g->hit.steps != w->steps) {
+        return 0;
+    }
+    return (g->status != CT_HIT && g->status != CT_HIT_VOID) ||
+           (g->hit.e_nm == w->enh[0] && g->hit.n_nm == w->enh[1] && g->hit.h_nm == w->enh[2]);
+}
+
+static ct_geo g_geo[64];
+static m4_grid_pixel g_want[64]; /* the host's results for the row at hand */
+
+/* One row of the geolocation table: the n pixels one by one (mean, min-max
+ * instructions) and in one batch (per pixel; the per-call set-up as the
+ * difference when setup != 0), each status, step count and hit checked
+ * against g_want.  0 on a mismatch or a batch that failed or may have
+ * wrapped SysTick (2^24 ticks). */
+static int pixel_row(const char *name, const ct_package *p, const ct_camera *cam, const ct_pose *pose,
+                     const ct_effects *fx, const int64_t *uv, uint32_t n, int setup, uint32_t empty,
+                     uint64_t ipt_q16)
+{
     uint64_t sum = 0u, steps = 0u, batch;
     uint32_t lo = 0xFFFFFFFFu, hi = 0u, hits = 0u, k, t0, dt, in;
     int ok = 1;
-    if (ct_camera_init_grid(&cam, &m4_geo_grid) != CT_OK) {
-        ct_plat_puts("bench_m4: FAIL: the unprojection grid is refused\n");
-        return 0;
-    }
     /* bound: n <= 64 pixels */
     for (k = 0u; k < n; ++k) {
         ct_geo g;
         ct_status st;
         t0 = SYST_CVR;
-        st = ct_geolocate(p, &cam, pose, CT_METHOD_DIRECTIONAL, (const ct_effects *)0, uv[2u * k], uv[2u * k + 1u], &g);
+        st = ct_geolocate(p, cam, pose, CT_METHOD_DIRECTIONAL, fx, uv[2u * k], uv[2u * k + 1u], &g);
         dt = ticks_since(t0);
         dt = dt > empty ? dt - empty : 0u;
         in = (uint32_t)(((uint64_t)dt * ipt_q16) >> 16);
@@ -130,30 +140,22 @@ static int grid_row(const ct_package *p, const ct_pose *pose, const int64_t *uv,
         lo = in < lo ? in : lo;
         hi = in > hi ? in : hi;
         steps += g.hit.steps;
-        if ((int32_t)st != m4_geo_grid_px[k].status || g.hit.steps != m4_geo_grid_px[k].steps) {
-            ok = 0;
-        }
-        if (st == CT_HIT || st == CT_HIT_VOID) {
-            hits++;
-            if (g.hit.e_nm != m4_geo_grid_px[k].enh[0] || g.hit.n_nm != m4_geo_grid_px[k].enh[1] ||
-                g.hit.h_nm != m4_geo_grid_px[k].enh[2]) {
-                ok = 0;
-            }
-        }
+        hits += (st == CT_HIT || st == CT_HIT_VOID) ? 1u : 0u;
+        g.status = st;
+        ok = ok && same_geo(&g, &g_want[k]);
     }
     t0 = SYST_CVR;
-    if (ct_geolocate_batch(p, &cam, pose, CT_METHOD_DIRECTIONAL, (const ct_effects *)0, uv, n, g_geo, 64u) != CT_OK) {
+    if (ct_geolocate_batch(p, cam, pose, CT_METHOD_DIRECTIONAL, fx, uv, n, g_geo, 64u) != CT_OK || sum >= 0xF00000u) {
+        ct_plat_puts("bench_m4: FAIL: the batch failed or may have wrapped SysTick\n");
         ok = 0;
     }
     dt = ticks_since(t0);
     batch = dt > empty ? dt - empty : 0u;
     /* bound: n <= 64 pixels */
     for (k = 0u; k < n; ++k) {
-        if ((int32_t)g_geo[k].status != m4_geo_grid_px[k].status || g_geo[k].hit.steps != m4_geo_grid_px[k].steps) {
-            ok = 0;
-        }
+        ok = ok && same_geo(&g_geo[k], &g_want[k]);
     }
-    put_pad("straight, 8 px grid", 26u);
+    put_pad(name, 26u);
     put_u(n, 7u);
     put_u(hits, 5u);
     put_u(n > 0u ? (steps * 10u / n) / 10u : 0u, 4u);
@@ -166,6 +168,12 @@ static int grid_row(const ct_package *p, const ct_pose *pose, const int64_t *uv,
     put("-");
     put_u(hi, 0u);
     put_u(n > 0u ? ((batch * ipt_q16) >> 16) / n : 0u, 14u);
+    /* n per-pixel calls form the set-up n times, the batch once */
+    if (setup && n > 1u && sum > batch) {
+        put_u((((sum - batch) * ipt_q16) >> 16) / (n - 1u), 13u);
+    } else if (setup) {
+        put("            -");
+    }
     flush();
     return ok;
 }
@@ -178,13 +186,13 @@ static int geo_bench(const ct_package *p, uint32_t empty, uint64_t ipt_q16)
                                                             "true Earth c+r, fitted", "true Earth c+r, kept map"};
     static ct_earth_map map;
     static int64_t uv[2 * 64];
-    ct_camera cam;
+    ct_camera cam, gcam;
     ct_pose pose;
     uint32_t n = m4_geo_count, k, t0, dt;
     int e, ok = 1;
-    if (n > 64u || ct_camera_init(&cam, &m4_geo_lens) != CT_OK ||
+    if (n > 64u || ct_camera_init(&cam, &m4_geo_lens) != CT_OK || ct_camera_init_grid(&gcam, &m4_geo_grid) != CT_OK ||
         ct_pose_from_map(&pose, m4_geo_centre_nm[0], m4_geo_centre_nm[1], m4_geo_centre_nm[2], m4_geo_q30) != CT_OK) {
-        ct_plat_puts("bench_m4: FAIL: the geolocation camera or pose fails\n");
+        ct_plat_puts("bench_m4: FAIL: the geolocation camera, grid or pose fails\n");
         return 0;
     }
     for (k = 0u; k < n; ++k) { /* bound: 64 pixels */
@@ -211,72 +219,20 @@ static int geo_bench(const ct_package *p, uint32_t empty, uint64_t ipt_q16)
     for (e = 0; e < M4_GEO_FX; ++e) {
         ct_effects fxs;
         const ct_effects *fx = m4_geo_effects(e, &fxs, &map);
-        uint64_t sum = 0u, steps = 0u, batch;
-        uint32_t lo = 0xFFFFFFFFu, hi = 0u, hits = 0u, in;
-        ct_status bs;
-        for (k = 0u; k < n; ++k) {
-            ct_geo g;
-            ct_status st;
-            t0 = SYST_CVR;
-            st = ct_geolocate(p, &cam, &pose, CT_METHOD_DIRECTIONAL, fx, uv[2u * k], uv[2u * k + 1u], &g);
-            dt = ticks_since(t0);
-            dt = dt > empty ? dt - empty : 0u;
-            in = (uint32_t)(((uint64_t)dt * ipt_q16) >> 16);
-            sum += dt;
-            lo = in < lo ? in : lo;
-            hi = in > hi ? in : hi;
-            steps += g.hit.steps;
-            if ((int32_t)st != m4_geo_px[k].status[e] || g.hit.steps != m4_geo_px[k].steps[e]) {
-                ok = 0;
-            }
-            if (st == CT_HIT || st == CT_HIT_VOID) {
-                hits++;
-                if (g.hit.e_nm != m4_geo_px[k].enh[e][0] || g.hit.n_nm != m4_geo_px[k].enh[e][1] ||
-                    g.hit.h_nm != m4_geo_px[k].enh[e][2]) {
-                    ok = 0;
-                }
-            }
+        for (k = 0u; k < n; ++k) { /* bound: n <= 64 pixels */
+            g_want[k].status = m4_geo_px[k].status[e];
+            g_want[k].steps = m4_geo_px[k].steps[e];
+            g_want[k].enh[0] = m4_geo_px[k].enh[e][0];
+            g_want[k].enh[1] = m4_geo_px[k].enh[e][1];
+            g_want[k].enh[2] = m4_geo_px[k].enh[e][2];
         }
-        /* the same pixels in one batch (SysTick wraps at 2^24 ticks) */
-        t0 = SYST_CVR;
-        bs = ct_geolocate_batch(p, &cam, &pose, CT_METHOD_DIRECTIONAL, fx, uv, n, g_geo, 64u);
-        dt = ticks_since(t0);
-        batch = dt > empty ? dt - empty : 0u;
-        if (bs != CT_OK || sum >= 0xF00000u) {
-            ct_plat_puts("bench_m4: FAIL: the batch failed or may have wrapped SysTick\n");
-            ok = 0;
-        }
-        for (k = 0u; k < n; ++k) {
-            const ct_geo *g = &g_geo[k];
-            if ((int32_t)g->status != m4_geo_px[k].status[e] || g->hit.steps != m4_geo_px[k].steps[e] ||
-                ((g->status == CT_HIT || g->status == CT_HIT_VOID) &&
-                 (g->hit.e_nm != m4_geo_px[k].enh[e][0] || g->hit.n_nm != m4_geo_px[k].enh[e][1] ||
-                  g->hit.h_nm != m4_geo_px[k].enh[e][2]))) {
-                ok = 0;
-            }
-        }
-        put_pad(fxname[e], 26u);
-        put_u(n, 7u);
-        put_u(hits, 5u);
-        put_u(n > 0u ? (steps * 10u / n) / 10u : 0u, 4u);
-        put(".");
-        put_u(n > 0u ? (steps * 10u / n) % 10u : 0u, 0u);
-        put(" | ");
-        put_u(n > 0u ? ((sum * ipt_q16) >> 16) / n : 0u, 24u);
-        put("  ");
-        put_u(lo, 8u);
-        put("-");
-        put_u(hi, 0u);
-        put_u(n > 0u ? ((batch * ipt_q16) >> 16) / n : 0u, 14u);
-        /* n per-pixel calls form the set-up n times, the batch once */
-        if (n > 1u && sum > batch) {
-            put_u((((sum - batch) * ipt_q16) >> 16) / (n - 1u), 13u);
-        } else {
-            put("            -");
-        }
-        flush();
+        ok = pixel_row(fxname[e], p, &cam, &pose, fx, uv, n, 1, empty, ipt_q16) && ok;
     }
-    return grid_row(p, &pose, uv, n, empty, ipt_q16) && ok;
+    /* straight again with the lens baked into the 8 px grid.  bound: n */
+    for (k = 0u; k < n; ++k) {
+        g_want[k] = m4_geo_grid_px[k];
+    }
+    return pixel_row("straight, 8 px grid", p, &gcam, &pose, (const ct_effects *)0, uv, n, 0, empty, ipt_q16) && ok;
 }
 
 int main(void)
