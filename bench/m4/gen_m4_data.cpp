@@ -125,21 +125,8 @@ bool geo_data(FILE *f, const ct_package &p)
     const int64_t step = INT64_C(8) << 16, u0 = -(INT64_C(17) << 15), v0 = u0;
     const uint32_t nu = (uint32_t)((((int64_t)lens.width << 16) - u0) / step) + 3u,
                    nv = (uint32_t)((((int64_t)lens.height << 16) - v0) / step) + 3u;
-    std::vector<int32_t> nodes(3u * nu * nv, 0);
-    for (uint32_t j = 0; j < nv; ++j)
-        for (uint32_t i = 0; i < nu; ++i) {
-            int32_t r[3];
-            if (ct_camera_unproject(&cam, u0 + (int64_t)i * step, v0 + (int64_t)j * step, r, nullptr) == CT_OK)
-                for (int c = 0; c < 3; ++c) nodes[3u * (j * nu + i) + (uint32_t)c] = r[c];
-        }
-    ct_unproject_grid grid;
-    grid.nu = nu;
-    grid.nv = nv;
-    grid.u0_q16 = u0;
-    grid.v0_q16 = v0;
-    grid.step_q16 = step;
-    grid.rays_q30 = nodes.data();
-    grid.rays_len = nodes.size();
+    std::vector<int32_t> nodes;
+    const ct_unproject_grid grid = dem_cases::grid_from_camera(cam, u0, v0, step, nu, nv, &nodes);
     ct_camera gcam;
     if (ct_camera_init_grid(&gcam, &grid) != CT_OK) {
         std::fprintf(stderr, "ct_gen_m4_data: the unprojection grid is refused\n");

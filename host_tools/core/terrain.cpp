@@ -53,16 +53,10 @@ Terrain terrain_from_heights(int width, int height, const std::vector<double> &h
     if (h_m.size() != n || (!valid.empty() && valid.size() != n)) {
         throw Error("height array size does not match the dimensions");
     }
-    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-    size_t nvalid = 0;
-    for (size_t k = 0; k < n; ++k) {
-        bool ok = (valid.empty() || valid[k]) && std::isfinite(h_m[k]);
-        if (ok) {
-            lo = std::min(lo, h_m[k]);
-            hi = std::max(hi, h_m[k]);
-            nvalid++;
-        }
-    }
+    HeightRange r;
+    for (size_t k = 0; k < n; ++k) r.add(h_m[k], valid.empty() || valid[k]);
+    const size_t nvalid = r.nvalid;
+    const double lo = r.lo, hi = r.hi;
     if (nvalid == 0) {
         throw Error("every sample is nodata");
     }
@@ -84,8 +78,7 @@ Terrain terrain_from_heights(int width, int height, const std::vector<double> &h
             t.void_post[k] = 1;
             continue;
         }
-        long c = std::lround((h_m[k] - lo) / scale_m);
-        t.codes[k] = (uint16_t)std::min(65535L, std::max(0L, c));
+        t.codes[k] = height_code(h_m[k], lo, scale_m);
     }
     return t;
 }

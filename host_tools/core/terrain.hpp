@@ -6,8 +6,11 @@
 // the package bytes in the format defined by lib/include/conetrace.h.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -109,6 +112,28 @@ std::string too_wide_for_package(int width, int height);
 // fit 16 bits at the scale.  Codes are lround((h - lo) / scale) clamped to
 // 0..65535, voids 0.
 double choose_height_scale(double lo, double hi, double scale_m);
+
+// The range of the valid, finite heights seen so far (nvalid of them).
+struct HeightRange {
+    double lo = std::numeric_limits<double>::infinity(), hi = -std::numeric_limits<double>::infinity();
+    size_t nvalid = 0;
+    // h counts when valid and finite; returns whether it did
+    bool add(double h, bool valid)
+    {
+        if (!valid || !std::isfinite(h)) return false;
+        lo = std::min(lo, h);
+        hi = std::max(hi, h);
+        nvalid++;
+        return true;
+    }
+};
+
+// A height's code: lround((h - lo) / scale) clamped to 0..65535.
+inline uint16_t height_code(double h_m, double lo, double scale_m)
+{
+    const long c = std::lround((h_m - lo) / scale_m);
+    return (uint16_t)std::min(65535L, std::max(0L, c));
+}
 
 // Quantise metres to codes.  scale_m <= 0 chooses the finest power-of-two
 // fraction of a metre that fits the range (at most 1/16 m ... up to 2^k m).

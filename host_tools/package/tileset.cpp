@@ -398,21 +398,16 @@ void build_mosaic_dir(int width, int height, const Georef &geo, double scale_m, 
     auto t0 = std::chrono::steady_clock::now();
     std::vector<double> h;
     std::vector<uint8_t> valid;
-    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-    size_t nvalid = 0;
+    HeightRange range;
     for (int y = 0; y < height; y += chunk_rows) {
         const int n = std::min(chunk_rows, height - y);
         read(y, n, h, valid);
-        for (size_t k = 0; k < h.size(); ++k)
-            if (valid[k] && std::isfinite(h[k])) {
-                lo = std::min(lo, h[k]);
-                hi = std::max(hi, h[k]);
-                nvalid++;
-            }
+        for (size_t k = 0; k < h.size(); ++k) range.add(h[k], valid[k] != 0);
         if (progress) progress("scanning heights", (size_t)(y + n), (size_t)height);
     }
-    if (nvalid == 0) throw Error("every sample is nodata");
-    scale_m = choose_height_scale(lo, hi, scale_m);
+    if (range.nvalid == 0) throw Error("every sample is nodata");
+    const double lo = range.lo;
+    scale_m = choose_height_scale(lo, range.hi, scale_m);
     sum.lo_m = lo;
     sum.scale_m = scale_m;
     auto t1 = std::chrono::steady_clock::now();
@@ -432,8 +427,16 @@ void build_mosaic_dir(int width, int height, const Georef &geo, double scale_m, 
         BuildOptions o = opt;
         o.threads = 1;
         o.progress = nullptr;
-        std::vector<uint16_t> codes((size_t)width * P);
-        std::vector<uint8_t> voids((size_t)width * P);
+        // the band: a row of tiles, P rows of the DEM at most (tile_terrain
+        // cuts its tiles as from a whole DEM: row 0 of the grid)
+        Terrain band;
+        band.width = width;
+        band.codes.resize((size_t)width * P);
+        band.void_post.resize((size_t)width * P);
+        band.height_offset_m = lo;
+        band.height_scale_m = scale_m;
+        band.vdatum = vdatum;
+        band.geoid = geoid;
         int have = 0;        // rows of the band already filled (the shared edge row)
         int next_row = 0;    // the next DEM row to read
         int chunk_y = 0;     // rows chunk_y .. chunk_y + chunk_n - 1 are in h / valid
@@ -455,11 +458,12 @@ void build_mosaic_dir(int width, int height, const Georef &geo, double scale_m, 
                 for (int i = 0; i < width; ++i) {
                     const double v = h[src + i];
                     const bool ok = valid[src + i] && std::isfinite(v);
-                    long c = ok ? std::lround((v - lo) / scale_m) : 0L;  // voids: the lowest height
-                    codes[dst + i] = (uint16_t)std::min(65535L, std::max(0L, c));
-                    voids[dst + i] = ok ? 0 : 1;
+                    band.codes[dst + i] = ok ? height_code(v, lo, scale_m) : 0;  // voids: the lowest height
+                    band.void_post[dst + i] = ok ? 0 : 1;
                 }
             }
+            band.height = rows;
+            band.geo = shifted_georef(geo, 0, y0);
             // this band's tiles, `nthreads` at a time
             std::atomic<int> next_col{0};
             std::mutex err_mu;
@@ -470,25 +474,7 @@ void build_mosaic_dir(int width, int height, const Georef &geo, double scale_m, 
                     const int col = next_col++;
                     if (col >= g.tiles_x) return;
                     try {
-                        const int x0 = g.first_col(col), w = std::min(P, width - x0);
-                        Terrain s;
-                        s.width = w;
-                        s.height = rows;
-                        s.codes.resize((size_t)w * rows);
-                        s.void_post.resize((size_t)w * rows);
-                        bool any = false;
-                        for (int j = 0; j < rows; ++j) {
-                            std::copy_n(&codes[(size_t)j * width + x0], w, &s.codes[(size_t)j * w]);
-                            std::copy_n(&voids[(size_t)j * width + x0], w, &s.void_post[(size_t)j * w]);
-                            for (int i = 0; i < w; ++i) any = any || s.void_post[(size_t)j * w + i];
-                        }
-                        if (!any) s.void_post.clear();
-                        s.geo = shifted_georef(geo, x0, y0);
-                        s.height_offset_m = lo;
-                        s.height_scale_m = scale_m;
-                        s.vdatum = vdatum;
-                        s.geoid = geoid;
-                        const std::vector<uint8_t> pkg = build_package(s, o);
+                        const std::vector<uint8_t> pkg = build_package(tile_terrain(band, g, col, 0), o);
                         const int bx = col / K, by = row / K;
                         write_file_atomic((fs::path(tmp) / mosaic_set_name(bx, by) /
                                            tile_file_name(col - bx * K, row - by * K))
@@ -517,8 +503,8 @@ void build_mosaic_dir(int width, int height, const Georef &geo, double scale_m, 
             if (progress) progress("building tiles", done.load(), ntiles);
             // the band's last row is the next band's first
             if (row + 1 < g.tiles_y) {
-                std::copy_n(&codes[(size_t)(rows - 1) * width], width, &codes[0]);
-                std::copy_n(&voids[(size_t)(rows - 1) * width], width, &voids[0]);
+                std::copy_n(&band.codes[(size_t)(rows - 1) * width], width, &band.codes[0]);
+                std::copy_n(&band.void_post[(size_t)(rows - 1) * width], width, &band.void_post[0]);
                 have = 1;
             }
         }

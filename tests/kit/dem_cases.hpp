@@ -371,6 +371,31 @@ inline ct_lens centred_pinhole(uint32_t w, uint32_t h, int64_t f)
     return lens;
 }
 
+// A camera's own unprojection (ct_camera_unproject) at nu x nv nodes from
+// pixel (u0, v0), step apart (all Q16), as an unprojection grid; a node it
+// refuses stays (0, 0, 0).  *nodes holds the rays and must outlive the grid.
+inline ct_unproject_grid grid_from_camera(const ct_camera &cam, int64_t u0_q16, int64_t v0_q16, int64_t step_q16,
+                                          uint32_t nu, uint32_t nv, std::vector<int32_t> *nodes)
+{
+    nodes->assign(3u * (size_t)nu * nv, 0);
+    for (uint32_t j = 0; j < nv; ++j)
+        for (uint32_t i = 0; i < nu; ++i) {
+            int32_t r[3];
+            if (ct_camera_unproject(&cam, u0_q16 + (int64_t)i * step_q16, v0_q16 + (int64_t)j * step_q16, r,
+                                    nullptr) == CT_OK)
+                for (uint32_t c = 0; c < 3u; ++c) (*nodes)[3u * ((size_t)j * nu + i) + c] = r[c];
+        }
+    ct_unproject_grid g;
+    g.nu = nu;
+    g.nv = nv;
+    g.u0_q16 = u0_q16;
+    g.v0_q16 = v0_q16;
+    g.step_q16 = step_q16;
+    g.rays_q30 = nodes->data();
+    g.rays_len = nodes->size();
+    return g;
+}
+
 // Every step-th pixel of a w x h image, row by row, as (u, v) Q16 pairs.
 inline std::vector<int64_t> pixel_grid(unsigned w, unsigned h, unsigned step)
 {

@@ -30,6 +30,7 @@
 #include <vector>
 
 #include "conetrace.h"
+#include "dem_cases.hpp"
 extern "C" {
 #include "fixed.h"
 }
@@ -868,24 +869,8 @@ std::vector<Cam> make_cameras(Rng &g, const std::vector<const ct_package *> &pk)
         ct_camera src;
         std::memset(&src, 0, sizeof src);
         if (ct_camera_init(&src, &cams[0].lens) != CT_OK) die("grid source lens");
-        const uint32_t nu = 13, nv = 10;
-        const int64_t step = 64, u0 = -64, v0 = -64;
-        for (uint32_t j = 0; j < nv; ++j)
-            for (uint32_t i = 0; i < nu; ++i) {
-                int32_t ray[3] = {0, 0, 0};
-                uint32_t it = 0;
-                if (ct_camera_unproject(&src, (u0 + (int64_t)i * step) << 16, (v0 + (int64_t)j * step) << 16, ray, &it) !=
-                    CT_OK)
-                    ray[0] = ray[1] = ray[2] = 0;
-                c.grid_rays.insert(c.grid_rays.end(), ray, ray + 3);
-            }
-        c.grid.nu = nu;
-        c.grid.nv = nv;
-        c.grid.u0_q16 = u0 << 16;
-        c.grid.v0_q16 = v0 << 16;
-        c.grid.step_q16 = step << 16;
-        c.grid.rays_q30 = c.grid_rays.data();
-        c.grid.rays_len = c.grid_rays.size();
+        c.grid = dem_cases::grid_from_camera(src, INT64_C(-64) << 16, INT64_C(-64) << 16, INT64_C(64) << 16, 13u, 10u,
+                                             &c.grid_rays);
         look(20, 40, c.R);
         c.e_nm = nm(E0 + 300);
         c.n_nm = nm(N0 - 1300);
