@@ -294,12 +294,16 @@ static ct_status walk_cones(const ctx *c, uint32_t plane, ct_hit *h)
     const ct_package *p = c->p;
     const ct_prepared *r = c->r;
     const uint8_t *ang = p->angles + (size_t)plane * p->coarse_x * p->coarse_y;
+    /* the ray's constants in locals: h's counters may alias them */
+    const int64_t ox = r->ox, oy = r->oy, oz = r->oz;
+    const int32_t dx = r->dx, dy = r->dy, dz = r->dz;
     int32_t i, j;
-    uint32_t it, bound = CT_WCET_CELL_ITERS(c->cx, c->cy);
+    uint32_t it, steps = h->steps, bound = CT_WCET_CELL_ITERS(c->cx, c->cy);
     rt t = c->t0;   /* current point */
     rt tin = c->t0; /* canonical entry of the current cell */
     int tin_ok = 1;
     int64_t lb;      /* lower_ahead at (i, j), -1 when not formed */
+    ct_status st = CT_ERR_INTERNAL;
     cexit e;
     i = c->i0;
     j = c->j0;
@@ -308,10 +312,10 @@ static ct_status walk_cones(const ctx *c, uint32_t plane, ct_hit *h)
         uint32_t code;
         size_t k;
         if (!inside(c, i, j)) {
-            h->iters = it;
-            return CT_MISS;
+            st = CT_MISS;
+            break;
         }
-        h->steps++;
+        steps++;
         k = coarse_index(p, i, j);
         code = ang[k];
         lb = -1;
@@ -327,8 +331,8 @@ static ct_status walk_cones(const ctx *c, uint32_t plane, ct_hit *h)
              * (z at T for a rising ray, at T + 1 for a descending one unless
              * t is exactly T / 2^26): t.n 2^26 < 2^60. */
             int64_t T = t.d == T_ONE ? t.n : ct_floor_div(t.n * T_ONE, t.d);
-            int64_t Tz = (t.d != T_ONE && r->dz < 0) ? T + 1 : T;
-            int64_t num = r->oz + floor_shr(Tz * (int64_t)r->dz, CT_T_FRAC_BITS) - a16; /* < 2^34 */
+            int64_t Tz = (t.d != T_ONE && dz < 0) ? T + 1 : T;
+            int64_t num = oz + floor_shr(Tz * (int64_t)dz, CT_T_FRAC_BITS) - a16; /* < 2^34 */
             if (num > 0) {
                 int64_t cot = p->cot_q16[code];
                 int64_t len = cot >= 0 ? r->len_hi : r->len_lo;
@@ -341,8 +345,9 @@ static ct_status walk_cones(const ctx *c, uint32_t plane, ct_hit *h)
                 int64_t dt, tn;
                 if (den <= 0) {
                     /* the ray never leaves the empty region: no hit ahead */
-                    h->iters = it + 1u;
-                    return CT_MISS;
+                    st = CT_MISS;
+                    it++;
+                    break;
                 }
                 num = (int64_t)((uint64_t)num * c->zmul);
                 dt = (num * T_ONE) / den; /* num*2^26 < 2^60 */
@@ -353,22 +358,22 @@ static ct_status walk_cones(const ctx *c, uint32_t plane, ct_hit *h)
                  * ray on [t, tn] lies in the empty region.  The jump is taken
                  * when it leaves the fine cell (the point at tn lies in
                  * another cell, or on the exit face, which belongs to the
-                 * next cell); otherwise the exact cell step below. */
+                 * next cell); otherwise the exact cell step below.  The cell
+                 * at tn as locate's for a Q26 t: o 2^26 < 2^57 and tn |d| <
+                 * (2^34 + 2^35) 2^26 < 2^61.6 (T < 2^34, dt <= 2^35). */
                 tn = T + dt - 1;
                 if (tn > T) {
-                    rt tj;
-                    int32_t ni, nj;
-                    tj.n = tn;
-                    tj.d = T_ONE;
-                    locate(c, tj, &ni, &nj);
+                    int32_t ni = axis_cell_q26(ox * T_ONE + tn * (int64_t)dx, c->sx, c->cx);
+                    int32_t nj = axis_cell_q26(oy * T_ONE + tn * (int64_t)dy, c->sy, c->cy);
                     if (ni != i || nj != j) {
+                        rt tj;
 #if CT_HAVE_PREFETCH
                         if (c->prefetch) {
                             /* a hint only: T2 = tn + dt < 2^36, times |d| <=
                              * 2^26; a cell off the tile is not asked for */
                             int64_t T2 = tn + dt;
-                            int64_t px = floor_shr(r->ox + floor_shr(T2 * (int64_t)r->dx, CT_T_FRAC_BITS), 16u);
-                            int64_t py = floor_shr(r->oy + floor_shr(T2 * (int64_t)r->dy, CT_T_FRAC_BITS), 16u);
+                            int64_t px = floor_shr(ox + floor_shr(T2 * (int64_t)dx, CT_T_FRAC_BITS), 16u);
+                            int64_t py = floor_shr(oy + floor_shr(T2 * (int64_t)dy, CT_T_FRAC_BITS), 16u);
                             if (px >= 0 && py >= 0 && px < c->cx && py < c->cy) {
                                 size_t k2 = coarse_index(p, (int32_t)px, (int32_t)py);
                                 CT_PREFETCH(ang + k2);
@@ -376,9 +381,12 @@ static ct_status walk_cones(const ctx *c, uint32_t plane, ct_hit *h)
                             }
                         }
 #endif
+                        tj.n = tn;
+                        tj.d = T_ONE;
                         if (!rt_lt(tj, c->tend)) {
-                            h->iters = it + 1u;
-                            return CT_MISS;
+                            st = CT_MISS;
+                            it++;
+                            break;
                         }
                         t = tj;
                         i = ni;
@@ -395,19 +403,25 @@ static ct_status walk_cones(const ctx *c, uint32_t plane, ct_hit *h)
             tin = cell_entry(c, i, j);
         }
         if (ct_cell_test(c, i, j, tin, &e, lb, h)) {
-            h->iters = it + 1u;
-            return ct_hit_status(p, i, j);
+            st = ct_hit_status(p, i, j);
+            it++;
+            break;
         }
         if (!rt_lt(e.t, c->tend)) {
-            h->iters = it + 1u;
-            return CT_MISS;
+            st = CT_MISS;
+            it++;
+            break;
         }
         next_cell(c, &e, &i, &j);
         t = e.t;
         tin = e.t;
         tin_ok = 1;
     }
-    return CT_ERR_INTERNAL;
+    h->steps = steps;
+    if (st != CT_ERR_INTERNAL) {
+        h->iters = it;
+    }
+    return st;
 }
 
 /* A seam start's cheap proof of f(t0) > 0, as the cone walk's first test
