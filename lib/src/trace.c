@@ -139,7 +139,8 @@ static void next_cell(const ctx *c, const cexit *e, int32_t *i, int32_t *j)
 static ct_status walk_incremental(const ctx *c, ct_hit *h)
 {
     int32_t i, j;
-    uint32_t it, bound = CT_WCET_CELL_ITERS(c->cx, c->cy);
+    uint32_t it, steps = h->steps, bound = CT_WCET_CELL_ITERS(c->cx, c->cy);
+    ct_status st = CT_ERR_INTERNAL;
     rt tin = c->t0;
     cexit e;
     i = c->i0;
@@ -147,23 +148,27 @@ static ct_status walk_incremental(const ctx *c, ct_hit *h)
     /* bound: each iteration leaves one fine cell */
     for (it = 0u; it < bound; ++it) {
         if (!inside(c, i, j)) {
-            h->iters = it;
-            return CT_MISS;
+            st = CT_MISS;
+            break;
         }
         cell_exit(c, i, j, &e);
-        h->steps++;
+        steps++;
         if (ct_cell_test(c, i, j, tin, &e, -1, h)) {
-            h->iters = it + 1u;
-            return ct_hit_status(c->p, i, j);
+            st = ct_hit_status(c->p, i, j);
+            it++;
+            break;
         }
         if (!rt_lt(e.t, c->tend)) {
-            h->iters = it + 1u;
-            return CT_MISS;
+            st = CT_MISS;
+            it++;
+            break;
         }
         next_cell(c, &e, &i, &j);
         tin = e.t;
     }
-    return CT_ERR_INTERNAL;
+    h->steps = steps;
+    h->iters = it; /* == bound with CT_ERR_INTERNAL */
+    return st;
 }
 
 static uint32_t mip_at(const ct_package *p, uint32_t l, int32_t bi, int32_t bj)
@@ -418,9 +423,7 @@ static ct_status walk_cones(const ctx *c, uint32_t plane, ct_hit *h)
         tin_ok = 1;
     }
     h->steps = steps;
-    if (st != CT_ERR_INTERNAL) {
-        h->iters = it;
-    }
+    h->iters = it; /* == bound with CT_ERR_INTERNAL */
     return st;
 }
 
