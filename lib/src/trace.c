@@ -308,6 +308,8 @@ static ct_status walk_cones(const ctx *c, uint32_t plane, ct_hit *h)
     rt tin = c->t0; /* canonical entry of the current cell */
     int tin_ok = 1;
     int64_t lb;      /* lower_ahead at (i, j), -1 when not formed */
+    size_t below_k = (size_t)-1; /* the coarse cell whose apex the ray was
+                                    found below (none: no index is 2^N-1) */
     ct_status st = CT_ERR_INTERNAL;
     cexit e;
     i = c->i0;
@@ -322,8 +324,13 @@ static ct_status walk_cones(const ctx *c, uint32_t plane, ct_hit *h)
         }
         steps++;
         k = coarse_index(p, i, j);
-        code = ang[k];
         lb = -1;
+        /* Below the apex of coarse cell k at an earlier fine cell of it (the
+         * ray leaves a coarse cell once: it is a rectangle): the exact step
+         * without consulting the cone again, which seldom jumps there (any
+         * step here is exact, so this changes the steps, never the hit).
+         * Code 0 (a closed cone) is never stepped with (ct_cot_table). */
+        code = k != below_k ? ang[k] : 0u;
         if (p->cot_ok[code]) {
             /* a bent ray: the apex less the lowering's bound ahead (the
              * cone of the lowered terrain; |a16| < 2^33) */
@@ -338,7 +345,9 @@ static ct_status walk_cones(const ctx *c, uint32_t plane, ct_hit *h)
             int64_t T = t.d == T_ONE ? t.n : ct_floor_div(t.n * T_ONE, t.d);
             int64_t Tz = (t.d != T_ONE && dz < 0) ? T + 1 : T;
             int64_t num = oz + floor_shr(Tz * (int64_t)dz, CT_T_FRAC_BITS) - a16; /* < 2^34 */
-            if (num > 0) {
+            if (num <= 0) {
+                below_k = k;
+            } else {
                 int64_t cot = p->cot_q16[code];
                 int64_t len = cot >= 0 ? r->len_hi : r->len_lo;
                 /* in Q16 z units: num 2^k < 2^34 (a lower bound of the
