@@ -452,7 +452,20 @@ ct_status ct_prepare_lowered(const ct_package *p, const ct_ray *ray, int seg, co
     }
     /* the first point is on the tile: the cell it is in, clamped */
     ct_prepared_first_cell(p, out, &i, &j);
-    return prep_finish(p, p, 0, 0, ct_clamp_cell(i, p->cells_x), ct_clamp_cell(j, p->cells_y), ray, seg, lw, out);
+    i = ct_clamp_cell(i, p->cells_x);
+    j = ct_clamp_cell(j, p->cells_y);
+#if CT_HAVE_PREFETCH
+    if (out->sector >= 0 && (uint64_t)p->coarse_x * p->coarse_y * p->sectors > (UINT64_C(1) << 20)) {
+        /* hosts, angle planes beyond L2 (as trace.c's set_ctx): start
+         * loading the first cone's code and apex (directional) while the
+         * first point is decided (a package opened whole, as prep_finish
+         * reads its posts: its planes are there) */
+        size_t k = ct_coarse_index(p, i, j);
+        CT_PREFETCH(p->angles + (size_t)(uint32_t)out->sector * p->coarse_x * p->coarse_y + k);
+        CT_PREFETCH(p->apex + 2u * k);
+    }
+#endif
+    return prep_finish(p, p, 0, 0, i, j, ray, seg, lw, out);
 }
 
 ct_status ct_ray_prepare(const ct_package *p, const ct_ray *ray, ct_prepared *out)

@@ -285,15 +285,6 @@ static ct_status walk_hierarchical(const ctx *c, ct_hit *h)
     return CT_ERR_INTERNAL;
 }
 
-/* Coarse cell index of fine cell (i, j): i / r by the multiplier (exact for
- * i < 2^16, see ct_package.reduce_mul). */
-static size_t coarse_index(const ct_package *p, int32_t i, int32_t j)
-{
-    uint32_t ci = (uint32_t)(((uint64_t)(uint32_t)i * p->reduce_mul) >> 32);
-    uint32_t cj = (uint32_t)(((uint64_t)(uint32_t)j * p->reduce_mul) >> 32);
-    return (size_t)cj * p->coarse_x + ci;
-}
-
 static ct_status walk_cones(const ctx *c, uint32_t plane, ct_hit *h)
 {
     const ct_package *p = c->p;
@@ -323,7 +314,7 @@ static ct_status walk_cones(const ctx *c, uint32_t plane, ct_hit *h)
             break;
         }
         steps++;
-        k = coarse_index(p, i, j);
+        k = ct_coarse_index(p, i, j);
         lb = -1;
         /* Below the apex of coarse cell k at an earlier fine cell of it (the
          * ray leaves a coarse cell once: it is a rectangle): the exact step
@@ -389,7 +380,7 @@ static ct_status walk_cones(const ctx *c, uint32_t plane, ct_hit *h)
                             int64_t px = floor_shr(ox + floor_shr(T2 * (int64_t)dx, CT_T_FRAC_BITS), 16u);
                             int64_t py = floor_shr(oy + floor_shr(T2 * (int64_t)dy, CT_T_FRAC_BITS), 16u);
                             if (px >= 0 && py >= 0 && px < c->cx && py < c->cy) {
-                                size_t k2 = coarse_index(p, (int32_t)px, (int32_t)py);
+                                size_t k2 = ct_coarse_index(p, (int32_t)px, (int32_t)py);
                                 CT_PREFETCH(ang + k2);
                                 CT_PREFETCH(p->apex + 2u * k2);
                             }
@@ -446,7 +437,7 @@ static int above_apex(const ctx *c, uint32_t plane, int32_t i, int32_t j)
 {
     const ct_package *p = c->p;
     const ct_prepared *r = c->r;
-    size_t k = coarse_index(p, i, j);
+    size_t k = ct_coarse_index(p, i, j);
     uint32_t code = p->angles[(size_t)plane * p->coarse_x * p->coarse_y + k];
     int64_t a16, T, Tz;
     if (!p->cot_ok[code]) {
