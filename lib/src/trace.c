@@ -355,7 +355,9 @@ static ct_status walk_cones(const ctx *c, uint32_t plane, ct_hit *h)
                     break;
                 }
                 num = (int64_t)((uint64_t)num * c->zmul);
-                dt = (num * T_ONE) / den; /* num*2^26 < 2^60 */
+                /* num*2^26 < 2^60 and den > 0: unsigned (a cheaper division
+                 * on the MCUs, whose 64-bit division is a library call) */
+                dt = (int64_t)((uint64_t)(num * T_ONE) / (uint64_t)den);
                 if (dt > (INT64_C(1) << 35)) {
                     dt = INT64_C(1) << 35;
                 }
