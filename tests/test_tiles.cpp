@@ -856,6 +856,76 @@ void test_los()
     TEST_ASSERT(counts[0] > 100 && counts[1] > 100 && nodata >= hidden && hidden > 0);
 }
 
+// A set's frame (ts.frame: a ct_package with no sections, base NULL, for
+// the georeference) handed to what reads terrain: CT_ERR_ARG from each, not
+// a NULL dereference; the same calls on the merged package succeed.
+void test_frame_refused()
+{
+    const ct_host::Terrain t = dem_cases::mirror_tiled(dem_cases::real_terrain(), 200, 200);
+    ct_host::BuildOptions o;
+    o.sectors = 8;
+    o.reduce = 2;
+    const TileSetBytes tb = ct_host::build_tileset(t, o, 65, 0);
+    const std::vector<uint8_t> merged = ct_host::build_package(t, o);
+    ct_package mp;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_package_open(&mp, merged.data(), merged.size()));
+    Set set;
+    TEST_ASSERT_EQUAL_INT(CT_OK, set.open(tb, 2));
+    const ct_package *f = &set.ts.frame;
+    TEST_ASSERT(f->base == nullptr && f->heights == nullptr);
+    ct_lens lens{};
+    lens.model = CT_LENS_PINHOLE;
+    lens.width = 64;
+    lens.height = 48;
+    lens.fx_q32 = lens.fy_q32 = (int64_t)50 << 32;
+    lens.cx_q32 = (int64_t)63 << 31;
+    lens.cy_q32 = (int64_t)47 << 31;
+    ct_camera cam;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_camera_init(&cam, &lens));
+    int32_t q[4];
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_quat_from_ypr(0, dem_cases::deg_q61(-60), 0, q));
+    ct_pose pose;
+    const int64_t e = mp.origin_e_nm + 100 * mp.posting_e_nm, n = mp.origin_n_nm + 100 * mp.posting_n_nm;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_pose_from_map(&pose, e, n, (int64_t)1500 * 1000000000, q));
+    ct_effects sphere = {CT_EFFECT_CURVATURE | CT_EFFECT_REFRACTION, CT_REFRACTION_K_STD_Q16,
+                         (int64_t)6371000 * 1000000000, 0, NULL};
+    // from 2,000 LSB above the highest post, 256 LSB down per cell: a hit
+    const ct_ray ray = {(int64_t)100 << 16, (int64_t)100 << 16, ((int64_t)mp.hmax + 2000) << 16, 1 << 16, 1 << 15,
+                        -(1 << 24)};
+    const ct_bend bd = {57016, CT_EARTH_RADIUS_NM, CT_EFFECTS_CHORD_NM, 0u};  // c = 0.87, as the effects
+    const int64_t uv[2] = {(int64_t)32 << 16, (int64_t)24 << 16};
+    const int64_t a[3] = {e, n, (int64_t)1500 * 1000000000}, b[3] = {e + 50 * mp.posting_e_nm, n, 0};
+    for (int side = 0; side < 2; ++side) {
+        const ct_package *p = side == 0 ? &mp : f;
+        const char *who = side == 0 ? "the merged package" : "the frame";
+        auto ok = [&](ct_status s) { return side == 0 ? s >= 0 : s == CT_ERR_ARG; };
+        ct_hit h;
+        ct_prepared pr;
+        int64_t z = 0, u = 0, v = 0;
+        uint32_t visible = 0;
+        ct_geo g, gb[1];
+        TEST_ASSERT_MSG(ok(ct_trace(p, &ray, CT_METHOD_DIRECTIONAL, &h)), "%s: ct_trace", who);
+        TEST_ASSERT_MSG(ok(ct_ray_prepare(p, &ray, &pr)), "%s: ct_ray_prepare", who);
+        TEST_ASSERT_MSG(ok(ct_ray_prepare_segment(p, &ray, &pr)), "%s: ct_ray_prepare_segment", who);
+        TEST_ASSERT_MSG(ok(ct_trace_bent(p, &ray, &bd, CT_METHOD_DIRECTIONAL, &h)), "%s: ct_trace_bent", who);
+        TEST_ASSERT_MSG(ok(ct_surface_height(p, 5 << 16, 5 << 16, &z)), "%s: ct_surface_height", who);
+        TEST_ASSERT_MSG(ok(ct_package_verify(p)), "%s: ct_package_verify", who);
+        TEST_ASSERT_MSG(ok(ct_los(p, a, b, &sphere, 0, CT_METHOD_DIRECTIONAL, &h)), "%s: ct_los", who);
+        TEST_ASSERT_MSG(ok(ct_locate_inverse(p, &cam, &pose, NULL, b, 0, &u, &v, &visible, &h)),
+                        "%s: ct_locate_inverse", who);
+        TEST_ASSERT_MSG(ok(ct_geolocate(p, &cam, &pose, CT_METHOD_DIRECTIONAL, &sphere, uv[0], uv[1], &g)) &&
+                            ok(g.status),
+                        "%s: ct_geolocate", who);
+        TEST_ASSERT_MSG(ok(ct_geolocate_batch(p, &cam, &pose, CT_METHOD_DIRECTIONAL, NULL, uv, 1, gb, 1)),
+                        "%s: ct_geolocate_batch", who);
+        if (side == 0) {
+            // a ray prepared on the package, traced on the frame
+            TEST_ASSERT_EQUAL_INT(CT_OK, ct_ray_prepare(&mp, &ray, &pr));
+            TEST_ASSERT_EQUAL_INT(CT_ERR_ARG, ct_trace_prepared(f, &pr, CT_METHOD_DIRECTIONAL, &h));
+        }
+    }
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------------------
@@ -950,6 +1020,7 @@ int main()
     RUN_TEST(test_voids);
     RUN_TEST(test_geolocation);
     RUN_TEST(test_los);
+    RUN_TEST(test_frame_refused);
     RUN_TEST(test_streamed_build);
     return TEST_END();
 }

@@ -1302,8 +1302,13 @@ typedef struct {
  * trace updates the cache (one set per thread).                           */
 typedef struct {
     ct_package frame;          /* the merged grid: its size, heights' range
-                                  and georeference (no sections): use it for
-                                  ct_map_to_grid, ct_ray_from_map, ...      */
+                                  and georeference (no sections: base is
+                                  NULL): use it for ct_map_to_grid,
+                                  ct_ray_from_map, ...; what reads terrain
+                                  (ct_trace, ct_ray_prepare*, ct_trace_*,
+                                  ct_surface_height, ct_los,
+                                  ct_locate_inverse, ct_geolocate*,
+                                  ct_package_verify) refuses it: CT_ERR_ARG */
     uint32_t tiles_x, tiles_y; /* the tile grid                             */
     uint32_t tile_posts;       /* P                                         */
     uint32_t tile_recip;       /* floor(2^32 / (P - 1)) + 1 (0 for P = 2):

@@ -418,8 +418,8 @@ ct_status ct_trace_bent(const ct_package *p, const ct_ray *ray, const ct_bend *b
     ct_bent_setup bs;
     ct_status st;
     CT_ASSERT(p != NULL && ray != NULL && bd != NULL && h != NULL);
-    if (p == NULL || ray == NULL || bd == NULL || h == NULL) {
-        return CT_ERR_ARG;
+    if (p == NULL || ray == NULL || bd == NULL || h == NULL || p->base == NULL) {
+        return CT_ERR_ARG; /* base NULL: a frame, which has no sections */
     }
     st = ct_bent_prepare(p, bd, ray->x_q16, ray->y_q16, &bs);
     if (st != CT_OK) {

@@ -591,8 +591,8 @@ ct_status ct_surface_height(const ct_package *p, int64_t x, int64_t y, int64_t *
     int32_t i, j;
     int64_t s;
     CT_ASSERT(p != NULL && z != NULL);
-    if (p == NULL || z == NULL) {
-        return CT_ERR_ARG;
+    if (p == NULL || z == NULL || p->base == NULL) {
+        return CT_ERR_ARG; /* base NULL: a frame, which has no sections */
     }
     if (x < 0 || y < 0 || x > (int64_t)p->cells_x * ONE16 || y > (int64_t)p->cells_y * ONE16) {
         return CT_ERR_RANGE;

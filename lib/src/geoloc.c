@@ -208,7 +208,9 @@ ct_status ct_geolocate(const ct_package *pkg, const ct_camera *cam, const ct_pos
                        const ct_effects *effects, int64_t u_q16, int64_t v_q16, ct_geo *out)
 {
     CT_ASSERT(pkg != NULL && cam != NULL && pose != NULL && out != NULL);
-    return geolocate_one(pkg, NULL, cam, pose, method, effects, u_q16, v_q16, out);
+    /* a frame (base NULL: a tile set's, no sections) as a NULL package */
+    return geolocate_one(pkg != NULL && pkg->base == NULL ? NULL : pkg, NULL, cam, pose, method, effects, u_q16,
+                         v_q16, out);
 }
 
 ct_status ct_geolocate_batch(const ct_package *pkg, const ct_camera *cam, const ct_pose *pose, ct_method method,
@@ -216,7 +218,9 @@ ct_status ct_geolocate_batch(const ct_package *pkg, const ct_camera *cam, const 
                              size_t out_len)
 {
     CT_ASSERT(pkg != NULL && cam != NULL && pose != NULL && (count == 0u || (uv_q16 != NULL && out != NULL)));
-    return geolocate_many(pkg, NULL, cam, pose, method, effects, uv_q16, count, out, out_len);
+    /* a frame (base NULL: a tile set's, no sections) as a NULL package */
+    return geolocate_many(pkg != NULL && pkg->base == NULL ? NULL : pkg, NULL, cam, pose, method, effects, uv_q16,
+                          count, out, out_len);
 }
 
 ct_status ct_geolocate_tiles(ct_tileset *ts, const ct_camera *cam, const ct_pose *pose, ct_method method,

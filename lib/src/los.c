@@ -231,7 +231,8 @@ static ct_status los_impl(const ct_package *p, ct_tileset *ts, const int64_t a_n
 ct_status ct_los(const ct_package *p, const int64_t a_nm[3], const int64_t b_nm[3], const ct_effects *effects,
                  int64_t margin_nm, ct_method m, ct_hit *block)
 {
-    return los_impl(p, NULL, a_nm, b_nm, effects, margin_nm, m, block);
+    /* a frame (base NULL: a tile set's, no sections) as a NULL package */
+    return los_impl(p != NULL && p->base == NULL ? NULL : p, NULL, a_nm, b_nm, effects, margin_nm, m, block);
 }
 
 ct_status ct_los_tiles(ct_tileset *ts, const int64_t a_nm[3], const int64_t b_nm[3], const ct_effects *effects,
@@ -252,8 +253,8 @@ ct_status ct_locate_inverse(const ct_package *p, const ct_camera *cam, const ct_
     int k, j, sh = 0;
     ct_status st;
     if (p == NULL || cam == NULL || pose == NULL || g_nm == NULL || u_q16 == NULL || v_q16 == NULL ||
-        visible == NULL || block == NULL || cam->ready == 0u || pose->ready == 0u) {
-        return CT_ERR_ARG;
+        visible == NULL || block == NULL || cam->ready == 0u || pose->ready == 0u || p->base == NULL) {
+        return CT_ERR_ARG; /* base NULL: a frame, which has no sections */
     }
     *visible = 0u;
     /* the camera centre and the ground point: |.| <= 2^61 each, the

@@ -446,7 +446,11 @@ ct_status ct_tile_prep_finish(const ct_package *frame, const ct_package *tile, i
 ct_status ct_prepare_lowered(const ct_package *p, const ct_ray *ray, int seg, const ct_lower *lw, ct_prepared *out)
 {
     int32_t i, j;
-    ct_status st = prep_geom(p, ray, seg, out);
+    ct_status st;
+    if (p != NULL && p->base == NULL) {
+        return CT_ERR_ARG; /* a frame (a tile set's): no sections to trace */
+    }
+    st = prep_geom(p, ray, seg, out);
     if (st != CT_OK) {
         return st;
     }

@@ -643,8 +643,8 @@ static ct_status trace_impl(const ct_package *p, const ct_prepared *r, ct_method
     ctx c;
     ct_status st;
     CT_ASSERT(p != NULL && r != NULL && h != NULL);
-    if (p == NULL || r == NULL || h == NULL) {
-        return CT_ERR_ARG;
+    if (p == NULL || r == NULL || h == NULL || p->base == NULL) {
+        return CT_ERR_ARG; /* base NULL: a frame, which has no sections */
     }
     if ((unsigned)m >= (unsigned)CT_METHOD_COUNT) {
         return CT_ERR_METHOD;
