@@ -300,7 +300,8 @@ static ct_status walk_cones(const ctx *c, uint32_t plane, ct_hit *h)
     int tin_ok = 1;
     int64_t lb;      /* lower_ahead at (i, j), -1 when not formed */
     size_t below_k = (size_t)-1; /* the coarse cell whose apex the ray was
-                                    found below (none: no index is 2^N-1) */
+                                    found below; none yet: SIZE_MAX, which
+                                    no coarse index (< 2^30) equals      */
     ct_status st = CT_ERR_INTERNAL;
     cexit e;
     i = c->i0;
