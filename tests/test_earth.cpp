@@ -10,7 +10,8 @@
 // into a package in-process; a pinhole camera looks at it from poses made
 // by ct_pose_from_wgs84 (nadir from 3 km; oblique 30 and 20 deg from 2.6
 // km; grazing 5 and 3 deg from ~1 km over the terrain in several azimuths;
-// long: 5 deg from 10 km outside the tile).  Seeded random pixels: the
+// long: 5 deg from 10 km outside the tile; far: 5 deg down from 200 km south
+// and west of it, 15 km up, half the pixels aimed at tile posts).  Seeded random pixels: the
 // library's hit (CT_METHOD_DIRECTIONAL) vs the reference, per pose family
 // (count, RMS and max 3D distance), with the same hit/miss status except
 // near-grazing rays (reference clearance at a local minimum before the hit
@@ -520,12 +521,18 @@ std::vector<PoseDef> pose_defs()
     // long: 10 km outside the tile, 5 deg down towards its middle
     v.push_back({"long", 185000, Nc, 1420, 90, -5});
     v.push_back({"long", Ec, 4050680, 1350, 0, -5});
+    // far: 200 km south and west of the tile, 15 km up, looking at it
+    // (about 5 deg down, the Earth's drop 3.1 km included): a range beyond
+    // 150 km, so the path is interpolated through 6 nodes; half the pixels
+    // aimed at tile posts (ct_locate_inverse), the others at random
+    v.push_back({"far", Ec, Nc - 200000, 15000, 0, -5.1L});
+    v.push_back({"far", Ec - 200000, Nc, 15000, 90, -5.1L});
     return v;
 }
 
 // compare()'s pose families, in pose_defs()' order.
-const char *const kFamilies[] = {"nadir", "oblique30", "oblique20", "grazing5", "grazing3", "long"};
-constexpr int kFamilyCount = 6;
+const char *const kFamilies[] = {"nadir", "oblique30", "oblique20", "grazing5", "grazing3", "long", "far"};
+constexpr int kFamilyCount = 7;
 
 // What compare() gathers: per family, each mode's statistics against the
 // reference (the exact mode, the old parabola on a 6371 km sphere, the fitted
@@ -777,6 +784,21 @@ void compare(unsigned flags)
         for (int k = 0; k < npix; ++k) {
             uv[2 * k] = ct_rng_range(&rng, 0, (int64_t)(cam.w - 1) << 16);
             uv[2 * k + 1] = ct_rng_range(&rng, 0, (int64_t)(cam.h - 1) << 16);
+            if (f == 6 && k % 2 == 0) {
+                // the tile takes a few pixels of the far poses' view: aim at a random post
+                const int i = (int)ct_rng_range(&rng, 0, w->sf.w - 1), j = (int)ct_rng_range(&rng, 0, w->sf.h - 1);
+                ld E, N;
+                w->sf.map_of(i, j, &E, &N);
+                const int64_t g[3] = {std::llround(E * 1e9L), std::llround(N * 1e9L), std::llround(w->sf.at(i, j) * 1e9L)};
+                int64_t u = 0, v = 0;
+                uint32_t vis = 0;
+                ct_hit blk;
+                if (ct_locate_inverse(&w->p, &cam.cam, &p.pose, &m.exact, g, 0, &u, &v, &vis, &blk) == CT_OK &&
+                    u >= 0 && v >= 0 && u <= (int64_t)(cam.w - 1) << 16 && v <= (int64_t)(cam.h - 1) << 16) {
+                    uv[2 * k] = u;
+                    uv[2 * k + 1] = v;
+                }
+            }
         }
         run_pose(w, cam, p, f, uv, m, T);
     }
