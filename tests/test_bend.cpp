@@ -437,6 +437,24 @@ void test_bent_edge_packages()
             TEST_ASSERT(cnt.hits > 0);
             if (cs.name == "voids") TEST_ASSERT(cnt.hit_void > 0);
         }
+    // 1 nm posts with 2^30 nm (1.07 m) height codes on a sphere of 2^54 nm:
+    // the lowering's constant K = c posting^2 / (2^33 R scale) is below
+    // 2^-127 (ct_lower_setup refuses it), so the polyline traces the rays
+    {
+        ct_host::Terrain t = dem_cases::make_terrain(30, 30, dem_cases::smooth(30, 30, 11, 100, 3000), 1.073741824);
+        t.geo.posting_e = 1e-9;
+        t.geo.posting_n = -1e-9;
+        const dem_cases::Case cs = dem_cases::make_case("1 nm posts", t, 8, 1);
+        ct_package p;
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_package_open(&p, cs.pkg.data(), cs.pkg.size()));
+        TEST_ASSERT(p.posting_e_nm == 1 && p.height_scale_nm == (INT64_C(1) << 30));
+        const Scene sc = {"sphere of 2^54 nm", 1.0, (double)(INT64_C(1) << 54) * 1e-9, 0.001};
+        Counts cnt;
+        run_scene(cs, sc, 200, &cnt);
+        printf("  %-20s %-28s %ld rays (%ld lowered, %ld polyline): %ld hit, %ld miss, %ld below; bad %ld\n",
+               cs.name.c_str(), sc.name, cnt.rays, cnt.lowered, cnt.polyline, cnt.hits, cnt.miss, cnt.below, cnt.bad);
+        TEST_ASSERT(cnt.bad == 0 && cnt.polyline == cnt.rays && cnt.hits > 0);
+    }
     // 69 x 2 flat cells of 30 m with a 2.5 km spike at the far corner;
     // polylines 1 km over them along x (inside the terrain's box), bent up
     // (k = 1.5 on a sphere of 2^40 nm) in segments of 0.59 m (just over

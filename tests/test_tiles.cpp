@@ -28,12 +28,14 @@
 
 #include <unistd.h>
 
+#include "bend.h"
 #include "conetrace.h"
 #include "dem_cases.hpp"
 #include "harness.h"
 #include "judge.hpp"
 #include "le.hpp"
 #include "terrain.hpp"
+#include "tiles.h"
 #include "tileset.hpp"
 #include "vdatum.hpp"
 
@@ -798,6 +800,28 @@ void test_geolocation()
                                     same_hit(ref.status, ref.hit, b.status, b.hit),
                                 "nadir, effects %d method %d: merged %d, set %d", f, m, a.status, b.status);
             }
+    }
+    // the bent walk's own entry (tiles.h) with a line of sight whose
+    // horizontal part vanishes once reduced (1 against 2^40 down): not
+    // bent, the straight trace's hit -- the polyline's (c < 0) and the
+    // lowered walk's set-ups, over the set and on the merged package
+    {
+        const ct_ray steep = {(int64_t)250 << 16, (int64_t)190 << 16, ((int64_t)mp.hmax + 100) << 16, 1, 0,
+                              -(INT64_C(1) << 40)};
+        ct_hit hs, hb;
+        const ct_status ss = ct_trace(&mp, &steep, CT_METHOD_DIRECTIONAL, &hs);
+        TEST_ASSERT_EQUAL_INT(CT_HIT, ss);
+        for (int32_t c : {-8520, 57016}) {
+            const ct_bend bd = {c, (int64_t)6371000 * 1000000000, 1000000, 0u};
+            ct_bent_setup bs, bm;
+            TEST_ASSERT_EQUAL_INT(CT_OK, ct_bent_prepare(&set.ts.frame, &bd, steep.x_q16, steep.y_q16, &bs));
+            TEST_ASSERT_EQUAL_INT(CT_OK, ct_bent_prepare(&mp, &bd, steep.x_q16, steep.y_q16, &bm));
+            for (int m = 0; m < 4; ++m) {
+                TEST_ASSERT(same_hit(ss, hs, ct_trace_bent_set_ts(&set.ts.frame, &set.ts, &steep, &bs, (ct_method)m, &hb),
+                                     hb));
+                TEST_ASSERT(same_hit(ss, hs, ct_trace_bent_set(&mp, &steep, &bm, (ct_method)m, &hb), hb));
+            }
+        }
     }
     // a tile missing, with every effect: the merged result or CT_NO_DATA,
     // never a hit on the missing tile
