@@ -437,6 +437,53 @@ void test_bent_edge_packages()
             TEST_ASSERT(cnt.hits > 0);
             if (cs.name == "voids") TEST_ASSERT(cnt.hit_void > 0);
         }
+    // observers 40,000 cells (1,200 km) west of a 30 x 30 tile on a sphere
+    // of 2^40 nm bent with c = -4 and c = 4 (beyond the lowered walk's
+    // 2^15 cells: the polyline): over the tile the path lies over 2^46 Q16
+    // below the terrain (CT_BELOW, before the polyline entered) or above it
+    // (vertices out of range, skipped: CT_MISS), as the reference's
+    {
+        const dem_cases::Case cs =
+            dem_cases::make_case("30 x 30", dem_cases::make_terrain(31, 31, dem_cases::smooth(31, 31, 3, 100, 3000), 0.25),
+                                 8, 1);
+        ct_package p;
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_package_open(&p, cs.pkg.data(), cs.pkg.size()));
+        const ref::Dem d = dem_cases::ref_dem(cs.t);
+        for (double c : {-4.0, 4.0}) {
+            const Scene sc = {c < 0 ? "c = -4, R = 2^40 nm" : "c = 4, R = 2^40 nm", c, (double)(INT64_C(1) << 40) * 1e-9,
+                              0.001};
+            Counts cnt;
+            for (int k = 0; k < 6; ++k) {
+                const ct_ray ray = {-(INT64_C(40000) << 16), (int64_t)(5 + 4 * k) << 16, (int64_t)2000 << 16, 1 << 16,
+                                    k * 7, -(k << 8)};
+                judge_ray(p, d, max_slope(d), cs, sc, ray, k, &cnt);
+            }
+            printf("  %-20s %-28s %ld rays (%ld polyline): %ld hit, %ld miss, %ld below; bad %ld\n", cs.name.c_str(),
+                   sc.name, cnt.rays, cnt.polyline, cnt.hits, cnt.miss, cnt.below, cnt.bad);
+            TEST_ASSERT(cnt.bad == 0 && cnt.polyline == cnt.rays);
+            TEST_ASSERT(c < 0 ? cnt.below > 0 : cnt.miss > 0);
+        }
+        // nearly vertical lines of sight upwards (2^28 up per cell across),
+        // bent down by k = 1.5 on a 40 km sphere: from beside the tile and
+        // from just over its surface, the vertices over the tile lie beyond
+        // 2^46 Q16 above it (skipped, before and after the polyline
+        // entered): a miss, as the reference's
+        const Scene up = {"steeply up, k 1.5 R 40 km", -0.5, 40000.0, 0.002};
+        Counts cnt;
+        for (int k = 0; k < 4; ++k) {
+            const int64_t x0 = k % 2 == 0 ? -(5 << 16) : (int64_t)(10 + k) << 16, y0 = (int64_t)(8 + 3 * k) << 16;
+            int64_t z0 = (int64_t)4000 << 16;
+            if (k % 2 == 1) {
+                TEST_ASSERT_EQUAL_INT(CT_OK, ct_surface_height(&p, x0, y0, &z0));
+                z0 += 5 << 16;
+            }
+            const ct_ray ray = {x0, y0, z0, 1 << 16, k << 10, INT64_C(1) << 44};
+            judge_ray(p, d, max_slope(d), cs, up, ray, k, &cnt);
+        }
+        printf("  %-20s %-28s %ld rays (%ld polyline): %ld hit, %ld miss, %ld below; bad %ld\n", cs.name.c_str(), up.name,
+               cnt.rays, cnt.polyline, cnt.hits, cnt.miss, cnt.below, cnt.bad);
+        TEST_ASSERT(cnt.bad == 0 && cnt.miss == cnt.rays);
+    }
     // 1 nm posts with 2^30 nm (1.07 m) height codes on a sphere of 2^54 nm:
     // the lowering's constant K = c posting^2 / (2^33 R scale) is below
     // 2^-127 (ct_lower_setup refuses it), so the polyline traces the rays
