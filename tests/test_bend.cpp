@@ -283,9 +283,9 @@ void test_bent_arguments()
 // a ray whose horizontal part vanishes once reduced (the straight trace, bit
 // for bit), horizontal paths that never cross the tile -- along an axis
 // beside it, or past a corner -- (CT_MISS, as straight), a start far under
-// the tile's floor (CT_BELOW, as straight), an observer beyond 2^52 nm and a
-// path needing more than CT_BEND_MAX_SEGMENTS segments (CT_ERR_RANGE, as
-// documented).
+// the tile's floor (CT_BELOW, as straight), an observer beyond 2^52 nm, a
+// tile straddling 2^52 nm from the observer, and a path needing more than
+// CT_BEND_MAX_SEGMENTS segments (CT_ERR_RANGE, as documented).
 void test_bent_polyline_edges()
 {
     auto cs = dem_cases::make_case("hills", dem_cases::make_terrain(40, 36, dem_cases::smooth(40, 36, 4, 1000, 9000)), 8, 2);
@@ -321,6 +321,28 @@ void test_bent_polyline_edges()
         const ct_ray far = {x0, H / 2, top, 1 << 20, 0, 0};
         ct_hit hf;
         TEST_ASSERT_EQUAL_INT(CT_ERR_RANGE, ct_trace_bent(&p, &far, &up, CT_METHOD_DIRECTIONAL, &hf));
+    }
+    // a tile straddling 2^52 nm from the observer (150,000 .. 150,400
+    // cells of 30 m west of it), the path 1 km over its flat ground there
+    // (refraction k = 0.13 drops it 207 km on the way): the polyline's
+    // vertices past 2^52 nm cannot be formed -- CT_ERR_RANGE (the observer
+    // must be within 2^52 nm of every point of the tile), culled or not
+    {
+        auto strip = dem_cases::make_case("strip", dem_cases::make_terrain(401, 3, std::vector<uint16_t>(1203, 100)), 1, 1);
+        ct_package q;
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_package_open(&q, strip.pkg.data(), strip.pkg.size()));
+        const ct_bend refr = {-8520, INT64_C(6371000000000000), 1000000, 0u};
+        const int64_t x0 = -(INT64_C(150000) << 16);
+        const long double drop = 0.13L * std::pow(150200 * 30.0L, 2) / (2 * 6371000.0L);  // m, to the straddle
+        const ct_ray ray = {x0, 1 << 16, (int64_t)std::llround((100 + 1000 + drop) * 65536), 1 << 20, 0, 0};
+        for (uint32_t flags : {0u, (uint32_t)CT_BEND_NO_CULL}) {
+            ct_bend b = refr;
+            b.flags = flags;
+            for (int m = 0; m < 4; ++m) {
+                ct_hit hr;
+                TEST_ASSERT_EQUAL_INT(CT_ERR_RANGE, ct_trace_bent(&q, &ray, &b, (ct_method)m, &hr));
+            }
+        }
     }
     // 2000 x 3 posts of 30 m and a chord that makes the segment just over
     // 1/64 cell: about 120,000 segments across the tile
