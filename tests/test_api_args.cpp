@@ -32,6 +32,10 @@ struct World {
     dem_cases::Case fine_c, west_c;
     ct_package fine{}, west{};
     int64_t fa[3] = {0, 0, 0};  // a map point over the fine tile
+    // and with a height scale of 2^24 nm (16.777216 mm)
+    dem_cases::Case pow2_c;
+    ct_package pow2{};
+    int64_t pa[3] = {0, 0, 0};  // a map point over it
 };
 
 World *world()
@@ -67,6 +71,13 @@ World *world()
     tw.geo.posting_n = 30.0;
     w->west_c = dem_cases::make_case("west", tw, 8, 2);
     if (ct_package_open(&w->west, w->west_c.pkg.data(), w->west_c.pkg.size()) != CT_OK) return nullptr;
+    ct_host::Terrain t2 = t;
+    t2.height_scale_m = 0.016777216;
+    w->pow2_c = dem_cases::make_case("pow2", t2, 8, 2);
+    if (ct_package_open(&w->pow2, w->pow2_c.pkg.data(), w->pow2_c.pkg.size()) != CT_OK ||
+        w->pow2.height_scale_nm != (INT64_C(1) << 24))
+        return nullptr;
+    (void)ct_grid_to_map(&w->pow2, 12 << 16, 10 << 16, (int64_t)w->pow2.hmax << 16, &w->pa[0], &w->pa[1], &w->pa[2]);
     return w;
 }
 
@@ -313,6 +324,20 @@ std::vector<Case> cases()
     add("ray_from_map: zero direction", CT_ERR_RAY, [](World &w) {
         ct_ray r;
         return ct_ray_from_map(&w.p, w.a[0], w.a[1], w.a[2], 0, 0, 0, &r);
+    });
+    // the direction (de scale, dn scale, dh |posting|) divided by the least
+    // power of two that brings it within 2^62: on a package whose height
+    // scale is 2^24 nm, de = +-2^40 makes exactly 2^64 -- divided by 4, to
+    // exactly +-2^62 (not by 8); dh's part rounded half away from zero
+    add("ray_from_map: largest component exactly 2^64", CT_OK, [](World &w) -> ct_status {
+        for (int64_t sign : {INT64_C(1), INT64_C(-1)}) {
+            ct_ray r;
+            const ct_status st = ct_ray_from_map(&w.pow2, w.pa[0], w.pa[1], w.pa[2], sign * (INT64_C(1) << 40), 0, 3, &r);
+            const int64_t dz = (3 * w.pow2.posting_e_nm + 2) / 4;
+            if (st != CT_OK) return st;
+            if (r.dx != sign * (INT64_C(1) << 62) || r.dy != 0 || r.dz != dz) return CT_ERR_INTERNAL;
+        }
+        return CT_OK;
     });
     add("surface_height: out NULL", CT_ERR_ARG, [](World &w) { return ct_surface_height(&w.p, 0, 0, nullptr); });
     add("surface_height: off the tile", CT_ERR_RANGE, [](World &w) {

@@ -30,6 +30,7 @@ struct Scene {
 
 struct Counts {
     long rays = 0, hits = 0, miss = 0, below = 0, differ_from_straight = 0, bad = 0, fewer_steps_culled = 0;
+    long hit_void = 0;
     long lowered = 0, polyline = 0;  // rays traced by each model
     bool rise_matters = false;       // the largest rise is 1/10 of the relief or more
     ld worst_lead = 0;
@@ -60,6 +61,110 @@ ld ref_t(const ref::Dem &d, ld ox, ld oy, ld oz, ld dx, ld dy, ld dz, ld kz, ld 
     return lo + h.t;
 }
 
+// One ray judged: the four methods bit for bit, culling changing nothing,
+// the status and hit against the reference curve's sandwich (cs's terrain
+// as d, the scene's bend), counted into cnt (ray number n for messages).
+// The DEM's largest slope (LSB per cell): the horizontal part of the delta
+// (every cell's steepest edges, the last row's and column's too).
+ld max_slope(const ref::Dem &d)
+{
+    ld slope = 0;
+    for (int j = 0; j + 1 < d.h; ++j)
+        for (int i = 0; i + 1 < d.w; ++i) {
+            const ld dx = std::max(std::abs(d.at(i + 1, j) - d.at(i, j)), std::abs(d.at(i + 1, j + 1) - d.at(i, j + 1)));
+            const ld dy = std::max(std::abs(d.at(i, j + 1) - d.at(i, j)), std::abs(d.at(i + 1, j + 1) - d.at(i + 1, j)));
+            slope = std::max(slope, dx + dy);
+        }
+    return slope;
+}
+
+void judge_ray(const ct_package &p, const ref::Dem &d, ld slope, const dem_cases::Case &cs, const Scene &sc,
+               const ct_ray &ray, long n, Counts *cnt)
+{
+    const ld posting = (ld)std::fabs(cs.t.geo.posting_e), scale = (ld)cs.t.height_scale_m;
+    ct_bend bd{};
+    bd.coeff_q16 = (int32_t)std::lround(sc.coeff * 65536);
+    bd.radius_nm = (int64_t)std::llround(sc.radius_m * 1e9);
+    bd.chord_nm = (int64_t)std::llround(sc.chord_m * 1e9);
+    const ld c = (ld)bd.coeff_q16 / 65536, R = (ld)bd.radius_nm * 1e-9L;
+    // the polyline's tolerance: its chord plus the vertices' and the prepared
+    // segments' rounding; the lowered model's (c > 0, ct_lower): the rise's
+    // bilinear interpolation between posts, c posting^2 / (4R), plus the
+    // prepared ray's rounding
+    const ld rounding = (3 + 3 * slope) / 65536.0L + 1e-6L;
+    const ld delta_poly = sc.chord_m / scale * 1.001L + rounding;
+    const ld delta_low = c * posting * posting / (4 * R) / scale * 1.001L + rounding;
+    ct_lower lw;
+    const bool lowered = ct_lower_setup(&p, ray.x_q16, ray.y_q16, &bd, &lw) == CT_OK;
+    const ld delta = lowered ? delta_low : delta_poly;
+    (lowered ? cnt->lowered : cnt->polyline)++;
+    ct_hit h[4];
+    ct_status st[4];
+    for (int m = 0; m < 4; ++m) st[m] = ct_trace_bent(&p, &ray, &bd, (ct_method)m, &h[m]);
+    cnt->rays++;
+    for (int m = 1; m < 4; ++m)
+        if (st[m] != st[0] || ((st[0] == CT_HIT || st[0] == CT_HIT_VOID) &&
+                               (h[m].x_q16 != h[0].x_q16 || h[m].y_q16 != h[0].y_q16 || h[m].z_q16 != h[0].z_q16)))
+            TEST_FAIL_MSG("%s/%s ray %ld: method %d disagrees with incremental", cs.name.c_str(), sc.name, n, m);
+    TEST_ASSERT(st[0] >= 0);
+    {
+        // culling (runs of segments skipped over the max-mipmap) changes
+        // no result: the same walk tracing every segment, bit for bit
+        ct_bend nc = bd;
+        nc.flags = CT_BEND_NO_CULL;
+        ct_hit hn;
+        ct_status sn = ct_trace_bent(&p, &ray, &nc, CT_METHOD_DIRECTIONAL, &hn);
+        if (sn != st[3] || ((sn == CT_HIT || sn == CT_HIT_VOID) &&
+                            (hn.x_q16 != h[3].x_q16 || hn.y_q16 != h[3].y_q16 || hn.z_q16 != h[3].z_q16 ||
+                             hn.t_q26 != h[3].t_q26 || hn.cell_x != h[3].cell_x || hn.cell_y != h[3].cell_y)))
+            TEST_FAIL_MSG("%s/%s ray %ld: culling changed the result (%d vs %d)", cs.name.c_str(), sc.name, n,
+                          (int)st[3], (int)sn);
+        if (hn.steps > h[3].steps) cnt->fewer_steps_culled++;
+    }
+    // the reference curve, in the caller's parameter
+    ld ox = (ld)ray.x_q16 / 65536, oy = (ld)ray.y_q16 / 65536, oz = (ld)ray.z_q16 / 65536;
+    ld dx = (ld)ray.dx / 65536, dy = (ld)ray.dy / 65536, dz = (ld)ray.dz / 65536;
+    ld hm = std::sqrt(dx * dx + dy * dy) * posting;  // metres per unit t
+    ld kz = c * hm * hm / (2 * R) / scale;
+    ld t_dn = ref_t(d, ox, oy, oz, dx, dy, dz, kz, -delta);
+    ld t_up = ref_t(d, ox, oy, oz, dx, dy, dz, kz, +delta);
+    ld slack = 3.0L / 65536 / std::sqrt(dx * dx + dy * dy);
+    bool ok = true;
+    if (st[0] == CT_HIT || st[0] == CT_HIT_VOID) {
+        cnt->hits++;
+        cnt->hit_void += st[0] == CT_HIT_VOID;
+        ld hx = (ld)h[0].x_q16 / 65536, hy = (ld)h[0].y_q16 / 65536;
+        ld tl = ((hx - ox) * dx + (hy - oy) * dy) / (dx * dx + dy * dy);
+        // the lowered curve hits no later (or starts below); the raised
+        // one hits no earlier
+        ok = (t_dn == -1 || t_dn <= tl + slack) && (t_up == INFINITY || t_up >= tl - slack);
+        // the hit lies on the curve within delta (vertically)
+        ld zc = oz + tl * dz + kz * tl * tl, zl = (ld)h[0].z_q16 / 65536;
+        ld lead = std::fabs(zl - zc);
+        cnt->worst_lead = std::max(cnt->worst_lead, lead);
+        if (lead > delta + std::fabs(dz) * slack) ok = false;
+        ct_hit hs;
+        ct_status ss = ct_trace(&p, &ray, CT_METHOD_DIRECTIONAL, &hs);
+        if (ss != st[0] || std::llabs(hs.x_q16 - h[0].x_q16) + std::llabs(hs.y_q16 - h[0].y_q16) > 65536)
+            cnt->differ_from_straight++;
+    } else if (st[0] == CT_MISS) {
+        cnt->miss++;
+        ok = t_up == INFINITY;  // the raised curve must miss too
+    } else if (st[0] == CT_BELOW) {
+        cnt->below++;
+        ok = t_dn == -1;  // the lowered curve starts below as well
+    }
+    if (!ok) {
+        cnt->bad++;
+        if (cnt->bad <= 5)
+            printf("  BAD %s/%s ray %ld: status %d (hit %.6Lf %.6Lf %.6Lf), ref t(down) %.6Lg t(up) %.6Lg (ray %lld %lld "
+                   "%lld / %lld %lld %lld)\n",
+                   cs.name.c_str(), sc.name, n, (int)st[0], (ld)h[0].x_q16 / 65536, (ld)h[0].y_q16 / 65536,
+                   (ld)h[0].z_q16 / 65536, t_dn, t_up, (long long)ray.x_q16, (long long)ray.y_q16, (long long)ray.z_q16,
+                   (long long)ray.dx, (long long)ray.dy, (long long)ray.dz);
+    }
+}
+
 void run_scene(const dem_cases::Case &cs, const Scene &sc, long nrays, Counts *cnt)
 {
     ct_package p;
@@ -68,25 +173,10 @@ void run_scene(const dem_cases::Case &cs, const Scene &sc, long nrays, Counts *c
     double lo, hi;
     dem_cases::minmax(cs.t, &lo, &hi);
     const ld posting = (ld)std::fabs(cs.t.geo.posting_e), scale = (ld)cs.t.height_scale_m;
-    ct_bend bd{};
-    bd.coeff_q16 = (int32_t)std::lround(sc.coeff * 65536);
-    bd.radius_nm = (int64_t)std::llround(sc.radius_m * 1e9);
-    bd.chord_nm = (int64_t)std::llround(sc.chord_m * 1e9);
-    const ld c = (ld)bd.coeff_q16 / 65536, R = (ld)bd.radius_nm * 1e-9L;
+    const ld c = (ld)std::lround(sc.coeff * 65536) / 65536, R = (ld)std::llround(sc.radius_m * 1e9) * 1e-9L;
     const double cw = cs.t.width - 1, ch = cs.t.height - 1;
     const ld cw_ = cw, ch_ = ch;
-    // largest slope (LSB per cell) for the horizontal part of the delta
-    ld slope = 0;
-    for (int j = 0; j + 1 < d.h; ++j)
-        for (int i = 0; i + 1 < d.w; ++i)
-            slope = std::max(slope, (ld)std::abs(d.at(i + 1, j) - d.at(i, j)) + std::abs(d.at(i, j + 1) - d.at(i, j)));
-    // the polyline's tolerance: its chord plus the vertices' and the prepared
-    // segments' rounding; the lowered model's (c > 0, ct_lower): the rise's
-    // bilinear interpolation between posts, c posting^2 / (4R), plus the
-    // prepared ray's rounding
-    const ld rounding = (3 + 3 * slope) / 65536.0L + 1e-6L;
-    const ld delta_poly = sc.chord_m / scale * 1.001L + rounding;
-    const ld delta_low = c * posting * posting / (4 * R) / scale * 1.001L + rounding;
+    const ld slope = max_slope(d);
     // the largest rise over the scene's lines of sight (2.5 tile widths), in LSB
     const ld rise = std::fabs(c) * std::pow(2.5L * std::max(cw_, ch_) * posting, 2) / (2 * R) / scale;
     cnt->rise_matters = rise > 0.1L * (hi - lo);
@@ -110,74 +200,7 @@ void run_scene(const dem_cases::Case &cs, const Scene &sc, long nrays, Counts *c
         }
         double dv[3];
         dem_cases::metric_dir(cs.t, az, -el, dv);
-        ct_ray ray = dem_cases::to_ray(x, y, zm, dv);
-        ct_lower lw;
-        const bool lowered = ct_lower_setup(&p, ray.x_q16, ray.y_q16, &bd, &lw) == CT_OK;
-        const ld delta = lowered ? delta_low : delta_poly;
-        (lowered ? cnt->lowered : cnt->polyline)++;
-        ct_hit h[4];
-        ct_status st[4];
-        for (int m = 0; m < 4; ++m) st[m] = ct_trace_bent(&p, &ray, &bd, (ct_method)m, &h[m]);
-        cnt->rays++;
-        for (int m = 1; m < 4; ++m)
-            if (st[m] != st[0] || ((st[0] == CT_HIT || st[0] == CT_HIT_VOID) &&
-                                   (h[m].x_q16 != h[0].x_q16 || h[m].y_q16 != h[0].y_q16 || h[m].z_q16 != h[0].z_q16)))
-                TEST_FAIL_MSG("%s/%s ray %ld: method %d disagrees with incremental", cs.name.c_str(), sc.name, n, m);
-        TEST_ASSERT(st[0] >= 0);
-        {
-            // culling (runs of segments skipped over the max-mipmap) changes
-            // no result: the same walk tracing every segment, bit for bit
-            ct_bend nc = bd;
-            nc.flags = CT_BEND_NO_CULL;
-            ct_hit hn;
-            ct_status sn = ct_trace_bent(&p, &ray, &nc, CT_METHOD_DIRECTIONAL, &hn);
-            if (sn != st[3] || ((sn == CT_HIT || sn == CT_HIT_VOID) &&
-                                (hn.x_q16 != h[3].x_q16 || hn.y_q16 != h[3].y_q16 || hn.z_q16 != h[3].z_q16 ||
-                                 hn.t_q26 != h[3].t_q26 || hn.cell_x != h[3].cell_x || hn.cell_y != h[3].cell_y)))
-                TEST_FAIL_MSG("%s/%s ray %ld: culling changed the result (%d vs %d)", cs.name.c_str(), sc.name, n,
-                              (int)st[3], (int)sn);
-            if (hn.steps > h[3].steps) cnt->fewer_steps_culled++;
-        }
-        // the reference curve, in the caller's parameter
-        ld ox = (ld)ray.x_q16 / 65536, oy = (ld)ray.y_q16 / 65536, oz = (ld)ray.z_q16 / 65536;
-        ld dx = (ld)ray.dx / 65536, dy = (ld)ray.dy / 65536, dz = (ld)ray.dz / 65536;
-        ld hm = std::sqrt(dx * dx + dy * dy) * posting;  // metres per unit t
-        ld kz = c * hm * hm / (2 * R) / scale;
-        ld t_dn = ref_t(d, ox, oy, oz, dx, dy, dz, kz, -delta);
-        ld t_up = ref_t(d, ox, oy, oz, dx, dy, dz, kz, +delta);
-        ld slack = 3.0L / 65536 / std::sqrt(dx * dx + dy * dy);
-        bool ok = true;
-        if (st[0] == CT_HIT || st[0] == CT_HIT_VOID) {
-            cnt->hits++;
-            ld hx = (ld)h[0].x_q16 / 65536, hy = (ld)h[0].y_q16 / 65536;
-            ld tl = ((hx - ox) * dx + (hy - oy) * dy) / (dx * dx + dy * dy);
-            // the lowered curve hits no later (or starts below); the raised
-            // one hits no earlier
-            ok = (t_dn == -1 || t_dn <= tl + slack) && (t_up == INFINITY || t_up >= tl - slack);
-            // the hit lies on the curve within delta (vertically)
-            ld zc = oz + tl * dz + kz * tl * tl, zl = (ld)h[0].z_q16 / 65536;
-            ld lead = std::fabs(zl - zc);
-            cnt->worst_lead = std::max(cnt->worst_lead, lead);
-            if (lead > delta + std::fabs(dz) * slack) ok = false;
-            ct_hit hs;
-            ct_status ss = ct_trace(&p, &ray, CT_METHOD_DIRECTIONAL, &hs);
-            if (ss != st[0] || std::llabs(hs.x_q16 - h[0].x_q16) + std::llabs(hs.y_q16 - h[0].y_q16) > 65536)
-                cnt->differ_from_straight++;
-        } else if (st[0] == CT_MISS) {
-            cnt->miss++;
-            ok = t_up == INFINITY;  // the raised curve must miss too
-        } else if (st[0] == CT_BELOW) {
-            cnt->below++;
-            ok = t_dn == -1;  // the lowered curve starts below as well
-        }
-        if (!ok) {
-            cnt->bad++;
-            if (cnt->bad <= 5)
-                printf("  BAD %s/%s ray %ld: status %d, ref t(down) %.6Lg t(up) %.6Lg (ray %lld %lld %lld / %lld %lld "
-                       "%lld)\n",
-                       cs.name.c_str(), sc.name, n, (int)st[0], t_dn, t_up, (long long)ray.x_q16, (long long)ray.y_q16,
-                       (long long)ray.z_q16, (long long)ray.dx, (long long)ray.dy, (long long)ray.dz);
-        }
+        judge_ray(p, d, slope, cs, sc, dem_cases::to_ray(x, y, zm, dv), n, cnt);
     }
 }
 
@@ -260,9 +283,9 @@ void test_bent_arguments()
 // a ray whose horizontal part vanishes once reduced (the straight trace, bit
 // for bit), horizontal paths that never cross the tile -- along an axis
 // beside it, or past a corner -- (CT_MISS, as straight), a start far under
-// the tile's floor (CT_BELOW, as straight), an observer beyond 2^52 nm and a
-// path needing more than CT_BEND_MAX_SEGMENTS segments (CT_ERR_RANGE, as
-// documented).
+// the tile's floor (CT_BELOW, as straight), an observer beyond 2^52 nm, a
+// tile straddling 2^52 nm from the observer, and a path needing more than
+// CT_BEND_MAX_SEGMENTS segments (CT_ERR_RANGE, as documented).
 void test_bent_polyline_edges()
 {
     auto cs = dem_cases::make_case("hills", dem_cases::make_terrain(40, 36, dem_cases::smooth(40, 36, 4, 1000, 9000)), 8, 2);
@@ -298,6 +321,28 @@ void test_bent_polyline_edges()
         const ct_ray far = {x0, H / 2, top, 1 << 20, 0, 0};
         ct_hit hf;
         TEST_ASSERT_EQUAL_INT(CT_ERR_RANGE, ct_trace_bent(&p, &far, &up, CT_METHOD_DIRECTIONAL, &hf));
+    }
+    // a tile straddling 2^52 nm from the observer (150,000 .. 150,400
+    // cells of 30 m west of it), the path 1 km over its flat ground there
+    // (refraction k = 0.13 drops it 207 km on the way): the polyline's
+    // vertices past 2^52 nm cannot be formed -- CT_ERR_RANGE (the observer
+    // must be within 2^52 nm of every point of the tile), culled or not
+    {
+        auto strip = dem_cases::make_case("strip", dem_cases::make_terrain(401, 3, std::vector<uint16_t>(1203, 100)), 1, 1);
+        ct_package q;
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_package_open(&q, strip.pkg.data(), strip.pkg.size()));
+        const ct_bend refr = {-8520, INT64_C(6371000000000000), 1000000, 0u};
+        const int64_t x0 = -(INT64_C(150000) << 16);
+        const long double drop = 0.13L * std::pow(150200 * 30.0L, 2) / (2 * 6371000.0L);  // m, to the straddle
+        const ct_ray ray = {x0, 1 << 16, (int64_t)std::llround((100 + 1000 + drop) * 65536), 1 << 20, 0, 0};
+        for (uint32_t flags : {0u, (uint32_t)CT_BEND_NO_CULL}) {
+            ct_bend b = refr;
+            b.flags = flags;
+            for (int m = 0; m < 4; ++m) {
+                ct_hit hr;
+                TEST_ASSERT_EQUAL_INT(CT_ERR_RANGE, ct_trace_bent(&q, &ray, &b, (ct_method)m, &hr));
+            }
+        }
     }
     // 2000 x 3 posts of 30 m and a chord that makes the segment just over
     // 1/64 cell: about 120,000 segments across the tile
@@ -378,6 +423,163 @@ void test_bent_chord_check_agrees()
     TEST_ASSERT(refused > 100 && accepted > 100);
 }
 
+// The same checks (four methods, culling, the reference's sandwich) on the
+// packages the scenes above do not make: a DEM with a patch of voids (the
+// polyline's and the lowered walk's hits on void cells: CT_HIT_VOID where
+// the reference hits the same place), a package of one cell (no mipmap
+// levels) and one of 4 x 4 cells, both of 1 km cells (runs of segments
+// wider than the mipmap's blocks); a polyline 1 km over one 100 km cell
+// (more than 2^11 segments culled in a row); a polyline from an observer
+// 35,000 cells (35 km) from a tile of 1 m posts (ranges past 2^31 Q16).
+void test_bent_edge_packages()
+{
+    std::vector<dem_cases::Case> cases;
+    {
+        ct_host::Terrain t = dem_cases::make_terrain(60, 50, dem_cases::smooth(60, 50, 23, 100, 9000), 0.125);
+        t.void_post.assign(60 * 50, 0);
+        for (int j = 15; j < 35; ++j)
+            for (int i = 20; i < 45; ++i) t.void_post[(size_t)j * 60 + i] = 1;
+        cases.push_back(dem_cases::make_case("voids", t, 16, 2));
+    }
+    for (int n : {2, 5}) {
+        ct_host::Terrain t = dem_cases::make_terrain(n, n, dem_cases::smooth(n, n, 5, 100, 3000), 0.125);
+        t.geo.posting_e = 1000.0;
+        t.geo.posting_n = -1000.0;
+        cases.push_back(dem_cases::make_case(n == 2 ? "one 1 km cell" : "4 x 4 cells of 1 km", t, 8, 1));
+    }
+    const long per = std::max(50L, (long)(400 * ct_test_scale()));
+    for (const auto &cs : cases)
+        for (const Scene &sc : kScenes) {
+            Counts cnt;
+            run_scene(cs, sc, per, &cnt);
+            printf("  %-20s %-28s %ld rays (%ld lowered, %ld polyline): %ld hit (%ld void), %ld miss, %ld below; bad %ld\n",
+                   cs.name.c_str(), sc.name, cnt.rays, cnt.lowered, cnt.polyline, cnt.hits, cnt.hit_void, cnt.miss,
+                   cnt.below, cnt.bad);
+            TEST_ASSERT(cnt.bad == 0);
+            TEST_ASSERT(cnt.hits > 0);
+            if (cs.name == "voids") TEST_ASSERT(cnt.hit_void > 0);
+        }
+    // observers 40,000 cells (1,200 km) west of a 30 x 30 tile on a sphere
+    // of 2^40 nm bent with c = -4 and c = 4 (beyond the lowered walk's
+    // 2^15 cells: the polyline): over the tile the path lies over 2^46 Q16
+    // below the terrain (CT_BELOW, before the polyline entered) or above it
+    // (vertices out of range, skipped: CT_MISS), as the reference's
+    {
+        const dem_cases::Case cs =
+            dem_cases::make_case("30 x 30", dem_cases::make_terrain(31, 31, dem_cases::smooth(31, 31, 3, 100, 3000), 0.25),
+                                 8, 1);
+        ct_package p;
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_package_open(&p, cs.pkg.data(), cs.pkg.size()));
+        const ref::Dem d = dem_cases::ref_dem(cs.t);
+        for (double c : {-4.0, 4.0}) {
+            const Scene sc = {c < 0 ? "c = -4, R = 2^40 nm" : "c = 4, R = 2^40 nm", c, (double)(INT64_C(1) << 40) * 1e-9,
+                              0.001};
+            Counts cnt;
+            for (int k = 0; k < 6; ++k) {
+                const ct_ray ray = {-(INT64_C(40000) << 16), (int64_t)(5 + 4 * k) << 16, (int64_t)2000 << 16, 1 << 16,
+                                    k * 7, -(k << 8)};
+                judge_ray(p, d, max_slope(d), cs, sc, ray, k, &cnt);
+            }
+            printf("  %-20s %-28s %ld rays (%ld polyline): %ld hit, %ld miss, %ld below; bad %ld\n", cs.name.c_str(),
+                   sc.name, cnt.rays, cnt.polyline, cnt.hits, cnt.miss, cnt.below, cnt.bad);
+            TEST_ASSERT(cnt.bad == 0 && cnt.polyline == cnt.rays);
+            TEST_ASSERT(c < 0 ? cnt.below > 0 : cnt.miss > 0);
+        }
+        // nearly vertical lines of sight upwards (2^28 up per cell across),
+        // bent down by k = 1.5 on a 40 km sphere: from beside the tile and
+        // from just over its surface, the vertices over the tile lie beyond
+        // 2^46 Q16 above it (skipped, before and after the polyline
+        // entered): a miss, as the reference's
+        const Scene up = {"steeply up, k 1.5 R 40 km", -0.5, 40000.0, 0.002};
+        Counts cnt;
+        for (int k = 0; k < 4; ++k) {
+            const int64_t x0 = k % 2 == 0 ? -(5 << 16) : (int64_t)(10 + k) << 16, y0 = (int64_t)(8 + 3 * k) << 16;
+            int64_t z0 = (int64_t)4000 << 16;
+            if (k % 2 == 1) {
+                TEST_ASSERT_EQUAL_INT(CT_OK, ct_surface_height(&p, x0, y0, &z0));
+                z0 += 5 << 16;
+            }
+            const ct_ray ray = {x0, y0, z0, 1 << 16, k << 10, INT64_C(1) << 44};
+            judge_ray(p, d, max_slope(d), cs, up, ray, k, &cnt);
+        }
+        printf("  %-20s %-28s %ld rays (%ld polyline): %ld hit, %ld miss, %ld below; bad %ld\n", cs.name.c_str(), up.name,
+               cnt.rays, cnt.polyline, cnt.hits, cnt.miss, cnt.below, cnt.bad);
+        TEST_ASSERT(cnt.bad == 0 && cnt.miss == cnt.rays);
+    }
+    // 1 nm posts with 2^30 nm (1.07 m) height codes on a sphere of 2^54 nm:
+    // the lowering's constant K = c posting^2 / (2^33 R scale) is below
+    // 2^-127 (ct_lower_setup refuses it), so the polyline traces the rays
+    {
+        ct_host::Terrain t = dem_cases::make_terrain(30, 30, dem_cases::smooth(30, 30, 11, 100, 3000), 1.073741824);
+        t.geo.posting_e = 1e-9;
+        t.geo.posting_n = -1e-9;
+        const dem_cases::Case cs = dem_cases::make_case("1 nm posts", t, 8, 1);
+        ct_package p;
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_package_open(&p, cs.pkg.data(), cs.pkg.size()));
+        TEST_ASSERT(p.posting_e_nm == 1 && p.height_scale_nm == (INT64_C(1) << 30));
+        const Scene sc = {"sphere of 2^54 nm", 1.0, (double)(INT64_C(1) << 54) * 1e-9, 0.001};
+        Counts cnt;
+        run_scene(cs, sc, 200, &cnt);
+        printf("  %-20s %-28s %ld rays (%ld lowered, %ld polyline): %ld hit, %ld miss, %ld below; bad %ld\n",
+               cs.name.c_str(), sc.name, cnt.rays, cnt.lowered, cnt.polyline, cnt.hits, cnt.miss, cnt.below, cnt.bad);
+        TEST_ASSERT(cnt.bad == 0 && cnt.polyline == cnt.rays && cnt.hits > 0);
+    }
+    // 69 x 2 flat cells of 30 m with a 2.5 km spike at the far corner;
+    // polylines 1 km over them along x (inside the terrain's box), bent up
+    // (k = 1.5 on a sphere of 2^40 nm) in segments of 0.59 m (just over
+    // 1/64 cell): 3,500 segments over the tile, thousands culled in a row
+    {
+        std::vector<uint16_t> z(210, 400);
+        z[2 * 70 + 69] = 20400;
+        const dem_cases::Case cs = dem_cases::make_case("69 x 2 cells, a spike", dem_cases::make_terrain(70, 3, z, 0.125), 4, 1);
+        ct_package p;
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_package_open(&p, cs.pkg.data(), cs.pkg.size()));
+        const ref::Dem d = dem_cases::ref_dem(cs.t);
+        const Scene sc = {"k 1.5, R 2^40 nm", -0.5, (double)(INT64_C(1) << 40) * 1e-9, 2e-5};
+        Counts cnt;
+        for (int k = 0; k < 10; ++k) {
+            const ct_ray ray = {-(1 << 12), (1 << 16) + k * 3000, (400 + 8000) << 16, 1 << 16, k * 100,
+                                -(int64_t)k << 14};
+            judge_ray(p, d, max_slope(d), cs, sc, ray, k, &cnt);
+        }
+        printf("  %-20s %-28s %ld rays: %ld hit, %ld miss, %ld below; bad %ld; culling saved steps on %ld\n",
+               cs.name.c_str(), sc.name, cnt.rays, cnt.hits, cnt.miss, cnt.below, cnt.bad, cnt.fewer_steps_culled);
+        TEST_ASSERT(cnt.bad == 0 && cnt.fewer_steps_culled == cnt.rays);
+    }
+    // 40 x 40 posts of 1 m; observers 35 km west, aimed (through the
+    // polyline's curve, refraction k = 0.13 on the Earth) at points just
+    // over the terrain
+    {
+        ct_host::Terrain t = dem_cases::make_terrain(40, 40, dem_cases::smooth(40, 40, 9, 100, 4000), 0.125);
+        t.geo.posting_e = 1.0;
+        t.geo.posting_n = -1.0;
+        const dem_cases::Case cs = dem_cases::make_case("1 m posts", t, 8, 1);
+        ct_package p;
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_package_open(&p, cs.pkg.data(), cs.pkg.size()));
+        const ref::Dem d = dem_cases::ref_dem(cs.t);
+        const Scene sc = {"refraction only, Earth", -0.13, 6371000.0, 0.001};
+        const ld c = (ld)std::lround(sc.coeff * 65536) / 65536, R = (ld)std::llround(sc.radius_m * 1e9) * 1e-9L;
+        const ld D = 35000;  // cells (m) back along x
+        Counts cnt;
+        ct_rng rng;
+        ct_rng_seed(&rng, 35);
+        for (int k = 0; k < 20; ++k) {
+            const ld tx = 5 + 30 * ct_rng_unit(&rng), ty = 5 + 30 * ct_rng_unit(&rng);
+            const ld tz = dem_cases::surf(cs.t, (double)tx, (double)ty) + 2 + 40 * ct_rng_unit(&rng);  // LSB
+            const ld el = 0.002L + 0.01L * ct_rng_unit(&rng);  // rad down
+            const ld dz = -std::tan(el) * 1.0L / 0.125L;       // LSB per cell
+            const ld kz = c * 1.0L / (2 * R) / 0.125L;         // the curve's t^2 term, LSB per cell^2
+            const ld oz = tz - D * dz - kz * D * D;
+            const ct_ray ray = {(int64_t)std::llround((tx - D) * 65536), (int64_t)std::llround(ty * 65536),
+                                (int64_t)std::llround(oz * 65536), 1 << 16, 0, (int64_t)std::llround(dz * 65536)};
+            judge_ray(p, d, max_slope(d), cs, sc, ray, k, &cnt);
+        }
+        printf("  %-20s %-28s %ld rays: %ld hit, %ld miss, %ld below; bad %ld\n", cs.name.c_str(), sc.name, cnt.rays,
+               cnt.hits, cnt.miss, cnt.below, cnt.bad);
+        TEST_ASSERT(cnt.bad == 0 && cnt.hits > 0);
+    }
+}
+
 }  // namespace
 
 int main()
@@ -388,5 +590,6 @@ int main()
     RUN_TEST(test_bent_segment_length_regression);
     RUN_TEST(test_bent_chord_check_agrees);
     RUN_TEST(test_bent_vs_reference);
+    RUN_TEST(test_bent_edge_packages);
     return TEST_END();
 }

@@ -313,6 +313,59 @@ void test_unproject_hard_values()
     TEST_ASSERT_EQUAL_INT(CT_OK, ct_camera_unproject(&cam, cxq, cyq, ray, nullptr));
 }
 
+// A lens whose tangential term alone folds it: OPENCV4 with p1 = 0.1 and no
+// radial terms (the valid field, found along radii, is the whole r <= 8).
+// The Jacobian's determinant (1 + 2 p1 y)(1 + 6 p1 y) - 4 p1^2 x^2 vanishes
+// near y = -1 / (6 p1) = -1.67.  Pixels imaged from points ever closer to
+// that fold (the long-double forward model): each unprojects to a ray that
+// re-projects onto its pixel (on either side of the fold), or is refused
+// (CT_ERR_UNPROJECT) -- and only near the fold, where the determinant at
+// the point is under 1e-3 (conetrace.h: a solution must have a determinant
+// of at least CT_UNPROJECT_MIN_DET, 2^-16, and Newton stops after
+// CT_UNPROJECT_MAX_ITERS steps).
+void test_tangential_fold()
+{
+    const Model m = {"opencv4_tangential_fold", "LENSMODEL_OPENCV4", {1000, 1000, 1000, 1000, 0, 0, 0.1, 0}, 2000,
+                     2000, false};
+    ct_camera cam;
+    TEST_ASSERT(make_camera(m, &cam));
+    long ok = 0, refused = 0, n = 0;
+    uint32_t most = 0, most_refused = 0;
+    ld worst = 0;
+    for (int k = 0; k < 4000; ++k) {
+        // y from the fold at -1/(6 p1) outwards by 2^-k/40 .. on both sides, x in [-0.5, 0.5]
+        const ld side = (k % 2 == 0) ? 1 : -1;
+        const ld y = -1.0L / 0.6L + side * std::ldexp(1.0L, -(k / 2) % 40);
+        const ld x = -0.5L + (ld)((k * 37) % 101) / 100;
+        ld xd, yd, det;
+        distort_ld(m, x, y, &xd, &yd, &det);
+        const int64_t uq = std::llround((1000 * xd + 1000) * 65536), vq = std::llround((1000 * yd + 1000) * 65536);
+        int32_t ray[3];
+        uint32_t it = 0;
+        const ct_status st = ct_camera_unproject(&cam, uq, vq, ray, &it);
+        n++;
+        if (st == CT_OK) {
+            ok++;
+            most = std::max(most, it);
+            // the ray re-projects onto the pixel (the forward model at its x, y)
+            ld rx = (ld)ray[0] / ray[2], ry = (ld)ray[1] / ray[2], qx, qy, qd;
+            distort_ld(m, rx, ry, &qx, &qy, &qd);
+            const ld e = std::hypot(1000 * qx + 1000 - (ld)uq / 65536, 1000 * qy + 1000 - (ld)vq / 65536);
+            worst = std::max(worst, e);
+            TEST_ASSERT_MSG(e < 1e-3L, "point (%.6Lf, %.9Lf): its ray re-projects %.3Lg px away", x, y, e);
+        } else {
+            refused++;
+            most_refused = std::max(most_refused, it);
+            TEST_ASSERT_MSG(st == CT_ERR_UNPROJECT && std::fabs(det) < 1e-3L,
+                            "point (%.6Lf, %.9Lf), det %.3Lg: status %d", x, y, det, st);
+        }
+        if (ct_harness_g.current_failed) return;
+    }
+    std::printf("  tangential fold: %ld pixels, %ld unprojected (within %.2Lg px, up to %u iterations), %ld refused near "
+                "the fold (after up to %u iterations)\n", n, ok, worst, most, refused, most_refused);
+    TEST_ASSERT(ok > n / 2 && refused > 0);
+}
+
 void test_lens_evil()
 {
     ct_camera cam;
@@ -807,6 +860,7 @@ int main()
     RUN_TEST(test_unproject_vs_mrcal);
     RUN_TEST(test_unproject_hard_values);
     RUN_TEST(test_lens_evil);
+    RUN_TEST(test_tangential_fold);
     RUN_TEST(test_project_vs_mrcal);
     RUN_TEST(test_grid_accuracy_vs_step);
     RUN_TEST(test_grid_evil);

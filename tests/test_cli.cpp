@@ -21,6 +21,8 @@
 #include <xtiffio.h>
 #include <zlib.h>
 
+#include <fcntl.h>
+#include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -33,6 +35,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iterator>
 #include <set>
 #include <sstream>
@@ -1156,12 +1159,12 @@ static int big_height(int i, int j)
     return 100 + (u + 2 * v) % 97 + 10 * ((I + 3 * J) % 7);
 }
 
-static std::string write_big_tiff(const std::string &path)
+static std::string write_big_tiff(const std::string &path, int width = kBigW, int height = kBigW)
 {
     TIFF *t = XTIFFOpen(path.c_str(), "w");
     if (!t) return "cannot open " + path;
     const double scale[3] = {30.0, 30.0, 0.0}, tie[6] = {0, 0, 0, sOE, sON, 0};
-    bool ok = TIFFSetField(t, TIFFTAG_IMAGEWIDTH, (uint32_t)kBigW) && TIFFSetField(t, TIFFTAG_IMAGELENGTH, (uint32_t)kBigW) &&
+    bool ok = TIFFSetField(t, TIFFTAG_IMAGEWIDTH, (uint32_t)width) && TIFFSetField(t, TIFFTAG_IMAGELENGTH, (uint32_t)height) &&
               TIFFSetField(t, TIFFTAG_SAMPLESPERPIXEL, (uint16_t)1) && TIFFSetField(t, TIFFTAG_BITSPERSAMPLE, (uint16_t)16) &&
               TIFFSetField(t, TIFFTAG_SAMPLEFORMAT, (uint16_t)SAMPLEFORMAT_INT) &&
               TIFFSetField(t, TIFFTAG_PHOTOMETRIC, (uint16_t)PHOTOMETRIC_MINISBLACK) &&
@@ -1185,9 +1188,9 @@ static std::string write_big_tiff(const std::string &path)
         ok = compress2(z[k].data(), &n, (const Bytef *)px.data(), (uLong)(px.size() * 2), 6) == Z_OK;
         z[k].resize(n);
     }
-    const int nt = (kBigW + kBigTile - 1) / kBigTile;
-    for (int J = 0; J < nt && ok; ++J)
-        for (int I = 0; I < nt && ok; ++I) {
+    const int ntx = (width + kBigTile - 1) / kBigTile, nty = (height + kBigTile - 1) / kBigTile;
+    for (int J = 0; J < nty && ok; ++J)
+        for (int I = 0; I < ntx && ok; ++I) {
             const std::vector<unsigned char> &b = z[(I + 3 * J) % 7];
             ok = TIFFWriteRawTile(t, TIFFComputeTile(t, (uint32_t)(I * kBigTile), (uint32_t)(J * kBigTile), 0, 0),
                                   (void *)b.data(), (tmsize_t)b.size()) == (tmsize_t)b.size();
@@ -1304,13 +1307,139 @@ static void test_big_dem(void)
 }
 
 // ---------------------------------------------------------------------------
+// interrupted builds (SIGINT, SIGTERM): the temporaries removed, one line
+// naming the output, the process ended by the signal
 
-// `test_cli`: every test but the big DEM's; `test_cli bigdem`: that one
-// (its own CTest entry, label "bigdem").
+// `conetrace ARGS` started in `dir` (fork + exec: its pid), sent `sig` once
+// ready(dir) holds (polled every 5 ms) and `delay_s` more have passed.
+// *why: what went wrong ("" if the signal was sent while it ran).
+static Run run_interrupted(const std::string &dir, const std::vector<std::string> &args, int sig,
+                           const std::function<bool(const std::string &)> &ready, double delay_s, std::string *why)
+{
+    Run r;
+    r.cmd = "conetrace";
+    for (const auto &a : args) r.cmd += " " + a;
+    const std::string fo = g_root + "/stdout.int", fe = g_root + "/stderr.int";
+    std::vector<std::string> argv_s = {CT_CLI};
+    argv_s.insert(argv_s.end(), args.begin(), args.end());
+    std::vector<char *> argv;
+    for (auto &a : argv_s) argv.push_back(&a[0]);
+    argv.push_back(nullptr);
+    fflush(stdout);
+    const pid_t pid = fork();
+    if (pid == 0) {
+        // as from a terminal: the signals' default actions, none blocked
+        // (ctest or a shell may start us with SIGINT ignored)
+        signal(SIGINT, SIG_DFL);
+        signal(SIGTERM, SIG_DFL);
+        sigset_t none;
+        sigemptyset(&none);
+        sigprocmask(SIG_SETMASK, &none, nullptr);
+        const int o = open(fo.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644), e = open(fe.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        const int in = open("/dev/null", O_RDONLY);
+        if (o < 0 || e < 0 || in < 0 || chdir(dir.c_str()) != 0) _exit(126);
+        dup2(in, 0);
+        dup2(o, 1);
+        dup2(e, 2);
+        execv(CT_CLI, argv.data());
+        _exit(127);
+    }
+    *why = pid < 0 ? "fork failed" : "";
+    int st = 0;
+    bool sent = false;
+    const auto t0 = std::chrono::steady_clock::now();
+    auto secs = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
+    while (pid > 0) {
+        const pid_t w = waitpid(pid, &st, sent ? 0 : WNOHANG);
+        if (w == pid) break;
+        if (secs() > 120) {
+            kill(pid, SIGKILL);
+            waitpid(pid, &st, 0);
+            *why = "not ready after 120 s";
+            break;
+        }
+        if (!sent && ready(dir)) {
+            std::this_thread::sleep_for(std::chrono::duration<double>(delay_s));
+            kill(pid, sig);
+            sent = true;
+            continue;
+        }
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    if (pid > 0 && !sent && why->empty()) *why = "ended before it was interrupted";
+    r.code = WIFEXITED(st) ? WEXITSTATUS(st) : 128 + (WIFSIGNALED(st) ? WTERMSIG(st) : 0);
+    r.out = slurp(fo);
+    r.err = slurp(fe);
+    for (const std::string &l : lines_of(r.err))
+        if (l.compare(0, 24, "libgcov profiling error:") != 0) r.err_lines.push_back(l);
+    if (verbose()) printf("  $ %s  (signal %d after %.2f s) -> %d\n%s", r.cmd.c_str(), sig, secs(), r.code, r.err.c_str());
+    return r;
+}
+
+// An entry of `dir` whose name starts with `prefix`, "" if none.
+static std::string entry_starting(const std::string &dir, const std::string &prefix)
+{
+    for (const std::string &n : listing(dir))
+        if (starts_with(n, prefix)) return n;
+    return "";
+}
+
+static void test_interrupt(void)
+{
+    std::string why;
+    // a package (r = 1, 64 sectors, one thread: ~12 s) with an earlier one
+    // in its place: SIGTERM once its temporary is being written
+    std::string d = new_dir("interrupt_pkg");
+    spit(d + "/X.ctp", "an earlier output");
+    std::set<std::string> before = listing(d);
+    Run r = run_interrupted(d, {"build", fixture_dem(), "-o", "X.ctp", "--reduce", "1", "--sectors", "64", "--threads", "1"},
+                            SIGTERM, [](const std::string &dir) { return !entry_starting(dir, "X.ctp.tmp-").empty(); },
+                            0.3, &why);
+    TEST_ASSERT_MSG(why.empty(), "`%s`: %s", r.cmd.c_str(), why.c_str());
+    TEST_ASSERT_MSG(r.code == 128 + SIGTERM, "`%s`: ended by SIGTERM, got code %d: %s", r.cmd.c_str(), r.code, r.err.c_str());
+    TEST_ASSERT_MSG(listing(d) == before, "left: {%s}", join(listing(d)).c_str());
+    TEST_ASSERT_MSG(slurp(d + "/X.ctp") == "an earlier output", "the earlier X.ctp changed");
+    TEST_ASSERT_MSG(!r.err_lines.empty() && r.err_lines.back() == "conetrace: interrupted by SIGTERM: X.ctp not written "
+                                                                  "(its temporaries removed)",
+                    "stderr: %s", r.err.c_str());
+
+    // a mosaic (a DEM of 40,000 x 1,024 posts, 79 x 2 tiles of 513, ~3 s):
+    // SIGINT once its first tiles are written in "mosaic.tmp.<pid>/"
+    d = new_dir("interrupt_mosaic");
+    const std::string w = write_big_tiff(d + "/wide.tif", kBigW, 2 * kBigTile);
+    TEST_ASSERT_MSG(w.empty(), "%s", w.c_str());
+    before = listing(d);
+    r = run_interrupted(d, {"build", "wide.tif", "-o", "mosaic", "--tile-size", "513", "--sectors", "1", "--reduce", "8",
+                            "--slices", "2", "--window", "1", "--threads", "2"},
+                        SIGINT,
+                        [](const std::string &dir) {
+                            const std::string tmp = entry_starting(dir, "mosaic.tmp.");
+                            std::error_code ec;
+                            if (tmp.empty()) return false;
+                            for (const auto &e : fs::recursive_directory_iterator(dir + "/" + tmp, ec))
+                                if (starts_with(e.path().filename().string(), "tile_")) return true;
+                            return false;
+                        },
+                        0.2, &why);
+    TEST_ASSERT_MSG(why.empty(), "`%s`: %s", r.cmd.c_str(), why.c_str());
+    TEST_ASSERT_MSG(r.code == 128 + SIGINT, "`%s`: ended by SIGINT, got code %d: %s", r.cmd.c_str(), r.code, r.err.c_str());
+    TEST_ASSERT_MSG(listing(d) == before, "left: {%s} (no mosaic, no mosaic.tmp.*)", join(listing(d)).c_str());
+    TEST_ASSERT_MSG(!r.err_lines.empty() && r.err_lines.back() == "conetrace: interrupted by SIGINT: mosaic not written "
+                                                                  "(its temporaries removed)",
+                    "stderr: %s", r.err.c_str());
+    if (!getenv("CT_TEST_KEEP")) fs::remove_all(d);
+}
+
+// ---------------------------------------------------------------------------
+
+// `test_cli`: every test but the big DEM's and the interrupted builds';
+// `test_cli bigdem`, `test_cli interrupt`: those (their own CTest entries,
+// test_cli_bigdem with the label "bigdem").
 int main(int argc, char **argv)
 {
     const bool big = argc > 1 && std::strcmp(argv[1], "bigdem") == 0;
-    TEST_BEGIN(big ? "test_cli bigdem" : "test_cli");
+    const bool interrupt = argc > 1 && std::strcmp(argv[1], "interrupt") == 0;
+    TEST_BEGIN(big ? "test_cli bigdem" : interrupt ? "test_cli interrupt" : "test_cli");
     char tmpl[] = "/tmp/ct_test_cli_XXXXXX";
     if (!mkdtemp(tmpl)) {
         printf("test_cli: mkdtemp failed\n");
@@ -1324,6 +1453,8 @@ int main(int argc, char **argv)
     load_fixture();
     if (big) {
         RUN_TEST(test_big_dem);
+    } else if (interrupt) {
+        RUN_TEST(test_interrupt);
     } else {
         RUN_TEST(test_light_start);
         RUN_TEST(test_help);

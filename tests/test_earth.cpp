@@ -10,7 +10,9 @@
 // into a package in-process; a pinhole camera looks at it from poses made
 // by ct_pose_from_wgs84 (nadir from 3 km; oblique 30 and 20 deg from 2.6
 // km; grazing 5 and 3 deg from ~1 km over the terrain in several azimuths;
-// long: 5 deg from 10 km outside the tile).  Seeded random pixels: the
+// long: 5 deg from 10 km outside the tile; far: 5 deg down from 200 km
+// south, west, north and east of it, 15 km up, half the pixels aimed at
+// tile posts).  Seeded random pixels: the
 // library's hit (CT_METHOD_DIRECTIONAL) vs the reference, per pose family
 // (count, RMS and max 3D distance), with the same hit/miss status except
 // near-grazing rays (reference clearance at a local minimum before the hit
@@ -71,6 +73,7 @@ const double kMaxErrM = 0.04;       // library exact mode vs reference, 3D dista
 const double kMaxRmsM = 0.005;      // the same, RMS over every family
 const double kFitMaxM = 2e-5;       // fitted map vs the reference ECEF -> UTM over its cube (m):
                                     // measured 1.4e-5 at 2^47 nm, degree 6; <= 1.7e-6 below
+const double kExactImageM = 2e-6;   // the exact image (Q24, 1.8 um at 30 m) vs the same reference (m)
 const double kSkipClearM = 0.05;    // skip rays passing this close (m) over terrain before the hit
 const double kRefCheckM = 5e-5;     // reference vs closed form on a flat package (m)
 const double kNadirM = 1e-3;        // nadir hit vs the point below the camera (m)
@@ -520,12 +523,21 @@ std::vector<PoseDef> pose_defs()
     // long: 10 km outside the tile, 5 deg down towards its middle
     v.push_back({"long", 185000, Nc, 1420, 90, -5});
     v.push_back({"long", Ec, 4050680, 1350, 0, -5});
+    // far: 200 km south, west, north and east of the tile, 15 km up,
+    // looking at it (about 5 deg down, the Earth's drop 3.1 km included): a
+    // range beyond 150 km, so the path is interpolated through 6 nodes, and
+    // lines of sight that pass over the tile leave it on every side; half
+    // the pixels aimed at tile posts (ct_locate_inverse), the others at random
+    v.push_back({"far", Ec, Nc - 200000, 15000, 0, -5.1L});
+    v.push_back({"far", Ec - 200000, Nc, 15000, 90, -5.1L});
+    v.push_back({"far", Ec, Nc + 200000, 15000, 179.9L, -5.1L});  // yaw: within ct_quat_from_ypr's pi
+    v.push_back({"far", Ec + 200000, Nc, 15000, 270, -5.1L});
     return v;
 }
 
 // compare()'s pose families, in pose_defs()' order.
-const char *const kFamilies[] = {"nadir", "oblique30", "oblique20", "grazing5", "grazing3", "long"};
-constexpr int kFamilyCount = 6;
+const char *const kFamilies[] = {"nadir", "oblique30", "oblique20", "grazing5", "grazing3", "long", "far"};
+constexpr int kFamilyCount = 7;
 
 // What compare() gathers: per family, each mode's statistics against the
 // reference (the exact mode, the old parabola on a 6371 km sphere, the fitted
@@ -777,6 +789,21 @@ void compare(unsigned flags)
         for (int k = 0; k < npix; ++k) {
             uv[2 * k] = ct_rng_range(&rng, 0, (int64_t)(cam.w - 1) << 16);
             uv[2 * k + 1] = ct_rng_range(&rng, 0, (int64_t)(cam.h - 1) << 16);
+            if (f == 6 && k % 2 == 0) {
+                // the tile takes a few pixels of the far poses' view: aim at a random post
+                const int i = (int)ct_rng_range(&rng, 0, w->sf.w - 1), j = (int)ct_rng_range(&rng, 0, w->sf.h - 1);
+                ld E, N;
+                w->sf.map_of(i, j, &E, &N);
+                const int64_t g[3] = {std::llround(E * 1e9L), std::llround(N * 1e9L), std::llround(w->sf.at(i, j) * 1e9L)};
+                int64_t u = 0, v = 0;
+                uint32_t vis = 0;
+                ct_hit blk;
+                if (ct_locate_inverse(&w->p, &cam.cam, &p.pose, &m.exact, g, 0, &u, &v, &vis, &blk) == CT_OK &&
+                    u >= 0 && v >= 0 && u <= (int64_t)(cam.w - 1) << 16 && v <= (int64_t)(cam.h - 1) << 16) {
+                    uv[2 * k] = u;
+                    uv[2 * k + 1] = v;
+                }
+            }
         }
         run_pose(w, cam, p, f, uv, m, T);
     }
@@ -798,13 +825,19 @@ void compare(unsigned flags)
 // reference: long-double geodetic coordinates (PROJ's own ECEF -> geodetic
 // is one Bowring step, off by tens of um 70 km from the ellipsoid), PROJ's
 // transverse Mercator; the largest |dE|, |dN|, |dh| (m) so far in err.
+// The reference's map point (m) of the Earth-fixed offset D from the camera.
+void ref_point(const ct_earth &es, const int64_t D[3], ld *E, ld *N, ld *h)
+{
+    ld X[3], lat, lon;
+    for (int k = 0; k < 3; ++k) X[k] = (ld)(es.c[k] + D[k]) * 1e-9L;
+    earth_ref::geodetic_ld(X, &lat, &lon, h);
+    proj().utm(lat * 180 / kPi, lon * 180 / kPi, E, N);
+}
+
 void fit_error(const ct_package &pk, const ct_earth &es, const int64_t D[3], const int64_t g[3], double err[3])
 {
-    earth_ref::Proj &pj = proj();
-    ld X[3], E, N, h, lat, lon;
-    for (int k = 0; k < 3; ++k) X[k] = (ld)(es.c[k] + D[k]) * 1e-9L;
-    earth_ref::geodetic_ld(X, &lat, &lon, &h);
-    pj.utm(lat * 180 / kPi, lon * 180 / kPi, &E, &N);
+    ld E, N, h;
+    ref_point(es, D, &E, &N, &h);
     const ld fe = pk.origin_e_nm * 1e-9L + (ld)(g[0] + (INT64_C(1) << 23)) * (ld)pk.posting_e_nm * 1e-9L / 16777216.0L;
     const ld fn = pk.origin_n_nm * 1e-9L + (ld)(g[1] + (INT64_C(1) << 23)) * (ld)pk.posting_n_nm * 1e-9L / 16777216.0L;
     const ld fh = pk.height_offset_nm * 1e-9L + (ld)g[2] * (ld)pk.height_scale_nm * 1e-9L / 16777216.0L;
@@ -829,11 +862,31 @@ void check_fit_for_camera(World *w, ld back_km, ct_rng *rng, int nrand, uint32_t
                     "no fit %d km back (range %.1f km)", (int)back_km, es.tmax_nm * 1e-12);
     *seen |= 1u << es.fit.qrho % 32u;
     const int64_t half = INT64_C(1) << es.fit.qrho;
-    double err[3] = {0, 0, 0};
+    double err[3] = {0, 0, 0}, err_exact[3] = {0, 0, 0};
+    int refused = 0;
     auto check = [&](const int64_t D[3]) {
         int64_t g[3];
         TEST_ASSERT_EQUAL_INT(CT_OK, ct_earth_image24(&pk, &es, D, 1, g));
         fit_error(pk, es, D, g, err);
+        // the exact image (what the fit interpolates) against the reference
+        // too; refused (CT_ERR_RANGE) only beyond its range, 2^23 grid units
+        // from the camera on an axis (it keeps 32 fraction bits below 2^55:
+        // 131 km of height at this package's 15.6 mm scale)
+        const ct_status st = ct_earth_image24(&pk, &es, D, 0, g);
+        if (st == CT_OK) {
+            fit_error(pk, es, D, g, err_exact);
+        } else {
+            ld E, N, h, E0, N0, h0;
+            const int64_t zero[3] = {0, 0, 0};
+            ref_point(es, D, &E, &N, &h);
+            ref_point(es, zero, &E0, &N0, &h0);
+            const ld units = std::max(std::max(std::fabs(E - E0) / (pk.posting_e_nm * 1e-9L),
+                                               std::fabs(N - N0) / std::fabs(pk.posting_n_nm * 1e-9L)),
+                                      std::fabs(h - h0) / (pk.height_scale_nm * 1e-9L));
+            TEST_ASSERT_MSG(st == CT_ERR_RANGE && units > 8388608.0L * (1 - 1e-6L),
+                            "exact image refused (%d) %.0Lf grid units from the camera", st, units);
+            refused++;
+        }
     };
     for (int c = 0; c < 27; ++c) {  // corners, edge and face middles, centre
         const int64_t D[3] = {(c % 3 - 1) * half, (c / 3 % 3 - 1) * half, (c / 9 - 1) * half};
@@ -848,11 +901,21 @@ void check_fit_for_camera(World *w, ld back_km, ct_rng *rng, int nrand, uint32_t
     const int64_t Dout[3] = {half + 1, 0, 0};
     int64_t gout[3];
     TEST_ASSERT_EQUAL_INT(CT_ERR_RANGE, ct_earth_image24(&pk, &es, Dout, 1, gout));
+    // beyond 2^50 nm on any axis: no image at all
+    for (int k = 0; k < 3; ++k) {
+        int64_t Dfar[3] = {0, 0, 0};
+        Dfar[k] = -(INT64_C(1) << 50) - 1;
+        TEST_ASSERT_EQUAL_INT(CT_ERR_RANGE, ct_earth_image24(&pk, &es, Dfar, 0, gout));
+        TEST_ASSERT_EQUAL_INT(CT_ERR_RANGE, ct_earth_image24(&pk, &es, Dfar, 1, gout));
+    }
+    const double ex = std::max(err_exact[0], std::max(err_exact[1], err_exact[2]));
+    TEST_ASSERT_MSG(ex <= kExactImageM, "exact image off PROJ by %.3g m (> %.3g m)", ex, kExactImageM);
     const double e = std::max(err[0], std::max(err[1], err[2]));
     std::printf("  camera %3.0Lf km east of the tile: range %.1f km, cube half-width 2^%u nm (%.1f km), degree %d "
-                "(%d exact images): fit vs the reference max |dE| %.2g, |dN| %.2g, |dh| %.2g m\n",
+                "(%d exact images): fit vs the reference max |dE| %.2g, |dN| %.2g, |dh| %.2g m; the exact image %.2g m "
+                "(%d points beyond its range)\n",
                 back_km, es.tmax_nm * 1e-12, es.fit.qrho, (double)half * 1e-12, es.fit.deg,
-                (es.fit.deg + 1) * (es.fit.deg + 1) * (es.fit.deg + 1), err[0], err[1], err[2]);
+                (es.fit.deg + 1) * (es.fit.deg + 1) * (es.fit.deg + 1), err[0], err[1], err[2], ex, refused);
     *worst = std::max(*worst, e);
 }
 
@@ -882,6 +945,10 @@ void check_kept_map_refusals(const ct_package &pk, const Pose &p, ct_earth_map *
     TEST_ASSERT_EQUAL_INT(CT_ERR_RANGE, ct_earth_map_init(&pk, 201045000000000, 4065840000000000, 0, 0, &blank));
     TEST_ASSERT_EQUAL_INT(CT_ERR_RANGE, ct_earth_map_init(&pk, 201045000000000, 4065840000000000, 0,
                                                           (INT64_C(1) << 47) + 1, &blank));
+    TEST_ASSERT_EQUAL_INT(CT_ERR_RANGE, ct_earth_map_init(&pk, 201045000000000, 4065840000000000,
+                                                          (INT64_C(1) << 50) + 1, INT64_C(1) << 44, &blank));
+    TEST_ASSERT_EQUAL_INT(CT_ERR_RANGE, ct_earth_map_init(&pk, 201045000000000, 4065840000000000,
+                                                          -(INT64_C(1) << 50) - 1, INT64_C(1) << 44, &blank));
     TEST_ASSERT_EQUAL_INT(CT_ERR_ARG, ct_earth_map_init(&pk, 0, 0, 0, 1, nullptr));
     other = pk;
     other.epsg = 0;
@@ -940,6 +1007,125 @@ void test_fitted_map()
     ct_earth es;
     const ct_status st = ct_earth_setup(&w->p, &far.pose, 0, CT_EARTH_RADIUS_NM, CT_EFFECTS_CHORD_NM, 0u, 1, nullptr, &es);
     TEST_ASSERT(st != CT_OK || es.map == nullptr);
+    if (st == CT_OK) {
+        const int64_t D0[3] = {0, 0, 0};
+        int64_t g0[3];
+        TEST_ASSERT_EQUAL_INT(CT_ERR_RANGE, ct_earth_image24(&w->p, &es, D0, 1, g0));  // no fit to use
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_earth_image24(&w->p, &es, D0, 0, g0));
+    }
+    // a kept map 1,600 km from the camera (over 2^50 nm on the polar axis:
+    // its cube is of no use there): set aside, the exact conversions instead
+    // -- the exact mode's results, bit for bit (the range capped at 2^48 nm,
+    // 281 km: the tile is below the horizon, every pixel a miss)
+    {
+        static ct_earth_map km;
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_earth_map_init(&w->p, INT64_C(201045) * 1000000000,
+                                                       INT64_C(4065840) * 1000000000, INT64_C(500) * 1000000000,
+                                                       INT64_C(60000) * 1000000000, &km));
+        Pose p;
+        TEST_ASSERT(make_pose(w->sf, {"far", 201045, 4065840 - 1600000, 3000, 0, -10}, &p));
+        ct_earth ek;
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_earth_setup(&w->p, &p.pose, 0, CT_EARTH_RADIUS_NM, CT_EFFECTS_CHORD_NM, 0u, 0,
+                                                    &km, &ek));
+        TEST_ASSERT(ek.map == nullptr);
+        Cam cam = make_camera();
+        ct_effects exact = {CT_EFFECT_CURVATURE, 0, 0, 0, nullptr}, kept = exact;
+        kept.earth_map = &km;
+        for (int k = 0; k < 8; ++k) {
+            ct_geo a, b;
+            const int64_t u = (int64_t)(64 + 128 * k) << 16, v = (int64_t)(100 + 80 * k) << 16;
+            const ct_status sa = ct_geolocate(&w->p, &cam.cam, &p.pose, CT_METHOD_DIRECTIONAL, &exact, u, v, &a);
+            const ct_status sb = ct_geolocate(&w->p, &cam.cam, &p.pose, CT_METHOD_DIRECTIONAL, &kept, u, v, &b);
+            TEST_ASSERT_MSG(sa == CT_MISS && sa == sb && a.hit.e_nm == b.hit.e_nm && a.hit.n_nm == b.hit.n_nm &&
+                                a.hit.h_nm == b.hit.h_nm && a.hit.steps == b.hit.steps,
+                            "pixel %d: kept map far away %d, exact %d", k, sb, sa);
+        }
+    }
+}
+
+// Regression: a 3 x 3 km tile (gentle hills) whose west edge lies 1 km
+// inside the projection's domain (9 deg west of zone 17's meridian),
+// cameras 0.5, 3 and 17 km east of it looking west 3 deg down: the lines of
+// sight leave the domain soon after the tile (within tmax).  Every pixel's
+// status and hit agree with the PROJ reference (which has no such domain):
+// curvature, with refraction, and with the map fitted (its cube crosses
+// the edge: the exact map instead).  A piece reaching past the edge was a
+// miss, though the tile lay on it: 276 hits of 3,199 pixels were missed.
+void test_zone_edge()
+{
+    earth_ref::Proj &pj = proj();
+    // the easting of longitude -90 deg at northing 4,064.5 km (bisection)
+    ld lo = -400000, hi = -200000, lat, lon;
+    for (int k = 0; k < 60; ++k) {
+        const ld mid = (lo + hi) / 2;
+        pj.utm_inverse(mid, 4064500, &lat, &lon);
+        (lon < -90 ? lo : hi) = mid;
+    }
+    const ld Eedge = lo;
+    static World *w = nullptr;
+    if (!w) {
+        w = new World;
+        Georef g = jacksboro()->dem.geo;
+        g.origin_e = std::floor(Eedge) + 1000;
+        g.origin_n = 4066000;
+        const int n = 101;
+        std::vector<double> h((size_t)n * n);
+        for (int j = 0; j < n; ++j)
+            for (int i = 0; i < n; ++i) h[(size_t)j * n + i] = 400.0 + 30 * std::sin(i * 0.2) * std::cos(j * 0.15);
+        std::vector<uint8_t> valid((size_t)n * n, 1);
+        w->t = terrain_from_heights(n, n, h, valid, g, 0.015625);
+        BuildOptions o;
+        o.sectors = 8;
+        o.reduce = 2;
+        w->bytes = build_package(w->t, o);
+        TEST_ASSERT(ct_package_open(&w->p, w->bytes.data(), w->bytes.size()) == CT_OK);
+        w->sf = earth_ref::Surface::from_package(w->p);
+    }
+    Cam cam = make_camera();
+    const ld E0 = w->p.origin_e_nm * 1e-9L, N0 = w->p.origin_n_nm * 1e-9L;
+    long n = 0, agree = 0, hits = 0;
+    double worst = 0;
+    // a kept map over the tile: its cube (17.6 km) reaches past the edge,
+    // where the projection cannot take it: CT_ERR_RANGE (conetrace.h)
+    static ct_earth_map km;
+    TEST_ASSERT_EQUAL_INT(CT_ERR_RANGE, ct_earth_map_init(&w->p, w->p.origin_e_nm + INT64_C(1500000000000),
+                                                          w->p.origin_n_nm - INT64_C(1500000000000),
+                                                          INT64_C(400000000000), INT64_C(1) << 44, &km));
+    for (ld back : {17000.0L, 3000.0L, 500.0L})
+        for (int mode = 0; mode < 3; ++mode) {  // curvature; with refraction; with refraction, the map fitted
+            Pose p;
+            TEST_ASSERT(make_pose(w->sf, {"edge", E0 + 3000 + back, N0 - 1500, 600, 270, -3.0L}, &p));
+            ct_effects fx = {CT_EFFECT_CURVATURE | (mode ? CT_EFFECT_REFRACTION : 0u) | (mode == 2 ? CT_EFFECT_EARTH_FIT : 0u),
+                             CT_REFRACTION_K_STD_Q16, 0, 0, nullptr};
+            for (int iv = 300; iv < 500; iv += 3)
+                for (int iu = 0; iu < 1024; iu += 128) {
+                    const int64_t u = (int64_t)iu << 16, v = (int64_t)iv << 16;
+                    ld ray[3];
+                    earth_ref::pinhole_ray(cam.fx, cam.fy, cam.cx, cam.cy, (ld)u / 65536, (ld)v / 65536, ray);
+                    const earth_ref::Los L = earth_ref::los_from_pose(pj, p.pose, ray, &fx);
+                    earth_ref::Result r = earth_ref::trace(pj, w->sf, L);
+                    if (r.min_clear < kSkipClearM) continue;
+                    ct_geo g;
+                    const ct_status st = ct_geolocate(&w->p, &cam.cam, &p.pose, CT_METHOD_DIRECTIONAL, &fx, u, v, &g);
+                    n++;
+                    const int ls = st == CT_HIT_VOID ? CT_HIT : st;
+                    if (ls != r.status) {
+                        if (n - agree < 5)
+                            std::printf("    zone edge: %.0Lf m back, px (%d, %d): library %d, reference %d (E %.1Lf, %.1Lf m "
+                                        "inside the domain)\n", back, iu, iv, st, r.status, r.e, r.e - Eedge);
+                        continue;
+                    }
+                    agree++;
+                    if (ls == CT_HIT) {
+                        hits++;
+                        worst = std::max(worst, (double)dist3(g.hit.e_nm * 1e-9L, g.hit.n_nm * 1e-9L, g.hit.h_nm * 1e-9L,
+                                                              r.e, r.n, r.h));
+                    }
+                }
+        }
+    std::printf("  zone edge (tile 1 km inside 9 deg): %ld pixels, %ld agree with the reference (%ld hits, within %.4f m)\n",
+                n, agree, hits, worst);
+    TEST_ASSERT(agree == n && hits > 100 && worst <= kMaxErrM);
 }
 
 void test_exact_curvature() { compare(CT_EFFECT_CURVATURE); }
@@ -957,5 +1143,6 @@ int main()
     RUN_TEST(test_fitted_map);
     RUN_TEST(test_exact_curvature);
     RUN_TEST(test_exact_curvature_refraction);
+    RUN_TEST(test_zone_edge);
     return TEST_END();
 }

@@ -394,6 +394,70 @@ void test_los_voids()
     TEST_ASSERT(void_blocks > 0 && checked > void_blocks);
 }
 
+// Segments that end just after entering the tile's box: shallow lines of
+// sight from far outside, ending a fraction of a Q16 unit under the box's
+// top (hmax + 1 LSB) over low ground, and ending a fraction of a unit past
+// the box's west face: the part inside is shorter than the entry point's
+// rounding, and nothing can be met there -- ct_ray_prepare_segment enters
+// (CT_OK) and the trace misses, or hits beyond the segment's end in its
+// last cell (as documented); every method alike.
+void test_los_short_entry()
+{
+    std::vector<uint16_t> z(40 * 40, 1000);
+    z[40 * 40 - 1] = 20000;  // the box's top far above the rest (the far corner's post)
+    const dem_cases::Case cs = dem_cases::make_case("low", dem_cases::make_terrain(40, 40, z, 0.25), 8, 2);
+    ct_package p;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_package_open(&p, cs.pkg.data(), cs.pkg.size()));
+    const int64_t top = ((int64_t)p.hmax + 1) << 16;
+    ct_rng rng;
+    ct_rng_seed(&rng, 907);
+    long entered = 0, beyond = 0;
+    for (int k = 0; k < 4000; ++k) {
+        ct_ray seg;
+        if (k % 3 == 2) {
+            // steep (z dominant past the package's zshift, 2^6 here) and
+            // ending on the west face, or up to 3 units inside it: the
+            // entry's z rounded to 64 units may pass the end
+            const int64_t xe = ct_rng_range(&rng, 0, 3), ye = ct_rng_range(&rng, 10 << 16, 30 << 16);
+            const int64_t ze = ct_rng_range(&rng, (int64_t)1200 << 16, (int64_t)15000 << 16);
+            const int64_t dx = ct_rng_range(&rng, 1, 1 << 8), dy = ct_rng_range(&rng, -(1 << 8), 1 << 8);
+            const int64_t dz = -dx * ct_rng_range(&rng, 1 << 10, 1 << 14);
+            seg = {xe - dx, ye - dy, ze - dz, dx, dy, dz};
+        } else if (k % 2 == 0) {
+            // through the top: 1 unit down per 1000 along x, ending 0..3 units under the top
+            const int64_t xe = ct_rng_range(&rng, 10 << 16, 30 << 16), ye = ct_rng_range(&rng, 10 << 16, 30 << 16);
+            const int64_t ze = top - ct_rng_range(&rng, 0, 3);
+            const int64_t dx = ct_rng_range(&rng, 1000 << 16, 2000 << 16), dy = ct_rng_range(&rng, -(5 << 16), 5 << 16);
+            const int64_t dz = -(dx / 1000) - ct_rng_range(&rng, 0, 7);
+            seg = {xe - dx, ye - dy, ze - dz, dx, dy, dz};
+        } else {
+            // through the west face: ending 0..3 units east of x = 0, 100-1000 times faster in y
+            const int64_t xe = ct_rng_range(&rng, 0, 3), ye = ct_rng_range(&rng, 10 << 16, 30 << 16);
+            const int64_t dx = ct_rng_range(&rng, 1 << 10, 1 << 16), dy = dx * ct_rng_range(&rng, 100, 1000);
+            seg = {xe - dx, ye - dy, (int64_t)1500 << 16, dx, dy, -ct_rng_range(&rng, 0, 1 << 16)};
+        }
+        ct_prepared pr;
+        const ct_status sp = ct_ray_prepare_segment(&p, &seg, &pr);
+        TEST_ASSERT_MSG(sp == CT_OK || sp == CT_MISS, "segment %d: prepare %d", k, sp);
+        if (sp != CT_OK) continue;
+        entered++;
+        for (int m = 0; m < 4; ++m) {
+            // a miss, or a hit beyond the segment's end in its last cell
+            // (which ct_ray_prepare_segment documents; the callers discard it)
+            ct_hit h;
+            const ct_status st = ct_trace_prepared(&p, &pr, (ct_method)m, &h);
+            TEST_ASSERT_MSG(st == CT_MISS || (st == CT_HIT && h.t_q26 * pr.tend_d > pr.tend_n * (INT64_C(1) << CT_T_FRAC_BITS)),
+                            "segment %d method %d: %d, t %lld against the end %lld / %lld", k, m, st, (long long)h.t_q26,
+                            (long long)pr.tend_n, (long long)pr.tend_d);
+            beyond += st == CT_HIT;
+        }
+        if (ct_harness_g.current_failed) return;
+    }
+    std::printf("  short entries: %ld of 4000 segments enter the box, none meets the surface before its end (%ld hits "
+                "beyond it, in the last cell)\n", entered, beyond);
+    TEST_ASSERT(entered > 1000);
+}
+
 }  // namespace
 
 int main()
@@ -404,5 +468,6 @@ int main()
     RUN_TEST(test_locate_inverse_cases);
     RUN_TEST(test_los_cases);
     RUN_TEST(test_los_voids);
+    RUN_TEST(test_los_short_entry);
     return TEST_END();
 }

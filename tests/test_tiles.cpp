@@ -28,12 +28,14 @@
 
 #include <unistd.h>
 
+#include "bend.h"
 #include "conetrace.h"
 #include "dem_cases.hpp"
 #include "harness.h"
 #include "judge.hpp"
 #include "le.hpp"
 #include "terrain.hpp"
+#include "tiles.h"
 #include "tileset.hpp"
 #include "vdatum.hpp"
 
@@ -745,6 +747,82 @@ void test_geolocation()
     // refraction alone on a sphere (c < 0: the polyline, each segment walked
     // tile by tile): the merged package's results too
     ct_effects refr = {CT_EFFECT_REFRACTION, CT_REFRACTION_K_STD_Q16, (int64_t)6371000 * 1000000000, 0, NULL};
+    // a camera 5 m under the surface, every effect model (the straight
+    // walk, the lowered walk, the polyline, the true Earth's pieces, exact
+    // and fitted): CT_BELOW for every pixel from the merged package and the
+    // set alike (ct_geolocate's documented status)
+    {
+        const int ci = 300, cj = 200;
+        const int64_t be = mp.origin_e_nm + (int64_t)std::llround((ci + 0.5) * mp.posting_e_nm);
+        const int64_t bn = mp.origin_n_nm + (int64_t)std::llround((cj + 0.5) * mp.posting_n_nm);
+        const int64_t bh = mp.height_offset_nm + (int64_t)t.codes[(size_t)cj * t.width + ci] * mp.height_scale_nm -
+                           (int64_t)5 * 1000000000;
+        ct_pose under;
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_pose_from_map(&under, be, bn, bh, q));
+        const ct_effects *all[5] = {nullptr, &sphere, &refr, &earth, &earth_fit};
+        for (int f = 0; f < 5; ++f)
+            for (int m : {0, 3}) {
+                std::vector<ct_geo> a(np), b(np);
+                TEST_ASSERT_EQUAL_INT(CT_OK, ct_geolocate_batch(&mp, &cam, &under, (ct_method)m, all[f], uv.data(), np,
+                                                                a.data(), np));
+                TEST_ASSERT_EQUAL_INT(CT_OK, ct_geolocate_batch_tiles(&set.ts, &cam, &under, (ct_method)m, all[f],
+                                                                      uv.data(), np, b.data(), np));
+                long below = 0;
+                for (size_t k = 0; k < np; ++k) {
+                    below += a[k].status == CT_BELOW && b[k].status == CT_BELOW;
+                    if (a[k].status != CT_BELOW || b[k].status != CT_BELOW) {
+                        TEST_ASSERT_MSG(false, "under the surface, effects %d method %d pixel %zu: merged %d, set %d", f,
+                                        m, k, a[k].status, b[k].status);
+                        break;
+                    }
+                }
+                TEST_ASSERT_EQUAL_INT((int)np, (int)below);
+            }
+    }
+    // a vertical line of sight (a nadir pose with an exact rotation, the
+    // principal point): no effect bends it -- the straight trace's hit,
+    // bit for bit, from the merged package and the set, with every effect
+    {
+        const int32_t nadir[9] = {1 << 30, 0, 0, 0, -(1 << 30), 0, 0, 0, -(1 << 30)};
+        ct_pose down;
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_pose_init(&down, nadir, e, n, (int64_t)2000 * 1000000000));
+        const int64_t pu = (int64_t)319 << 15, pv = (int64_t)239 << 15;  // (159.5, 119.5)
+        ct_geo ref;
+        TEST_ASSERT_EQUAL_INT(CT_HIT, ct_geolocate(&mp, &cam, &down, CT_METHOD_INCREMENTAL, nullptr, pu, pv, &ref));
+        TEST_ASSERT(ref.dir_map_q39[0] == 0 && ref.dir_map_q39[1] == 0);
+        const ct_effects *all[3] = {&sphere, &refr, nullptr};
+        for (int f = 0; f < 3; ++f)
+            for (int m = 0; m < 4; ++m) {
+                ct_geo a, b;
+                ct_geolocate(&mp, &cam, &down, (ct_method)m, all[f], pu, pv, &a);
+                ct_geolocate_tiles(&set.ts, &cam, &down, (ct_method)m, all[f], pu, pv, &b);
+                TEST_ASSERT_MSG(same_hit(ref.status, ref.hit, a.status, a.hit) &&
+                                    same_hit(ref.status, ref.hit, b.status, b.hit),
+                                "nadir, effects %d method %d: merged %d, set %d", f, m, a.status, b.status);
+            }
+    }
+    // the bent walk's own entry (tiles.h) with a line of sight whose
+    // horizontal part vanishes once reduced (1 against 2^40 down): not
+    // bent, the straight trace's hit -- the polyline's (c < 0) and the
+    // lowered walk's set-ups, over the set and on the merged package
+    {
+        const ct_ray steep = {(int64_t)250 << 16, (int64_t)190 << 16, ((int64_t)mp.hmax + 100) << 16, 1, 0,
+                              -(INT64_C(1) << 40)};
+        ct_hit hs, hb;
+        const ct_status ss = ct_trace(&mp, &steep, CT_METHOD_DIRECTIONAL, &hs);
+        TEST_ASSERT_EQUAL_INT(CT_HIT, ss);
+        for (int32_t c : {-8520, 57016}) {
+            const ct_bend bd = {c, (int64_t)6371000 * 1000000000, 1000000, 0u};
+            ct_bent_setup bs, bm;
+            TEST_ASSERT_EQUAL_INT(CT_OK, ct_bent_prepare(&set.ts.frame, &bd, steep.x_q16, steep.y_q16, &bs));
+            TEST_ASSERT_EQUAL_INT(CT_OK, ct_bent_prepare(&mp, &bd, steep.x_q16, steep.y_q16, &bm));
+            for (int m = 0; m < 4; ++m) {
+                TEST_ASSERT(same_hit(ss, hs, ct_trace_bent_set_ts(&set.ts.frame, &set.ts, &steep, &bs, (ct_method)m, &hb),
+                                     hb));
+                TEST_ASSERT(same_hit(ss, hs, ct_trace_bent_set(&mp, &steep, &bm, (ct_method)m, &hb), hb));
+            }
+        }
+    }
     // a tile missing, with every effect: the merged result or CT_NO_DATA,
     // never a hit on the missing tile
     {
@@ -775,6 +853,28 @@ void test_geolocation()
             }
             std::printf("  a missing tile, effects %d: %ld pixels no_data (%ld merged hits on it)\n", f, nodata, on_hole);
             TEST_ASSERT(nodata >= on_hole && on_hole > 0);
+        }
+        // the camera 20 m over the missing tile, inside the terrain's box:
+        // every line of sight starts there -- CT_NO_DATA at its first
+        // point, with every effect model
+        ct_pose over;
+        const int oi = x0 + 64, oj = y0 + 64;
+        const int64_t oe = mp.origin_e_nm + (int64_t)std::llround((oi + 0.5) * mp.posting_e_nm);
+        const int64_t on = mp.origin_n_nm + (int64_t)std::llround((oj + 0.5) * mp.posting_n_nm);
+        const int64_t oh = mp.height_offset_nm + (int64_t)t.codes[(size_t)oj * t.width + oi] * mp.height_scale_nm +
+                           (int64_t)20 * 1000000000;
+        TEST_ASSERT((oh - mp.height_offset_nm) / mp.height_scale_nm < (int64_t)mp.hmax);
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_pose_from_map(&over, oe, on, oh, q));
+        for (int f = 0; f < 5; ++f) {
+            std::vector<ct_geo> b(np);
+            TEST_ASSERT_EQUAL_INT(CT_OK, ct_geolocate_batch_tiles(&hs.ts, &cam, &over, CT_METHOD_DIRECTIONAL, all[f],
+                                                                  uv.data(), np, b.data(), np));
+            long nodata = 0;
+            for (size_t k = 0; k < np; ++k)
+                nodata += b[k].status == CT_NO_DATA && b[k].hit.cell_x >= x0 && b[k].hit.cell_x < x0 + 128 &&
+                          b[k].hit.cell_y >= y0 && b[k].hit.cell_y < y0 + 128;
+            TEST_ASSERT_MSG(nodata == (long)np, "camera over the missing tile, effects %d: %ld of %zu no_data on it "
+                            "(pixel 0: status %d cell %d,%d)", f, nodata, np, b[0].status, b[0].hit.cell_x, b[0].hit.cell_y);
         }
     }
     for (int m : {0, 3}) {
@@ -831,13 +931,17 @@ void test_los()
                    (int64_t)std::llround(lift * 1e9);
             return q;
         };
-        const auto A = point(2 + 300 * ct_rng_unit(&rng)), B = point(ct_rng_unit(&rng) < 0.5 ? 0.5 : 30);
+        // one pair in ten with A 5 m under the surface: CT_BELOW (ct_los's documented status)
+        const bool under = k % 10 == 9;
+        const auto A = point(under ? -5 : 2 + 300 * ct_rng_unit(&rng)), B = point(ct_rng_unit(&rng) < 0.5 ? 0.5 : 30);
         const ct_effects *fx = fxs[k % 3];
         ct_hit hm, hs1, hh;
         const ct_status sm = ct_los(&mp, A.data(), B.data(), fx, 1000000, CT_METHOD_DIRECTIONAL, &hm);
         const ct_status ss = ct_los_tiles(&set.ts, A.data(), B.data(), fx, 1000000, CT_METHOD_DIRECTIONAL, &hs1);
         const ct_status sh = ct_los_tiles(&hs.ts, A.data(), B.data(), fx, 1000000, CT_METHOD_DIRECTIONAL, &hh);
         TEST_ASSERT_MSG(sm >= 0, "ct_los %d", sm);
+        TEST_ASSERT_MSG(under == (sm == CT_BELOW), "pair %d effects %d: A %s the surface, ct_los %d", k, k % 3,
+                        under ? "under" : "over", sm);
         TEST_ASSERT_MSG(same_hit(sm, hm, ss, hs1), "pair %d effects %d: set %d vs merged %d", k, k % 3, ss, sm);
         counts[sm == CT_OK ? 0 : (sm == CT_HIT ? 1 : 2)]++;
         const bool on_hole = sm == CT_HIT && hm.cell_x >= hx0 && hm.cell_x < hx0 + 128 && hm.cell_y >= hy0 &&
@@ -853,7 +957,7 @@ void test_los()
     std::printf("  line of sight: 1500 pairs (straight, sphere, true Earth): %ld visible, %ld blocked, %ld below; "
                 "with a tile missing %ld no_data (%ld blocked on it)\n",
                 counts[0], counts[1], counts[2], nodata, hidden);
-    TEST_ASSERT(counts[0] > 100 && counts[1] > 100 && nodata >= hidden && hidden > 0);
+    TEST_ASSERT(counts[0] > 100 && counts[1] > 100 && counts[2] == 150 && nodata >= hidden && hidden > 0);
 }
 
 // A set's frame (ts.frame: a ct_package with no sections, base NULL, for

@@ -386,6 +386,7 @@ int cmd_build(int argc, char **argv)
     double work = std::max(0.0, proc_status_kib("VmHWM") * 1024.0 - rss0);
     bar.finish();
     if (a.opt.count("--emit-c")) {
+        RemovedIfInterrupted all_or_none(out);  // the package goes if the C array is interrupted
         try {
             emit_c_array(out, a.opt["--emit-c"]);
         } catch (...) {
@@ -634,6 +635,12 @@ int main(int argc, char **argv)
             return 0;
         }
     }
+    // Ctrl-C, SIGTERM, SIGHUP: the temporaries in progress removed, one line
+    // naming the output (-o), the process ended by the signal (temp_output.hpp)
+    std::string output;
+    for (int k = 2; k + 1 < argc; ++k)
+        if (std::strcmp(argv[k], "-o") == 0) output = argv[k + 1];
+    remove_temporaries_on_interrupt("conetrace", output);
     try {
         if (cmd == "build") return cmd_build(argc, argv);
         if (cmd == "info") return cmd_info(argc, argv);

@@ -78,6 +78,7 @@ void emit_c_array(const std::string &package_path, const std::string &name)
         put("}};\n\nconst uint8_t *const " + name + " = " + name + "_storage.bytes;\n");
         out.commit();
     }
+    RemovedIfInterrupted all_or_none(dir + name + ".c");  // both files or none
     try {
         write_file_atomic(dir + name + ".h", std::vector<uint8_t>(h.begin(), h.end()));
     } catch (...) {

@@ -185,22 +185,29 @@ void check_replaceable(const std::string &dir)
 void install_dir(const std::string &tmp, const std::string &dir, const std::string &old)
 {
     std::error_code ec;
-    try {
-        if (fs::exists(dir, ec)) {
-            fs::rename(dir, old, ec);
-            if (ec) throw Error(dir + ": cannot replace (" + ec.message() + ")");
+    {
+        InterruptLock lock;  // renamed and (un)registered at once: an interrupt waits
+        try {
+            if (fs::exists(dir, ec)) {
+                fs::rename(dir, old, ec);
+                if (ec) throw Error(dir + ": cannot replace (" + ec.message() + ")");
+            }
+            fs::rename(tmp, dir, ec);
+            if (ec) {
+                std::error_code ec2;
+                if (fs::exists(old, ec2)) fs::rename(old, dir, ec2);
+                throw Error(dir + ": cannot create (" + ec.message() + ")");
+            }
+        } catch (...) {
+            fs::remove_all(tmp, ec);
+            unregister_temporary(tmp);
+            throw;
         }
-        fs::rename(tmp, dir, ec);
-        if (ec) {
-            std::error_code ec2;
-            if (fs::exists(old, ec2)) fs::rename(old, dir, ec2);
-            throw Error(dir + ": cannot create (" + ec.message() + ")");
-        }
-    } catch (...) {
-        fs::remove_all(tmp, ec);
-        throw;
+        unregister_temporary(tmp);
+        register_temporary(old, old, true);  // the replaced set: removed now, or by an interrupt
     }
     fs::remove_all(old, ec);
+    unregister_temporary(old);
 }
 
 }  // namespace
@@ -276,7 +283,7 @@ void build_tileset_dir(const Terrain &t, const BuildOptions &opt, int P, const s
     check_replaceable(dir);
     TileSetBytes b = build_tileset(t, opt, P, threads, nullptr, progress);
     fs::remove_all(tmp, ec);
-    if (!fs::create_directories(tmp, ec)) throw Error(tmp + ": cannot create (" + ec.message() + ")");
+    create_registered_dir(tmp, dir);  // removed by an interrupt from now on
     try {
         for (int row = 0; row < b.grid.tiles_y; ++row)
             for (int col = 0; col < b.grid.tiles_x; ++col)
@@ -285,6 +292,7 @@ void build_tileset_dir(const Terrain &t, const BuildOptions &opt, int P, const s
         write_file_atomic((fs::path(tmp) / kManifestName).string(), b.manifest);
     } catch (...) {
         fs::remove_all(tmp, ec);
+        unregister_temporary(tmp);
         throw;
     }
     install_dir(tmp, dir, old);
@@ -417,7 +425,7 @@ void build_mosaic_dir(int width, int height, const Georef &geo, double scale_m, 
     const std::string pid = std::to_string((long)getpid());
     const std::string tmp = dir + ".tmp." + pid, old = dir + ".old." + pid;
     fs::remove_all(tmp, ec);
-    if (!fs::create_directories(tmp, ec)) throw Error(tmp + ": cannot create (" + ec.message() + ")");
+    create_registered_dir(tmp, dir);  // removed by an interrupt from now on
     std::vector<TileEntry> entries((size_t)g.tiles_x * g.tiles_y);
     try {
         for (int by = 0; by < sets_y; ++by)
@@ -541,6 +549,7 @@ void build_mosaic_dir(int width, int height, const Georef &geo, double scale_m, 
             }
     } catch (...) {
         fs::remove_all(tmp, ec);
+        unregister_temporary(tmp);
         throw;
     }
     install_dir(tmp, dir, old);

@@ -870,7 +870,9 @@ ct_status ct_effects_for_tolerance(const ct_package *pkg, const ct_camera *cam, 
  * ct_trace (both points as ct_map_to_grid rounds them, Q16); with effects
  * as for geolocation: curvature with earth_radius_nm 0 on a UTM package is
  * the true Earth (the Earth-fixed line of sight from A aimed at B -- with
- * refraction at B raised by its drop k t^2 / 2R -- traced by earth.c, the
+ * refraction at B raised by the path's drop k t^2 / 2R along the
+ * direction the path bends: the vertical at A made perpendicular to the
+ * line -- traced by earth.c, the
  * margin an Earth-fixed distance; earth_map / CT_EFFECT_EARTH_FIT honoured);
  * otherwise the sphere (c > 0; 0 = 6371 km): the line of sight from A
  * through B bent by c rho^2 / 2R, as ct_trace_bent's lowered walk.  CT_OK: nothing stands

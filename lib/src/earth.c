@@ -1124,23 +1124,31 @@ static int check_piece(const ct_package *p, const path *pa, const ct_earth *es, 
 /* The next piece from A (at ta): *L long at most (and no longer than the
  * rest of the path), shortened until its model is within the tolerances
  * or it is PIECE_MIN_NM long; *L is left at the length of the last try.
- * CT_MISS when a vertex is beyond the projection's domain (nothing of this
- * tile), else CT_OK. */
+ * A piece with a point beyond the projection's domain (its end, middle or
+ * quarter points) is shortened to 1/8 too: the tile lies inside the
+ * domain, so the path may still meet it before leaving (a tile near the
+ * zone's edge).  CT_MISS when even PIECE_MIN_NM reaches beyond the domain
+ * (or the tries run out on such a piece), else CT_OK. */
 static ct_status next_piece(const ct_package *p, const path *pa, const ct_earth *es, const gv *A, int64_t ta,
                             int64_t *L, piece *pc)
 {
     uint32_t r;
+    int ok = -1;
     pc->dB = 0;
     /* bound: EARTH_MAX_RETRIES + 1 tries */
     for (r = 0u; r <= EARTH_MAX_RETRIES; ++r) {
-        int ok;
         pc->Lc = ct_min64(*L, es->tmax_nm - ta);
-        if (vertex(pa, ta + pc->Lc, &pc->B) != CT_OK || vertex(pa, ta + pc->Lc / 2, &pc->M) != CT_OK) {
-            return CT_MISS;
+        ok = -1;
+        if (vertex(pa, ta + pc->Lc, &pc->B) == CT_OK && vertex(pa, ta + pc->Lc / 2, &pc->M) == CT_OK) {
+            ok = check_piece(p, pa, es, A, ta, pc);
         }
-        ok = check_piece(p, pa, es, A, ta, pc);
         if (ok < 0) {
-            return CT_MISS;
+            /* beyond the domain: a shorter piece, down to PIECE_MIN_NM */
+            if (pc->Lc <= PIECE_MIN_NM) {
+                return CT_MISS;
+            }
+            *L = ct_max64(PIECE_MIN_NM, pc->Lc / 8);
+            continue;
         }
         if (ok || pc->Lc <= PIECE_MIN_NM) {
             break;
@@ -1152,7 +1160,7 @@ static ct_status next_piece(const ct_package *p, const path *pa, const ct_earth 
             *L = ct_max64(PIECE_MIN_NM, ct_max64(pc->Lc / 8, ct_mul_shr(pc->Lc, fr * 4 / 5, 15u)));
         }
     }
-    return CT_OK;
+    return ok < 0 ? CT_MISS : CT_OK;
 }
 
 /* The length to try for the piece after pc: longer where pc was well
