@@ -103,6 +103,20 @@ struct Set {
     }
 };
 
+// A pinhole camera of w x h pixels, focal length f pixels, principal point
+// (cx2 / 2, cy2 / 2) pixels.
+ct_status pinhole(ct_camera *cam, uint32_t w, uint32_t h, int64_t f, int64_t cx2, int64_t cy2)
+{
+    ct_lens lens{};
+    lens.model = CT_LENS_PINHOLE;
+    lens.width = w;
+    lens.height = h;
+    lens.fx_q32 = lens.fy_q32 = f << 32;
+    lens.cx_q32 = cx2 << 31;
+    lens.cy_q32 = cy2 << 31;
+    return ct_camera_init(cam, &lens);
+}
+
 bool same_hit(ct_status sa, const ct_hit &a, ct_status sb, const ct_hit &b)
 {
     if (sa != sb) return false;
@@ -694,15 +708,8 @@ void test_geolocation()
     TEST_ASSERT_EQUAL_INT(CT_OK, ct_package_open(&mp, merged.data(), merged.size()));
     Set set;
     TEST_ASSERT_EQUAL_INT(CT_OK, set.open(tb, 4));
-    ct_lens lens{};  // principal point (159.5, 119.5): off centre
-    lens.model = CT_LENS_PINHOLE;
-    lens.width = 640;
-    lens.height = 480;
-    lens.fx_q32 = lens.fy_q32 = (int64_t)500 << 32;
-    lens.cx_q32 = (int64_t)319 << 31;
-    lens.cy_q32 = (int64_t)239 << 31;
-    ct_camera cam;
-    TEST_ASSERT_EQUAL_INT(CT_OK, ct_camera_init(&cam, &lens));
+    ct_camera cam;  // principal point (159.5, 119.5): off centre
+    TEST_ASSERT_EQUAL_INT(CT_OK, pinhole(&cam, 640, 480, 500, 319, 239));
     // over the set's centre, 2 km up, looking 20 deg down to the north-east
     int32_t q[4];
     TEST_ASSERT_EQUAL_INT(CT_OK, ct_quat_from_ypr(dem_cases::deg_q61(45), dem_cases::deg_q61(-20), 0, q));
@@ -977,15 +984,8 @@ void test_frame_refused()
     TEST_ASSERT_EQUAL_INT(CT_OK, set.open(tb, 2));
     const ct_package *f = &set.ts.frame;
     TEST_ASSERT(f->base == nullptr && f->heights == nullptr);
-    ct_lens lens{};
-    lens.model = CT_LENS_PINHOLE;
-    lens.width = 64;
-    lens.height = 48;
-    lens.fx_q32 = lens.fy_q32 = (int64_t)50 << 32;
-    lens.cx_q32 = (int64_t)63 << 31;
-    lens.cy_q32 = (int64_t)47 << 31;
     ct_camera cam;
-    TEST_ASSERT_EQUAL_INT(CT_OK, ct_camera_init(&cam, &lens));
+    TEST_ASSERT_EQUAL_INT(CT_OK, pinhole(&cam, 64, 48, 50, 63, 47));
     int32_t q[4];
     TEST_ASSERT_EQUAL_INT(CT_OK, ct_quat_from_ypr(0, dem_cases::deg_q61(-60), 0, q));
     ct_pose pose;
