@@ -969,7 +969,8 @@ void test_los()
 
 // A set's frame (ts.frame: a ct_package with no sections, base NULL, for
 // the georeference) handed to what reads terrain: CT_ERR_ARG from each, not
-// a NULL dereference; the same calls on the merged package succeed.
+// a NULL dereference; the same calls on the merged package succeed.  And a
+// set that is not ready (never opened, or its open failed): CT_ERR_ARG.
 void test_frame_refused()
 {
     const ct_host::Terrain t = dem_cases::mirror_tiled(dem_cases::real_terrain(), 200, 200);
@@ -1027,6 +1028,32 @@ void test_frame_refused()
             TEST_ASSERT_EQUAL_INT(CT_OK, ct_ray_prepare(&mp, &ray, &pr));
             TEST_ASSERT_EQUAL_INT(CT_ERR_ARG, ct_trace_prepared(f, &pr, CT_METHOD_DIRECTIONAL, &h));
         }
+    }
+    // A set ct_tileset_open did not make ready -- never opened (zeroed), or
+    // its last open failed (a truncated manifest over a set that was open)
+    // -- refused by every _tiles function; the open set answers.
+    Set failed;
+    TEST_ASSERT_EQUAL_INT(CT_OK, failed.open(tb, 2));
+    TEST_ASSERT_EQUAL_INT(CT_SET_READY, failed.ts.ready);
+    const std::vector<uint8_t> cut(tb.manifest.begin(), tb.manifest.end() - 1);
+    TEST_ASSERT(failed.open(tb, 2, &cut) < 0);
+    ct_tileset zeroed{};
+    for (int which = 0; which < 3; ++which) {
+        ct_tileset *ts = which == 0 ? &set.ts : (which == 1 ? &zeroed : &failed.ts);
+        auto ok = [&](ct_status st) { return which == 0 ? st >= 0 : st == CT_ERR_ARG; };
+        const ct_package *frame = &set.ts.frame;  // the open set's georeference for the rays
+        ct_ray gr;
+        ct_hit h;
+        ct_geo g, gb[1];
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_ray_from_map(frame, e, n, (int64_t)1500 * 1000000000, 1, 0, -1, &gr));
+        TEST_ASSERT_MSG(ok(ct_tileset_trace(ts, &gr, CT_METHOD_DIRECTIONAL, &h)), "set %d: ct_tileset_trace", which);
+        TEST_ASSERT_MSG(ok(ct_los_tiles(ts, a, b, &sphere, 0, CT_METHOD_DIRECTIONAL, &h)), "set %d: ct_los_tiles",
+                        which);
+        TEST_ASSERT_MSG(ok(ct_geolocate_tiles(ts, &cam, &pose, CT_METHOD_DIRECTIONAL, &sphere, uv[0], uv[1], &g)) &&
+                            ok(g.status),
+                        "set %d: ct_geolocate_tiles", which);
+        TEST_ASSERT_MSG(ok(ct_geolocate_batch_tiles(ts, &cam, &pose, CT_METHOD_DIRECTIONAL, NULL, uv, 1, gb, 1)),
+                        "set %d: ct_geolocate_batch_tiles", which);
     }
 }
 

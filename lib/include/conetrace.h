@@ -1330,7 +1330,13 @@ typedef struct {
                                   k mod CT_SET_HINTS (checked against held) */
     uint32_t loads;            /* tiles loaded and accepted                 */
     uint32_t refused;          /* loads that failed or were refused         */
+    uint32_t ready;            /* CT_SET_READY once ct_tileset_open
+                                  succeeded (0 from its start): the _tiles
+                                  functions refuse any other set with
+                                  CT_ERR_ARG                               */
 } ct_tileset;
+
+#define CT_SET_READY 0x52544553u /* "SETR" */
 
 /* Validate a tile set's manifest and set up *ts over the caller's slots.
  *   [out] ts        the set (kept by reference: manifest, slots, user).
@@ -1343,7 +1349,8 @@ typedef struct {
  * _VERSION, _HEADER, _CRC; _SECTORS, _REDUCE, _GEOREF, _FLAGS), CT_ERR_DIMS
  * (a tile grid that does not fit W x H, or more than CT_SET_MAX_TILES
  * tiles), CT_ERR_RANGE (hmin > hmax, a tile's range outside the set's),
- * CT_ERR_ARG (NULL, nslots out of range).                                  */
+ * CT_ERR_ARG (NULL, nslots out of range).  On any error the set is not
+ * ready (ts->ready 0): tracing it is refused, not undefined.              */
 ct_status ct_tileset_open(ct_tileset *ts, const uint8_t *manifest, size_t len, ct_tile_slot *slots, uint32_t nslots,
                           ct_tile_loader load, void *user);
 
@@ -1356,7 +1363,8 @@ ct_status ct_tileset_open(ct_tileset *ts, const uint8_t *manifest, size_t len, c
  *                    add up over the tiles walked.
  * Returns as ct_trace, or CT_NO_DATA (the ray reached a tile the set does
  * not have, the loader could not give, or whose bytes failed their checks;
- * hit: where it entered that tile).                                        */
+ * hit: where it entered that tile); CT_ERR_ARG for a set that
+ * ct_tileset_open did not make ready (as the other _tiles functions).     */
 ct_status ct_tileset_trace(ct_tileset *ts, const ct_ray *ray, ct_method method, ct_hit *hit);
 
 /* ct_geolocate / ct_geolocate_batch over a tile set (ts->frame is the

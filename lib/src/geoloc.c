@@ -227,7 +227,9 @@ ct_status ct_geolocate_tiles(ct_tileset *ts, const ct_camera *cam, const ct_pose
                              const ct_effects *effects, int64_t u_q16, int64_t v_q16, ct_geo *out)
 {
     CT_ASSERT(ts != NULL && cam != NULL && pose != NULL && out != NULL);
-    return geolocate_one(ts != NULL ? &ts->frame : NULL, ts, cam, pose, method, effects, u_q16, v_q16, out);
+    /* a set not ready as a NULL package: CT_ERR_ARG */
+    return geolocate_one(ts != NULL && ts->ready == CT_SET_READY ? &ts->frame : NULL, ts, cam, pose, method, effects,
+                         u_q16, v_q16, out);
 }
 
 ct_status ct_geolocate_batch_tiles(ct_tileset *ts, const ct_camera *cam, const ct_pose *pose, ct_method method,
@@ -235,8 +237,9 @@ ct_status ct_geolocate_batch_tiles(ct_tileset *ts, const ct_camera *cam, const c
                                    size_t out_len)
 {
     CT_ASSERT(ts != NULL && cam != NULL && pose != NULL && (count == 0u || (uv_q16 != NULL && out != NULL)));
-    return geolocate_many(ts != NULL ? &ts->frame : NULL, ts, cam, pose, method, effects, uv_q16, count, out,
-                          out_len);
+    /* a set not ready as a NULL package: CT_ERR_ARG */
+    return geolocate_many(ts != NULL && ts->ready == CT_SET_READY ? &ts->frame : NULL, ts, cam, pose, method, effects,
+                          uv_q16, count, out, out_len);
 }
 
 /* ---- effects for a tolerance ------------------------------------------ */

@@ -276,7 +276,7 @@ ct_status ct_los(const ct_package *p, const int64_t a_nm[3], const int64_t b_nm[
 ct_status ct_los_tiles(ct_tileset *ts, const int64_t a_nm[3], const int64_t b_nm[3], const ct_effects *effects,
                        int64_t margin_nm, ct_method m, ct_hit *block)
 {
-    if (ts == NULL) {
+    if (ts == NULL || ts->ready != CT_SET_READY) {
         return CT_ERR_ARG;
     }
     return los_impl(&ts->frame, ts, a_nm, b_nm, effects, margin_nm, m, block);

@@ -43,6 +43,7 @@ ct_status ct_tileset_open(ct_tileset *ts, const uint8_t *b, size_t len, ct_tile_
     if (ts == NULL || b == NULL || slots == NULL || load == NULL || nslots == 0u || nslots > CT_SET_MAX_SLOTS) {
         return CT_ERR_ARG;
     }
+    ts->ready = 0u; /* until every check has passed */
     st = ct_check_stamped(b, len, CT_SET_MAGIC, CT_SET_VERSION, CT_SET_HEADER_SIZE, &total);
     if (st != CT_OK) {
         return st;
@@ -127,6 +128,7 @@ ct_status ct_tileset_open(ct_tileset *ts, const uint8_t *b, size_t len, ct_tile_
     for (k = 0u; k < CT_SET_HINTS; ++k) {
         ts->hint[k] = 0u;
     }
+    ts->ready = CT_SET_READY;
     return CT_OK;
 }
 
@@ -458,7 +460,7 @@ static ct_status set_trace(ct_tileset *ts, const ct_ray *ray, int seg, const ct_
 ct_status ct_tileset_trace(ct_tileset *ts, const ct_ray *ray, ct_method m, ct_hit *h)
 {
     CT_ASSERT(ts != NULL && ray != NULL && h != NULL);
-    if (ts == NULL || ray == NULL || h == NULL) {
+    if (ts == NULL || ray == NULL || h == NULL || ts->ready != CT_SET_READY) {
         return CT_ERR_ARG;
     }
     return set_trace(ts, ray, 0, NULL, 0, m, h, NULL);
