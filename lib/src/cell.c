@@ -89,34 +89,44 @@ typedef struct {
     int64_t dps; /* s * (L - o_p): d times t at the w = 0 line */
 } quad;
 
-static void make_quad(const ctx *c, int32_t i, int32_t j, const posts4 *q, quad *Q)
+/* What make_quad and make_quad_low share: the primary axis p (x when |dx|
+ * >= |dy|), the posts h00..h11 (LSB, or the lowered posts' units) put in
+ * (p, q) order and mirrored along p when the ray runs towards -p (w = 1 -
+ * the cell coordinate), so that w grows along the ray from the cell's entry
+ * line L; Q->p, Q->d = |D_p|, Q->dps = s (L - o_p) (|L - o_p| < 2^31), the
+ * bilinear coefficients a, b, cc in the (p, q) frame, g00, D_q, and
+ * V0 = d (o_q - k_q 2^16) + dps D_q (2^26 2^31 + 2^31 2^26). */
+typedef struct {
+    int64_t a, b, cc, g00, Dq, V0;
+} qframe;
+
+static void quad_frame(const ctx *c, int32_t i, int32_t j, int64_t h00, int64_t h10, int64_t h01, int64_t h11,
+                       quad *Q, qframe *F)
 {
-    int64_t op, oq, Dp, Dq, kq, L, g00, g10, g01, g11, a, b, cc, V0, Z0, s;
+    int64_t op, oq, Dp, kq, L, g00, g10, g01, g11, s;
     int32_t kp;
     Q->p = (c->adx >= c->ady) ? 0 : 1;
     if (Q->p == 0) {
         op = c->r->ox;
         oq = c->r->oy;
         Dp = c->r->dx;
-        Dq = c->r->dy;
+        F->Dq = c->r->dy;
         kp = i;
         kq = j;
-        g00 = q->h00;
-        g10 = q->h10;
-        g01 = q->h01;
-        g11 = q->h11;
+        g10 = h10;
+        g01 = h01;
     } else {
         op = c->r->oy;
         oq = c->r->ox;
         Dp = c->r->dy;
-        Dq = c->r->dx;
+        F->Dq = c->r->dx;
         kp = j;
         kq = i;
-        g00 = q->h00;
-        g10 = q->h01;
-        g01 = q->h10;
-        g11 = q->h11;
+        g10 = h01;
+        g01 = h10;
     }
+    g00 = h00;
+    g11 = h11;
     s = Dp > 0 ? 1 : -1;
     if (s < 0) {
         /* mirror along p: w = 1 - (cell coordinate) */
@@ -129,22 +139,29 @@ static void make_quad(const ctx *c, int32_t i, int32_t j, const posts4 *q, quad 
     } else {
         L = (int64_t)kp * ONE16;
     }
-    a = g10 - g00;
-    b = g01 - g00;
-    cc = g11 - g10 - g01 + g00;
+    F->a = g10 - g00;
+    F->b = g01 - g00;
+    F->cc = g11 - g10 - g01 + g00;
+    F->g00 = g00;
     Q->d = ct_abs64(Dp);
-    Q->dps = s * (L - op); /* |L - o_p| < 2^31 */
-    /* d*(o_q - k_q 2^16): 2^26 * 2^31; s*(L - o_p)*D_q: 2^31 * 2^26 */
-    V0 = Q->d * (oq - kq * ONE16) + Q->dps * Dq;
+    Q->dps = s * (L - op);
+    F->V0 = Q->d * (oq - kq * ONE16) + Q->dps * F->Dq;
+}
+
+static void make_quad(const ctx *c, int32_t i, int32_t j, const posts4 *q, quad *Q)
+{
+    qframe F;
+    int64_t Z0;
+    quad_frame(c, i, j, q->h00, q->h10, q->h01, q->h11, Q, &F);
     /* Z0 = d * 2^16 * (z(L) - g00) with z(L) in LSB: the bracket is d times
      * z(L) - g00 in prepared z units (d*(o_z - g00*zone): 2^26 * 2^33;
      * s*(L - o_p)*D_z: 2^31 * 2^26), times 2^k it is d * (z_q16(L) -
      * g00 2^16) < 2^59 + 2^58 (the header's argument: L is the cell's
      * entry line, within one cell of tin). */
-    Z0 = (int64_t)c->zmul * (Q->d * (c->r->oz - zh(c, (uint32_t)g00)) + Q->dps * (int64_t)c->r->dz);
-    Q->C = Z0 - b * V0;
-    Q->B = ONE16 * (c->dzf - a * Q->d - b * Dq) - cc * V0;
-    Q->A = -cc * ONE16 * Dq;
+    Z0 = (int64_t)c->zmul * (Q->d * (c->r->oz - zh(c, (uint32_t)F.g00)) + Q->dps * (int64_t)c->r->dz);
+    Q->C = Z0 - F.b * F.V0;
+    Q->B = ONE16 * (c->dzf - F.a * Q->d - F.b * F.Dq) - F.cc * F.V0;
+    Q->A = -F.cc * ONE16 * F.Dq;
 }
 
 /* w at parameter t as pn / pd (pd > 0): d*t - dps over 2^16:
@@ -324,58 +341,18 @@ typedef struct {
 
 static void make_quad_low(const ctx *c, int32_t i, int32_t j, const lposts *L, wquad *W)
 {
-    int64_t op, oq, Dp, Dq, kq, Lp, g00, g10, g01, g11, a, b, cc, V0, Z0, s;
-    int32_t kp;
+    qframe F;
+    int64_t Z0;
     quad *Q = &W->q;
-    Q->p = (c->adx >= c->ady) ? 0 : 1;
-    if (Q->p == 0) {
-        op = c->r->ox;
-        oq = c->r->oy;
-        Dp = c->r->dx;
-        Dq = c->r->dy;
-        kp = i;
-        kq = j;
-        g00 = L->g00;
-        g10 = L->g10;
-        g01 = L->g01;
-        g11 = L->g11;
-    } else {
-        op = c->r->oy;
-        oq = c->r->ox;
-        Dp = c->r->dy;
-        Dq = c->r->dx;
-        kp = j;
-        kq = i;
-        g00 = L->g00;
-        g10 = L->g01;
-        g01 = L->g10;
-        g11 = L->g11;
-    }
-    s = Dp > 0 ? 1 : -1;
-    if (s < 0) {
-        int64_t t0 = g00, t1 = g01;
-        g00 = g10;
-        g01 = g11;
-        g10 = t0;
-        g11 = t1;
-        Lp = ((int64_t)kp + 1) * ONE16;
-    } else {
-        Lp = (int64_t)kp * ONE16;
-    }
-    a = g10 - g00;
-    b = g01 - g00;
-    cc = g11 - g10 - g01 + g00;
-    Q->d = ct_abs64(Dp);
-    Q->dps = s * (Lp - op);
-    V0 = Q->d * (oq - kq * ONE16) + Q->dps * Dq;
+    quad_frame(c, i, j, L->g00, L->g10, L->g01, L->g11, Q, &F);
     /* d z_q16(L) (< 2^59 + 2^58, the header's argument) - d g00 (< 2^59) */
-    Z0 = (int64_t)c->zmul * (Q->d * c->r->oz + Q->dps * (int64_t)c->r->dz) - Q->d * g00;
-    W->C = ct_i128_sub(ct_i128_shl(ct_i128_from64(Z0), 16), ct_i128_mul(b, V0));
+    Z0 = (int64_t)c->zmul * (Q->d * c->r->oz + Q->dps * (int64_t)c->r->dz) - Q->d * F.g00;
+    W->C = ct_i128_sub(ct_i128_shl(ct_i128_from64(Z0), 16), ct_i128_mul(F.b, F.V0));
     /* a d, b D_q < 2^60 each */
     W->B = ct_i128_sub(ct_i128_sub(ct_i128_shl(ct_i128_from64(c->dzf), 32),
-                                   ct_i128_shl(ct_i128_from64(a * Q->d + b * Dq), 16)),
-                       ct_i128_mul(cc, V0));
-    W->A = ct_i128_neg(ct_i128_shl(ct_i128_mul(cc, Dq), 16)); /* cc D_q < 2^61 */
+                                   ct_i128_shl(ct_i128_from64(F.a * Q->d + F.b * F.Dq), 16)),
+                       ct_i128_mul(F.cc, F.V0));
+    W->A = ct_i128_neg(ct_i128_shl(ct_i128_mul(F.cc, F.Dq), 16)); /* cc D_q < 2^61 */
 }
 
 /* Unsigned 128 x 128 -> 256-bit product (a, b < 2^127), limbs low first. */
