@@ -328,6 +328,96 @@ void test_seams()
     TEST_ASSERT(st.by_tiles[0] > 0 && st.by_tiles[1] > 0 && st.by_tiles[3] + st.by_tiles[4] > 0);
 }
 
+// Rays that touch the surface exactly on a seam (f = 0 at the seam point,
+// above the surface everywhere before it).  Every method, over the set,
+// reports the merged package's hit, and that hit is the touch point itself
+// (exact: the ray's point at t = 1 is a lattice point of Q16, at code 50).
+// The touch is found by the tile the ray leaves: its last cell's test
+// includes the exit face, a cone jump or a mipmap skip ends strictly above
+// the surface, and a tile passed over is one the ray stays strictly above
+// -- which is why seam_start's own sign test never decides a hit (listed
+// as defensive in tests/coverage_exceptions.txt).
+//  - terrain 0: flat at code 50; rays descending one code over 8 cells from
+//    code 51 reach it on the seam line x = 10 or y = 10, from either side,
+//    along x, along y, obliquely, and diagonally through the tile corner;
+//  - terrain 1: code 10, except code 50 for x >= 10 or y >= 10 (a step up
+//    exactly on the seams), the same rays;
+//  - terrain 2: code 10, except the seam line x = 10 and the post row y = 5
+//    at code 50; a horizontal ray at code 50 along y = 5.5 meets the
+//    surface at one point only, (10, 5.5) on the seam, from either side.
+void test_seam_touch()
+{
+    const int W = 21;
+    const int64_t C = 65536;
+    // (start x, start y, dx, dy): 8 cells of run to the seam point at t = 1
+    const int64_t rays[][4] = {
+        {2 * C, 5 * C + C / 2, 1 << 19, 0},        // along x, west to east onto x = 10
+        {5 * C + C / 3, 2 * C, 0, 1 << 19},        // along y, south to north onto y = 10
+        {2 * C, 2 * C, 1 << 19, 1 << 19},          // diagonal onto the tile corner (10, 10)
+        {18 * C, 5 * C + C / 2, -(1 << 19), 0},    // east to west onto x = 10
+        {2 * C, 7 * C + C / 4, 1 << 19, 3 << 16},  // oblique onto x = 10, across y = 10 before it
+    };
+    long touches = 0;
+    for (int terrain = 0; terrain < 3; ++terrain) {
+        std::vector<uint16_t> codes((size_t)W * W);
+        for (int j = 0; j < W; ++j)
+            for (int i = 0; i < W; ++i) {
+                const bool high = terrain == 0   ? true
+                                  : terrain == 1 ? (i >= 10 || j >= 10)
+                                                 : (i == 10 || j == 5);
+                codes[(size_t)j * W + (size_t)i] = (uint16_t)(high ? 50 : 10);
+            }
+        const ct_host::Terrain t = dem_cases::make_terrain(W, W, codes);
+        for (int sectors : {1, 8, 24}) {
+            ct_host::BuildOptions o;
+            o.sectors = sectors;
+            o.reduce = 1;
+            const std::vector<uint8_t> merged = ct_host::build_package(t, o);
+            const TileSetBytes tb = ct_host::build_tileset(t, o, 11, 0);
+            TEST_ASSERT(tb.grid.tiles_x == 2 && tb.grid.tiles_y == 2);
+            ct_package mp;
+            TEST_ASSERT_EQUAL_INT(CT_OK, ct_package_open(&mp, merged.data(), merged.size()));
+            Set set;
+            TEST_ASSERT_EQUAL_INT(CT_OK, set.open(tb, 4));
+            if (ct_harness_g.current_failed) return;
+            for (int k = 0; k < 5; ++k) {
+                const int64_t *rr = rays[k];
+                if (terrain == 2 && k != 0 && k != 3) continue;  // the others meet the row y = 5 first
+                ct_ray ray;
+                ray.x_q16 = rr[0];
+                ray.y_q16 = rr[1];
+                ray.z_q16 = (terrain == 2 ? 50 : 51) * C;
+                ray.dx = rr[2];
+                ray.dy = rr[3];
+                ray.dz = terrain == 2 ? 0 : -C;
+                const int64_t tx = rr[0] + rr[2], ty = rr[1] + rr[3];
+                TEST_ASSERT(tx == 10 * C || ty == 10 * C);
+                for (int m = 0; m < 4; ++m) {
+                    ct_hit hm, hs;
+                    const ct_status sm = ct_trace(&mp, &ray, (ct_method)m, &hm);
+                    const ct_status ss = ct_tileset_trace(&set.ts, &ray, (ct_method)m, &hs);
+                    TEST_ASSERT_MSG(sm == CT_HIT && ss == CT_HIT, "terrain %d N=%d ray %d method %d: merged %d, set %d",
+                                    terrain, sectors, k, m, sm, ss);
+                    TEST_ASSERT_MSG(same_hit(sm, hm, ss, hs),
+                                    "terrain %d N=%d ray %d method %d: set (%lld, %lld, %lld) cell %d,%d, merged "
+                                    "(%lld, %lld, %lld) cell %d,%d",
+                                    terrain, sectors, k, m, (long long)hs.x_q16, (long long)hs.y_q16,
+                                    (long long)hs.z_q16, hs.cell_x, hs.cell_y, (long long)hm.x_q16,
+                                    (long long)hm.y_q16, (long long)hm.z_q16, hm.cell_x, hm.cell_y);
+                    TEST_ASSERT_MSG(hs.x_q16 == tx && hs.y_q16 == ty && hs.z_q16 == 50 * C,
+                                    "terrain %d N=%d ray %d method %d: hit (%lld, %lld, %lld), the touch is (%lld, "
+                                    "%lld, %lld)",
+                                    terrain, sectors, k, m, (long long)hs.x_q16, (long long)hs.y_q16,
+                                    (long long)hs.z_q16, (long long)tx, (long long)ty, (long long)(50 * C));
+                    if (ct_harness_g.current_failed) return;
+                    touches++;
+                }
+            }
+        }
+    }
+    TEST_ASSERT(touches == (5 + 5 + 2) * 3 * 4);
+}
+
 // The same hits with 1, 2 and all slots, zero copy or not; loads counted.
 void test_cache_sizes()
 {
@@ -1144,6 +1234,7 @@ int main()
 {
     TEST_BEGIN("test_tiles");
     RUN_TEST(test_seams);
+    RUN_TEST(test_seam_touch);
     RUN_TEST(test_cache_sizes);
     RUN_TEST(test_skips_tiles_above);
     RUN_TEST(test_missing_and_corrupt);
