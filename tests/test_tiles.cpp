@@ -334,9 +334,9 @@ void test_seams()
 // (exact: the ray's point at t = 1 is a lattice point of Q16, at code 50).
 // The touch is found by the tile the ray leaves: its last cell's test
 // includes the exit face, a cone jump or a mipmap skip ends strictly above
-// the surface, and a tile passed over is one the ray stays strictly above
-// -- which is why seam_start's own sign test never decides a hit (listed
-// as defensive in tests/coverage_exceptions.txt).
+// the surface, and a tile passed over is one the ray stays strictly above;
+// the next tile's own sign test decides only where tiles disagree on their
+// seam posts (test_seam_disagree).
 //  - terrain 0: flat at code 50; rays descending one code over 8 cells from
 //    code 51 reach it on the seam line x = 10 or y = 10, from either side,
 //    along x, along y, obliquely, and diagonally through the tile corner;
@@ -416,6 +416,63 @@ void test_seam_touch()
         }
     }
     TEST_ASSERT(touches == (5 + 5 + 2) * 3 * 4);
+}
+
+// Tiles that disagree on their shared seam posts (a set assembled from two
+// builds, each tile vouched for by the manifest): tile (0, 0) has code 10
+// everywhere, its seam column included; tile (1, 0) has code 50 on that
+// column and beyond.  A horizontal ray at code 30 crosses tile (0, 0) above
+// its surface and meets tile (1, 0)'s surface on the seam itself, where its
+// own posts stand at 50 (f < 0 on the entry face): every method reports the
+// hit there, on the seam point, in tile (1, 0)'s first cell -- each tile's
+// terrain is its own, and the ray is first at or below one on the seam.
+void test_seam_disagree()
+{
+    const int W = 21;
+    const int64_t C = 65536;
+    std::vector<uint16_t> low((size_t)W * W, 10), high((size_t)W * W, 10);
+    for (int j = 0; j < W; ++j)
+        for (int i = 10; i < W; ++i) high[(size_t)j * W + (size_t)i] = 50;
+    const ct_host::Terrain ta = dem_cases::make_terrain(W, W, low), tb_ = dem_cases::make_terrain(W, W, high);
+    for (int sectors : {1, 8, 24}) {
+        ct_host::BuildOptions o;
+        o.sectors = sectors;
+        o.reduce = 1;
+        TileSetBytes tb = ct_host::build_tileset(ta, o, 11, 0);
+        TEST_ASSERT(tb.grid.tiles_x == 2 && tb.grid.tiles_y == 2);
+        tb.tiles[1] = ct_host::build_package(ct_host::tile_terrain(tb_, tb.grid, 1, 0), o);  // tile (1, 0)
+        tb.manifest = ct_host::make_manifest(tb_, tb.grid, o.reduce, o.sectors, tb.tiles);
+        Set set;
+        TEST_ASSERT_EQUAL_INT(CT_OK, set.open(tb, 4));
+        if (ct_harness_g.current_failed) return;
+        // along x from three starts, slightly north, two other lengths of
+        // direction, and steeply north (y dominant: the seam's parameter is
+        // no multiple of 2^-26)
+        for (int k = 0; k < 6; ++k) {
+            ct_ray ray;
+            ray.x_q16 = k == 5 ? 9 * C : 2 * C + (k % 3) * (C / 4);
+            ray.y_q16 = k == 5 ? C / 2 : 5 * C + C / 2 + k * 4099;
+            ray.z_q16 = 30 * C;
+            ray.dx = k == 3 ? 1 << 26 : k == 4 ? 3 << 24 : 1 << 19;
+            ray.dy = k == 2 ? 1 << 14 : k == 5 ? 1 << 20 : 0;
+            ray.dz = 0;
+            // where the ray is on the seam line x = 10 (exact: dx divides the run)
+            const int64_t run = 10 * C - ray.x_q16;
+            TEST_ASSERT(run * ray.dy % ray.dx == 0);
+            const int64_t sy = ray.y_q16 + run * ray.dy / ray.dx;
+            for (int m = 0; m < 4; ++m) {
+                ct_hit h;
+                const ct_status st = ct_tileset_trace(&set.ts, &ray, (ct_method)m, &h);
+                TEST_ASSERT_MSG(st == CT_HIT && h.x_q16 == 10 * C && h.y_q16 == sy && h.z_q16 == 30 * C &&
+                                    h.cell_x == 10 && h.cell_y == (int32_t)(sy >> 16),
+                                "N=%d ray %d method %d: status %d at (%lld, %lld, %lld) cell %d,%d; the seam point is "
+                                "(%lld, %lld, %lld)",
+                                sectors, k, m, st, (long long)h.x_q16, (long long)h.y_q16, (long long)h.z_q16,
+                                h.cell_x, h.cell_y, (long long)(10 * C), (long long)sy, (long long)(30 * C));
+                if (ct_harness_g.current_failed) return;
+            }
+        }
+    }
 }
 
 // The same hits with 1, 2 and all slots, zero copy or not; loads counted.
@@ -1235,6 +1292,7 @@ int main()
     TEST_BEGIN("test_tiles");
     RUN_TEST(test_seams);
     RUN_TEST(test_seam_touch);
+    RUN_TEST(test_seam_disagree);
     RUN_TEST(test_cache_sizes);
     RUN_TEST(test_skips_tiles_above);
     RUN_TEST(test_missing_and_corrupt);
