@@ -221,7 +221,11 @@ static int64_t root_t_q26(const ctx *c, const quad *Q, rt tin, rt tout)
     ct_i128 num;
     (void)c;
     if (ct_i128_sign(D) < 0) {
-        D = ct_i128_from64(0); /* cannot happen for a decided hit */
+        /* not for a decided hit on a builder's package (f(tin) > 0, f(exit)
+         * <= 0); a package whose angle codes were edited (CRC re-stamped)
+         * can let a cone walk pass terrain and decide a cell entered below
+         * it (tests/fuzz/corpus/pkg-angle-edit-*) */
+        D = ct_i128_from64(0);
     }
     sd = (int64_t)ct_i128_isqrt(D); /* < 2^61.5 */
     if (Q->B < 0) {
@@ -236,7 +240,7 @@ static int64_t root_t_q26(const ctx *c, const quad *Q, rt tin, rt tout)
         }
         w = ct_i128_floor_div_sat(nn, den);
     } else {
-        w = 0; /* f not decreasing: cannot happen for a decided hit */
+        w = 0; /* f not decreasing: as for D < 0 above */
     }
     /* clamp to the segment: w >= lo = ceil(w(tin) 2^60) and w <= hi =
      * floor(w(tout) 2^60), w(t) = pn / pd.  For an integer w, w < lo iff
