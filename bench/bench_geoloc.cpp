@@ -26,7 +26,10 @@
 //          --samples N, --scene NAME (only that one),
 //          --profile B (no table: B batches of the whole image with the
 //          scene's effects and the 8 px grid, directional, for perf or
-//          callgrind; prints ns per pixel of the best batch).
+//          callgrind; prints ns per pixel of the best batch),
+//          --effects scene|straight|true|fit (what --profile traces: the
+//          scene's effects, none, the true Earth exact or with the map
+//          fitted per batch; default scene).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -73,7 +76,7 @@ Run geolocate(const scene::World &w, const std::vector<int64_t> &uv, ct_method m
 int main(int argc, char **argv)
 {
     int stride = 1, samples = 2000, profile = 0;
-    std::string only;
+    std::string only, prof_fx = "scene";
     for (int k = 1; k < argc; ++k) {
         if (!std::strcmp(argv[k], "--quick")) {
             stride = 4;
@@ -84,8 +87,13 @@ int main(int argc, char **argv)
             only = argv[++k];
         } else if (!std::strcmp(argv[k], "--profile") && k + 1 < argc) {
             profile = std::max(1, std::atoi(argv[++k]));
+        } else if (!std::strcmp(argv[k], "--effects") && k + 1 < argc &&
+                   (!std::strcmp(argv[k + 1], "scene") || !std::strcmp(argv[k + 1], "straight") ||
+                    !std::strcmp(argv[k + 1], "true") || !std::strcmp(argv[k + 1], "fit"))) {
+            prof_fx = argv[++k];
         } else {
-            std::fprintf(stderr, "usage: ct_bench_geoloc [--quick] [--samples N] [--scene NAME] [--profile B]\n");
+            std::fprintf(stderr, "usage: ct_bench_geoloc [--quick] [--samples N] [--scene NAME] [--profile B] "
+                                 "[--effects scene|straight|true|fit]\n");
             return 2;
         }
     }
@@ -151,10 +159,28 @@ int main(int argc, char **argv)
         }
         std::vector<ct_geo> gg;
         if (profile > 0) {
+            const ct_effects *pf = prof_fx == "straight" ? nullptr
+                                   : prof_fx == "true"   ? &fx_true
+                                   : prof_fx == "fit"    ? &fx_fit
+                                                         : &fx;
+            if ((prof_fx == "true" || prof_fx == "fit") && !true_earth) {
+                std::printf("%s: no true Earth here (no curvature, or not a UTM package)\n", name);
+                delete w;
+                continue;
+            }
             double best = 1e30;
             for (int b = 0; b < profile; ++b)
-                best = std::min(best, geolocate(*w, uv, CT_METHOD_DIRECTIONAL, &fx, &gg, &grid_cam).ns);
-            std::printf("%s: whole image, 8 px grid, directional: %.0f ns per pixel (best of %d)\n", name, best, profile);
+                best = std::min(best, geolocate(*w, uv, CT_METHOD_DIRECTIONAL, pf, &gg, &grid_cam).ns);
+            // a digest of every result, to compare two builds' bits
+            uint64_t digest = 1469598103934665603u;
+            for (const ct_geo &g : gg) {
+                const int64_t v[6] = {(int64_t)g.status, g.hit.x_q16, g.hit.y_q16, g.hit.z_q16, g.hit.t_q26,
+                                      (int64_t)g.hit.steps};
+                for (int64_t x : v) digest = (digest ^ (uint64_t)x) * 1099511628211u;
+            }
+            std::printf("%s: whole image, 8 px grid, directional, effects %s: %.0f ns per pixel (best of %d), results "
+                        "digest %016llx\n",
+                        name, prof_fx.c_str(), best, profile, (unsigned long long)digest);
             delete w;
             continue;
         }
