@@ -582,6 +582,52 @@ void test_bent_edge_packages()
 
 }  // namespace
 
+// An exact tangency of a ray with the lowered surface (issue 19: the
+// lowered cell test's B^2 = 4AC to the last bit, and the root of the
+// coefficients root_low scales down).  One cell, posts 0 0 0 H (H at (1,
+// 1)), and horizontal rays along the anti-diagonal x + y = 1 from points
+// (a, 1 - a), a <= 31000 / 2^16 (H from 3 to 65535: coefficients that are
+// not powers of two): along it (x = 1/2 + s, y = 1/2 - s) the surface is
+// H (1/4 - s^2),
+// so the ray at z = H/4 touches it at the cell's centre and nowhere else
+// (f = H s^2, exact rational arithmetic).  The lowered walk (ct_lower_setup_k
+// with kf 2^-64 per squared Q16 cell: D = 0 at every post, the lowered posts
+// are the terrain's) must report that point (every method); the ray one Q16
+// unit higher misses (f >= 2^-16 > 0); one unit lower it crosses twice and
+// hits at the first root s = -sqrt(2^-16 / H) (within 2 Q16 units).
+void test_lowered_tangency()
+{
+    for (int H : {4, 64, 1024, 40000, 3, 777, 65535}) {
+      for (int64_t ox : {8192, 1, 5001, 12345, 30001, 31000}) {
+        ct_host::Terrain t = dem_cases::make_terrain(2, 2, {0, 0, 0, (uint16_t)H}, 0.01);
+        const dem_cases::Case cs = dem_cases::make_case("tangent", t, 8, 1);
+        ct_package p;
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_package_open(&p, cs.pkg.data(), cs.pkg.size()));
+        const int64_t oy = 65536 - ox, z = (int64_t)H * 16384;  // H/4 in Q16
+        ct_lower lw;
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_lower_setup_k(&p, ox, oy, 1u, 64u, 0, &lw));
+        for (int m = 0; m < CT_METHOD_COUNT; ++m) {
+            for (int dz = -1; dz <= 1; ++dz) {
+                const ct_ray ray = {ox, oy, z + dz, 1 << 20, -(1 << 20), 0};
+                ct_hit h;
+                const ct_status st = ct_trace_lowered(&p, &ray, &lw, (ct_method)m, &h);
+                if (dz > 0) {
+                    TEST_ASSERT_MSG(st == CT_MISS, "H %d method %d: 1 unit above the tangent: status %d", H, m, st);
+                    continue;
+                }
+                TEST_ASSERT_MSG(st == CT_HIT, "H %d ox %lld method %d dz %d: status %d", H, (long long)ox, m, dz, st);
+                const ld s = dz == 0 ? 0 : -std::sqrt(1.0L / 65536 / H);
+                const ld xe = (0.5L + s) * 65536, ye = (0.5L - s) * 65536;
+                TEST_ASSERT_MSG(std::fabs(h.x_q16 - xe) <= 2 && std::fabs(h.y_q16 - ye) <= 2 && h.cell_x == 0 &&
+                                    h.cell_y == 0,
+                                "H %d method %d dz %d: hit (%lld, %lld), exact (%.2Lf, %.2Lf)", H, m, dz,
+                                (long long)h.x_q16, (long long)h.y_q16, xe, ye);
+            }
+        }
+      }
+    }
+}
+
 int main()
 {
     TEST_BEGIN("test_bend");
@@ -591,5 +637,6 @@ int main()
     RUN_TEST(test_bent_chord_check_agrees);
     RUN_TEST(test_bent_vs_reference);
     RUN_TEST(test_bent_edge_packages);
+    RUN_TEST(test_lowered_tangency);
     return TEST_END();
 }

@@ -492,6 +492,210 @@ void test_project_vs_mrcal()
            worst, worst_rel);
 }
 
+// ---- the valid field's guards (issue 19: branches of camera.c) ------------
+
+// A lens from its intrinsics, fx = fy = 1000 px, centre (0, 0), exact Q48
+// distortion coefficients (dyadic values).
+struct GuardLens {
+    Model m;
+    ct_lens l;
+};
+
+GuardLens guard_lens(const char *name, const char *lens, std::vector<double> k)
+{
+    GuardLens g;
+    std::vector<double> in = {1000, 1000, 0, 0};
+    in.insert(in.end(), k.begin(), k.end());
+    g.m = {name, lens, in, 2000, 2000, false};
+    g.l = ct_host::lens_from_intrinsics(lens, in, 2000, 2000);
+    return g;
+}
+
+// The documented guards of the valid field (conetrace.h) in long double at
+// r2 = s: R = N/D in [2^-8, 2^8], D >= 2^-16, |R'| <= 2^20, and the slope
+// of r R, R + 2 s R', >= 2^-8.
+bool guards_ld(const Model &m, ld s, ld *R_out = nullptr, ld *D_out = nullptr)
+{
+    ld k[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+    for (size_t i = 4; i < m.in.size(); ++i) k[i - 4] = m.in[i];
+    const ld N = 1 + s * (k[0] + s * (k[1] + s * k[4])), Np = k[0] + s * (2 * k[1] + 3 * s * k[4]);
+    const ld D = 1 + s * (k[5] + s * (k[6] + s * k[7])), Dp = k[5] + s * (2 * k[6] + 3 * s * k[7]);
+    const ld R = N / D, Rp = (Np - R * Dp) / D;
+    if (R_out) *R_out = R;
+    if (D_out) *D_out = D;
+    const ld lo = 1.0L / 256;
+    return D >= 1.0L / 65536 && R >= lo && R <= 256 && std::fabs(Rp) <= 1048576.0L &&
+           R + 2 * s * Rp >= lo;
+}
+
+// The first radius where the guards fail, from 0 outwards (steps of 1e-5,
+// then bisection), long double.
+ld first_failure_ld(const Model &m, ld rmax)
+{
+    ld good = 0, bad = -1;
+    for (ld r = 1e-5L; r <= rmax; r += 1e-5L) {
+        if (!guards_ld(m, r * r)) {
+            bad = r;
+            break;
+        }
+        good = r;
+    }
+    if (bad < 0) return rmax;
+    for (int i = 0; i < 80; ++i) {
+        ld mid = (good + bad) / 2;
+        (guards_ld(m, mid * mid) ? good : bad) = mid;
+    }
+    return good;
+}
+
+int32_t q30(ld v) { return (int32_t)std::llroundl(v * 1073741824.0L); }
+
+// ct_camera_project of the ray (x, y, 1): the status, and for CT_OK in *err
+// its distance from mrcal_project's pixel in units of the bound
+// test_project_vs_mrcal uses: PROJECT_TOL_PX, or far out (beyond 4e4 px)
+// 5e-10 of the distance from the centre (*err <= 1: within the bound).
+ct_status project_vs_mrcal(const GuardLens &g, const ct_camera &cam, ld x, ld y, double *err)
+{
+    ld n = std::sqrt(x * x + y * y + 1);
+    int32_t q[3] = {q30(x / n), q30(y / n), q30(1 / n)};
+    int64_t u = 0, v = 0;
+    ct_status s = ct_camera_project(&cam, q, &u, &v);
+    if (s != CT_OK) return s;
+    mrcal_lensmodel_t lm = mrcal_model(g.m.lens);
+    mrcal_point3_t p = {{(double)q[0], (double)q[1], (double)q[2]}};
+    mrcal_point2_t mq;
+    mrcal_project(&mq, NULL, NULL, &p, 1, &lm, g.m.in.data());
+    const double e = std::hypot(u / 65536.0 - mq.x, v / 65536.0 - mq.y), dist = std::hypot(mq.x, mq.y);
+    *err = std::min(e / PROJECT_TOL_PX, e / (5e-10 * dist));
+    return CT_OK;
+}
+
+// Lenses whose radial factor N/D is already below 2^-8 at the valid-field
+// scan's first sample (r = 8/256, r^2 = 2^-10): k1 = -1024 makes N = 1 +
+// k1 r^2 exactly 0 there (ct_camera_init's scan stops on the R guard, for a
+// polynomial lens and, with a denominator, for a rational one), while the
+// lens is well behaved nearer the axis.  The valid field is then found by
+// bisection: it must end where the long-double model's guards first fail
+// (the slope 1 - 3 * 1024 r^2 reaching 2^-8, r = 0.018), rays inside
+// project as mrcal projects them, rays beyond are refused.
+void test_valid_field_first_sample()
+{
+    const GuardLens lenses[] = {
+        guard_lens("poly_k1_-1024", "LENSMODEL_OPENCV4", {-1024, 0, 0, 0}),
+        guard_lens("rational_k1_-1024", "LENSMODEL_OPENCV8", {-1024, 0, 0, 0, 0, 1, 0, 0}),
+    };
+    for (const GuardLens &g : lenses) {
+        ct_camera cam;
+        ld R;
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_camera_init(&cam, &g.l));
+        // the reference: the first sample fails on R (not on the slope)
+        TEST_ASSERT(!guards_ld(g.m, 1.0L / 1024, &R) && R < 1.0L / 256);
+        const ld rref = first_failure_ld(g.m, 8), rmax = std::sqrt((ld)cam.r2_max_q32 / 4294967296.0L);
+        TEST_ASSERT_MSG(rref > 0.015L && rref < 0.02L && std::fabs(rmax - rref) < 1e-7L,
+                        "%s: valid field r <= %.9Lf, the model's guards fail from %.9Lf", g.m.name, rmax, rref);
+        double worst = 0;
+        for (int k = 0; k < 16; ++k) {
+            const ld a = k * (ld)M_PI / 8, r = rref * (k % 2 ? 0.98L : 0.5L);
+            double e = 1e9;
+            TEST_ASSERT_EQUAL_INT(CT_OK, project_vs_mrcal(g, cam, r * std::cos(a), r * std::sin(a), &e));
+            TEST_ASSERT_MSG(e <= 1, "%s: %.3g x the bound from mrcal", g.m.name, e);
+            worst = std::max(worst, e);
+            TEST_ASSERT_EQUAL_INT(CT_ERR_UNPROJECT,
+                                  project_vs_mrcal(g, cam, 1.02L * rref * std::cos(a), 1.02L * rref * std::sin(a), &e));
+            TEST_ASSERT_EQUAL_INT(CT_ERR_UNPROJECT,
+                                  project_vs_mrcal(g, cam, std::cos(a) / 32, std::sin(a) / 32, &e));
+        }
+        std::printf("  %s: valid field r <= %.9Lf (model %.9Lf), projections within %.2g of the bound from mrcal\n", g.m.name,
+                    rmax, rref, worst);
+    }
+}
+
+// A hole in the valid field between the scan's samples: a rational lens
+// whose numerator and denominator share the double root r^2 = 1/2,
+// D = (1 - 2 r^2)^2, N = D (1 + r^2 / 8): R = 1 + r^2 / 8 wherever D != 0,
+// and every sample r = k/32 passes (the nearest, k = 22, 23, lie 17/1024
+// from the root), so ct_camera_init takes the whole r <= 8.  D < 2^-16
+// (the documented guard) only for |r^2 - 1/2| < 2^-9: rays there must be
+// refused (lens_forward re-checks the guards at every point); rays with
+// |r^2 - 1/2| >= 0.1 project as mrcal projects them (nearer the root the
+// Q32 quotient N/D loses 2^-32 / D relative: 2.7e-5 px at D = 0.006).
+void test_valid_field_hole()
+{
+    const GuardLens g = guard_lens("shared_root", "LENSMODEL_OPENCV8",
+                                   {-3.875, 3.5, 0, 0, 0.5, -4, 4, 0});
+    ct_camera cam;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_camera_init(&cam, &g.l));
+    TEST_ASSERT(cam.r2_max_q32 == (int64_t)64 << 32);
+    // the reference: the guards hold at every scan sample, and fail in the hole
+    for (int k = 1; k <= 256; ++k) TEST_ASSERT(guards_ld(g.m, (ld)k * k / 1024));
+    long refused = 0, projected = 0;
+    double worst = 0;
+    for (int k = 0; k < 400; ++k) {
+        const ld a = k * 0.0157L, s = 0.5L + (k % 2 ? 1 : -1) * std::ldexp(1.0L, -10 - (k / 2) % 12);
+        ld R, D;
+        TEST_ASSERT(!guards_ld(g.m, s, &R, &D) && D < 1.0L / 65536);
+        double e;
+        TEST_ASSERT_EQUAL_INT(CT_ERR_UNPROJECT,
+                              project_vs_mrcal(g, cam, std::sqrt(s) * std::cos(a), std::sqrt(s) * std::sin(a), &e));
+        refused++;
+        // off the hole, from r = 0.05 to 7.9
+        const ld r = 0.05L + 7.85L * k / 399;
+        if (std::fabs(r * r - 0.5L) < 0.1L) continue;
+        TEST_ASSERT(guards_ld(g.m, r * r));
+        e = 1e9;
+        TEST_ASSERT_EQUAL_INT(CT_OK, project_vs_mrcal(g, cam, r * std::cos(a), r * std::sin(a), &e));
+        TEST_ASSERT_MSG(e <= 1, "r %.4Lf: %.3g x the bound from mrcal", r, e);
+        worst = std::max(worst, e);
+        projected++;
+    }
+    std::printf("  hole at r^2 = 1/2: %ld rays in it refused, %ld others within %.2g of the bound from mrcal\n",
+                refused, projected, worst);
+}
+
+// Newton's full CT_UNPROJECT_MAX_ITERS steps: a pincushion lens (OPENCV4,
+// k1 = 2^-8) whose valid field is the whole r <= 8, and pixels imaged (by
+// mrcal_project) from points just beyond that edge, r = 8 + 2^-e (e = 14
+// .. 24; from 2^-12 out a step may land nearer and save one): each
+// Newton step overshoots the edge and is halved back into the field, so
+// the iterate halves its distance to the edge per step and the loop ends
+// by its count.  The documented answer is CT_ERR_UNPROJECT: the solution
+// lies outside the valid field, and the field's closest point, r = 8,
+// images 1.75 * 2^-e > 2^-26 (CT_UNPROJECT_TOL_Q32) away.  Pixels from
+// r = 8 - 2^-e inside unproject to mrcal's ray.
+void test_unproject_max_iters()
+{
+    const GuardLens g = guard_lens("pincushion_edge", "LENSMODEL_OPENCV4", {1.0 / 256, 0, 0, 0});
+    ct_camera cam;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_camera_init(&cam, &g.l));
+    TEST_ASSERT(cam.r2_max_q32 == (int64_t)64 << 32);
+    mrcal_lensmodel_t lm = mrcal_model(g.m.lens);
+    for (int e = 14; e <= 24; ++e) {
+        for (int side = -1; side <= 1; side += 2) {
+            const ld r = 8 + side * std::ldexp(1.0L, -e);
+            mrcal_point3_t p = {{(double)r, 0.0, 1.0}};
+            mrcal_point2_t q;
+            mrcal_project(&q, NULL, NULL, &p, 1, &lm, g.m.in.data());
+            const int64_t uq = std::llround(q.x * 65536), vq = std::llround(q.y * 65536);
+            int32_t ray[3];
+            uint32_t it = 0;
+            const ct_status s = ct_camera_unproject(&cam, uq, vq, ray, &it);
+            if (side > 0) {
+                TEST_ASSERT_MSG(s == CT_ERR_UNPROJECT && it == CT_UNPROJECT_MAX_ITERS,
+                                "r = 8 + 2^-%d: status %d after %u iterations", e, (int)s, it);
+            } else {
+                TEST_ASSERT_MSG(s == CT_OK, "r = 8 - 2^-%d: status %d", e, (int)s);
+                mrcal_point2_t qq = {{uq / 65536.0, vq / 65536.0}};
+                mrcal_point3_t mv;
+                mrcal_unproject(&mv, &qq, 1, &lm, g.m.in.data());
+                ld a[3], b[3] = {mv.x, mv.y, mv.z};
+                ray_ld(ray, a);
+                TEST_ASSERT_MSG(angle_between(a, b) < 2e-9L, "r = 8 - 2^-%d: %.3Lg rad from mrcal", e,
+                                angle_between(a, b));
+            }
+        }
+    }
+}
+
 // ---- unprojection grids ----------------------------------------------------
 
 // A splined stereographic lens (mrcal's richest model) with a smooth
@@ -862,6 +1066,9 @@ int main()
     RUN_TEST(test_lens_evil);
     RUN_TEST(test_tangential_fold);
     RUN_TEST(test_project_vs_mrcal);
+    RUN_TEST(test_valid_field_first_sample);
+    RUN_TEST(test_valid_field_hole);
+    RUN_TEST(test_unproject_max_iters);
     RUN_TEST(test_grid_accuracy_vs_step);
     RUN_TEST(test_grid_evil);
     RUN_TEST(test_rodrigues_vs_mrcal);
