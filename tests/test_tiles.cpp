@@ -971,6 +971,61 @@ void test_los()
 // the georeference) handed to what reads terrain: CT_ERR_ARG from each, not
 // a NULL dereference; the same calls on the merged package succeed.  And a
 // set that is not ready (never opened, or its open failed): CT_ERR_ARG.
+// The polyline over a set where its vertices saturate (test_bend's
+// test_bent_saturated_vertices: 1 nm height codes, a sphere of 2^40 nm,
+// c = -4 and 4, a chord of 2^46 nm, one segment of ~400 cells over the
+// 30 x 30 cells): over the set (tiles of 11 posts) every method's result is
+// the merged package's bit for bit -- hits from over the terrain (c = -4),
+// CT_BELOW from beside the tile (the first segment enters the west face
+// over 2^46 Q16 under the terrain: decided at its preparation), misses
+// (c = 4).  Before, the set's segment trace returned that CT_BELOW with
+// no end (td 0) and the polyline took it for a segment off the box: a
+// miss where the merged package says CT_BELOW.
+void test_bent_saturated()
+{
+    const ct_host::Terrain t =
+        dem_cases::make_terrain(31, 31, dem_cases::smooth(31, 31, 7, 100, 3000), 1e-9);
+    ct_host::BuildOptions o;
+    o.sectors = 8;
+    o.reduce = 1;
+    const TileSetBytes tb = ct_host::build_tileset(t, o, 11, 0);
+    const std::vector<uint8_t> merged = ct_host::build_package(t, o);
+    ct_package mp;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_package_open(&mp, merged.data(), merged.size()));
+    TEST_ASSERT(mp.height_scale_nm == 1);
+    Set set;
+    TEST_ASSERT_EQUAL_INT(CT_OK, set.open(tb, 2));
+    long hits = 0, below = 0, miss = 0;
+    for (int32_t c : {-4 * 65536, 4 * 65536}) {
+        const ct_bend bd = {c, INT64_C(1) << 40, INT64_C(1) << 46, 0u};
+        for (int k = 0; k < 8; ++k) {
+            const double az = 0.3 + 0.7 * k, y = 4.0 + 3.0 * k;
+            const double x = k % 2 == 0 ? 3.0 + 2.5 * k : -0.125;
+            double dv[3];
+            dem_cases::metric_dir(t, k % 2 == 0 ? az : 0.2 * (k - 4), -1e-7 * k, dv);
+            const ct_ray ray = dem_cases::to_ray(x, y, dem_cases::surf(t, std::max(0.0, x), y) + 50, dv);
+            ct_bent_setup bs, bm;
+            TEST_ASSERT_EQUAL_INT(CT_OK, ct_bent_prepare(&set.ts.frame, &bd, ray.x_q16, ray.y_q16, &bs));
+            TEST_ASSERT_EQUAL_INT(CT_OK, ct_bent_prepare(&mp, &bd, ray.x_q16, ray.y_q16, &bm));
+            TEST_ASSERT(!bs.lowered && !bm.lowered);
+            for (int m = 0; m < 4; ++m) {
+                ct_hit hm, hs;
+                const ct_status sm = ct_trace_bent_set(&mp, &ray, &bm, (ct_method)m, &hm);
+                const ct_status ss = ct_trace_bent_set_ts(&set.ts.frame, &set.ts, &ray, &bs, (ct_method)m, &hs);
+                TEST_ASSERT_MSG(same_hit(sm, hm, ss, hs), "c %d ray %d method %d: set %d, merged %d", (int)c, k, m,
+                                (int)ss, (int)sm);
+                if (m == 0) {
+                    hits += sm == CT_HIT;
+                    below += sm == CT_BELOW;
+                    miss += sm == CT_MISS;
+                }
+            }
+        }
+    }
+    std::printf("  saturated polyline: %ld hit, %ld below, %ld miss, as merged\n", hits, below, miss);
+    TEST_ASSERT(hits == 4 && below == 4 && miss == 8);
+}
+
 void test_frame_refused()
 {
     const ct_host::Terrain t = dem_cases::mirror_tiled(dem_cases::real_terrain(), 200, 200);
@@ -1151,6 +1206,7 @@ int main()
     RUN_TEST(test_voids);
     RUN_TEST(test_geolocation);
     RUN_TEST(test_los);
+    RUN_TEST(test_bent_saturated);
     RUN_TEST(test_frame_refused);
     RUN_TEST(test_streamed_build);
     return TEST_END();
