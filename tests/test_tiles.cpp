@@ -1026,6 +1026,49 @@ void test_bent_saturated()
     TEST_ASSERT(hits == 4 && below == 4 && miss == 8);
 }
 
+// Polyline segments starting just under the surface after the polyline
+// entered (test_bend's test_bent_start_below_after_entered: 1 mm codes on
+// 30 m posts, c = -4, R = 2^40 nm, a chord of 0.1 mm; its rays): over a set
+// of 13-post tiles the set's segment trace takes that start as the hit
+// (below_hit), and every method's result is the merged package's bit for
+// bit.
+void test_bent_start_below_after_entered()
+{
+    const ct_host::Terrain t = dem_cases::make_terrain(40, 40, dem_cases::smooth(40, 40, 5, 1000, 30000), 0.001);
+    ct_host::BuildOptions o;
+    o.sectors = 8;
+    o.reduce = 1;
+    const TileSetBytes tb = ct_host::build_tileset(t, o, 13, 0);
+    const std::vector<uint8_t> merged = ct_host::build_package(t, o);
+    ct_package mp;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_package_open(&mp, merged.data(), merged.size()));
+    Set set;
+    TEST_ASSERT_EQUAL_INT(CT_OK, set.open(tb, 2));
+    const ct_ray rays[] = {
+        {1463966, 1863104, 824113802, -11723337624, -8935396427, -1099511627776},
+        {1094272, 1384564, 487285953, -2179200295, -1912324554, -1099511627776},
+        {895832, 844974, 639287769, -1769281208, 4330961408, -1099511627776},
+        {1032338, 2035326, 661998285, 10652333117, 8898833412, -1099511627776},
+        {524396, 1695986, 818069374, 3617659896, -126108301, -1099511627776},
+    };
+    const ct_bend bd = {-4 * 65536, INT64_C(1) << 40, 100000, 0u};
+    long hits = 0;
+    for (const ct_ray &ray : rays) {
+        ct_bent_setup bs, bm;
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_bent_prepare(&set.ts.frame, &bd, ray.x_q16, ray.y_q16, &bs));
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_bent_prepare(&mp, &bd, ray.x_q16, ray.y_q16, &bm));
+        for (int m = 0; m < 4; ++m) {
+            ct_hit hm, hs;
+            const ct_status sm = ct_trace_bent_set(&mp, &ray, &bm, (ct_method)m, &hm);
+            const ct_status ss = ct_trace_bent_set_ts(&set.ts.frame, &set.ts, &ray, &bs, (ct_method)m, &hs);
+            TEST_ASSERT_MSG(same_hit(sm, hm, ss, hs), "ray %lld method %d: set %d, merged %d", (long long)ray.x_q16, m,
+                            (int)ss, (int)sm);
+            hits += m == 0 && sm == CT_HIT;
+        }
+    }
+    TEST_ASSERT(hits == 5);
+}
+
 void test_frame_refused()
 {
     const ct_host::Terrain t = dem_cases::mirror_tiled(dem_cases::real_terrain(), 200, 200);
@@ -1207,6 +1250,7 @@ int main()
     RUN_TEST(test_geolocation);
     RUN_TEST(test_los);
     RUN_TEST(test_bent_saturated);
+    RUN_TEST(test_bent_start_below_after_entered);
     RUN_TEST(test_frame_refused);
     RUN_TEST(test_streamed_build);
     return TEST_END();
