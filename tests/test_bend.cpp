@@ -314,10 +314,12 @@ void test_bent_polyline_edges()
         TEST_ASSERT_MSG(sb == r.want && ss == r.want, "%s: bent %d, straight %d, expected %d", r.name, sb, ss, r.want);
         if (sb == CT_HIT) TEST_ASSERT(hb.x_q16 == hs.x_q16 && hb.y_q16 == hs.y_q16 && hb.z_q16 == hs.z_q16);
     }
-    // an observer 4,600 km west of the tile (beyond RHO_MAX, 2^52 nm), and
-    // one 2^45.5 Q16 cells west (its range times the posting passes 2^80):
-    // CT_ERR_RANGE, "the observer beyond 2^52 nm of the tile"
-    for (int64_t x0 : {-(INT64_C(153333) << 16), -(INT64_C(46000000000000))}) {
+    // an observer 4,600 km west of the tile (beyond RHO_MAX, 2^52 nm), one
+    // 2^45.5 Q16 cells west (its range times the posting passes 2^80) and
+    // one 3e13 Q16 cells west (range times posting in [2^79, 2^80): the
+    // range in nm passes 2^63): CT_ERR_RANGE, "the observer beyond 2^52 nm
+    // of the tile"
+    for (int64_t x0 : {-(INT64_C(153333) << 16), -(INT64_C(46000000000000)), -(INT64_C(30000000000000))}) {
         const ct_ray far = {x0, H / 2, top, 1 << 20, 0, 0};
         ct_hit hf;
         TEST_ASSERT_EQUAL_INT(CT_ERR_RANGE, ct_trace_bent(&p, &far, &up, CT_METHOD_DIRECTIONAL, &hf));
@@ -580,6 +582,107 @@ void test_bent_edge_packages()
     }
 }
 
+// Vertices beyond +-2^62 Q16: 30 m posts with 1 nm height codes (the
+// terrain 3 um tall) on a sphere of 2^40 nm bent with c = -4 and c = 4, and
+// a chord of 2^46 nm: the drop at the first vertex after the observer is
+// 4 chord / scale = 2^48 LSB (2^64 Q16), so it is kept at +-2^62 (vertex's
+// saturation) and the first segment, from an observer over the terrain,
+// descends (c = -4) by more than 2^62 -- ct_ray_prepare_segment's limit.
+// The polyline must still be traced (the documented statuses, never an
+// error for a ray and a bend in their ranges), and judged by the
+// reference's sandwich (its tolerance, chord / scale, is 2^46 LSB) --
+// observers over the tile and beside it, above the terrain and (c = 4)
+// under its floor.
+void test_bent_saturated_vertices()
+{
+    const dem_cases::Case cs =
+        dem_cases::make_case("1 nm codes", dem_cases::make_terrain(31, 31, dem_cases::smooth(31, 31, 7, 100, 3000), 1e-9), 8, 1);
+    ct_package p;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_package_open(&p, cs.pkg.data(), cs.pkg.size()));
+    TEST_ASSERT(p.height_scale_nm == 1);
+    const ref::Dem d = dem_cases::ref_dem(cs.t);
+    const ld slope = max_slope(d);
+    const ld chord_nm = std::ldexp(1.0L, 46), R_nm = std::ldexp(1.0L, 40);
+    for (double c : {-4.0, 4.0}) {
+        const Scene sc = {c < 0 ? "c = -4, 2^62 Q16 drops" : "c = 4, 2^62 Q16 rises", c, (double)(R_nm * 1e-9L),
+                          (double)(chord_nm * 1e-9L)};
+        // the first vertex's bend is beyond 2^62 Q16 (saturated)
+        {
+            const ct_bend bd = {(int32_t)std::lround(c * 65536), INT64_C(1) << 40, INT64_C(1) << 46, 0u};
+            int64_t delta = 0;
+            TEST_ASSERT_EQUAL_INT(CT_OK, ct_bend_segment(&p, &bd, &delta));
+            const ld rho = (ld)delta * (ld)p.posting_e_nm / 65536;  // nm
+            TEST_ASSERT(std::fabs(c) * rho * rho / (2 * R_nm) * 65536 > std::ldexp(1.0L, 62));
+        }
+        Counts cnt;
+        long n = 0;
+        for (int k = 0; k < 8; ++k) {
+            // over the tile (k even) or 1/8 cell beside its west edge (odd),
+            // 50 LSB over the terrain there, aimed along az, level or down
+            const double az = 0.3 + 0.7 * k, y = 4.0 + 3.0 * k;
+            const double x = k % 2 == 0 ? 3.0 + 2.5 * k : -0.125;
+            const double zs = dem_cases::surf(cs.t, std::max(0.0, x), y);
+            double dv[3];
+            dem_cases::metric_dir(cs.t, k % 2 == 0 ? az : 0.2 * (k - 4), -1e-7 * k, dv);
+            judge_ray(p, d, slope, cs, sc, dem_cases::to_ray(x, y, zs + 50, dv), n++, &cnt);
+            if (c > 0) {
+                // from under the tile's floor, beside it, rising: the curve
+                // enters the tile below the surface or above the box
+                const ct_ray under = {-(1 << 13), (int64_t)(4 + 3 * k) << 16, -(INT64_C(200) << 16), 1 << 20, k << 16,
+                                      (int64_t)k << 10};
+                judge_ray(p, d, slope, cs, sc, under, n++, &cnt);
+            }
+        }
+        printf("  %-20s %-28s %ld rays (%ld polyline): %ld hit, %ld miss, %ld below; bad %ld\n", cs.name.c_str(),
+               sc.name, cnt.rays, cnt.polyline, cnt.hits, cnt.miss, cnt.below, cnt.bad);
+        TEST_ASSERT(cnt.bad == 0 && cnt.polyline == cnt.rays);
+        // c = -4: from over the tile the curve falls onto the terrain at
+        // once (25 mm in 1/8 cell); from beside it, it enters the tile
+        // that far under the 3 um terrain: BELOW
+        if (c < 0) TEST_ASSERT(cnt.hits == 4 && cnt.below == 4);
+    }
+}
+
+// Polyline segments starting just under the surface after the polyline
+// entered the tile: 30 m posts, 1 mm height codes (prepared z units up to
+// 2^14 Q16), refraction c = -4 on a sphere of 2^40 nm with a chord of
+// 0.1 mm (segments of 0.06 cells).  A segment's prepared ray starts at its
+// vertex rounded to its z unit, so where a vertex lies below the surface by
+// less than that rounding, the previous segment may end above it: the
+// next segment starts under the surface, and that is the polyline's hit
+// (the surface crossed within the vertex rounding), not CT_BELOW.  Rays
+// found by a search (steep in Q16: 600 LSB per cell), judged as every
+// other: the four methods, culling, the reference's sandwich.
+const ct_ray kBelowAfterEntered[] = {
+    {1463966, 1863104, 824113802, -11723337624, -8935396427, -1099511627776},
+    {1094272, 1384564, 487285953, -2179200295, -1912324554, -1099511627776},
+    {895832, 844974, 639287769, -1769281208, 4330961408, -1099511627776},
+    {1032338, 2035326, 661998285, 10652333117, 8898833412, -1099511627776},
+    {524396, 1695986, 818069374, 3617659896, -126108301, -1099511627776},
+};
+
+dem_cases::Case below_after_entered_case()
+{
+    return dem_cases::make_case("1 mm codes", dem_cases::make_terrain(40, 40, dem_cases::smooth(40, 40, 5, 1000, 30000), 0.001),
+                                8, 1);
+}
+
+void test_bent_start_below_after_entered()
+{
+    const dem_cases::Case cs = below_after_entered_case();
+    ct_package p;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_package_open(&p, cs.pkg.data(), cs.pkg.size()));
+    TEST_ASSERT(p.zshift_max >= 12);
+    const ref::Dem d = dem_cases::ref_dem(cs.t);
+    const Scene sc = {"c = -4, R 2^40 nm, 0.1 mm", -4.0, (double)(INT64_C(1) << 40) * 1e-9, 1e-4};
+    Counts cnt;
+    long n = 0;
+    for (const ct_ray &ray : kBelowAfterEntered) judge_ray(p, d, max_slope(d), cs, sc, ray, n++, &cnt);
+    printf("  %-20s %-28s %ld rays: %ld hit, %ld miss, %ld below; bad %ld\n", cs.name.c_str(), sc.name, cnt.rays,
+           cnt.hits, cnt.miss, cnt.below, cnt.bad);
+    TEST_ASSERT(cnt.bad == 0 && cnt.polyline == cnt.rays && cnt.hits == cnt.rays);
+}
+
 }  // namespace
 
 // An exact tangency of a ray with the lowered surface (issue 19: the
@@ -638,5 +741,7 @@ int main()
     RUN_TEST(test_bent_vs_reference);
     RUN_TEST(test_bent_edge_packages);
     RUN_TEST(test_lowered_tangency);
+    RUN_TEST(test_bent_saturated_vertices);
+    RUN_TEST(test_bent_start_below_after_entered);
     return TEST_END();
 }

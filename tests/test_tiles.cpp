@@ -1118,6 +1118,104 @@ void test_los()
 // the georeference) handed to what reads terrain: CT_ERR_ARG from each, not
 // a NULL dereference; the same calls on the merged package succeed.  And a
 // set that is not ready (never opened, or its open failed): CT_ERR_ARG.
+// The polyline over a set where its vertices saturate (test_bend's
+// test_bent_saturated_vertices: 1 nm height codes, a sphere of 2^40 nm,
+// c = -4 and 4, a chord of 2^46 nm, one segment of ~400 cells over the
+// 30 x 30 cells): over the set (tiles of 11 posts) every method's result is
+// the merged package's bit for bit -- hits from over the terrain (c = -4),
+// CT_BELOW from beside the tile (the first segment enters the west face
+// over 2^46 Q16 under the terrain: decided at its preparation), misses
+// (c = 4).  Before, the set's segment trace returned that CT_BELOW with
+// no end (td 0) and the polyline took it for a segment off the box: a
+// miss where the merged package says CT_BELOW.
+void test_bent_saturated()
+{
+    const ct_host::Terrain t =
+        dem_cases::make_terrain(31, 31, dem_cases::smooth(31, 31, 7, 100, 3000), 1e-9);
+    ct_host::BuildOptions o;
+    o.sectors = 8;
+    o.reduce = 1;
+    const TileSetBytes tb = ct_host::build_tileset(t, o, 11, 0);
+    const std::vector<uint8_t> merged = ct_host::build_package(t, o);
+    ct_package mp;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_package_open(&mp, merged.data(), merged.size()));
+    TEST_ASSERT(mp.height_scale_nm == 1);
+    Set set;
+    TEST_ASSERT_EQUAL_INT(CT_OK, set.open(tb, 2));
+    long hits = 0, below = 0, miss = 0;
+    for (int32_t c : {-4 * 65536, 4 * 65536}) {
+        const ct_bend bd = {c, INT64_C(1) << 40, INT64_C(1) << 46, 0u};
+        for (int k = 0; k < 8; ++k) {
+            const double az = 0.3 + 0.7 * k, y = 4.0 + 3.0 * k;
+            const double x = k % 2 == 0 ? 3.0 + 2.5 * k : -0.125;
+            double dv[3];
+            dem_cases::metric_dir(t, k % 2 == 0 ? az : 0.2 * (k - 4), -1e-7 * k, dv);
+            const ct_ray ray = dem_cases::to_ray(x, y, dem_cases::surf(t, std::max(0.0, x), y) + 50, dv);
+            ct_bent_setup bs, bm;
+            TEST_ASSERT_EQUAL_INT(CT_OK, ct_bent_prepare(&set.ts.frame, &bd, ray.x_q16, ray.y_q16, &bs));
+            TEST_ASSERT_EQUAL_INT(CT_OK, ct_bent_prepare(&mp, &bd, ray.x_q16, ray.y_q16, &bm));
+            TEST_ASSERT(!bs.lowered && !bm.lowered);
+            for (int m = 0; m < 4; ++m) {
+                ct_hit hm, hs;
+                const ct_status sm = ct_trace_bent_set(&mp, &ray, &bm, (ct_method)m, &hm);
+                const ct_status ss = ct_trace_bent_set_ts(&set.ts.frame, &set.ts, &ray, &bs, (ct_method)m, &hs);
+                TEST_ASSERT_MSG(same_hit(sm, hm, ss, hs), "c %d ray %d method %d: set %d, merged %d", (int)c, k, m,
+                                (int)ss, (int)sm);
+                if (m == 0) {
+                    hits += sm == CT_HIT;
+                    below += sm == CT_BELOW;
+                    miss += sm == CT_MISS;
+                }
+            }
+        }
+    }
+    std::printf("  saturated polyline: %ld hit, %ld below, %ld miss, as merged\n", hits, below, miss);
+    TEST_ASSERT(hits == 4 && below == 4 && miss == 8);
+}
+
+// Polyline segments starting just under the surface after the polyline
+// entered (test_bend's test_bent_start_below_after_entered: 1 mm codes on
+// 30 m posts, c = -4, R = 2^40 nm, a chord of 0.1 mm; its rays): over a set
+// of 13-post tiles the set's segment trace takes that start as the hit
+// (below_hit), and every method's result is the merged package's bit for
+// bit.
+void test_bent_start_below_after_entered()
+{
+    const ct_host::Terrain t = dem_cases::make_terrain(40, 40, dem_cases::smooth(40, 40, 5, 1000, 30000), 0.001);
+    ct_host::BuildOptions o;
+    o.sectors = 8;
+    o.reduce = 1;
+    const TileSetBytes tb = ct_host::build_tileset(t, o, 13, 0);
+    const std::vector<uint8_t> merged = ct_host::build_package(t, o);
+    ct_package mp;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_package_open(&mp, merged.data(), merged.size()));
+    Set set;
+    TEST_ASSERT_EQUAL_INT(CT_OK, set.open(tb, 2));
+    const ct_ray rays[] = {
+        {1463966, 1863104, 824113802, -11723337624, -8935396427, -1099511627776},
+        {1094272, 1384564, 487285953, -2179200295, -1912324554, -1099511627776},
+        {895832, 844974, 639287769, -1769281208, 4330961408, -1099511627776},
+        {1032338, 2035326, 661998285, 10652333117, 8898833412, -1099511627776},
+        {524396, 1695986, 818069374, 3617659896, -126108301, -1099511627776},
+    };
+    const ct_bend bd = {-4 * 65536, INT64_C(1) << 40, 100000, 0u};
+    long hits = 0;
+    for (const ct_ray &ray : rays) {
+        ct_bent_setup bs, bm;
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_bent_prepare(&set.ts.frame, &bd, ray.x_q16, ray.y_q16, &bs));
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_bent_prepare(&mp, &bd, ray.x_q16, ray.y_q16, &bm));
+        for (int m = 0; m < 4; ++m) {
+            ct_hit hm, hs;
+            const ct_status sm = ct_trace_bent_set(&mp, &ray, &bm, (ct_method)m, &hm);
+            const ct_status ss = ct_trace_bent_set_ts(&set.ts.frame, &set.ts, &ray, &bs, (ct_method)m, &hs);
+            TEST_ASSERT_MSG(same_hit(sm, hm, ss, hs), "ray %lld method %d: set %d, merged %d", (long long)ray.x_q16, m,
+                            (int)ss, (int)sm);
+            hits += m == 0 && sm == CT_HIT;
+        }
+    }
+    TEST_ASSERT(hits == 5);
+}
+
 void test_frame_refused()
 {
     const ct_host::Terrain t = dem_cases::mirror_tiled(dem_cases::real_terrain(), 200, 200);
@@ -1300,6 +1398,8 @@ int main()
     RUN_TEST(test_voids);
     RUN_TEST(test_geolocation);
     RUN_TEST(test_los);
+    RUN_TEST(test_bent_saturated);
+    RUN_TEST(test_bent_start_below_after_entered);
     RUN_TEST(test_frame_refused);
     RUN_TEST(test_streamed_build);
     return TEST_END();

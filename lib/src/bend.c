@@ -541,8 +541,18 @@ static ct_status trace_segment(const ct_package *p, ct_tileset *ts, const ct_ray
     *oc = SEG_SKIP;
     if (ts != NULL) {
         st = ct_tileset_trace_segment(ts, seg, NULL, entered, m, sh, tn, td);
-        if (st >= 0 && (*td != 0 || st == CT_NO_DATA)) {
+        /* td 0: decided by the set's preparation, before any tile (tend
+         * unset): a segment off the box (CT_MISS), or one entering a side
+         * face over 2^46 under the terrain (CT_BELOW, as
+         * ct_ray_prepare_segment's below the box: before the polyline
+         * entered, the whole trace is CT_BELOW; once entered, every
+         * segment starts in the footprint, so it cannot enter a side
+         * face).  Every other outcome sets tend (td >= 1), CT_NO_DATA at
+         * the first point too; errors are returned as they come. */
+        if (*td != 0) {
             *oc = SEG_TRACED;
+        } else if (st == CT_BELOW) {
+            *oc = SEG_BELOW;
         }
         return st;
     }
@@ -660,10 +670,14 @@ CT_NOINLINE static ct_status trace_polyline(const ct_package *p, ct_tileset *ts,
             continue;
         }
         /* |va| <= 2^46 (just checked) and |vb| <= 2^62 + 2^46 (vertex's
-         * saturation): the differences fit in int64 */
+         * saturation): the differences fit in int64.  dz is kept within
+         * ct_ray's +-2^62: beyond it the end vertex lies over 2^62 - 2^46
+         * from the datum (saturated, or nearly), far outside every tile,
+         * and is moved towards the start vertically as vertex's saturation
+         * does (before, such a segment was refused, CT_ERR_RAY). */
         seg.dx = vb.x - va.x;
         seg.dy = vb.y - va.y;
-        seg.dz = vb.z - va.z;
+        seg.dz = ct_min64(ct_max64(vb.z - va.z, -(INT64_C(1) << 62)), INT64_C(1) << 62);
         va = vb;
         k = kn;
         if (seg.dx == 0 && seg.dy == 0 && seg.dz == 0) {
