@@ -274,7 +274,10 @@ static int64_t mul30(int64_t x, int64_t y)
  *   cf' (2^(sh - 1) per term) costs under 2 um at 141 km (fit_map). */
 static void fit_eval(const ct_earth_map *mp, const int64_t D[3], int64_t g[3])
 {
-    int64_t T[3][3], U[3][CT_EARTH_MAP_DEG + 1], gs[CT_EARTH_MAP_DEG + 1][3];
+    /* gs[o][k]: the degree-k sum of coordinate o (each coordinate's sums
+     * apart: adjacent ones invite x86's SLP vectoriser to emulate 64-bit
+     * products with 32-bit vector ones, 6x the instructions) */
+    int64_t T[3][3], U[3][CT_EARTH_MAP_DEG + 1], gs[3][CT_EARTH_MAP_DEG + 1];
     ct_i128 acc[3];
     int a, b, c, k, o, t = 0, deg = mp->deg;
     unsigned q = mp->qrho;
@@ -291,29 +294,39 @@ static void fit_eval(const ct_earth_map *mp, const int64_t D[3], int64_t g[3])
         acc[k] = ct_i128_from64(0);
     }
     for (k = 0; k <= deg; ++k) { /* bound: CT_EARTH_MAP_DEG + 1 */
-        gs[k][0] = gs[k][1] = gs[k][2] = 0;
+        gs[0][k] = gs[1][k] = gs[2][k] = 0;
     }
-    for (a = 0; a <= deg; ++a) {             /* bound: CT_EARTH_MAP_DEG + 1 */
-        for (b = 0; a + b <= deg; ++b) {     /* bound: CT_EARTH_MAP_DEG + 1 */
-            for (c = 0; a + b + c <= deg; ++c) { /* bound: CT_EARTH_MAP_DEG + 1 */
-                if (a + b + c <= 2) {
-                    int64_t ttt = mul62(mul62(T[0][a], T[1][b]), T[2][c]);
-                    for (o = 0; o < 3; ++o) { /* bound: 3 coordinates */
-                        acc[o] = ct_i128_add(acc[o], ct_i128_mul(mp->cf[t][o], ttt));
-                    }
-                } else {
-                    int64_t ttt = mul30(mul30(U[0][a], U[1][b]), U[2][c]);
-                    for (o = 0; o < 3; ++o) { /* bound: 3 coordinates */
-                        gs[a + b + c][o] += mp->cf[t][o] * ttt;
-                    }
+    /* the terms in the stored order (a, then b, then c); T_a T_b and U_a
+     * U_b formed once per (a, b), the degree <= 2 terms (c <= 2 - a - b)
+     * before the others */
+    for (a = 0; a <= deg; ++a) {         /* bound: CT_EARTH_MAP_DEG + 1 */
+        for (b = 0; a + b <= deg; ++b) { /* bound: CT_EARTH_MAP_DEG + 1 */
+            const int64_t *cf = mp->cf[t];
+            int64_t uab = mul30(U[0][a], U[1][b]);
+            c = 0;
+            if (a + b <= 2) {
+                int64_t tab = mul62(T[0][a], T[1][b]);
+                for (; a + b + c <= 2; ++c) { /* bound: 3 */
+                    int64_t ttt = mul62(tab, T[2][c]);
+                    acc[0] = ct_i128_add(acc[0], ct_i128_mul(cf[0], ttt));
+                    acc[1] = ct_i128_add(acc[1], ct_i128_mul(cf[1], ttt));
+                    acc[2] = ct_i128_add(acc[2], ct_i128_mul(cf[2], ttt));
+                    cf += 3;
                 }
-                t++;
             }
+            for (; a + b + c <= deg; ++c) { /* bound: CT_EARTH_MAP_DEG + 1 */
+                int64_t ttt = mul30(uab, U[2][c]);
+                gs[0][a + b + c] += cf[0] * ttt;
+                gs[1][a + b + c] += cf[1] * ttt;
+                gs[2][a + b + c] += cf[2] * ttt;
+                cf += 3;
+            }
+            t += deg + 1 - a - b;
         }
     }
     for (o = 0; o < 3; ++o) { /* bound: 3 coordinates */
         for (k = 3; k <= deg; ++k) { /* bound: CT_EARTH_MAP_DEG - 2 */
-            acc[o] = ct_i128_add(acc[o], ct_i128_shl(ct_i128_from64(gs[k][o]), 32u + mp->sh[k][o]));
+            acc[o] = ct_i128_add(acc[o], ct_i128_shl(ct_i128_from64(gs[o][k]), 32u + mp->sh[k][o]));
         }
         g[o] = mp->g16[o] * 256 + ct_i128_round_shr(acc[o], 36u + mp->fb[o]);
     }
