@@ -45,6 +45,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -54,6 +55,7 @@
 #include "earth_reference.hpp"
 #include "harness.h"
 #include "terrain.hpp"
+#include "tiles.h"
 
 using namespace ct_host;
 using earth_ref::ld;
@@ -955,6 +957,20 @@ void check_kept_map_refusals(const ct_package &pk, const Pose &p, ct_earth_map *
     TEST_ASSERT_EQUAL_INT(CT_ERR_CRS, ct_earth_map_init(&other, 201045000000000, 4065840000000000, 0,
                                                         INT64_C(1) << 44, &blank));
     TEST_ASSERT(blank.ready != CT_EARTH_MAP_READY);
+    // a georeference ct_package_frame accepts (heights offset -2^60 nm in
+    // 1 um codes) whose grid cannot hold a point the projection takes: 500
+    // m is (500 m + 2^60 nm) / 1 um codes from the offset, beyond
+    // ct_map_to_grid's 2^62 Q16 (long double below): CT_ERR_RANGE
+    {
+        ct_package fr;
+        const int64_t gr[6] = {pk.origin_e_nm, pk.origin_n_nm, pk.posting_e_nm, pk.posting_n_nm, -(INT64_C(1) << 60),
+                               1000};
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_package_frame(&fr, pk.width, pk.height, 3u, 8u, 0, 100, gr, pk.epsg));
+        TEST_ASSERT((500e9L + std::ldexp(1.0L, 60)) / 1000 * 65536 >= std::ldexp(1.0L, 62));
+        TEST_ASSERT_EQUAL_INT(CT_ERR_RANGE, ct_earth_map_init(&fr, 201045000000000, 4065840000000000, 500000000000,
+                                                              INT64_C(1) << 44, &blank));
+        TEST_ASSERT(blank.ready != CT_EARTH_MAP_READY);
+    }
 }
 
 // A map kept across calls (ct_earth_map_init): centred on the tile at 500 m,
@@ -1128,6 +1144,275 @@ void test_zone_edge()
     TEST_ASSERT(agree == n && hits > 100 && worst <= kMaxErrM);
 }
 
+// ---------------------------------------------------------------------------
+// The projection's domain and extreme packages.
+
+// A synthetic package on EPSG epsg: nx x ny posts `post` m apart from the
+// corner (oe, on) (north-west, rows southwards), heights h(i, j) (m) coded
+// in `scale` m.
+template <class F>
+World *synthetic(int epsg, ld oe, ld on, double post, int nx, int ny, F h, double scale)
+{
+    World *w = new World;
+    Georef g;
+    g.origin_e = (double)oe;
+    g.origin_n = (double)on;
+    g.posting_e = post;
+    g.posting_n = -post;
+    g.epsg = epsg;
+    std::vector<double> hv((size_t)nx * ny);
+    for (int j = 0; j < ny; ++j)
+        for (int i = 0; i < nx; ++i) hv[(size_t)j * nx + i] = h(i, j);
+    std::vector<uint8_t> valid((size_t)nx * ny, 1);
+    w->t = terrain_from_heights(nx, ny, hv, valid, g, scale);
+    BuildOptions o;
+    o.sectors = 8;
+    o.reduce = 2;
+    w->bytes = build_package(w->t, o);
+    if (ct_package_open(&w->p, w->bytes.data(), w->bytes.size()) != CT_OK) std::abort();
+    w->sf = earth_ref::Surface::from_package(w->p);
+    return w;
+}
+
+// A pose at map point (E, N) of zone z, ellipsoidal height h (m), yaw and
+// pitch (deg) w.r.t. north-east-down.
+bool pose_at(earth_ref::Proj &pj, const ct_utm &z, ld E, ld N, ld h, ld yaw, ld pitch, Pose *out)
+{
+    ld lat, lon;
+    pj.utm_inverse(E, N, &lat, &lon);
+    out->def = {"domain", E, N, 0, yaw, pitch};
+    const int64_t la = q61(lat), lo = q61(lon), h_nm = std::llround(h * 1e9L);
+    out->lat = deg_of_q61(la);
+    out->lon = deg_of_q61(lo);
+    out->h = (ld)h_nm * 1e-9L;
+    if (ct_quat_from_ypr(q61(yaw > 180 ? yaw - 360 : yaw), q61(pitch), 0, out->q) != CT_OK) return false;
+    return ct_pose_from_wgs84(&out->pose, &z, la, lo, h_nm, out->q) == CT_OK;
+}
+
+// The first range t (m) in [0, t_end] where the reference path is outside
+// the projection's domain (|lat| > 84.5 deg, or more than 9 deg from the
+// zone's meridian lon0): sampled every `step` m, then bisected to 1 mm;
+// +inf when every sample is inside.
+ld domain_exit(const earth_ref::Los &L, ld lon0_deg, ld t_end, ld step)
+{
+    auto outside = [&](ld t) {
+        ld P[3], la, lo, hh;
+        L.at(t, P);
+        earth_ref::geodetic_ld(P, &la, &lo, &hh);
+        ld dl = lo * 180 / kPi - lon0_deg;
+        dl -= 360 * std::floor((dl + 180) / 360);
+        return std::fabs(la * 180 / kPi) > 84.5L || std::fabs(dl) > 9;
+    };
+    for (ld t = 0; t <= t_end + step; t += step) {
+        if (!outside(t)) continue;
+        ld a = std::max<ld>(0, t - step), b = t;
+        while (b - a > 1e-3L) (outside((a + b) / 2) ? b : a) = (a + b) / 2;
+        return b;
+    }
+    return std::numeric_limits<ld>::infinity();
+}
+
+// Pixels judged against the reference where lines of sight leave the
+// projection's domain: a library hit must be the reference's; a library
+// miss where the reference hits only when the reference path left the
+// domain before its hit, or within 25 m after (the pieces stop up to 20 m
+// short of the edge: next_piece, docs/geolocation.md).
+struct DomainTally {
+    long n = 0, hits = 0, misses = 0, domain_miss = 0, bad = 0;
+    double worst = 0;
+};
+
+void judge_domain(World *w, earth_ref::Proj &pj, ld lon0, const Cam &cam, const Pose &p, const ct_effects &fx,
+                  int64_t u, int64_t v, DomainTally &T, ld skip_clear = kSkipClearM)
+{
+    ld ray[3];
+    earth_ref::pinhole_ray(cam.fx, cam.fy, cam.cx, cam.cy, (ld)u / 65536, (ld)v / 65536, ray);
+    const earth_ref::Los L = earth_ref::los_from_pose(pj, p.pose, ray, &fx);
+    const earth_ref::Result r = earth_ref::trace(pj, w->sf, L);
+    if (r.min_clear < skip_clear) return;
+    ct_geo g;
+    const ct_status st = ct_geolocate(&w->p, &cam.cam, &p.pose, CT_METHOD_DIRECTIONAL, &fx, u, v, &g);
+    const int ls = st == CT_HIT_VOID ? CT_HIT : st;
+    T.n++;
+    const char *why = nullptr;
+    if (ls == CT_HIT && r.status == CT_HIT) {
+        const double d = (double)dist3(g.hit.e_nm * 1e-9L, g.hit.n_nm * 1e-9L, g.hit.h_nm * 1e-9L, r.e, r.n, r.h);
+        T.worst = std::max(T.worst, d);
+        T.hits++;
+        if (d > kMaxErrM) why = "hit off the reference's";
+    } else if (ls == CT_MISS && r.status == CT_MISS) {
+        T.misses++;
+    } else if (ls == CT_MISS && r.status == CT_HIT) {
+        if (domain_exit(L, lon0, r.t + 25, 0.5L) <= r.t + 25) {
+            T.domain_miss++;
+        } else {
+            why = "a miss inside the domain";
+        }
+    } else if (!(r.wall && ls == CT_BELOW)) {
+        why = "status differs";
+    }
+    if (why) {
+        T.bad++;
+        if (T.bad <= 5)
+            std::printf("    px (%.3f, %.3f): %s: library %d (%.3f %.3f %.3f), reference %d (%.3Lf %.3Lf %.3Lf, t %.1Lf m)\n",
+                        u / 65536.0, v / 65536.0, why, st, g.hit.e_nm * 1e-9, g.hit.n_nm * 1e-9, g.hit.h_nm * 1e-9,
+                        r.status, r.e, r.n, r.h, r.t);
+    }
+}
+
+// A 3 x 3 km tile (gentle hills) reaching 1 km past the projection's 9 deg
+// edge (zone 17, west), cameras 0.5, 3 and 17 km east of it looking west
+// 3 deg down: lines of sight pass over the tile into the region the
+// projection cannot take (PROJ, the reference, can): the pieces shrink to
+// 20 m at the edge and the path is a miss there (next_piece), every hit
+// before it as the reference's.
+void test_zone_edge_straddle()
+{
+    earth_ref::Proj &pj = proj();
+    ld lo = -400000, hi = -200000, lat, lon;
+    for (int k = 0; k < 60; ++k) {
+        const ld mid = (lo + hi) / 2;
+        pj.utm_inverse(mid, 4064500, &lat, &lon);
+        (lon < -90 ? lo : hi) = mid;
+    }
+    static World *w = nullptr;
+    if (!w)
+        w = synthetic(32617, std::floor(lo) - 1000, 4066000, 30.0, 101, 101,
+                      [](int i, int j) { return 400.0 + 30 * std::sin(i * 0.2) * std::cos(j * 0.15); }, 0.015625);
+    Cam cam = make_camera();
+    const ct_utm z = {17, 0};
+    const ld E0 = w->p.origin_e_nm * 1e-9L, N0 = w->p.origin_n_nm * 1e-9L;
+    DomainTally T;
+    for (ld back : {17000.0L, 3000.0L, 500.0L})
+        for (int mode = 0; mode < 2; ++mode) {
+            Pose p;
+            TEST_ASSERT(pose_at(pj, z, E0 + 3000 + back, N0 - 1500, 1000, 270, -3.0L, &p));
+            ct_effects fx = {CT_EFFECT_CURVATURE | (mode ? CT_EFFECT_REFRACTION : 0u), CT_REFRACTION_K_STD_Q16, 0, 0,
+                             nullptr};
+            for (int iv = 300; iv < 560; iv += 5)
+                for (int iu = 0; iu < 1024; iu += 128)
+                    judge_domain(w, pj, -81, cam, p, fx, (int64_t)iu << 16, (int64_t)iv << 16, T);
+        }
+    std::printf("  tile across the zone's 9 deg edge: %ld pixels, %ld hits as the reference's (within %.4f m), %ld "
+                "misses as its, %ld misses where the path leaves the domain before its hit; %ld wrong\n",
+                T.n, T.hits, T.worst, T.misses, T.domain_miss, T.bad);
+    TEST_ASSERT(T.bad == 0 && T.hits > 100 && T.domain_miss > 50);
+}
+
+// A 3 x 3 km tile across the 84.5 deg limit of latitude (zone 33, on its
+// meridian), cameras west of it looking east along the limit and south of
+// it looking north, 60 m over the terrain.  In the map the limit is a
+// circle around the pole (611 km), so an eastward line of sight cuts a
+// chord of it: its ends inside the domain, its middle or quarter points
+// beyond (next_piece, check_piece).  Every library hit is the reference's,
+// every miss either the reference's or one past the limit.
+void test_latitude_limit()
+{
+    static earth_ref::Proj *pjp = new earth_ref::Proj(32633);
+    earth_ref::Proj &pj = *pjp;
+    ld El, Nl;
+    pj.utm(84.5L, 15, &El, &Nl);
+    static World *w = nullptr;
+    if (!w)
+        w = synthetic(32633, 500000 - 1500, std::floor(Nl) + 1500, 30.0, 101, 101,
+                      [](int i, int j) { return 400.0 + 20 * std::sin(i * 0.3) * std::cos(j * 0.2); }, 0.015625);
+    Cam cam = make_camera();
+    const ct_utm z = {33, 0};
+    DomainTally T;
+    for (int mode = 0; mode < 2; ++mode) {
+        ct_effects fx = {CT_EFFECT_CURVATURE | (mode ? CT_EFFECT_REFRACTION : 0u), CT_REFRACTION_K_STD_Q16, 0, 0,
+                         nullptr};
+        // east, beta north of grid east from (E, Nl + dn): the northing
+        // Nl + dn + beta (x - x0) (x = E - 500 km) against the limit's Nl +
+        // x^2 / 2 rho (rho = 611 km) peaks at xp = beta rho, by dn - beta x0
+        // + rho beta^2 / 2: a chord of the polar cap centred at xp, about
+        // sqrt(2 rho excess) either side, somewhere along the first pieces
+        const ld rho = 611000, x0 = -5000;
+        for (int kb = 0; kb <= 80; ++kb) {
+            const ld xp = -3000 + 50 * kb, beta = xp / rho, excess = kb % 2 ? 0.1L : 0.4L;
+            const ld dn = excess + beta * x0 - rho * beta * beta / 2;
+            ld la, lo;
+            pj.utm_inverse(500000 + x0, Nl + dn, &la, &lo);
+            const ld yaw = 90 - std::atan(beta) * 180 / kPi + pj.convergence(la, lo) * 180 / kPi;
+            Pose p;
+            TEST_ASSERT(pose_at(pj, z, 500000 + x0, Nl + dn, 480, yaw, -0.5L, &p));
+            for (int iv = 364; iv < 404; iv += 8)
+                judge_domain(w, pj, 15, cam, p, fx, (int64_t)1023 << 15, (int64_t)iv << 16, T);
+        }
+        Pose p;
+        TEST_ASSERT(pose_at(pj, z, 500000, Nl - 5000, 480, 0, -0.5L, &p));
+        for (int iv = 370; iv < 400; iv += 3)
+            for (int iu = 0; iu < 1024; iu += 64) judge_domain(w, pj, 15, cam, p, fx, (int64_t)iu << 16, (int64_t)iv << 16, T);
+    }
+    std::printf("  tile across the 84.5 deg limit: %ld pixels, %ld hits as the reference's (within %.4f m), %ld "
+                "misses as its, %ld misses where the path leaves the domain before its hit; %ld wrong\n",
+                T.n, T.hits, T.worst, T.misses, T.domain_miss, T.bad);
+    TEST_ASSERT(T.bad == 0 && T.hits > 100 && T.domain_miss > 50);
+}
+
+// A pose looking (yaw, pitch) from h (m) whose centre pixel's reference
+// path meets height hz at map point (Et, Nt): the camera's place moved by
+// the miss, three times.
+Pose aim_at(earth_ref::Proj &pj, const ct_utm &z, const ct_effects &fx, ld Et, ld Nt, ld hz, ld back_e, ld back_n,
+            ld h, ld yaw, ld pitch)
+{
+    ld ce = Et - back_e, cn = Nt - back_n;
+    Pose p;
+    for (int it = 0; it < 3; ++it) {
+        if (!pose_at(pj, z, ce, cn, h, yaw, pitch, &p)) std::abort();
+        const ld ray[3] = {0, 0, 1};
+        const earth_ref::Los L = earth_ref::los_from_pose(pj, p.pose, ray, &fx);
+        ld a = 0, b = 2 * (h - hz) + 2 * std::hypot(back_e, back_n);
+        for (int k = 0; k < 100; ++k) {
+            ld P[3], la, lo, hh;
+            L.at((a + b) / 2, P);
+            earth_ref::geodetic_ld(P, &la, &lo, &hh);
+            (hh > hz ? a : b) = (a + b) / 2;
+        }
+        ld P[3], E, N, hh;
+        L.at(a, P);
+        pj.map(P, &E, &N, &hh);
+        ce += Et - E;
+        cn += Nt - N;
+    }
+    return p;
+}
+
+// A 20 x 20 cm tile of 1 mm posts (201 x 201, a plane rising 4 and 2 cm across it) in zone
+// 17: cameras 60 km west and south of it, 60 km up, looking at it 45 deg
+// down: the path's interpolation nodes lie over 2^22 cells apart (the
+// vertices are then exact: set_nodes) and the pieces off the tile grow
+// past 2^24 cells (beyond the vertical fit's range: fit_piece); and a
+// camera 5 km over it looking 1.5 mrad off the vertical with refraction k
+// = 2 (constant curvature k / R along w, the spec's): the path's
+// horizontal image ep t - k t^2 / 2R turns back 4.8 km along it, so a
+// piece's middle lies outside the middle half of its chord (fit_piece).
+// Every status and hit as the reference's.
+void test_tiny_posting()
+{
+    earth_ref::Proj &pj = proj();
+    static World *w = nullptr;
+    if (!w)
+        w = synthetic(32617, 201045, 4065840, 0.001, 201, 201,
+                      [](int i, int j) { return 400.0 + 0.0002 * i + 0.0001 * j; }, 0.0009765625);
+    Cam cam = make_camera();
+    const ct_utm z = {17, 0};
+    const ld Ec = 201045.1L, Nc = 4065840 - 0.1L;
+    const int64_t u0 = (int64_t)1023 << 15, v0 = (int64_t)767 << 15;
+    DomainTally T;
+    for (int side = 0; side < 2; ++side) {
+            const int mode = side;  // west: curvature; south: with refraction
+            const ct_effects fx = {CT_EFFECT_CURVATURE | (mode ? CT_EFFECT_REFRACTION : 0u), CT_REFRACTION_K_STD_Q16, 0,
+                                   0, nullptr};
+            const Pose p = aim_at(pj, z, fx, Ec, Nc, 400, side ? 0 : 60000, side ? 60000 : 0, 60400, side ? 0 : 90, -45);
+            for (int iv = -1; iv <= 1; ++iv)
+                for (int iu = -1; iu <= 1; ++iu) judge_domain(w, pj, -81, cam, p, fx, u0 + iu * 40, v0 + iv * 40, T, 0);
+    }
+    std::printf("  1 mm posts, cameras 60 km away: %ld pixels, %ld hits as the reference's (within %.5f m), %ld misses as "
+                "its; %ld wrong\n", T.n, T.hits, T.worst, T.misses, T.bad);
+    TEST_ASSERT(T.bad == 0 && T.domain_miss == 0 && T.hits >= 12 && T.n == 18);
+}
+
 void test_exact_curvature() { compare(CT_EFFECT_CURVATURE); }
 void test_exact_curvature_refraction() { compare(CT_EFFECT_CURVATURE | CT_EFFECT_REFRACTION); }
 
@@ -1144,5 +1429,8 @@ int main()
     RUN_TEST(test_exact_curvature);
     RUN_TEST(test_exact_curvature_refraction);
     RUN_TEST(test_zone_edge);
+    RUN_TEST(test_zone_edge_straddle);
+    RUN_TEST(test_latitude_limit);
+    RUN_TEST(test_tiny_posting);
     return TEST_END();
 }
