@@ -904,7 +904,9 @@ ct_status ct_los(const ct_package *pkg, const int64_t a_nm[3], const int64_t b_n
  * G (nm), and does it see it?  The pixel (Q16) by ct_camera_project of the
  * direction from the camera centre to G -- with effects, to G lowered by
  * the line of sight's rise c rho^2 / 2R (the sphere model, as the tracer's
- * bent rays: the apparent point) -- and *visible from ct_los between the
+ * bent rays: the apparent point); on the true Earth (curvature, radius 0,
+ * a UTM package) the Earth-fixed line of sight's direction, aimed as
+ * ct_los aims it -- and *visible from ct_los between the
  * camera centre and G (the same effects and margin; *block the blocking
  * point when hidden).  CT_OK (pixel set, *visible 0 or 1); CT_BELOW (the
  * camera under the surface; pixel set, *visible 0); CT_ERR_UNPROJECT

@@ -37,36 +37,20 @@ static ct_status to_ecef(const ct_utm *zone, const int64_t m[3], int64_t x[3])
     return st == CT_OK ? ct_ecef_from_wgs84(lat, lon, m[2], x) : st;
 }
 
-/* The true Earth (curvature with radius 0 on a UTM package): the Earth-fixed
- * line of sight from A aimed at B (with refraction, at B raised by the bent
- * path's drop there, k t^2 / 2R along the direction earth.c bends it),
- * traced by earth.c as geolocation does; hidden when its first hit lies more than the
- * margin (Earth-fixed distance from A) before B.  fx checked and its chord
- * taken by the caller (ct_effects_to_bend).  CT_ERR_CRS: not UTM. */
-static ct_status los_earth(const ct_package *p, ct_tileset *ts, const int64_t a_nm[3], const int64_t b_nm[3],
-                           const ct_effects *fx, int64_t chord_nm, int64_t margin_nm, ct_method m, ct_hit *block)
+/* The true Earth's aim from A at B (map points, nm): the Earth-fixed line
+ * of sight from A to B -- with refraction aimed at B raised by the bent
+ * path's drop there, k t^2 / 2R along the direction earth.c bends it -- as
+ * a Q39 unit vector dg in the grid frame at A (es: ct_earth_setup's for a
+ * pose at A; its frame is all that is read); A and B in ECEF in *A_ecef,
+ * *B_ecef.  fx checked by the caller.  CT_ERR_RAY: a point off the
+ * zone's projection, or A = B. */
+static ct_status earth_aim(const ct_utm *zone, const ct_earth *es, const int64_t a_nm[3], const int64_t b_nm[3],
+                           const ct_effects *fx, int64_t A[3], int64_t B[3], int64_t dg[3])
 {
-    static const int32_t ident[9] = {1 << 30, 0, 0, 0, 1 << 30, 0, 0, 0, 1 << 30};
-    ct_utm zone;
-    ct_pose pose;
-    ct_earth es;
-    int64_t A[3], B[3], H[3], d[3], dg[3], big = 0, lim;
-    ct_status st;
+    int64_t d[3], big = 0;
     int k, j;
     unsigned sh = 0u;
-    if (p->epsg > 0x7fffffffu || ct_utm_zone_of_epsg((int32_t)p->epsg, &zone) != CT_OK) {
-        return CT_ERR_CRS;
-    }
-    if (ct_pose_init(&pose, ident, a_nm[0], a_nm[1], a_nm[2]) != CT_OK) {
-        return CT_ERR_RAY;
-    }
-    st = ct_earth_setup(p, &pose, (fx->flags & CT_EFFECT_REFRACTION) != 0u ? fx->refraction_k_q16 : 0,
-                        CT_EARTH_RADIUS_NM, chord_nm, 0u,
-                        (fx->flags & CT_EFFECT_EARTH_FIT) != 0u, fx->earth_map, &es);
-    if (st != CT_OK) {
-        return st == CT_ERR_RAY ? CT_ERR_RAY : CT_ERR_EFFECTS;
-    }
-    if (to_ecef(&zone, a_nm, A) != CT_OK || to_ecef(&zone, b_nm, B) != CT_OK) {
+    if (to_ecef(zone, a_nm, A) != CT_OK || to_ecef(zone, b_nm, B) != CT_OK) {
         return CT_ERR_RAY;
     }
     for (k = 0; k < 3; ++k) { /* bound: 3 axes */
@@ -105,12 +89,12 @@ static ct_status los_earth(const ct_package *p, ct_tileset *ts, const int64_t a_
             dot = 0;
             for (k = 0; k < 3; ++k) { /* bound: 3 axes */
                 w[k] = ct_i128_round_div(ct_i128_shl(ct_i128_from64(aim[k]), 30u), na);
-                dot += es.frame_q30[3 * k + 2] * w[k]; /* |.| <= 2^60 each */
+                dot += es->frame_q30[3 * k + 2] * w[k]; /* |.| <= 2^60 each */
             }
             dot = ct_floor_div(dot + (INT64_C(1) << 29), INT64_C(1) << 30);
             nw = 0;
             for (k = 0; k < 3; ++k) { /* bound: 3 axes */
-                w[k] = es.frame_q30[3 * k + 2] - ct_floor_div(dot * w[k] + (INT64_C(1) << 29), INT64_C(1) << 30);
+                w[k] = es->frame_q30[3 * k + 2] - ct_floor_div(dot * w[k] + (INT64_C(1) << 29), INT64_C(1) << 30);
                 nw += w[k] * w[k]; /* < 3 2^62 / 4: |w| <= 2^30 + 1 */
             }
             nw = (int64_t)ct_isqrt64((uint64_t)nw);
@@ -135,7 +119,7 @@ static ct_status los_earth(const ct_package *p, ct_tileset *ts, const int64_t a_
     for (k = 0; k < 3; ++k) { /* bound: 3 axes */
         ct_i128 s = ct_i128_from64(0);
         for (j = 0; j < 3; ++j) { /* bound: 3 terms, Q30 x 2^40 */
-            s = ct_i128_add(s, ct_i128_mul(es.frame_q30[3 * j + k], ct_floor_div(d[j], INT64_C(1) << sh)));
+            s = ct_i128_add(s, ct_i128_mul(es->frame_q30[3 * j + k], ct_floor_div(d[j], INT64_C(1) << sh)));
         }
         dg[k] = ct_i128_round_shr(s, 30u); /* < 2^42 */
     }
@@ -148,6 +132,39 @@ static ct_status los_earth(const ct_package *p, ct_tileset *ts, const int64_t a_
         for (k = 0; k < 3; ++k) { /* bound: 3 axes; |dg| <= n < 2^43: 2^82 / n */
             dg[k] = ct_i128_round_div(ct_i128_shl(ct_i128_from64(dg[k]), 39u), n);
         }
+    }
+    return CT_OK;
+}
+
+/* The true Earth (curvature with radius 0 on a UTM package): the Earth-fixed
+ * line of sight from A aimed at B (earth_aim), traced by earth.c as
+ * geolocation does; hidden when its first hit lies more than the margin
+ * (Earth-fixed distance from A) before B.  fx checked and its chord taken
+ * by the caller (ct_effects_to_bend).  CT_ERR_CRS: not UTM. */
+static ct_status los_earth(const ct_package *p, ct_tileset *ts, const int64_t a_nm[3], const int64_t b_nm[3],
+                           const ct_effects *fx, int64_t chord_nm, int64_t margin_nm, ct_method m, ct_hit *block)
+{
+    static const int32_t ident[9] = {1 << 30, 0, 0, 0, 1 << 30, 0, 0, 0, 1 << 30};
+    ct_utm zone;
+    ct_pose pose;
+    ct_earth es;
+    int64_t A[3], B[3], H[3], dg[3], lim;
+    ct_status st;
+    if (p->epsg > 0x7fffffffu || ct_utm_zone_of_epsg((int32_t)p->epsg, &zone) != CT_OK) {
+        return CT_ERR_CRS;
+    }
+    if (ct_pose_init(&pose, ident, a_nm[0], a_nm[1], a_nm[2]) != CT_OK) {
+        return CT_ERR_RAY;
+    }
+    st = ct_earth_setup(p, &pose, (fx->flags & CT_EFFECT_REFRACTION) != 0u ? fx->refraction_k_q16 : 0,
+                        CT_EARTH_RADIUS_NM, chord_nm, 0u,
+                        (fx->flags & CT_EFFECT_EARTH_FIT) != 0u, fx->earth_map, &es);
+    if (st != CT_OK) {
+        return st == CT_ERR_RAY ? CT_ERR_RAY : CT_ERR_EFFECTS;
+    }
+    st = earth_aim(&zone, &es, a_nm, b_nm, fx, A, B, dg);
+    if (st != CT_OK) {
+        return st;
     }
     st = ct_trace_earth_set(p, ts, &es, dg, m, block);
     if (st == CT_BELOW || st == CT_NO_DATA || st < 0) {
@@ -282,13 +299,40 @@ ct_status ct_los_tiles(ct_tileset *ts, const int64_t a_nm[3], const int64_t b_nm
     return los_impl(&ts->frame, ts, a_nm, b_nm, effects, margin_nm, m, block);
 }
 
+/* ct_locate_inverse's direction on the true Earth: the line of sight from
+ * the camera centre to G as ct_los's (earth_aim), in the grid frame at the
+ * camera (Q39) -- the frame ct_geolocate's true Earth turns a camera ray
+ * into (ct_pose_rotate_grid: no horizontal scale).  CT_ERR_CRS: not a UTM
+ * package (the sphere then, as geolocation). */
+static ct_status inverse_earth(const ct_package *p, const ct_pose *pose, const ct_effects *fx, int64_t chord_nm,
+                               const int64_t g_nm[3], int64_t dg[3])
+{
+    ct_utm zone;
+    ct_earth es;
+    int64_t c[3], A[3], B[3];
+    ct_status st;
+    if (p->epsg > 0x7fffffffu || ct_utm_zone_of_epsg((int32_t)p->epsg, &zone) != CT_OK) {
+        return CT_ERR_CRS;
+    }
+    /* only the frame at the camera is read: no map fitted */
+    st = ct_earth_setup(p, pose, (fx->flags & CT_EFFECT_REFRACTION) != 0u ? fx->refraction_k_q16 : 0,
+                        CT_EARTH_RADIUS_NM, chord_nm, 0u, 0, NULL, &es);
+    if (st != CT_OK) {
+        return st == CT_ERR_RAY ? CT_ERR_RAY : CT_ERR_EFFECTS;
+    }
+    c[0] = pose->e_nm;
+    c[1] = pose->n_nm;
+    c[2] = pose->h_nm;
+    return earth_aim(&zone, &es, c, g_nm, fx, A, B, dg);
+}
+
 ct_status ct_locate_inverse(const ct_package *p, const ct_camera *cam, const ct_pose *pose, const ct_effects *effects,
                             const int64_t g_nm[3], int64_t margin_nm, int64_t *u_q16, int64_t *v_q16,
                             uint32_t *visible, ct_hit *block)
 {
     int64_t d[3], c[3], big = 0, rise = 0;
     int32_t ray[3];
-    int k, j, sh = 0;
+    int k, j, sh = 0, earth = 0;
     ct_status st;
     if (p == NULL || cam == NULL || pose == NULL || g_nm == NULL || u_q16 == NULL || v_q16 == NULL ||
         visible == NULL || block == NULL || cam->ready == 0u || pose->ready == 0u || p->base == NULL) {
@@ -309,21 +353,30 @@ ct_status ct_locate_inverse(const ct_package *p, const ct_camera *cam, const ct_
     if (effects != NULL && (effects->flags & CT_EFFECT_ALL) != 0u) {
         /* the apparent point: the line of sight rises c rho^2 / 2R on its
          * way, so the camera sees the point along the tangent to the point
-         * lowered by that rise (the sphere of the effects' radius) */
+         * lowered by that rise (the sphere of the effects' radius); on the
+         * true Earth, the Earth-fixed line of sight's own direction */
         ct_bend bd;
-        int64_t rho2h;
         if (ct_effects_to_bend(p, effects, &bd) != CT_OK) {
             return CT_ERR_EFFECTS;
         }
-        /* rho^2 / 2R with rho <= 2^50 (capped): < 2^100 / 2^41 */
-        {
-            int64_t de = ct_min64(ct_abs64(d[0]), INT64_C(1) << 50), dn = ct_min64(ct_abs64(d[1]), INT64_C(1) << 50);
-            rho2h = ct_i128_floor_div_sat(ct_i128_add(ct_i128_mul(de, de), ct_i128_mul(dn, dn)), 2 * bd.radius_nm);
+        if ((effects->flags & CT_EFFECT_CURVATURE) != 0u && effects->earth_radius_nm == 0) {
+            st = inverse_earth(p, pose, effects, bd.chord_nm, g_nm, d);
+            if (st == CT_OK) {
+                earth = 1;
+            } else if (st != CT_ERR_CRS) {
+                return st;
+            }
         }
-        /* |c| <= 3 2^16: the rise, capped at 2^60 (|d| <= 2^62: no wrap) */
-        rise = ct_i128_floor_div_sat(ct_i128_mul(rho2h, bd.coeff_q16), 65536);
-        rise = ct_max64(-(INT64_C(1) << 60), ct_min64(INT64_C(1) << 60, rise));
-        d[2] -= rise;
+        if (!earth) {
+            /* rho^2 / 2R with rho <= 2^50 (capped): < 2^100 / 2^41 */
+            int64_t de = ct_min64(ct_abs64(d[0]), INT64_C(1) << 50), dn = ct_min64(ct_abs64(d[1]), INT64_C(1) << 50);
+            int64_t rho2h =
+                ct_i128_floor_div_sat(ct_i128_add(ct_i128_mul(de, de), ct_i128_mul(dn, dn)), 2 * bd.radius_nm);
+            /* |c| <= 3 2^16: the rise, capped at 2^60 (|d| <= 2^62: no wrap) */
+            rise = ct_i128_floor_div_sat(ct_i128_mul(rho2h, bd.coeff_q16), 65536);
+            rise = ct_max64(-(INT64_C(1) << 60), ct_min64(INT64_C(1) << 60, rise));
+            d[2] -= rise;
+        }
     }
     /* the camera frame: R^T d, with a geodetic pose's horizontal scale
      * undone first (map metres per ground metre, Q30); d scaled into 2^40
@@ -338,7 +391,8 @@ ct_status ct_locate_inverse(const ct_package *p, const ct_camera *cam, const ct_
     for (k = 0; k < 3; ++k) { /* bound: 3 axes */
         d[k] = ct_floor_div(d[k], INT64_C(1) << sh);
     }
-    if (pose->hscale_q30 != ((int32_t)1 << 30)) {
+    if (!earth && pose->hscale_q30 != ((int32_t)1 << 30)) {
+        /* (the true Earth's direction is in the grid frame already) */
         for (k = 0; k < 2; ++k) { /* bound: 2 horizontal axes; |d| < 2^40, hscale >= 2^29 */
             d[k] = ct_i128_floor_div(ct_i128_shl(ct_i128_from64(d[k]), 30u), pose->hscale_q30);
         }
