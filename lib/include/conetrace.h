@@ -806,7 +806,9 @@ typedef struct {
     int64_t earth_radius_nm;   /* 0: with CT_EFFECT_CURVATURE on a package
                                   on a UTM zone, the true Earth (earth.c:
                                   the line of sight straight in Earth-fixed
-                                  space, WGS84, traced at most 2^48 nm,
+                                  space, WGS84 -- with REFRACTION bent in
+                                  its vertical plane with the textbook
+                                  curvature k cos(elevation) / R --, traced at most 2^48 nm,
                                   281 km, from the camera: terrain farther
                                   is not seen); else the sphere of
                                   CT_EARTH_RADIUS_NM.  Non-zero: the sphere

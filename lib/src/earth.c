@@ -3,9 +3,10 @@
  * (WGS84), or refracted, traced over a package on a UTM zone.
  *
  * The path: P(t) = C + t d - (k t^2 / 2R) w  (ECEF, nm; t >= 0 the range
- * from the camera centre C, d the unit direction, w the unit vector normal
- * to d in its vertical plane, upwards; the last term only with refraction,
- * R the mean radius).  Its image in the package's frame (UTM E, N, the
+ * from the camera centre C, d the unit direction, w = up - (up . d) d:
+ * normal to d in its vertical plane, upwards, of length cos(elevation) --
+ * the textbook ray curvature k cos(elev) / R; the last term only with
+ * refraction, R the mean radius).  Its image in the package's frame (UTM E, N, the
  * ellipsoidal height: ct_wgs84_from_ecef, ct_utm_forward, ct_map_to_grid)
  * is neither a map-frame line nor a vertical parabola: it stretches along
  * track (rho^2 tan(depression) / R), bends sideways (transverse Mercator:
@@ -916,7 +917,7 @@ static int piece_off(const ct_package *p, const gv *A, const gv *B, const gv *M,
 
 /* 1 when the path never comes back over the tile: beyond an edge and
  * moving away on that axis faster than 1/1024 of its horizontal progress
- * (its heading turns by far less over 281 km), or above the tallest post
+ * (its heading turns by far less over 281 km: refraction_axis), or above the tallest post
  * and rising on a convex piece. */
 static int gone(const ct_package *p, const gv *A, const gv *B, const gv *M, const fit *f)
 {
@@ -1024,12 +1025,18 @@ CT_NOINLINE static ct_status trace_piece(const ct_package *p, ct_tileset *ts, co
     return CT_MISS;
 }
 
-/* Refraction's bending direction w = up - (up . d) d, normalised (Q30); up
- * is the frame's third column.  Near the vertical (|w| < 2^-10)
- * refraction bends nothing worth a term: pa->refract stays 0. */
+/* Refraction's bending vector w = up - (up . d) d (Q30), up the frame's
+ * third column, d the unit direction: of length cos(elevation), so that the
+ * path P(t) = C + t d - (k t^2 / 2R) w bends with the textbook ray
+ * curvature k cos(elev) / R of a horizontally layered atmosphere -- its
+ * vertical drop k t^2 cos^2(elev) / 2R = k rho^2 / 2R is the sphere
+ * model's (the lowered walk's), and a steep path's horizontal speed
+ * cos(elev) shrinks by at most t k / R cos(elev) |sin(elev)|, so it never
+ * turns back within R / k >= 3,185 km (gone() relies on its heading).  A
+ * vertical path (w = 0) is not bent: pa->refract stays 0. */
 static void refraction_axis(path *pa, const ct_earth *es)
 {
-    int64_t up[3], dq[3], dot = 0, n2, nn;
+    int64_t up[3], dq[3], dot = 0;
     int k;
     for (k = 0; k < 3; ++k) { /* bound: 3 */
         up[k] = es->frame_q30[3 * k + 2];
@@ -1037,17 +1044,11 @@ static void refraction_axis(path *pa, const ct_earth *es)
         dot += up[k] * dq[k];                                               /* < 2^62 */
     }
     dot = ct_floor_div(dot + (INT64_C(1) << 29), INT64_C(1) << 30);
-    n2 = 0;
-    for (k = 0; k < 3; ++k) { /* bound: 3 */
+    for (k = 0; k < 3; ++k) { /* bound: 3; |w| <= 2^30 + 2 */
         pa->w[k] = up[k] - ct_floor_div(dot * dq[k] + (INT64_C(1) << 29), INT64_C(1) << 30);
-        n2 += pa->w[k] * pa->w[k];
-    }
-    nn = (int64_t)ct_isqrt64((uint64_t)n2);
-    if (nn >= (INT64_C(1) << 20)) {
-        for (k = 0; k < 3; ++k) { /* bound: 3 */
-            pa->w[k] = ct_floor_div(pa->w[k] * (INT64_C(1) << 30) + nn / 2, nn);
+        if (pa->w[k] != 0) {
+            pa->refract = 1;
         }
-        pa->refract = 1;
     }
 }
 

@@ -58,15 +58,14 @@ static ct_status earth_aim(const ct_utm *zone, const ct_earth *es, const int64_t
     }
     if ((fx->flags & CT_EFFECT_REFRACTION) != 0u) {
         /* earth.c bends the path P(t) = A + t u - (k t^2 / 2R) w, u the
-         * unit direction, w the camera's vertical (the frame's third
-         * column) made perpendicular to u and unit (refraction_axis; none
-         * within 2^-10 of the vertical): aim at B + (k t^2 / 2R) w with t =
-         * |that aim|.  u, w and t depend on the aim: from the aim B - A,
-         * three rounds (each shrinks the error by about k t / R < 1e-2 at
-         * 200 km; aiming along the vertical instead misses B by 1.6 m at
-         * 200 km 5 deg down).  t < 2^50 capped, t^2 |k| < 2^117, / 2R
-         * saturated at 2^62, / 2^16; |aim| < 2^56 + 2^50. */
-        int64_t aim[3], w[3], t, up, dot, nw, na;
+         * unit direction, w = up - (up . u) u with up the camera's vertical
+         * (the frame's third column; refraction_axis): aim at B + (k t^2 /
+         * 2R) w with t = |that aim|.  u, w and t depend on the aim: from
+         * the aim B - A, three rounds (each shrinks the error by about k t
+         * / R < 1e-2 at 200 km; aiming along the vertical instead misses B
+         * by 1.6 m at 200 km 5 deg down).  t < 2^50 capped, t^2 |k| <
+         * 2^117, / 2R saturated at 2^62, / 2^16; |aim| < 2^56 + 2^50. */
+        int64_t aim[3], w[3], t, up, dot, na;
         int round;
         for (k = 0; k < 3; ++k) { /* bound: 3 axes */
             aim[k] = d[k];
@@ -92,14 +91,8 @@ static ct_status earth_aim(const ct_utm *zone, const ct_earth *es, const int64_t
                 dot += es->frame_q30[3 * k + 2] * w[k]; /* |.| <= 2^60 each */
             }
             dot = ct_floor_div(dot + (INT64_C(1) << 29), INT64_C(1) << 30);
-            nw = 0;
-            for (k = 0; k < 3; ++k) { /* bound: 3 axes */
+            for (k = 0; k < 3; ++k) { /* bound: 3 axes; |w| <= 2^30 + 2 */
                 w[k] = es->frame_q30[3 * k + 2] - ct_floor_div(dot * w[k] + (INT64_C(1) << 29), INT64_C(1) << 30);
-                nw += w[k] * w[k]; /* < 3 2^62 / 4: |w| <= 2^30 + 1 */
-            }
-            nw = (int64_t)ct_isqrt64((uint64_t)nw);
-            for (k = 0; k < 3; ++k) { /* bound: 3 axes */
-                w[k] = nw >= (INT64_C(1) << 20) ? ct_floor_div(w[k] * (INT64_C(1) << 30) + nw / 2, nw) : 0;
                 aim[k] = d[k] + ct_mul_shr(up, w[k], 30u);
             }
         }

@@ -4,14 +4,12 @@
 // The line of sight is a straight line in Earth-fixed coordinates
 // (EPSG:4978), optionally bent down by refraction:
 //     P(t) = C + t d - k t^2 / (2 R) w,   t >= 0 metres, R = 6371 km,
-// C the camera centre, d the unit direction, w the unit vector
-// perpendicular to d in the vertical plane through d pointing up
-// (w = normalise(u - (u.d) d), u the ellipsoid normal at C; w = 0 for a
-// vertical ray).  (This refraction term has the constant curvature k / R
-// whatever the ray's elevation; the textbook ray curvature is k cos(elev) / R,
-// whose vertical drop k t^2 cos^2(elev) / 2R is the parabola model's
-// k rho^2 / 2R.  The two differ by cm on oblique rays: 3 cm at 30 deg over
-// 5 km.  The reference follows the definition above.)  The terrain is the package's bilinear surface over its
+// C the camera centre, d the unit direction, w = u - (u.d) d, u the
+// ellipsoid normal at C: perpendicular to d in the vertical plane through
+// d, pointing up, of length cos(elevation) -- the textbook ray curvature
+// k cos(elev) / R of a layered atmosphere, whose vertical drop
+// k t^2 cos^2(elev) / 2R is the parabola model's k rho^2 / 2R (w = 0 for a
+// vertical ray).  The terrain is the package's bilinear surface over its
 // posts in the map frame (UTM E, N; h = height_offset + code * scale,
 // taken as WGS84 ellipsoidal heights): post (i, j) at
 //     E = origin_e + (i + 1/2) posting_e,  N = origin_n + (j + 1/2) posting_n.
@@ -267,7 +265,7 @@ inline void geodetic_ld(const ld X[3], ld *lat_rad, ld *lon_rad, ld *h)
 struct Los {
     ld C[3] = {0, 0, 0};  // ECEF camera centre (m)
     ld d[3] = {0, 0, 0};  // ECEF unit direction
-    ld w[3] = {0, 0, 0};  // ECEF unit "up" perpendicular to d (0 for vertical d)
+    ld w[3] = {0, 0, 0};  // ECEF "up" made perpendicular to d, 
     ld kr = 0;            // refraction: P(t) = C + t d - kr t^2 w, kr = k / (2R)
     ld lat = 0, lon = 0, h = 0;  // camera centre, geodetic (deg, deg, m)
     ld gamma = 0;         // convergence at C used (radians; from_pose only)
@@ -291,11 +289,8 @@ inline void set_effects(Los &L, const ct_effects *fx, const ld u[3])
     for (int k = 0; k < 3; ++k) L.w[k] = 0;
     if (fx == nullptr || (fx->flags & CT_EFFECT_REFRACTION) == 0u) return;
     const ld kk = (ld)fx->refraction_k_q16 / 65536.0L;
-    ld ud = dot3(u, L.d), w[3];
-    for (int k = 0; k < 3; ++k) w[k] = u[k] - ud * L.d[k];
-    ld n = std::sqrt(dot3(w, w));
-    if (n < 1e-12L) return;  // vertical: no bending
-    for (int k = 0; k < 3; ++k) L.w[k] = w[k] / n;
+    ld ud = dot3(u, L.d);
+    for (int k = 0; k < 3; ++k) L.w[k] = u[k] - ud * L.d[k];  // |w| = cos(elevation)
     L.kr = kk / (2 * kRefractionRadius);
 }
 
