@@ -265,7 +265,7 @@ inline void geodetic_ld(const ld X[3], ld *lat_rad, ld *lon_rad, ld *h)
 struct Los {
     ld C[3] = {0, 0, 0};  // ECEF camera centre (m)
     ld d[3] = {0, 0, 0};  // ECEF unit direction
-    ld w[3] = {0, 0, 0};  // ECEF "up" made perpendicular to d, 
+    ld w[3] = {0, 0, 0};  // ECEF "up" made perpendicular to d: length cos(elevation), 0 for a vertical d
     ld kr = 0;            // refraction: P(t) = C + t d - kr t^2 w, kr = k / (2R)
     ld lat = 0, lon = 0, h = 0;  // camera centre, geodetic (deg, deg, m)
     ld gamma = 0;         // convergence at C used (radians; from_pose only)
