@@ -26,6 +26,7 @@ struct Scene {
     double coeff;      // c
     double radius_m;   // R
     double chord_m;    // polyline tolerance
+    double tol_m = 0;  // the judge's tolerance for the polyline when tighter than chord_m (0: chord_m)
 };
 
 struct Counts {
@@ -92,7 +93,7 @@ void judge_ray(const ct_package &p, const ref::Dem &d, ld slope, const dem_cases
     // bilinear interpolation between posts, c posting^2 / (4R), plus the
     // prepared ray's rounding
     const ld rounding = (3 + 3 * slope) / 65536.0L + 1e-6L;
-    const ld delta_poly = sc.chord_m / scale * 1.001L + rounding;
+    const ld delta_poly = (sc.tol_m > 0 ? sc.tol_m : sc.chord_m) / scale * 1.001L + rounding;
     const ld delta_low = c * posting * posting / (4 * R) / scale * 1.001L + rounding;
     ct_lower lw;
     const bool lowered = ct_lower_setup(&p, ray.x_q16, ray.y_q16, &bd, &lw) == CT_OK;
@@ -383,12 +384,38 @@ void test_bent_segment_length_regression()
             continue;
         }
         TEST_ASSERT_EQUAL_INT(CT_OK, st);
+        // segments of at most 2^50 nm
+        want = std::min(want, std::ldexp(1.0L, 50) * 65536 / (long double)std::llabs(p.posting_e_nm));
         want = std::min(want, std::ldexp(1.0L, 62));
         // floor of the exact value (the polyline never deviates more than chord)
         TEST_ASSERT_MSG(delta <= want && delta >= want - 2 - want * 1e-15L,
                         "c %d R %lld chord %lld: Delta %lld Q16 cells, want %.3Lf", (int)k.c, (long long)k.r_nm,
                         (long long)k.chord_nm, (long long)delta, want);
     }
+}
+
+// A bend whose tolerance allows segments longer than 2^50 nm (a tiny |c|
+// with a large chord and radius: c = -1/65536, R = 2^54 nm, chord 2^50 nm
+// would give 2^53.5 nm) is traced with segments of 2^50 nm, not refused:
+// the polyline's last vertex, a segment past the box, stayed beyond the
+// vertices' range (CT_ERR_RANGE for every ray, an observer beside the tile
+// included).  Judged against the reference curve within the capped
+// segment's sagitta |c| Delta^2 / 8R (2^27 nm, 0.13 m).
+void test_bent_capped_segment()
+{
+    std::vector<dem_cases::Case> cases;
+    {
+        int w = 97, h = 83;
+        cases.push_back(
+            dem_cases::make_case("smooth", dem_cases::make_terrain(w, h, dem_cases::smooth(w, h, 17, 100, 9000), 0.125), 16, 2));
+    }
+    Scene sc{"tiny c, 2^50 nm chord", -1.0 / 65536, std::ldexp(1.0, 54) * 1e-9, std::ldexp(1.0, 50) * 1e-9,
+             std::ldexp(1.0, 27) * 1e-9};
+    Counts cnt;
+    run_scene(cases[0], sc, (long)(400 * ct_test_scale()), &cnt);
+    printf("  %s: %ld rays (%ld polyline): %ld hit, %ld miss, %ld below; bad %ld\n", sc.name, cnt.rays, cnt.polyline,
+           cnt.hits, cnt.miss, cnt.below, cnt.bad);
+    TEST_ASSERT(cnt.bad == 0 && cnt.polyline == cnt.rays && cnt.hits > cnt.rays / 3);
 }
 
 // ct_trace_bent refuses a chord whose polyline segment would be under 1/64
@@ -737,6 +764,7 @@ int main()
     RUN_TEST(test_bent_arguments);
     RUN_TEST(test_bent_polyline_edges);
     RUN_TEST(test_bent_segment_length_regression);
+    RUN_TEST(test_bent_capped_segment);
     RUN_TEST(test_bent_chord_check_agrees);
     RUN_TEST(test_bent_vs_reference);
     RUN_TEST(test_bent_edge_packages);

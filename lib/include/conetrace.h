@@ -551,7 +551,7 @@ ct_status ct_ray_prepare_segment(const ct_package *pkg, const ct_ray *ray,
  * the observer on each axis and the rise over the tile below 2^16 LSB.
  * Otherwise (c < 0, or out of that range) the library traces the polyline
  * with vertices on the curve (rounded to Q16) every Delta of horizontal
- * range, Delta = sqrt(8 * chord * R / |c|), so the polyline stays within
+ * range, Delta = min(sqrt(8 * chord * R / |c|), 2^50 nm), so the polyline stays within
  * chord_nm (+ 1 Q16 unit of vertex rounding) of the curve; each segment is
  * traced exactly (ct_ray_prepare_segment), so the result is the exact first
  * hit of the polyline.  The observer must be within 2^52 nm (4500 km)

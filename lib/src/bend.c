@@ -25,6 +25,8 @@
 
 #define ONE16 INT64_C(65536)
 #define RHO_MAX_NM (INT64_C(1) << 52)
+/* the polyline's longest segment (1,126 km) */
+#define SEG_MAX_NM (INT64_C(1) << 50)
 #define DIR_MAX (INT64_C(1) << 30)
 /* Largest run of segments culled at once: 2^10 (e.g. 245 km of 240 m
  * segments); the cull's box then reaches the mipmap's top levels. */
@@ -298,6 +300,14 @@ ct_status ct_bend_segment(const ct_package *p, const ct_bend *bd, int64_t *delta
         ct_i128 num = ct_i128_shl(ct_umul64((uint64_t)bd->chord_nm, (uint64_t)bd->radius_nm), 19);
         ct_i128 q = udiv128_small(num, (uint64_t)ct_abs64((int64_t)bd->coeff_q16));
         uint64_t dn = ct_i128_isqrt(q);
+        /* at most SEG_MAX_NM: a segment shorter than the tolerance allows
+         * is as good, and the polyline's last vertex, a segment past the
+         * far side of the box, must stay within RHO_MAX_NM (a tiny |c| with
+         * a large chord and R gave segments of 2^53.5 nm: CT_ERR_RANGE for
+         * every ray) */
+        if (dn > (uint64_t)SEG_MAX_NM) {
+            dn = (uint64_t)SEG_MAX_NM;
+        }
         *delta = ct_i128_floor_div_sat(ct_i128_shl(ct_i128_from64((int64_t)dn), 16), ct_abs64(p->posting_e_nm));
         if (*delta < 1024) {
             return CT_ERR_ARG; /* chord too small for this posting */
