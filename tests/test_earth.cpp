@@ -1471,6 +1471,47 @@ void test_tiny_posting()
     TEST_ASSERT(S.bad == 0 && S.domain_miss == 0 && S.hits >= 300 && S.n == 420);
 }
 
+// Height codes of 100 nm (a tile of 1 m posts with 2 mm of relief, the
+// camera 1 m over it, within CT_MAX_ORIGIN_Q16 = 2^30 codes of the offset):
+// the lines of sight below the horizon hit the ground metres away, those
+// above it miss; with a chord tolerance of 100 m (pieces as long as the
+// path's 1.1 km) the ones rising over 23 deg climb 2^32 codes (430 m)
+// within their first piece, beyond the vertical fit's range (fit_piece
+// shortens the piece).  Every status and hit as the reference's.
+void test_tiny_height_scale()
+{
+    earth_ref::Proj &pj = proj();
+    static World *w = nullptr;
+    if (!w)
+        w = synthetic(32617, 201045, 4065840, 1.0, 101, 101,
+                      [](int i, int j) { return 400.0 + 0.002 * std::sin(0.3 * i) * std::cos(0.2 * j); }, 1e-7);
+    TEST_ASSERT(w->p.height_scale_nm == 100);
+    Cam cam = make_camera();
+    const ct_utm z = {17, 0};
+    DomainTally T;
+    for (int refr = 0; refr < 2; ++refr) {
+        const ct_effects fx = {CT_EFFECT_CURVATURE | (refr ? CT_EFFECT_REFRACTION : 0u), CT_REFRACTION_K_STD_Q16, 0,
+                               0, nullptr};
+        Pose p;
+        TEST_ASSERT(pose_at(pj, z, 201045 + 50.3L, 4065840 - 50.7L, 401, 45 + 90 * refr, 0, &p));
+        for (int iv = 0; iv < 768; iv += 48)
+            for (int iu = 0; iu < 1024; iu += 128)
+                judge_domain(w, pj, -81, cam, p, fx, (int64_t)iu << 16, (int64_t)iv << 16, T, 0);
+        // the path ends 1.1 km out (tmax: the farthest tile corner, plus
+        // 10 % and 1 km): looking 20 deg up, rows rising 5-35 deg
+        ct_effects loose = fx;
+        loose.chord_nm = INT64_C(100000000000);  // 100 m
+        Pose up;
+        TEST_ASSERT(pose_at(pj, z, 201045 + 50.3L, 4065840 - 50.7L, 401, 45 + 90 * refr, 20, &up));
+        for (int iv = 0; iv < 768; iv += 64)
+            for (int iu = 0; iu < 1024; iu += 256)
+                judge_domain(w, pj, -81, cam, up, loose, (int64_t)iu << 16, (int64_t)iv << 16, T, 0);
+    }
+    std::printf("  100 nm height codes, a camera 1 m up: %ld pixels, %ld hits as the reference's (within %.5f m), %ld "
+                "misses as its; %ld wrong\n", T.n, T.hits, T.worst, T.misses, T.bad);
+    TEST_ASSERT(T.bad == 0 && T.domain_miss == 0 && T.hits >= 50 && T.misses >= 50);
+}
+
 void test_exact_curvature() { compare(CT_EFFECT_CURVATURE); }
 void test_exact_curvature_refraction() { compare(CT_EFFECT_CURVATURE | CT_EFFECT_REFRACTION); }
 
@@ -1490,5 +1531,6 @@ int main()
     RUN_TEST(test_zone_edge_straddle);
     RUN_TEST(test_latitude_limit);
     RUN_TEST(test_tiny_posting);
+    RUN_TEST(test_tiny_height_scale);
     return TEST_END();
 }
