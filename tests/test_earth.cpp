@@ -1476,8 +1476,8 @@ void test_tiny_posting()
 // the lines of sight below the horizon hit the ground metres away, those
 // above it miss; with a chord tolerance of 100 m (pieces as long as the
 // path's 1.1 km) the ones rising over 23 deg climb 2^32 codes (430 m)
-// within their first piece, beyond the vertical fit's range (fit_piece
-// shortens the piece).  Every status and hit as the reference's.
+// within their first piece, over 60 deg by its middle, beyond the
+// vertical fit's range (fit_piece shortens the piece).  Every status and hit as the reference's.
 void test_tiny_height_scale()
 {
     earth_ref::Proj &pj = proj();
@@ -1498,11 +1498,12 @@ void test_tiny_height_scale()
             for (int iu = 0; iu < 1024; iu += 128)
                 judge_domain(w, pj, -81, cam, p, fx, (int64_t)iu << 16, (int64_t)iv << 16, T, 0);
         // the path ends 1.1 km out (tmax: the farthest tile corner, plus
-        // 10 % and 1 km): looking 20 deg up, rows rising 5-35 deg
+        // 10 % and 1 km): looking 50 deg up, rows rising 35-65 deg (over
+        // 60 deg the piece's middle, too, is 430 m up)
         ct_effects loose = fx;
         loose.chord_nm = INT64_C(100000000000);  // 100 m
         Pose up;
-        TEST_ASSERT(pose_at(pj, z, 201045 + 50.3L, 4065840 - 50.7L, 401, 45 + 90 * refr, 20, &up));
+        TEST_ASSERT(pose_at(pj, z, 201045 + 50.3L, 4065840 - 50.7L, 401, 45 + 90 * refr, 50, &up));
         for (int iv = 0; iv < 768; iv += 64)
             for (int iu = 0; iu < 1024; iu += 256)
                 judge_domain(w, pj, -81, cam, up, loose, (int64_t)iu << 16, (int64_t)iv << 16, T, 0);

@@ -337,6 +337,42 @@ void test_los_cases()
         if (ct_harness_g.current_failed) return;
     }
     TEST_ASSERT(hidden > 0);
+    // ct_locate_inverse likewise: on the package with no CRS the true Earth
+    // is the sphere (the same pixel and visibility as asking for it); on
+    // the UTM package a camera far off the zone (its frame cannot be
+    // formed) and one beyond the grid's range give ct_los's own statuses
+    // for the same line of sight
+    const ct_lens lens = dem_cases::centred_pinhole(640, 480, 500);
+    ct_camera cam;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_camera_init(&cam, &lens));
+    int32_t qd[4];
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_quat_from_ypr(0, dem_cases::deg_q61(-60), 0, qd));
+    ct_pose pose;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_pose_from_map(&pose, a[0] - 300000000000, a[1] - 300000000000, a[2], qd));
+    {
+        int64_t u1, v1, u2, v2;
+        uint32_t vis1 = 7, vis2 = 7;
+        ct_hit b1, b2;
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_locate_inverse(&q, &cam, &pose, &earth, g, 500000000, &u1, &v1, &vis1, &b1));
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_locate_inverse(&q, &cam, &pose, &sphere, g, 500000000, &u2, &v2, &vis2, &b2));
+        TEST_ASSERT(u1 == u2 && v1 == v2 && vis1 == vis2);
+    }
+    for (int far = 0; far < 2; ++far) {
+        // 3,000 km east: off the zone's projection; 2^61 nm north: beyond
+        // the grid's range
+        ct_pose fp;
+        const int64_t fe = far ? a[0] : a[0] + INT64_C(3000000000000000), fn = far ? (INT64_C(1) << 61) : a[1];
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_pose_from_map(&fp, fe, fn, a[2], qd));
+        const int64_t fa[3] = {fe, fn, a[2]};
+        int64_t uu, vv;
+        uint32_t vis = 7;
+        ct_hit b1, b2;
+        const ct_status sl = ct_los(&p, fa, g, &earth, 500000000, CT_METHOD_DIRECTIONAL, &b1);
+        const ct_status si = ct_locate_inverse(&p, &cam, &fp, &earth, g, 500000000, &uu, &vv, &vis, &b2);
+        TEST_ASSERT_MSG(sl < 0 && si == sl, "camera %s: ct_los %d, ct_locate_inverse %d", far ? "beyond the grid" : "off the zone",
+                        (int)sl, (int)si);
+        TEST_ASSERT_EQUAL_INT(0, (int)vis);
+    }
 }
 
 // A DEM with a patch of voids: ct_los decides as its definition says -- the

@@ -303,8 +303,8 @@ ct_status ct_bend_segment(const ct_package *p, const ct_bend *bd, int64_t *delta
         /* at most SEG_MAX_NM: a segment shorter than the tolerance allows
          * is as good, and the polyline's last vertex, a segment past the
          * far side of the box, must stay within RHO_MAX_NM (a tiny |c| with
-         * a large chord and R gave segments of 2^53.5 nm: CT_ERR_RANGE for
-         * every ray) */
+         * a large chord and R would give segments of 2^53.5 nm, and
+         * CT_ERR_RANGE for every ray) */
         if (dn > (uint64_t)SEG_MAX_NM) {
             dn = (uint64_t)SEG_MAX_NM;
         }
@@ -684,7 +684,7 @@ CT_NOINLINE static ct_status trace_polyline(const ct_package *p, ct_tileset *ts,
          * ct_ray's +-2^62: beyond it the end vertex lies over 2^62 - 2^46
          * from the datum (saturated, or nearly), far outside every tile,
          * and is moved towards the start vertically as vertex's saturation
-         * does (before, such a segment was refused, CT_ERR_RAY). */
+         * does (else ct_ray_prepare_segment would refuse it: CT_ERR_RAY). */
         seg.dx = vb.x - va.x;
         seg.dy = vb.y - va.y;
         seg.dz = ct_min64(ct_max64(vb.z - va.z, -(INT64_C(1) << 62)), INT64_C(1) << 62);

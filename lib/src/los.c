@@ -41,9 +41,9 @@ static ct_status to_ecef(const ct_utm *zone, const int64_t m[3], int64_t x[3])
  * of sight from A to B -- with refraction aimed at B raised by the bent
  * path's drop there, k t^2 / 2R along the direction earth.c bends it -- as
  * a Q39 unit vector dg in the grid frame at A (es: ct_earth_setup's for a
- * pose at A; its frame is all that is read); A and B in ECEF in *A_ecef,
- * *B_ecef.  fx checked by the caller.  CT_ERR_RAY: a point off the
- * zone's projection, or A = B. */
+ * pose at A; its frame is all that is read); A and B also in ECEF (A[],
+ * B[]).  fx checked by the caller.  CT_ERR_RAY: a point off the zone's
+ * projection, or A = B. */
 static ct_status earth_aim(const ct_utm *zone, const ct_earth *es, const int64_t a_nm[3], const int64_t b_nm[3],
                            const ct_effects *fx, int64_t A[3], int64_t B[3], int64_t dg[3])
 {
