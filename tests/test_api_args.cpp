@@ -691,6 +691,18 @@ std::vector<Case> cases()
         const ct_status s2 = ct_los(&q, w.a, w.b, &sphere, 0, CT_METHOD_DIRECTIONAL, &h2);
         return s1 == s2 && s1 >= 0 ? CT_OK : CT_ERR_INTERNAL;
     });
+    add("locate_inverse: true Earth, EPSG beyond INT32_MAX: the sphere's pixel", CT_OK, [](World &w) -> ct_status {
+        ct_package q = w.p;
+        q.epsg = 0x80000000u + 32617u;
+        const ct_effects earth = {CT_EFFECT_CURVATURE, 0, 0, 0, nullptr};
+        const ct_effects sphere = {CT_EFFECT_CURVATURE, 0, CT_EARTH_RADIUS_NM, 0, nullptr};
+        int64_t u1, v1, u2, v2;
+        uint32_t vis1, vis2;
+        ct_hit h1, h2;
+        const ct_status s1 = ct_locate_inverse(&q, &w.cam, &w.pose, &earth, w.b, 0, &u1, &v1, &vis1, &h1);
+        const ct_status s2 = ct_locate_inverse(&q, &w.cam, &w.pose, &sphere, w.b, 0, &u2, &v2, &vis2, &h2);
+        return s1 == s2 && s1 >= 0 && u1 == u2 && v1 == v2 && vis1 == vis2 ? CT_OK : CT_ERR_INTERNAL;
+    });
     add("earth_map_init: centre 2,000 km east of the zone's meridian", CT_ERR_RANGE, [](World &w) {
         static ct_earth_map m;
         return ct_earth_map_init(&w.p, w.a[0] + INT64_C(2000000000000000), w.a[1], w.a[2], INT64_C(10000000000000), &m);
@@ -1073,6 +1085,19 @@ std::vector<Case> cases()
         add(name("10 km up"), CT_ERR_RAY, [fine_geo, fx, km10](World &w) { return fine_geo(w, 0, 0, km10, fx); });
         add(name("2^57 nm west"), CT_ERR_RAY, [fine_geo, fx, far57](World &w) { return fine_geo(w, -far57, 0, 0, fx); });
     }
+    // inverse location on the true Earth with the camera 10 km east on the
+    // 1 um grid: beyond the grid's range (ct_los's status for that camera)
+    add("locate_inverse (1 um grid): camera 10 km east, true Earth", CT_ERR_RAY, [km10](World &w) -> ct_status {
+        int32_t q[4];
+        ct_pose pose;
+        if (ct_quat_from_ypr(0, dem_cases::deg_q61(-60), 0, q) != CT_OK ||
+            ct_pose_from_map(&pose, w.fa[0] + km10, w.fa[1], w.fa[2], q) != CT_OK)
+            return CT_ERR_INTERNAL;
+        int64_t u, vv;
+        uint32_t vis;
+        ct_hit h;
+        return ct_locate_inverse(&w.fine, &w.cam, &pose, &earth, w.fa, 0, &u, &vv, &vis, &h);
+    });
     // line of sight with one end beyond the grid's range on one axis
     struct LosEnd {
         const char *name;
