@@ -522,7 +522,7 @@ static int grid_axis(int64_t p, int64_t p0, int64_t step, uint32_t n, uint32_t *
  * |V| ~ 2^62).  V >> 32 (rounded) leaves |V'_k| < 2^30.8 and |V'|^2 < 3 *
  * 2^61.6 < 2^64 (unsigned).  |V'| shorter than 2^29 means the 16 rays
  * disagree.  The unit result is |V'_k| f / 2^32 with f = floor(2^62 / L),
- * L = floor(|V'|) >= 2^29: f <= 2^33, products < 2^63.8 (unsigned). */
+ * L = |V'| rounded, >= 2^29: f <= 2^33, products < 2^63.8 (unsigned). */
 static ct_status grid_unproject(const ct_camera *c, int64_t u, int64_t v, int32_t out[3])
 {
     const ct_unproject_grid *g = &c->grid;
@@ -564,6 +564,14 @@ static ct_status grid_unproject(const ct_camera *c, int64_t u, int64_t v, int32_
     L = ct_isqrt64(l2);
     if (L < (UINT64_C(1) << 29)) {
         return CT_ERR_UNPROJECT;
+    }
+    /* L rounded to the nearest (|V'| >= L + 1/2 <=> l2 - L^2 > L): with
+     * the floor, |V'| / L reached 1 + 2^-29 and the rounded components
+     * |ray| = 1 + 2^-28.6 beyond the ray_cam format's 2^-29 (found by
+     * fuzzing, corpus grid-unit-length); rounded, 1 +- 2^-30 and the
+     * components' rounding keep it within 2^-29.  l2 - L^2 <= 2 L < 2^33 */
+    if (l2 - L * L > L) {
+        L += 1u;
     }
     f = (UINT64_C(1) << 62) / L;
     /* bound: 3 components.  |V'_k| is an integer <= |V'|, so <= L, and

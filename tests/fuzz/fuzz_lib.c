@@ -9,7 +9,7 @@
  *   mode 0 (ray, byte 0 = 0 mod 4):     six int64 (x, y, z, dx, dy, dz), then a bend (c Q16,
  *                     R and chord exponents) -- traced straight and bent
  *                     with all four methods on the intact package;
- *   mode 1 (package): edits (u16 offset, u8 value) applied to a copy of the
+ *   mode 1 (package, byte 0 = 1 mod 8): edits (u16 offset, u8 value) applied to a copy of the
  *                     package, its CRC re-stamped (unless bit 7 of byte 1
  *                     is set), then ct_package_open / ct_package_verify and
  *                     a few rays from the bytes that follow the edits;
@@ -42,7 +42,38 @@
  *                     traced with every method: documented statuses
  *                     (CT_NO_DATA included), the bound, hits in the box,
  *                     and with no tile accepted edited, each result is the
- *                     merged package's, or CT_NO_DATA no later than it.
+ *                     merged package's, or CT_NO_DATA no later than it;
+ *   mode 5 (lens, byte 0 = 5 mod 16, taken from mode 1, whose corpus
+ *                     inputs have byte 0 = 1; its byte 1 the flags): a
+ *                     ct_lens of every model (or a raw model number) with
+ *                     raw int64 parameters, any within the documented
+ *                     ranges, or a plausible lens -> ct_camera_init: the
+ *                     status the ranges imply (always CT_OK for pinholes and
+ *                     plausible lenses); pixels through ct_camera_unproject
+ *                     (iters <= CT_UNPROJECT_MAX_ITERS, 0 for a pinhole, whose
+ *                     ray and refusals beyond x^2 + y^2 = 64 are judged
+ *                     exactly; unit rays ahead) that project back within
+ *                     the residual CT_UNPROJECT_TOL_Q32 plus the Q30 ray's
+ *                     rounding (its effect measured by projecting the ray's
+ *                     +-1 neighbours); rays through ct_camera_project
+ *                     (refused behind the camera), their pixels unprojected
+ *                     again: they re-project, and for lenses without
+ *                     tangential terms (injective on the valid field) come
+ *                     back parallel within the pixel error times the
+ *                     ray's change between neighbouring pixels;
+ *   mode 13 (grid, byte 0 = 13 mod 16): ct_camera_init_grid on up to
+ *                     16 x 16 nodes (geometry raw or in range; nodes baked
+ *                     by ct_camera_unproject from a plausible lens, a
+ *                     coherent field from the input with missing nodes, the
+ *                     same with raw noise near the 2^-20 unit test, or a
+ *                     field in the plane y = 0): the status the geometry and
+ *                     nodes imply; pixels on nodes, inside and raw against
+ *                     the header's interpolation in double (the 4 x 4 nodes,
+ *                     t kept to 2^-20 of a step, Catmull-Rom, refusals for
+ *                     a missing node, |V| < 1/2, a node beyond 60 deg; on a
+ *                     node line either neighbouring cell): the same status,
+ *                     the ray within 2^-24 rad, unit, y = 0 exactly for the
+ *                     planar field, and ct_camera_project CT_ERR_LENS.
  * Contracts asserted (abort on violation):
  *   - every status is one the API documents for the call;
  *   - on a package that opens and verifies, the four methods return the same
@@ -648,6 +679,597 @@ static void geodesy_mode(const uint8_t *d, size_t n)
     ecef_mode(v);
 }
 
+/* ---- modes 5 and 13: lenses and unprojection grids ----------------------- */
+
+/* sqrt for the harness's judgements (no libm: replay links the library only) */
+static double dsqrt(double x)
+{
+    double g = x > 1.0 ? x : 1.0;
+    int k;
+    if (x <= 0.0) {
+        return 0.0;
+    }
+    for (k = 0; k < 200; ++k) { /* bound: Newton from above, |x| < 2^130 */
+        double h = 0.5 * (g + x / g);
+        if (h >= g) {
+            break;
+        }
+        g = h;
+    }
+    return g;
+}
+
+/* the angle between a and b at most tol (rad; both non-zero): |a x b|^2 <=
+ * tol^2 |a|^2 |b|^2, and a . b > 0 */
+static int parallel(const double a[3], const double b[3], double tol)
+{
+    double c0 = a[1] * b[2] - a[2] * b[1], c1 = a[2] * b[0] - a[0] * b[2], c2 = a[0] * b[1] - a[1] * b[0];
+    double aa = a[0] * a[0] + a[1] * a[1] + a[2] * a[2], bb = b[0] * b[0] + b[1] * b[1] + b[2] * b[2];
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2] > 0.0 && c0 * c0 + c1 * c1 + c2 * c2 <= tol * tol * aa * bb;
+}
+
+static void to_d3(const int32_t r[3], double o[3])
+{
+    o[0] = (double)r[0];
+    o[1] = (double)r[1];
+    o[2] = (double)r[2];
+}
+
+/* |ray| = 1 within 2^-29 (the ray_cam format): 2 Q30 units */
+static int unit_q30(const int32_t r[3])
+{
+    const double l = dsqrt((double)r[0] * r[0] + (double)r[1] * r[1] + (double)r[2] * r[2]);
+    return l >= 1073741824.0 - 2.0 && l <= 1073741824.0 + 2.0;
+}
+
+#define PIX_LIM_Q16 ((int64_t)CT_CAM_MAX_PIXEL << 16)
+#define Q32F 4294967296.0
+
+/* Lens parameters from the input: how 0 raw int64 (unused coefficients
+ * zeroed unless keep), 1 anywhere in the documented ranges (coefficients
+ * also scaled down by 0..63 bits), 2 a plausible lens (f 200..4000 px,
+ * |k| <= 0.5, |p| <= 0.005 or none). */
+static void lens_from(const uint8_t *d, size_t n, size_t *pos, uint32_t model, int how, int keep, ct_lens *l)
+{
+    static const int64_t kmax[8] = {INT64_C(1) << 47, INT64_C(3) << 46, INT64_C(1) << 40, INT64_C(1) << 40,
+                                    INT64_C(1) << 46, INT64_C(1) << 47, INT64_C(3) << 46, INT64_C(1) << 46};
+    int64_t v[12];
+    uint32_t k, used;
+    for (k = 0u; k < 12u; ++k) { /* bound: 12 parameters */
+        v[k] = rd64(d, n, pos);
+    }
+    memset(l, 0, sizeof *l);
+    l->model = model;
+    l->width = 1000u;
+    l->height = 1000u;
+    used = model == CT_LENS_PINHOLE ? 0u : (model == CT_LENS_OPENCV4 ? 4u : (model == CT_LENS_OPENCV5 ? 5u : 8u));
+    if (how == 0) {
+        l->fx_q32 = v[0];
+        l->fy_q32 = v[1];
+        l->cx_q32 = v[2];
+        l->cy_q32 = v[3];
+        for (k = 0u; k < 8u; ++k) { /* bound: 8 coefficients */
+            l->dist_q48[k] = (k < used || keep) ? v[4 + k] : 0;
+        }
+    } else if (how == 1) {
+        l->fx_q32 = fold(v[0], INT64_C(1) << 32, PIX_LIM_Q16 << 16);
+        l->fy_q32 = fold(v[1], INT64_C(1) << 32, PIX_LIM_Q16 << 16);
+        l->cx_q32 = fold(v[2], -(PIX_LIM_Q16 << 16), PIX_LIM_Q16 << 16);
+        l->cy_q32 = fold(v[3], -(PIX_LIM_Q16 << 16), PIX_LIM_Q16 << 16);
+        for (k = 0u; k < 8u; ++k) { /* bound: 8 coefficients */
+            l->dist_q48[k] = k < used ? fold(v[4 + k], -CT_CAM_MAX_DIST, CT_CAM_MAX_DIST) >> ((uint64_t)v[4 + k] >> 58) : 0;
+        }
+    } else {
+        l->fx_q32 = fold(v[0], INT64_C(200) << 32, INT64_C(4000) << 32);
+        l->fy_q32 = l->fx_q32 + fold(v[1], -(l->fx_q32 >> 6), l->fx_q32 >> 6);
+        l->cx_q32 = fold(v[2], 0, INT64_C(2000) << 32);
+        l->cy_q32 = fold(v[3], 0, INT64_C(2000) << 32);
+        for (k = 0u; k < 8u; ++k) { /* bound: 8 coefficients */
+            l->dist_q48[k] = k < used ? fold(v[4 + k], -kmax[k], kmax[k]) : 0;
+        }
+        if ((v[6] >> 62) & 1) { /* radial only */
+            l->dist_q48[2] = l->dist_q48[3] = 0;
+        }
+    }
+}
+
+/* ct_camera_init's status as documented: CT_ERR_LENS for an unknown model,
+ * f outside [1, 2^20] px, |c| > 2^20 px, a coefficient beyond 2^10 or set
+ * but unused; otherwise CT_OK or CT_ERR_LENS (no valid field). */
+static int lens_legal(const ct_lens *l)
+{
+    uint32_t k, used;
+    const int64_t fmax = PIX_LIM_Q16 << 16;
+    if (l->model >= (uint32_t)CT_LENS_COUNT || l->fx_q32 < (INT64_C(1) << 32) || l->fy_q32 < (INT64_C(1) << 32) ||
+        l->fx_q32 > fmax || l->fy_q32 > fmax || l->cx_q32 < -fmax || l->cx_q32 > fmax || l->cy_q32 < -fmax ||
+        l->cy_q32 > fmax) {
+        return 0;
+    }
+    used = l->model == CT_LENS_PINHOLE ? 0u : (l->model == CT_LENS_OPENCV4 ? 4u : (l->model == CT_LENS_OPENCV5 ? 5u : 8u));
+    for (k = 0u; k < 8u; ++k) { /* bound: 8 coefficients */
+        if (l->dist_q48[k] < -CT_CAM_MAX_DIST || l->dist_q48[k] > CT_CAM_MAX_DIST || (k >= used && l->dist_q48[k] != 0)) {
+            return 0;
+        }
+    }
+    return 1;
+}
+
+static int64_t imax64(int64_t a, int64_t b) { return a > b ? a : b; }
+
+/* |v| <= 2^20 px (Q16), the pixels' and grid origins' documented range */
+static int in_pix(int64_t v) { return v >= -PIX_LIM_Q16 && v <= PIX_LIM_Q16; }
+
+/* |a - b| for values within 2^62 of each other */
+static int64_t dist64(int64_t a, int64_t b) { return a > b ? (int64_t)((uint64_t)a - (uint64_t)b) : (int64_t)((uint64_t)b - (uint64_t)a); }
+
+/* The pixel moves (Q16, summed over the components) when each component
+ * of the ray moves by +-1 (Q30 units): the projection's sensitivity to the
+ * ray's rounding.  -1 where one of those projections fails. */
+static int64_t proj_sens(const ct_camera *cam, const int32_t r[3], int64_t pu, int64_t pv)
+{
+    int64_t sum = 0;
+    int k, s;
+    for (k = 0; k < 3; ++k) { /* bound: 3 components */
+        if (r[k] >= INT32_MAX - 1 || r[k] <= INT32_MIN + 1) {
+            return -1;
+        }
+    }
+    for (k = 0; k < 3; ++k) { /* bound: 3 components */
+        int64_t m = 0;
+        for (s = -1; s <= 1; s += 2) { /* bound: 2 signs */
+            int32_t q[3];
+            int64_t u2, v2;
+            q[0] = r[0];
+            q[1] = r[1];
+            q[2] = r[2];
+            q[k] += s;
+            if (ct_camera_project(cam, q, &u2, &v2) != CT_OK) {
+                return -1;
+            }
+            m = imax64(m, imax64(dist64(u2, pu), dist64(v2, pv)));
+        }
+        sum += m;
+    }
+    return sum;
+}
+
+/* The pixel (Q16) where a lens ray came from, within what the residual
+ * (CT_UNPROJECT_TOL_Q32 in normalised units, i.e. f 2^-26 px, twice for the
+ * evaluation's rounding) and the ray's rounding to Q30 (its effect measured
+ * by proj_sens, three times) allow. */
+static void check_reproject(const ct_camera *cam, const int32_t ray[3], int64_t u, int64_t v)
+{
+    int64_t pu, pv, sens;
+    double f = (double)imax64(cam->lens.fx_q32, cam->lens.fy_q32) / Q32F, tol;
+    const ct_status s = ct_camera_project(cam, ray, &pu, &pv);
+    CHECK(s == CT_OK || s == CT_ERR_UNPROJECT);
+    if (s != CT_OK) {
+        /* only at the valid field's edge: a neighbour of the ray is refused too */
+        CHECK(proj_sens(cam, ray, 0, 0) < 0 || (double)ray[0] * ray[0] + (double)ray[1] * ray[1] >=
+                                                 (double)cam->r2_max_q32 / Q32F * (double)ray[2] * ray[2] * 0.999999);
+        return;
+    }
+    sens = proj_sens(cam, ray, pu, pv);
+    if (sens < 0) {
+        return; /* at the edge: no sensitivity to judge by */
+    }
+    tol = 3.0 * (double)sens + 2.0 * f * 65536.0 * (double)CT_UNPROJECT_TOL_Q32 / Q32F + 4.0;
+    CHECK((double)dist64(pu, u) <= tol && (double)dist64(pv, v) <= tol);
+}
+
+static int lens_model_radial(const ct_lens *l) { return l->dist_q48[2] == 0 && l->dist_q48[3] == 0; }
+
+/* A ray through ct_camera_project, and its pixel back through
+ * ct_camera_unproject: the pixel re-projects (check_reproject); for a lens
+ * without tangential terms (injective on its valid field) the ray comes
+ * back parallel within what the pixel's error (its rounding, the residual,
+ * the projection's rounding) turns into at that pixel, measured by
+ * unprojecting its neighbours. */
+static void check_ray(const ct_camera *cam, const int32_t r[3])
+{
+    int64_t pu, pv, sens, h;
+    int32_t back[3], nb[3];
+    uint32_t it;
+    double f = (double)imax64(cam->lens.fx_q32, cam->lens.fy_q32) / Q32F, e, worst = 0.0, a[3], b[3];
+    ct_status s = ct_camera_project(cam, r, &pu, &pv);
+    int k;
+    CHECK(s == CT_OK || s == CT_ERR_UNPROJECT);
+    if (r[2] <= 0) {
+        CHECK(s == CT_ERR_UNPROJECT);
+    }
+    if (s != CT_OK || !in_pix(pu) || !in_pix(pv)) {
+        return;
+    }
+    s = ct_camera_unproject(cam, pu, pv, back, &it);
+    CHECK((s == CT_OK || s == CT_ERR_UNPROJECT) && it <= CT_UNPROJECT_MAX_ITERS);
+    if (s != CT_OK) {
+        return;
+    }
+    CHECK(unit_q30(back) && back[2] > 0);
+    check_reproject(cam, back, pu, pv);
+    sens = proj_sens(cam, r, pu, pv);
+    if (!lens_model_radial(&cam->lens) || sens < 0) {
+        return;
+    }
+    e = (double)sens + 2.0 * f * 65536.0 * (double)CT_UNPROJECT_TOL_Q32 / Q32F + 2.0; /* pixel error, Q16 */
+    h = (int64_t)e + 1;
+    to_d3(back, b);
+    for (k = 0; k < 4; ++k) { /* bound: 4 neighbours */
+        const int64_t du = k == 0 ? h : (k == 1 ? -h : 0), dv = k == 2 ? h : (k == 3 ? -h : 0);
+        double c[3], c0, c1, c2, s2;
+        if (ct_camera_unproject(cam, pu + du, pv + dv, nb, NULL) != CT_OK) {
+            return;
+        }
+        to_d3(nb, c);
+        c0 = b[1] * c[2] - b[2] * c[1];
+        c1 = b[2] * c[0] - b[0] * c[2];
+        c2 = b[0] * c[1] - b[1] * c[0];
+        s2 = (c0 * c0 + c1 * c1 + c2 * c2) / ((b[0] * b[0] + b[1] * b[1] + b[2] * b[2]) * (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]));
+        if (s2 > worst) {
+            worst = s2;
+        }
+    }
+    to_d3(r, a);
+    CHECK(parallel(a, b, 3.0 * dsqrt(worst) * e / (double)h + 4.0 / 1073741824.0));
+}
+
+/* mode 5: a lens from the input through ct_camera_init, pixels through
+ * ct_camera_unproject and rays through ct_camera_project. */
+static void lens_mode(const uint8_t *d, size_t n)
+{
+    ct_lens lens;
+    ct_camera cam;
+    size_t pos = 1u;
+    const uint32_t fl = n > 0u ? d[0] : 0u;
+    const int how = (int)((fl >> 3) & 3u) >= 2 ? 2 : (int)((fl >> 3) & 3u);
+    uint32_t model = fl & 3u;
+    ct_status st;
+    int k;
+    if (how == 0 && (fl & 4u)) {
+        model = (uint32_t)rd64(d, n, &pos);
+    }
+    lens_from(d, n, &pos, model, how, (fl & 0x80u) != 0u, &lens);
+    st = ct_camera_init(&cam, &lens);
+    CHECK(st == CT_OK || st == CT_ERR_LENS);
+    if (!lens_legal(&lens)) {
+        CHECK(st == CT_ERR_LENS);
+        return;
+    }
+    if (lens.model == CT_LENS_PINHOLE || how == 2) {
+        CHECK(st == CT_OK); /* a valid field around the axis (R = 1, slope 1 there) */
+    }
+    if (st != CT_OK) {
+        return;
+    }
+    CHECK(cam.r2_max_q32 > 0 && cam.r2_max_q32 <= ((int64_t)CT_CAM_MAX_R2 << 32));
+    {
+        int64_t u, v;
+        CHECK(ct_camera_project(&cam, NULL, &u, &v) == CT_ERR_ARG);
+    }
+    for (k = 0; k < 4 && pos < n; ++k) { /* bound: 4 pixels */
+        int64_t u = rd64(d, n, &pos), v = rd64(d, n, &pos);
+        int32_t ray[3];
+        uint32_t it = 99u;
+        if (k >= 1) { /* within 2^20 px; then near the principal point (+-3 f) */
+            u = fold(u, -PIX_LIM_Q16, PIX_LIM_Q16);
+            v = fold(v, -PIX_LIM_Q16, PIX_LIM_Q16);
+        }
+        if (k >= 2) {
+            u = (lens.cx_q32 >> 16) + u % ((lens.fx_q32 >> 16) * 3 + 1);
+            v = (lens.cy_q32 >> 16) + v % ((lens.fy_q32 >> 16) * 3 + 1);
+        }
+        st = ct_camera_unproject(&cam, u, v, ray, &it);
+        CHECK(st == CT_OK || st == CT_ERR_UNPROJECT);
+        CHECK(it <= CT_UNPROJECT_MAX_ITERS);
+        if (lens.model == CT_LENS_PINHOLE) {
+            /* no iteration; the ray ((u - cx) / fx, (v - cy) / fy, 1), refused
+             * exactly beyond x^2 + y^2 = 64 */
+            const double x = ((double)u * 65536.0 - (double)lens.cx_q32) / (double)lens.fx_q32;
+            const double y = ((double)v * 65536.0 - (double)lens.cy_q32) / (double)lens.fy_q32;
+            const double r2 = x * x + y * y;
+            CHECK(it == 0u);
+            if (!in_pix(u) || !in_pix(v) || r2 > 64.000001) {
+                CHECK(st == CT_ERR_UNPROJECT);
+            } else if (r2 < 63.999999) {
+                double a[3], b[3];
+                CHECK(st == CT_OK);
+                a[0] = x;
+                a[1] = y;
+                a[2] = 1.0;
+                to_d3(ray, b);
+                CHECK(parallel(a, b, 4.0 / 1073741824.0));
+            }
+        }
+        if (!in_pix(u) || !in_pix(v)) {
+            CHECK(st == CT_ERR_UNPROJECT);
+        }
+        if (st == CT_OK) {
+            CHECK(unit_q30(ray) && ray[2] > 0);
+            check_reproject(&cam, ray, u, v);
+        }
+    }
+    for (k = 0; k < 4 && pos < n; ++k) { /* bound: 4 rays */
+        int64_t a = rd64(d, n, &pos), b = rd64(d, n, &pos);
+        int32_t r[3];
+        r[0] = (int32_t)a;
+        r[1] = (int32_t)(a >> 32);
+        r[2] = (int32_t)b;
+        if (k >= 1) { /* ahead of the camera, within ~83 deg of the axis mostly */
+            r[2] = (int32_t)(1 + ((uint32_t)b & 0x3fffffffu));
+            r[0] = (int32_t)(((int64_t)r[0] * (int64_t)((b >> 32) & 0xffff)) >> 16) % (8 * (r[2] / 8 + 1));
+            r[1] = (int32_t)(((int64_t)r[1] * (int64_t)((b >> 48) & 0xffff)) >> 16) % (8 * (r[2] / 8 + 1));
+        }
+        check_ray(&cam, r);
+    }
+}
+
+/* ---- grids ---- */
+
+static int32_t g_grid_rays[3u * 256u];
+
+/* Catmull-Rom weights at t in [0, 1] */
+static void cr_ref(double t, double w[4])
+{
+    w[0] = 0.5 * (-t * t * t + 2.0 * t * t - t);
+    w[1] = 0.5 * (3.0 * t * t * t - 5.0 * t * t + 2.0);
+    w[2] = 0.5 * (-3.0 * t * t * t + 4.0 * t * t + t);
+    w[3] = 0.5 * (t * t * t - t * t);
+}
+
+/* The grid's documented unprojection, in double: the 4 x 4 nodes around
+ * the pixel (cell i, fraction t kept to 2^-20 of a step; at a node either
+ * neighbouring cell), Catmull-Rom, renormalised; refused if a node is
+ * missing or (0, 0, 0), |V| < 1/2 or a node more than 60 deg from the
+ * result.  Returns 1 (unprojects), 0 (refused), -1 (within 1e-6 of a
+ * threshold: either); V the interpolated vector. */
+static int grid_ref_at(const ct_unproject_grid *g, int64_t iu, double tu, int64_t iv, double tv, double V[3])
+{
+    double wu[4], wv[4], l, worst = 2.0;
+    int a, b, k;
+    if (iu < 1 || iu > (int64_t)g->nu - 3 || iv < 1 || iv > (int64_t)g->nv - 3) {
+        return 0;
+    }
+    cr_ref(tu, wu);
+    cr_ref(tv, wv);
+    V[0] = V[1] = V[2] = 0.0;
+    for (b = 0; b < 4; ++b) { /* bound: 4 x 4 nodes */
+        for (a = 0; a < 4; ++a) {
+            const int32_t *r = g->rays_q30 + 3 * ((iv + b - 1) * (int64_t)g->nu + iu + a - 1);
+            if (r[0] == 0 && r[1] == 0 && r[2] == 0) {
+                return 0;
+            }
+            for (k = 0; k < 3; ++k) { /* bound: 3 components */
+                V[k] += wv[b] * wu[a] * (double)r[k] / 1073741824.0;
+            }
+        }
+    }
+    l = dsqrt(V[0] * V[0] + V[1] * V[1] + V[2] * V[2]);
+    if (l < 0.5 * (1.0 - 1e-6)) {
+        return 0;
+    }
+    for (b = 0; b < 4; ++b) { /* bound: 4 x 4 nodes */
+        for (a = 0; a < 4; ++a) {
+            const int32_t *r = g->rays_q30 + 3 * ((iv + b - 1) * (int64_t)g->nu + iu + a - 1);
+            const double c = ((double)r[0] * V[0] + (double)r[1] * V[1] + (double)r[2] * V[2]) / (l * 1073741824.0);
+            if (c < worst) {
+                worst = c;
+            }
+        }
+    }
+    if (worst < 0.5 - 1e-6) {
+        return 0;
+    }
+    return l < 0.5 * (1.0 + 1e-6) || worst < 0.5 + 1e-6 ? -1 : 1;
+}
+
+/* cell and fraction along one axis; *alt set where the pixel is on a node
+ * (the cell before it, t = 1, is as good a reading) */
+static void grid_ref_axis(int64_t p, int64_t p0, int64_t step, int64_t *i, double *t, int *alt)
+{
+    int64_t dd = p - p0, k = dd / step, rem;
+    if (dd % step < 0) {
+        k -= 1;
+    }
+    rem = dd - k * step;
+    *i = k;
+    *t = (double)((rem << 20) / step) / 1048576.0;
+    *alt = rem == 0;
+}
+
+static int grid_ref(const ct_unproject_grid *g, int64_t u, int64_t v, double V[3])
+{
+    int64_t iu, iv;
+    double tu, tv, W[3];
+    int au, av, r, r0, r2;
+    if (!in_pix(u) || !in_pix(v)) {
+        return 0;
+    }
+    grid_ref_axis(u, g->u0_q16, g->step_q16, &iu, &tu, &au);
+    grid_ref_axis(v, g->v0_q16, g->step_q16, &iv, &tv, &av);
+    r0 = grid_ref_at(g, iu, tu, iv, tv, V);
+    r = r0;
+    if (au || av) { /* on a node line: the other readings may decide otherwise */
+        int m;
+        for (m = 1; m < 4; ++m) { /* bound: 3 other readings */
+            if (((m & 1) && !au) || ((m & 2) && !av)) {
+                continue;
+            }
+            r2 = grid_ref_at(g, (m & 1) ? iu - 1 : iu, (m & 1) ? 1.0 : tu, (m & 2) ? iv - 1 : iv, (m & 2) ? 1.0 : tv, W);
+            if (r2 != r0) {
+                if (r0 == 0 && r2 != 0) { /* V: a reading that interpolated */
+                    V[0] = W[0];
+                    V[1] = W[1];
+                    V[2] = W[2];
+                }
+                r = -1;
+            }
+        }
+    }
+    return r;
+}
+
+/* mode 13: ct_camera_init_grid on a small grid from the input (its geometry
+ * raw or in range; nodes baked from a plausible lens, a coherent field from
+ * the input, such a field with raw noise near the unit test's 2^-20, or a
+ * field in the plane y = 0), then pixels (on nodes, inside, raw) through
+ * ct_camera_unproject against the documented interpolation. */
+static void grid_mode(const uint8_t *d, size_t n)
+{
+    ct_unproject_grid g;
+    ct_camera cam;
+    size_t pos = 1u;
+    const uint32_t fl = n > 0u ? d[0] : 0u, src = fl & 3u;
+    int64_t a = rd64(d, n, &pos), b = rd64(d, n, &pos), c = rd64(d, n, &pos), e = rd64(d, n, &pos);
+    int64_t pix[12], base[3];
+    uint32_t k, nodes, valid = 1u;
+    ct_status st;
+    int p;
+    memset(&g, 0, sizeof g);
+    if (fl & 4u) { /* raw geometry */
+        g.nu = (uint32_t)a;
+        g.nv = (uint32_t)(a >> 32);
+        g.step_q16 = b;
+        g.u0_q16 = c;
+        g.v0_q16 = e;
+        if (fl & 0x40u) {
+            g.nu = 4u + g.nu % 29u; /* around the table's 256 nodes */
+            g.nv = 4u + g.nv % 29u;
+        }
+        g.rays_len = sizeof g_grid_rays / sizeof g_grid_rays[0];
+    } else {
+        g.nu = 4u + (uint32_t)(a & 0xff) % 13u;
+        g.nv = 4u + (uint32_t)((a >> 8) & 0xff) % 13u;
+        g.step_q16 = 65536 + (fold(b, 0, INT64_C(4095) << 16) >> ((a >> 16) & 31));
+        g.u0_q16 = fold(c, -PIX_LIM_Q16, PIX_LIM_Q16) >> ((a >> 24) & 31);
+        g.v0_q16 = fold(e, -PIX_LIM_Q16, PIX_LIM_Q16) >> ((a >> 32) & 31);
+        g.rays_len = 3u * g.nu * g.nv - ((fl & 0x80u) ? 1u : 0u);
+    }
+    g.rays_q30 = g_grid_rays;
+    for (p = 0; p < 12; ++p) { /* bound: 6 pixels */
+        pix[p] = rd64(d, n, &pos);
+    }
+    for (k = 0u; k < 3u; ++k) { /* bound: 3 components */
+        base[k] = (int16_t)(pos + 1u < n ? (uint32_t)d[pos] | (uint32_t)d[pos + 1u] << 8 : 0u);
+        pos += 2u;
+    }
+    if (base[0] == 0 && base[1] == 0 && base[2] == 0) {
+        base[2] = 1;
+    }
+    /* the nodes: node k is (i, j) = (k % nu, k / nu) */
+    nodes = g.nu >= 1u ? 256u : 0u;
+    memset(g_grid_rays, 0, sizeof g_grid_rays);
+    if (src == 0u && g.nu >= 1u) {
+        ct_lens lens;
+        ct_camera lc;
+        lens_from(d, n, &pos, (fl >> 4) & 3u, 2, 0, &lens);
+        CHECK(ct_camera_init(&lc, &lens) == CT_OK);
+        for (k = 0u; k < nodes; ++k) { /* bound: 256 nodes */
+            const int64_t u = (int64_t)((uint64_t)g.u0_q16 + (uint64_t)(k % g.nu) * ((uint64_t)g.step_q16 & 0xfffffffu));
+            const int64_t v = (int64_t)((uint64_t)g.v0_q16 + (uint64_t)(k / g.nu) * ((uint64_t)g.step_q16 & 0xfffffffu));
+            uint32_t it;
+            if (!in_pix(u) || !in_pix(v) ||
+                ct_camera_unproject(&lc, u, v, g_grid_rays + 3u * k, &it) != CT_OK) {
+                g_grid_rays[3u * k] = g_grid_rays[3u * k + 1u] = g_grid_rays[3u * k + 2u] = 0;
+            }
+        }
+    } else {
+        const unsigned sh = (fl >> 4) & 7u;
+        for (k = 0u; k < nodes; ++k) { /* bound: 256 nodes */
+            int32_t q[3];
+            double w[3], l;
+            uint32_t m;
+            const int32_t n0 = pos < n ? (int8_t)d[pos] : 0;
+            const int32_t n1 = pos + 1u < n ? (int8_t)d[pos + 1u] : 0;
+            const int32_t n2 = pos + 2u < n ? (int8_t)d[pos + 2u] : 0;
+            pos += 3u;
+            if (n0 == -128) {
+                continue; /* a node without a ray */
+            }
+            w[0] = (double)(base[0] * 256 + (int64_t)n0 * (INT64_C(1) << sh));
+            w[1] = src == 3u ? 0.0 : (double)(base[1] * 256 + (int64_t)n1 * (INT64_C(1) << sh));
+            w[2] = (double)(base[2] * 256 + (int64_t)n2 * (INT64_C(1) << sh));
+            l = dsqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+            if (l == 0.0) {
+                continue;
+            }
+            for (m = 0u; m < 3u; ++m) { /* bound: 3 components */
+                double x = w[m] / l * 1073741824.0;
+                q[m] = (int32_t)(x < 0.0 ? x - 0.5 : x + 0.5);
+            }
+            if (src == 2u) { /* raw noise of up to 2^(3..10) Q30 units: the unit test's edge */
+                q[0] += n1 * (INT32_C(1) << (3u + (uint32_t)(e & 7)));
+                q[1] += n2 * (INT32_C(1) << (3u + (uint32_t)((e >> 3) & 7)));
+                q[2] += n0 * (INT32_C(1) << (3u + (uint32_t)((e >> 6) & 7)));
+            }
+            g_grid_rays[3u * k] = q[0];
+            g_grid_rays[3u * k + 1u] = q[1];
+            g_grid_rays[3u * k + 2u] = q[2];
+        }
+    }
+    /* the documented geometry and node checks */
+    if (g.nu < 4u || g.nv < 4u || g.nu > CT_GRID_MAX_NODES || g.nv > CT_GRID_MAX_NODES || g.step_q16 < 65536 ||
+        g.step_q16 > (INT64_C(4096) << 16) || !in_pix(g.u0_q16) || !in_pix(g.v0_q16) ||
+        g.rays_len < 3u * (size_t)g.nu * g.nv) {
+        valid = 0u;
+    } else {
+        for (k = 0u; k < g.nu * g.nv; ++k) { /* bound: <= 256 nodes (rays_len) */
+            const int32_t *r = g_grid_rays + 3u * k;
+            double l;
+            if (r[0] == 0 && r[1] == 0 && r[2] == 0) {
+                continue;
+            }
+            l = dsqrt((double)r[0] * r[0] + (double)r[1] * r[1] + (double)r[2] * r[2]) / 1073741824.0 - 1.0;
+            if (l > 1.01 / 1048576.0 || l < -1.01 / 1048576.0) {
+                valid = 0u;
+            } else if ((l > 0.99 / 1048576.0 || l < -0.99 / 1048576.0) && valid == 1u) {
+                valid = 2u; /* at the edge: either */
+            }
+        }
+    }
+    st = ct_camera_init_grid(&cam, &g);
+    CHECK(st == CT_OK || st == CT_ERR_LENS);
+    CHECK(valid == 2u || st == (valid ? CT_OK : CT_ERR_LENS));
+    if (st != CT_OK) {
+        return;
+    }
+    for (p = 0; p < 6; ++p) { /* bound: 6 pixels */
+        int64_t u = pix[2 * p], v = pix[2 * p + 1];
+        int32_t ray[3];
+        uint32_t it = 99u;
+        double V[3], o[3];
+        int want;
+        const int sel = (int)(((uint64_t)u >> 60) & 3u);
+        if (sel == 0) { /* on a node (or just off the table) */
+            u = g.u0_q16 + ((int64_t)((uint64_t)u % (g.nu + 2u)) - 1) * g.step_q16;
+            v = g.v0_q16 + ((int64_t)((uint64_t)v % (g.nv + 2u)) - 1) * g.step_q16;
+        } else if (sel != 3) { /* within the table's span (and a step beyond) */
+            u = g.u0_q16 + fold(u, -g.step_q16, (int64_t)g.nu * g.step_q16);
+            v = g.v0_q16 + fold(v, -g.step_q16, (int64_t)g.nv * g.step_q16);
+        }
+        st = ct_camera_unproject(&cam, u, v, ray, &it);
+        CHECK(st == CT_OK || st == CT_ERR_UNPROJECT);
+        CHECK(it <= CT_UNPROJECT_MAX_ITERS);
+        want = grid_ref(&g, u, v, V);
+        if (want >= 0) {
+            CHECK(st == (want ? CT_OK : CT_ERR_UNPROJECT));
+        }
+        if (st != CT_OK) {
+            continue;
+        }
+        CHECK(unit_q30(ray));
+        to_d3(ray, o);
+        CHECK(parallel(o, V, 1.0 / 16777216.0)); /* 2^-24 rad */
+        if (src == 3u) {
+            CHECK(ray[1] == 0); /* nodes in the plane y = 0 */
+        }
+        {
+            /* grid cameras have no projection */
+            int64_t pu, pv;
+            CHECK(ct_camera_project(&cam, ray, &pu, &pv) == CT_ERR_LENS);
+        }
+    }
+}
+
 int LLVMFuzzerTestOneInput(const uint8_t *d, size_t n);
 int LLVMFuzzerTestOneInput(const uint8_t *d, size_t n)
 {
@@ -669,6 +1291,14 @@ int LLVMFuzzerTestOneInput(const uint8_t *d, size_t n)
         tileset_mode(d + 1, n - 1u);
     } else if ((d[0] & 1u) == 0u) {
         ray_mode(vp, idx, d + 2, n - 2u);
+    } else if ((d[0] & 7u) == 5u) {
+        /* byte 0 = 5 mod 16 lenses, 13 mod 16 grids (taken from the
+         * package mode, whose corpus inputs all have byte 0 = 1) */
+        if (d[0] & 8u) {
+            grid_mode(d + 1, n - 1u);
+        } else {
+            lens_mode(d + 1, n - 1u);
+        }
     } else {
         package_mode(vp, (d[1] & 0x80u) == 0u, d + 2, n - 2u);
     }
