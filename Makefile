@@ -5,6 +5,7 @@ JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 
 .PHONY: all test demo bench tradeoff cross fuzz coverage soak clean deps
 FUZZ_SECONDS ?= 2700
+FUZZ_HOST_SECONDS ?= 900
 
 all: deps
 	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release
@@ -41,10 +42,11 @@ cross: deps
 	scripts/cross.sh $(BUILD)/cross
 
 # long fuzzing of lib/ (10^7 inputs or FUZZ_SECONDS, whichever comes first,
-# one worker per core);
-# the corpus is kept in $(BUILD)/fuzz_corpus between runs
+# one worker per core), then of the host tools' file readers (FUZZ_HOST_SECONDS);
+# the corpora are kept in $(BUILD)/fuzz_corpus and $(BUILD)/fuzz_host_corpus between runs
 fuzz: all
 	sh tests/fuzz/fuzz.sh $(BUILD) 10000000 $(FUZZ_SECONDS) $(BUILD)/fuzz_corpus
+	sh tests/fuzz/fuzz_host.sh $(BUILD) 100000000 $(FUZZ_HOST_SECONDS) $(BUILD)/fuzz_host_corpus
 
 # many seeded rays (10^7, or SOAK_SECONDS) on generated terrain against the
 # long-double reference, the methods compared (tests/soak.cpp)

@@ -861,6 +861,9 @@ static void test_bad_inputs(void)
          good + "195600,4068000,inf,0,0,-1\n"},
         {"nan", {"trace", pkg, "--rays", "rays.csv", "-o", "hits.csv"}, "rays.csv:2:", "nan", false,
          "E,N,h,dE,dN,dh\n195600,4068000,1500,nan,0,-1\n"},
+        // a NUL ended strtod's text: "-1\0x" was read as -1 (found by fuzz_host)
+        {"nulbyte", {"trace", pkg, "--rays", "rays.csv", "-o", "hits.csv"}, "rays.csv:2:", "bad number '-1?x' in column dh",
+         false, std::string("E,N,h,dE,dN,dh\n195600,4068000,1500,0,0,-1\0x\n", 44)},
         {"dupcol", {"trace", pkg, "--rays", "rays.csv", "-o", "hits.csv"}, "rays.csv:1:", "twice", false,
          "E,N,h,dE,dN,dh,dh\n195600,4068000,1500,0,0,-1,-1\n"},
         {"short", {"trace", pkg, "--rays", "rays.csv", "-o", "hits.csv"}, "rays.csv:3:", "too few", false,

@@ -1302,6 +1302,15 @@ void test_geoloc_bad_inputs()
     const std::string intr = "[ 3000, 3001.5, 1023.5, 767.5, -0.28, 0.09, 0.0001, -0.0002 ]";
     cah.replace(cah.find(intr), intr.size(), "[ 3000, 3001.5, 1023.5, 767.5, 0, 0, 0, 0, 0, 0, 0, 0 ]");
     spit(g_dir + "/cahvore.cameramodel", cah);
+    // libmrcal 2.2 read past the end of these (found by fuzz_host): refused first
+    spit(g_dir + "/unclosed.cameramodel", "{ 'lensmodel': 'LENSMODEL_OPENCV4, 'intrinsics' [ 1, 2 ]\n");
+    static const char nul_model[] = "{ 'lensmodel':\0 'LENSMODEL_OPENCV4' }\n";
+    spit(g_dir + "/nul.cameramodel", std::string(nul_model, sizeof nul_model - 1));
+    // mrcal's message quotes the file's carriage returns: blanked
+    spit(g_dir + "/cr.cameramodel", "{\r\n 'lensmodel\r\r': 'LENSMODEL_OPENCV4' 3,\r\n");
+    // a NUL ended the number's text: '4\0junk' was read as 4
+    static const char nul_csv[] = "u,v\n1,2\n3,4\0junk\n";
+    spit(g_dir + "/nul.csv", std::string(nul_csv, sizeof nul_csv - 1));
     spit(g_dir + "/badnum.csv", "u,v\n1,2\n3,x4\n");
     spit(g_dir + "/nocol.csv", "u,w\n1,2\n");
     spit(g_dir + "/empty.csv", "");
@@ -1323,6 +1332,11 @@ void test_geoloc_bad_inputs()
         {with("--camera", "missing.cameramodel"), "missing.cameramodel"},
         {with("--camera", "garbage.cameramodel"), "garbage.cameramodel"},
         {with("--camera", "cahvore.cameramodel"), "CAHVORE"},
+        {with("--camera", "unclosed.cameramodel"),
+         "unclosed.cameramodel: not a valid mrcal .cameramodel (a string not closed"},
+        {with("--camera", "nul.cameramodel"), "nul.cameramodel: not a valid mrcal .cameramodel (a NUL byte"},
+        {with("--camera", "cr.cameramodel"), "cr.cameramodel: not a valid mrcal .cameramodel ("},
+        {with("--pixels", "nul.csv"), "nul.csv:3: bad number '4?junk' in column v"},
         {with("--pixels", "missing.csv"), "missing.csv"},
         {with("--pixels", "badnum.csv"), "badnum.csv:3"},
         {with("--pixels", "nocol.csv"), "nocol.csv:1"},
@@ -1359,7 +1373,7 @@ void test_geoloc_bad_inputs()
          "--threads"},
     };
     // pixels 'bad.ctp' swap: the package is the second argument
-    cases[7].args = {"geoloc", "bad.ctp", "--camera", "cam.cameramodel", "--pixels", "px.csv", "-o", "out.csv"};
+    cases[11].args = {"geoloc", "bad.ctp", "--camera", "cam.cameramodel", "--pixels", "px.csv", "-o", "out.csv"};
     for (const Case &c : cases) {
         std::set<std::string> before = listing();
         Run r = run(c.args);
@@ -1371,9 +1385,18 @@ void test_geoloc_bad_inputs()
                         r.err.c_str());
         TEST_ASSERT_MSG(r.err_lines[0].rfind("conetrace: ", 0) == 0 && r.err_lines[0].find(c.needle) != std::string::npos,
                         "%s: stderr '%s' lacks '%s'", all.c_str(), r.err_lines[0].c_str(), c.needle.c_str());
+        for (char ch : r.err_lines[0])
+            TEST_ASSERT_MSG((unsigned char)ch >= 0x20 && ch != 0x7f, "%s: a control character in '%s'", all.c_str(),
+                            r.err_lines[0].c_str());
         TEST_ASSERT_MSG(listing() == before, "%s: the directory changed (partial output or temporary left)",
                         all.c_str());
     }
+    // a last comment line without a newline (libmrcal 2.2 read on past the
+    // file for the comment's newline): the model as without it
+    spit(g_dir + "/comment.cameramodel", s->model_text + "\n# no newline after this comment");
+    ct_host::CameraModel a = ct_host::read_cameramodel(g_dir + "/cam.cameramodel");
+    ct_host::CameraModel b = ct_host::read_cameramodel(g_dir + "/comment.cameramodel");
+    TEST_ASSERT(a.model == b.model && a.intrinsics == b.intrinsics && a.width == b.width && a.height == b.height);
     // an existing output survives a failed run
     spit(g_dir + "/out.csv", "keep me\n");
     Run r = run(with("--pixels", "badnum.csv"));

@@ -1,6 +1,7 @@
 // camera_host.cpp -- see camera_host.hpp.
 #include "camera_host.hpp"
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -24,8 +25,11 @@ typedef long double ld;
 
 namespace {
 
-// Run f with stderr redirected to a temporary file; return the last line
-// mrcal wrote there, without its "source.c(123): " prefix ("" if none).
+// Run f with stderr redirected to a temporary file; return the last message
+// mrcal wrote there, without its "source.c(123): " prefix ("" if none), as
+// one line: a message may run over several lines (mrcal quotes the text it
+// could not parse), and control characters are blanked (a '\r' in the
+// file would overwrite the terminal's line); cut to 300 characters.
 template <class F>
 std::string quiet_mrcal(F f)
 {
@@ -41,14 +45,28 @@ std::string quiet_mrcal(F f)
     if (cap) {
         std::rewind(cap);
         char buf[512];
+        bool at_line_start = true;
         while (std::fgets(buf, sizeof buf, cap)) {
             std::string s(buf);
-            while (!s.empty() && (s.back() == '\n' || s.back() == '\r')) s.pop_back();
+            const bool whole = !s.empty() && s.back() == '\n';
             size_t k = s.find("): ");
-            if (k != std::string::npos && k < 60) s = s.substr(k + 3);
-            if (!s.empty()) why = s;
+            if (at_line_start && k != std::string::npos && k < 60) {
+                why = s.substr(k + 3);  // a new message
+            } else if (why.size() < 400) {
+                why += ' ';  // the message goes on
+                why += s;
+            }
+            at_line_start = whole;
         }
         std::fclose(cap);
+        for (char &c : why)
+            if ((unsigned char)c < 0x20 || c == 0x7f) c = ' ';
+        std::string one;  // blanks collapsed, ends trimmed
+        for (char c : why)
+            if (c != ' ' || (!one.empty() && one.back() != ' ')) one += c;
+        while (!one.empty() && one.back() == ' ') one.pop_back();
+        if (one.size() > 300) one = one.substr(0, 300) + " ...";
+        why = one;
     }
     return why;
 }
@@ -151,16 +169,69 @@ ct_lens lens_from_intrinsics(const std::string &model, const std::vector<double>
     return l;
 }
 
+namespace {
+
+// libmrcal 2.2's parser (Debian 12) scans a quoted string to its closing
+// quote and a '#' comment to its newline without stopping at the end of
+// the text, and copies the lens model's name and each number into arrays
+// on the stack: an unterminated string or a last comment line without a
+// newline read past the end of the file's bytes (found by fuzz_host), a
+// 10 MB number would overflow the stack.  What it is given is checked
+// first (strings and comments found as its lexer finds them: a comment
+// outside strings, strings closed by either quote); "" if acceptable.
+std::string mrcal_unsafe(const std::string &t)
+{
+    if (t.find('\0') != std::string::npos) return "a NUL byte (not a text file)";
+    size_t run = 0;  // characters of one number so far
+    std::string last;  // the string before this one (a key: "lensmodel"?)
+    for (size_t k = 0; k < t.size(); ++k) {
+        const char c = t[k];
+        if (c == '#') {
+            k = t.find('\n', k);  // the caller appended a newline
+            run = 0;
+        } else if (c == '\'' || c == '"') {
+            const size_t e = t.find_first_of("'\"", k + 1);
+            if (e == std::string::npos) return "a string not closed (from byte " + std::to_string(k) + ")";
+            if (last == "lensmodel" && e - k > 1000) return "a lens model name of over 1000 characters";
+            last = t.substr(k + 1, std::min<size_t>(e - k - 1, 16));
+            k = e;
+            run = 0;
+        } else if ((c >= '0' && c <= '9') || c == '.' || c == '-' || c == '+' || c == 'e' || c == 'E') {
+            if (++run > 1000) return "a number of over 1000 characters";
+        } else {
+            run = 0;
+        }
+    }
+    return "";
+}
+
+}  // namespace
+
 CameraModel read_cameramodel(const std::string &path)
 {
+    std::string text;
     {
         std::FILE *f = std::fopen(path.c_str(), "rb");
         if (!f) throw Error(path + ": " + std::strerror(errno));
+        char buf[65536];
+        size_t n;
+        while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) {
+            text.append(buf, n);
+            if (text.size() > ((size_t)1 << 30)) {
+                std::fclose(f);
+                throw Error(path + ": over 1 GB: not a .cameramodel");
+            }
+        }
+        const bool bad = std::ferror(f) != 0;
         std::fclose(f);
+        if (bad) throw Error(path + ": cannot read");
     }
+    text += '\n';  // a last comment line ends
+    const std::string unsafe = mrcal_unsafe(text);
+    if (!unsafe.empty()) throw Error(path + ": not a valid mrcal .cameramodel (" + unsafe + ")");
     // mrcal reports parse errors on stderr: capture them into one line
     mrcal_cameramodel_t *m = nullptr;
-    std::string why = quiet_mrcal([&] { m = mrcal_read_cameramodel_file(path.c_str()); });
+    std::string why = quiet_mrcal([&] { m = mrcal_read_cameramodel_string(text.c_str(), (int)text.size()); });
     if (!m) throw Error(path + ": not a valid mrcal .cameramodel" + (why.empty() ? "" : " (" + why + ")"));
     CameraModel c;
     char name[256];

@@ -242,7 +242,7 @@ void read_georef(const std::string &path, DemRaster &r)
         errno = 0;
         double v = std::strtod(s.c_str(), &end);
         if (s.empty() || end == s.c_str() || *end != '\0')
-            throw fail("unparsable GDAL_NODATA value '" + s + "'");
+            throw fail("unparsable GDAL_NODATA value '" + clipped(s, 60) + "'");
         r.has_nodata = true;
         r.nodata = v;
     }

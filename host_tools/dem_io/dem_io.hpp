@@ -76,11 +76,12 @@ private:
     void *handle_ = nullptr;
 };
 
-// A library's message on one line (line breaks as spaces, ends trimmed).
+// A library's message on one line (line breaks and other control
+// characters as spaces: a message may quote the file's bytes; ends trimmed).
 inline std::string one_line(std::string s)
 {
     for (char &c : s)
-        if (c == '\n' || c == '\r') c = ' ';
+        if ((unsigned char)c < 0x20 || c == 0x7f) c = ' ';
     while (!s.empty() && s.back() == ' ') s.pop_back();
     size_t b = 0;
     while (b < s.size() && s[b] == ' ') b++;

@@ -128,6 +128,18 @@ std::string parse_cmdline(int argc, char **argv, int first, const std::vector<st
     return "";
 }
 
+namespace {
+// A field of a file quoted in a message: control characters (a NUL would
+// end the message, a '\r' overwrite the line) as '?', cut to 60 characters.
+std::string printable(const std::string &s)
+{
+    std::string o = s.substr(0, 60);
+    for (char &c : o)
+        if ((unsigned char)c < 0x20 || c == 0x7f) c = '?';
+    return s.size() > 60 ? o + "..." : o;
+}
+}  // namespace
+
 void read_number_csv(const std::string &path, const std::vector<std::string> &names,
                      const std::function<void(const double *v, const std::vector<std::string> &text)> &row)
 {
@@ -173,10 +185,12 @@ void read_number_csv(const std::string &path, const std::vector<std::string> &na
         for (size_t k = 0; k < n; ++k) {
             if ((size_t)col[k] >= f.size()) throw Error(path + ":" + std::to_string(lineno) + ": too few columns");
             char *end = nullptr;
-            v[k] = std::strtod(f[col[k]].c_str(), &end);
-            if (f[col[k]].empty() || !end || *end || !std::isfinite(v[k]))
-                throw Error(path + ":" + std::to_string(lineno) + ": bad number '" + f[col[k]] + "' in column " +
-                            names[k]);
+            const std::string &t = f[col[k]];
+            v[k] = std::strtod(t.c_str(), &end);
+            // the whole field a number (a NUL in it would end strtod's text)
+            if (t.empty() || end != t.c_str() + t.size() || !std::isfinite(v[k]))
+                throw Error(path + ":" + std::to_string(lineno) + ": bad number '" + printable(f[col[k]]) +
+                            "' in column " + names[k]);
             text[k] = std::move(f[col[k]]);
         }
         row(v.data(), text);

@@ -87,13 +87,24 @@ inline Scene read_scene(const std::string &path)
         std::istringstream is(line);
         std::string key;
         if (!(is >> key)) continue;
-        auto bad = [&](const std::string &why) { throw ct_host::Error(path + ":" + std::to_string(ln) + ": " + why); };
+        auto bad = [&](std::string why) {
+            for (char &c : why)  // the file's text quoted: no control characters
+                if ((unsigned char)c < 0x20 || c == 0x7f) c = '?';
+            throw ct_host::Error(path + ":" + std::to_string(ln) + ": " + why.substr(0, 200));
+        };
         auto nums = [&](size_t n) {
             std::vector<double> v;
             double x;
             while (is >> x) v.push_back(x);
             if (!is.eof() || (n && v.size() != n)) bad("'" + key + "' needs " + std::to_string(n) + " numbers");
             return v;
+        };
+        // a whole number in [lo, hi] (checked before a cast: a double beyond an
+        // int's range is undefined behaviour)
+        auto whole = [&](double x, double lo, double hi) {
+            if (!(x >= lo && x <= hi && x == std::floor(x)))
+                bad("'" + key + "' needs whole numbers in " + std::to_string((long)lo) + ".." + std::to_string((long)hi));
+            return x;
         };
         if (key == "name") {
             if (!(is >> s.name)) bad("name needs a value");
@@ -102,11 +113,12 @@ inline Scene read_scene(const std::string &path)
             have[0] = true;
         } else if (key == "tile") {
             auto v = nums(2);
+            if (!(v[0] >= 1 && v[0] <= 8 && v[1] >= 1 && v[1] <= 8 && v[0] == std::floor(v[0]) && v[1] == std::floor(v[1])))
+                bad("tile needs 1..8 1..8");
             s.tile_x = (int)v[0], s.tile_y = (int)v[1];
-            if (s.tile_x < 1 || s.tile_y < 1 || s.tile_x > 8 || s.tile_y > 8) bad("tile needs 1..8 1..8");
         } else if (key == "package") {
             auto v = nums(2);
-            s.sectors = (int)v[0], s.reduce = (int)v[1];
+            s.sectors = (int)whole(v[0], 1, 1 << 20), s.reduce = (int)whole(v[1], 1, 1 << 20);
         } else if (key == "camera") {
             if (!(is >> s.camera)) bad("camera needs a path");
             have[1] = true;
@@ -116,7 +128,7 @@ inline Scene read_scene(const std::string &path)
             have[2] = true;
         } else if (key == "imager") {
             auto v = nums(2);
-            s.width = (unsigned)v[0], s.height = (unsigned)v[1];
+            s.width = (unsigned)whole(v[0], 1, 1 << 30), s.height = (unsigned)whole(v[1], 1, 1 << 30);
             have[3] = true;
         } else if (key == "pose") {
             auto v = nums(6);
