@@ -1108,17 +1108,23 @@ void test_fitted_map()
 // curvature, with refraction, and with the map fitted (its cube crosses
 // the edge: the exact map instead).  A piece reaching past the edge was a
 // miss, though the tile lay on it: 276 hits of 3,199 pixels were missed.
-void test_zone_edge()
+// The easting of zone 17's western edge (longitude -90 deg) at northing
+// 4,064.5 km, by bisection through PROJ's inverse.
+ld zone17_west_edge(earth_ref::Proj &pj)
 {
-    earth_ref::Proj &pj = proj();
-    // the easting of longitude -90 deg at northing 4,064.5 km (bisection)
     ld lo = -400000, hi = -200000, lat, lon;
     for (int k = 0; k < 60; ++k) {
         const ld mid = (lo + hi) / 2;
         pj.utm_inverse(mid, 4064500, &lat, &lon);
         (lon < -90 ? lo : hi) = mid;
     }
-    const ld Eedge = lo;
+    return lo;
+}
+
+void test_zone_edge()
+{
+    earth_ref::Proj &pj = proj();
+    const ld Eedge = zone17_west_edge(pj);
     static World *w = nullptr;
     if (!w) {
         w = new World;
@@ -1310,12 +1316,7 @@ void judge_domain(World *w, earth_ref::Proj &pj, ld lon0, const Cam &cam, const 
 void test_zone_edge_straddle()
 {
     earth_ref::Proj &pj = proj();
-    ld lo = -400000, hi = -200000, lat, lon;
-    for (int k = 0; k < 60; ++k) {
-        const ld mid = (lo + hi) / 2;
-        pj.utm_inverse(mid, 4064500, &lat, &lon);
-        (lon < -90 ? lo : hi) = mid;
-    }
+    const ld lo = zone17_west_edge(pj);
     static World *w = nullptr;
     if (!w)
         w = synthetic(32617, std::floor(lo) - 1000, 4066000, 30.0, 101, 101,
