@@ -156,8 +156,8 @@ void read_number_csv(const std::string &path, const std::vector<std::string> &na
             if (ch == ',') {
                 v.push_back(cur);
                 cur.clear();
-            } else if (ch != '\r' && ch != ' ' && ch != '\t') {
-                cur += ch;
+            } else if (ch != '\r' && ch != ' ' && ch != '\t' && ch != '\f' && ch != '\v') {
+                cur += ch;  // blanks of every kind dropped (strtod would skip them, the text keep them)
             }
         }
         v.push_back(cur);
@@ -180,7 +180,7 @@ void read_number_csv(const std::string &path, const std::vector<std::string> &na
     int lineno = 1;
     while (std::getline(in, line)) {
         ++lineno;
-        if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+        if (line.find_first_not_of(" \t\r\f\v") == std::string::npos) continue;
         std::vector<std::string> f = split(line);
         for (size_t k = 0; k < n; ++k) {
             if ((size_t)col[k] >= f.size()) throw Error(path + ":" + std::to_string(lineno) + ": too few columns");

@@ -88,7 +88,7 @@ size_t data_lines(const uint8_t *p, size_t n)
         bool blank = true;
         size_t b = k;
         while (k < n && p[k] != '\n') {
-            if (p[k] != ' ' && p[k] != '\t' && p[k] != '\r') blank = false;
+            if (p[k] != ' ' && p[k] != '\t' && p[k] != '\r' && p[k] != '\f' && p[k] != '\v') blank = false;
             ++k;
         }
         if (b < n && !blank) ++lines;
