@@ -518,6 +518,19 @@ static void test_errors(void)
         std::ofstream(g_dir + "/junk.ctp") << "CTPK garbage";
     }
     expect_failure({"junk.ctp", "--what", "apex", "-o", "keep.png"}, "junk.ctp");
+    // a DEM wider than a package may be (40,000 x 2 posts): refused from its
+    // header, as build refuses it
+    {
+        ct_host::Georef g;
+        g.origin_e = 500000;
+        g.origin_n = 4000000;
+        g.posting_e = 30.0;
+        g.posting_n = -30.0;
+        g.epsg = 32617;
+        ct_host::write_geotiff(g_dir + "/wide.tif", 40000, 2, std::vector<double>(80000, 100.0),
+                               ct_host::SampleType::Int16, g);
+    }
+    expect_failure({"wide.tif", "--what", "bitmap", "--slice", "100", "-o", "keep.png"}, "posts per side");
 }
 
 int main(void)

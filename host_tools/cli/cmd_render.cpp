@@ -115,6 +115,16 @@ Input load_input(const std::string &path)
         open_package_file(path, &in.bytes, &in.pkg);
         in.t = terrain_from_package(in.pkg);
     } else {
+        {
+            // the size from the header first, as build's: a DEM beyond one
+            // package is refused before its pixels are read (a compressed
+            // file's header could promise any size)
+            DemRows rows(path);
+            const int w = rows.header().width, h = rows.header().height;
+            if (w > kMaxPackagePosts || h > kMaxPackagePosts)
+                throw Error(path + ": DEM of " + std::to_string(w) + "x" + std::to_string(h) +
+                            " posts: render takes at most " + std::to_string(kMaxPackagePosts) + " posts per side");
+        }
         DemRaster r = read_dem(path);
         try {
             in.t = terrain_from_heights(r.width, r.height, r.h, r.valid, r.geo, 0.0);
