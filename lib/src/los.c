@@ -44,13 +44,13 @@ static ct_status to_ecef(const ct_utm *zone, const int64_t m[3], int64_t x[3])
  * pose at A; its frame is all that is read); A and B also in ECEF (A[],
  * B[]).  fx checked by the caller.  CT_ERR_RAY: a point off the zone's
  * projection, or A = B. */
-static ct_status earth_aim(const ct_utm *zone, const ct_earth *es, const int64_t a_nm[3], const int64_t b_nm[3],
+static ct_status earth_aim(const ct_earth *es, const int64_t a_nm[3], const int64_t b_nm[3],
                            const ct_effects *fx, int64_t A[3], int64_t B[3], int64_t dg[3])
 {
     int64_t d[3], big = 0;
     int k, j;
     unsigned sh = 0u;
-    if (to_ecef(zone, a_nm, A) != CT_OK || to_ecef(zone, b_nm, B) != CT_OK) {
+    if (to_ecef(&es->zone, a_nm, A) != CT_OK || to_ecef(&es->zone, b_nm, B) != CT_OK) {
         return CT_ERR_RAY;
     }
     for (k = 0; k < 3; ++k) { /* bound: 3 axes */
@@ -129,33 +129,39 @@ static ct_status earth_aim(const ct_utm *zone, const ct_earth *es, const int64_t
     return CT_OK;
 }
 
+/* ct_earth_setup at a pose with fx's refraction (bent on the sphere of
+ * CT_EARTH_RADIUS_NM), no bend flags, the map fitted or given as asked:
+ * CT_ERR_CRS for a package on no UTM zone (its zone check), CT_ERR_RAY for
+ * a point beyond the grid's range, CT_ERR_EFFECTS for any other refusal. */
+static ct_status earth_at(const ct_package *p, const ct_pose *pose, const ct_effects *fx, int64_t chord_nm, int fitted,
+                          const ct_earth_map *map, ct_earth *es)
+{
+    ct_status st = ct_earth_setup(p, pose, (fx->flags & CT_EFFECT_REFRACTION) != 0u ? fx->refraction_k_q16 : 0,
+                                  CT_EARTH_RADIUS_NM, chord_nm, 0u, fitted, map, es);
+    return st == CT_OK || st == CT_ERR_CRS || st == CT_ERR_RAY ? st : CT_ERR_EFFECTS;
+}
+
 /* The true Earth (curvature with radius 0 on a UTM package): the Earth-fixed
  * line of sight from A aimed at B (earth_aim), traced by earth.c as
  * geolocation does; hidden when its first hit lies more than the margin
  * (Earth-fixed distance from A) before B.  fx checked and its chord taken
- * by the caller (ct_effects_to_bend).  CT_ERR_CRS: not UTM. */
+ * by the caller (ct_effects_to_bend).  CT_ERR_CRS: not UTM (earth_at). */
 static ct_status los_earth(const ct_package *p, ct_tileset *ts, const int64_t a_nm[3], const int64_t b_nm[3],
                            const ct_effects *fx, int64_t chord_nm, int64_t margin_nm, ct_method m, ct_hit *block)
 {
     static const int32_t ident[9] = {1 << 30, 0, 0, 0, 1 << 30, 0, 0, 0, 1 << 30};
-    ct_utm zone;
     ct_pose pose;
     ct_earth es;
     int64_t A[3], B[3], H[3], dg[3], lim;
     ct_status st;
-    if (p->epsg > 0x7fffffffu || ct_utm_zone_of_epsg((int32_t)p->epsg, &zone) != CT_OK) {
-        return CT_ERR_CRS;
-    }
     if (ct_pose_init(&pose, ident, a_nm[0], a_nm[1], a_nm[2]) != CT_OK) {
         return CT_ERR_RAY;
     }
-    st = ct_earth_setup(p, &pose, (fx->flags & CT_EFFECT_REFRACTION) != 0u ? fx->refraction_k_q16 : 0,
-                        CT_EARTH_RADIUS_NM, chord_nm, 0u,
-                        (fx->flags & CT_EFFECT_EARTH_FIT) != 0u, fx->earth_map, &es);
+    st = earth_at(p, &pose, fx, chord_nm, (fx->flags & CT_EFFECT_EARTH_FIT) != 0u, fx->earth_map, &es);
     if (st != CT_OK) {
-        return st == CT_ERR_RAY ? CT_ERR_RAY : CT_ERR_EFFECTS;
+        return st;
     }
-    st = earth_aim(&zone, &es, a_nm, b_nm, fx, A, B, dg);
+    st = earth_aim(&es, a_nm, b_nm, fx, A, B, dg);
     if (st != CT_OK) {
         return st;
     }
@@ -168,7 +174,7 @@ static ct_status los_earth(const ct_package *p, ct_tileset *ts, const int64_t a_
     }
     {
         const int64_t hm[3] = {block->e_nm, block->n_nm, block->h_nm};
-        if (to_ecef(&zone, hm, H) != CT_OK) {
+        if (to_ecef(&es.zone, hm, H) != CT_OK) {
             return CT_ERR_RAY;
         }
         lim = dist3(A, B) - margin_nm;
@@ -300,23 +306,17 @@ ct_status ct_los_tiles(ct_tileset *ts, const int64_t a_nm[3], const int64_t b_nm
 static ct_status inverse_earth(const ct_package *p, const ct_pose *pose, const ct_effects *fx, int64_t chord_nm,
                                const int64_t g_nm[3], int64_t dg[3])
 {
-    ct_utm zone;
     ct_earth es;
     int64_t c[3], A[3], B[3];
-    ct_status st;
-    if (p->epsg > 0x7fffffffu || ct_utm_zone_of_epsg((int32_t)p->epsg, &zone) != CT_OK) {
-        return CT_ERR_CRS;
-    }
     /* only the frame at the camera is read: no map fitted */
-    st = ct_earth_setup(p, pose, (fx->flags & CT_EFFECT_REFRACTION) != 0u ? fx->refraction_k_q16 : 0,
-                        CT_EARTH_RADIUS_NM, chord_nm, 0u, 0, NULL, &es);
+    ct_status st = earth_at(p, pose, fx, chord_nm, 0, NULL, &es);
     if (st != CT_OK) {
-        return st == CT_ERR_RAY ? CT_ERR_RAY : CT_ERR_EFFECTS;
+        return st;
     }
     c[0] = pose->e_nm;
     c[1] = pose->n_nm;
     c[2] = pose->h_nm;
-    return earth_aim(&zone, &es, c, g_nm, fx, A, B, dg);
+    return earth_aim(&es, c, g_nm, fx, A, B, dg);
 }
 
 ct_status ct_locate_inverse(const ct_package *p, const ct_camera *cam, const ct_pose *pose, const ct_effects *effects,
