@@ -680,23 +680,9 @@ void test_bent_saturated_vertices()
 // (the surface crossed within the vertex rounding), not CT_BELOW.  Rays
 // found by a search (steep in Q16: 600 LSB per cell), judged as every
 // other: the four methods, culling, the reference's sandwich.
-const ct_ray kBelowAfterEntered[] = {
-    {1463966, 1863104, 824113802, -11723337624, -8935396427, -1099511627776},
-    {1094272, 1384564, 487285953, -2179200295, -1912324554, -1099511627776},
-    {895832, 844974, 639287769, -1769281208, 4330961408, -1099511627776},
-    {1032338, 2035326, 661998285, 10652333117, 8898833412, -1099511627776},
-    {524396, 1695986, 818069374, 3617659896, -126108301, -1099511627776},
-};
-
-dem_cases::Case below_after_entered_case()
-{
-    return dem_cases::make_case("1 mm codes", dem_cases::make_terrain(40, 40, dem_cases::smooth(40, 40, 5, 1000, 30000), 0.001),
-                                8, 1);
-}
-
 void test_bent_start_below_after_entered()
 {
-    const dem_cases::Case cs = below_after_entered_case();
+    const dem_cases::Case cs = dem_cases::make_case("1 mm codes", dem_cases::below_after_entered_terrain(), 8, 1);
     ct_package p;
     TEST_ASSERT_EQUAL_INT(CT_OK, ct_package_open(&p, cs.pkg.data(), cs.pkg.size()));
     TEST_ASSERT(p.zshift_max >= 12);
@@ -704,7 +690,7 @@ void test_bent_start_below_after_entered()
     const Scene sc = {"c = -4, R 2^40 nm, 0.1 mm", -4.0, (double)(INT64_C(1) << 40) * 1e-9, 1e-4};
     Counts cnt;
     long n = 0;
-    for (const ct_ray &ray : kBelowAfterEntered) judge_ray(p, d, max_slope(d), cs, sc, ray, n++, &cnt);
+    for (const ct_ray &ray : dem_cases::kBelowAfterEnteredRays) judge_ray(p, d, max_slope(d), cs, sc, ray, n++, &cnt);
     printf("  %-20s %-28s %ld rays: %ld hit, %ld miss, %ld below; bad %ld\n", cs.name.c_str(), sc.name, cnt.rays,
            cnt.hits, cnt.miss, cnt.below, cnt.bad);
     TEST_ASSERT(cnt.bad == 0 && cnt.polyline == cnt.rays && cnt.hits == cnt.rays);

@@ -1181,7 +1181,7 @@ void test_bent_saturated()
 // bit.
 void test_bent_start_below_after_entered()
 {
-    const ct_host::Terrain t = dem_cases::make_terrain(40, 40, dem_cases::smooth(40, 40, 5, 1000, 30000), 0.001);
+    const ct_host::Terrain t = dem_cases::below_after_entered_terrain();
     ct_host::BuildOptions o;
     o.sectors = 8;
     o.reduce = 1;
@@ -1191,16 +1191,9 @@ void test_bent_start_below_after_entered()
     TEST_ASSERT_EQUAL_INT(CT_OK, ct_package_open(&mp, merged.data(), merged.size()));
     Set set;
     TEST_ASSERT_EQUAL_INT(CT_OK, set.open(tb, 2));
-    const ct_ray rays[] = {
-        {1463966, 1863104, 824113802, -11723337624, -8935396427, -1099511627776},
-        {1094272, 1384564, 487285953, -2179200295, -1912324554, -1099511627776},
-        {895832, 844974, 639287769, -1769281208, 4330961408, -1099511627776},
-        {1032338, 2035326, 661998285, 10652333117, 8898833412, -1099511627776},
-        {524396, 1695986, 818069374, 3617659896, -126108301, -1099511627776},
-    };
     const ct_bend bd = {-4 * 65536, INT64_C(1) << 40, 100000, 0u};
     long hits = 0;
-    for (const ct_ray &ray : rays) {
+    for (const ct_ray &ray : dem_cases::kBelowAfterEnteredRays) {
         ct_bent_setup bs, bm;
         TEST_ASSERT_EQUAL_INT(CT_OK, ct_bent_prepare(&set.ts.frame, &bd, ray.x_q16, ray.y_q16, &bs));
         TEST_ASSERT_EQUAL_INT(CT_OK, ct_bent_prepare(&mp, &bd, ray.x_q16, ray.y_q16, &bm));

@@ -27,14 +27,8 @@ VEC="$BUILD/tests/mcu/ct_vectors.c"
 [ -f "$VEC" ] || { echo "fuzz: $VEC missing (build the project first)"; exit 1; }
 command -v "$CC" >/dev/null 2>&1 || { echo "fuzz: $CC not found (scripts/deps.sh installs clang)"; exit 77; }
 mkdir -p "$OUT"
-if [ -z "$CORPUS" ]; then
-    CORPUS=$(mktemp -d /tmp/ct_fuzz_XXXXXX)
-    trap 'rm -rf "$CORPUS"' EXIT
-fi
-mkdir -p "$CORPUS"
-CORPUS=$(cd "$CORPUS" && pwd)  # absolute: the fuzzer runs in $OUT
-# the seed corpus: inputs worth keeping (earlier findings among them)
-cp "$ROOT"/tests/fuzz/corpus/* "$CORPUS"/ 2>/dev/null || true
+. "$ROOT/tests/fuzz/common.sh"
+fuzz_corpus "$ROOT"/tests/fuzz/corpus ct_fuzz
 FLAGS="-g -O1 -std=c99 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all -fno-sanitize-coverage=trace-cmp"
 if ! "$CC" $FLAGS -I"$ROOT/lib/include" -I"$ROOT/lib/src" -I"$ROOT/tests/mcu" \
         "$ROOT/tests/fuzz/fuzz_lib.c" "$VEC" "$ROOT"/lib/src/*.c -o "$OUT/fuzz_lib" 2>"$OUT/build.log"; then
@@ -44,17 +38,10 @@ if ! "$CC" $FLAGS -I"$ROOT/lib/include" -I"$ROOT/lib/src" -I"$ROOT/tests/mcu" \
     cat "$OUT/build.log"; echo "fuzz: build failed"; exit 1
 fi
 cd "$OUT" || exit 1
-LIMIT=""
-[ "$SECS" -gt 0 ] && LIMIT="-max_total_time=$SECS"
-FORK=""
-if [ "$RUNS" -gt 100000 ]; then
-    # a long run: one worker per core; the parent counts every worker's inputs
-    FORK="-fork=${FUZZ_JOBS:-$(nproc 2>/dev/null || echo 1)}"
-fi
+fuzz_limits
 ./fuzz_lib $FORK -runs="$RUNS" $LIMIT -seed=1 -max_len=512 -len_control=0 -print_final_stats=1 "$CORPUS" >"$OUT/run.log" 2>&1
 rc=$?
-grep -E "^(stat::number_of_executed_units|stat::new_units_added)|^#[0-9]+.*DONE|Done [0-9]+ runs|fuzzed for [0-9]+ iterations" "$OUT/run.log"
-grep -E "oom/timeout/crash" "$OUT/run.log" | tail -n 1
+fuzz_summary "$OUT/run.log"
 if [ $rc -ne 0 ]; then
     tail -40 "$OUT/run.log"
     echo "fuzz: FINDING (input saved in $OUT, see run.log)"

@@ -27,13 +27,8 @@ OUT="$BUILD/fuzz_host"
 command -v "$CXX" >/dev/null 2>&1 || { echo "fuzz_host: $CXX not found (scripts/deps.sh installs clang)"; exit 77; }
 command -v "$CC" >/dev/null 2>&1 || { echo "fuzz_host: $CC not found (scripts/deps.sh installs clang)"; exit 77; }
 mkdir -p "$OUT/obj"
-if [ -z "$CORPUS" ]; then
-    CORPUS=$(mktemp -d /tmp/ct_fuzz_host_XXXXXX)
-    trap 'rm -rf "$CORPUS"' EXIT
-fi
-mkdir -p "$CORPUS"
-CORPUS=$(cd "$CORPUS" && pwd)  # absolute: the fuzzer runs in $OUT
-cp "$ROOT"/tests/fuzz/corpus_host/* "$CORPUS"/ 2>/dev/null || true
+. "$ROOT/tests/fuzz/common.sh"
+fuzz_corpus "$ROOT"/tests/fuzz/corpus_host ct_fuzz_host
 
 SAN="-g -O1 -fsanitize=address,undefined -fno-sanitize-recover=all"
 H="$ROOT/host_tools"
@@ -63,12 +58,7 @@ if [ $fail -ne 0 ] || ! "$CXX" $SAN -fsanitize=fuzzer -std=c++17 $INC "$ROOT/tes
     cat "$OUT/build.log"; echo "fuzz_host: build failed"; exit 1
 fi
 cd "$OUT" || exit 1
-LIMIT=""
-[ "$SECS" -gt 0 ] && LIMIT="-max_total_time=$SECS"
-FORK=""
-if [ "$RUNS" -gt 100000 ]; then
-    FORK="-fork=${FUZZ_JOBS:-$(nproc 2>/dev/null || echo 1)}"
-fi
+fuzz_limits
 # -timeout: one input over 20 s is a hang; -rss_limit_mb: a header may
 # promise gigabytes the harness then declines to allocate (see dem())
 rm -f "$OUT"/san.*
@@ -76,8 +66,7 @@ ASAN_OPTIONS=${ASAN_OPTIONS:-log_path=$OUT/san} UBSAN_OPTIONS=${UBSAN_OPTIONS:-l
 ./fuzz_host $FORK -runs="$RUNS" $LIMIT -seed=1 -max_len=4096 -timeout=20 -rss_limit_mb=2048 \
     -print_final_stats=1 "$CORPUS" >"$OUT/run.log" 2>&1
 rc=$?
-grep -E "^(stat::number_of_executed_units|stat::new_units_added)|^#[0-9]+.*DONE|Done [0-9]+ runs|fuzzed for [0-9]+ iterations" "$OUT/run.log"
-grep -E "oom/timeout/crash" "$OUT/run.log" | tail -n 1
+fuzz_summary "$OUT/run.log"
 if [ $rc -ne 0 ]; then
     grep -a -v -E "^#[0-9]+ +(NEW|REDUCE|pulse)|NEW_FUNC" "$OUT/run.log" | tail -30
     grep -a "FINDING" "$OUT/run.log" | cut -c1-500

@@ -164,6 +164,22 @@ struct Geo {
     }
 };
 
+// Polyline segments that start just under the surface after the polyline
+// entered (a bend of c = -4, R = 2^40 nm and a 0.1 mm chord): 1 mm height
+// codes on 30 m posts, and five rays found by a search (test_bend on a
+// package, test_tiles over a set).
+inline ct_host::Terrain below_after_entered_terrain()
+{
+    return make_terrain(40, 40, smooth(40, 40, 5, 1000, 30000), 0.001);
+}
+const ct_ray kBelowAfterEnteredRays[5] = {
+    {1463966, 1863104, 824113802, -11723337624, -8935396427, -1099511627776},
+    {1094272, 1384564, 487285953, -2179200295, -1912324554, -1099511627776},
+    {895832, 844974, 639287769, -1769281208, 4330961408, -1099511627776},
+    {1032338, 2035326, 661998285, 10652333117, 8898833412, -1099511627776},
+    {524396, 1695986, 818069374, 3617659896, -126108301, -1099511627776},
+};
+
 // t mirror-tiled to w x h posts (every other copy flipped, so heights stay
 // continuous across the seams); the voids are dropped.
 inline ct_host::Terrain mirror_tiled(const ct_host::Terrain &t, int w, int h)
