@@ -5,7 +5,7 @@ JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 
 .PHONY: all test demo bench tradeoff cross fuzz coverage soak clean deps
 FUZZ_SECONDS ?= 2700
-FUZZ_HOST_SECONDS ?= 900
+FUZZ_HOST_SECONDS ?= 3600
 
 all: deps
 	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release
@@ -46,7 +46,7 @@ cross: deps
 # the corpora are kept in $(BUILD)/fuzz_corpus and $(BUILD)/fuzz_host_corpus between runs
 fuzz: all
 	sh tests/fuzz/fuzz.sh $(BUILD) 10000000 $(FUZZ_SECONDS) $(BUILD)/fuzz_corpus
-	sh tests/fuzz/fuzz_host.sh $(BUILD) 100000000 $(FUZZ_HOST_SECONDS) $(BUILD)/fuzz_host_corpus
+	sh tests/fuzz/fuzz_host.sh $(BUILD) 10000000 $(FUZZ_HOST_SECONDS) $(BUILD)/fuzz_host_corpus
 
 # many seeded rays (10^7, or SOAK_SECONDS) on generated terrain against the
 # long-double reference, the methods compared (tests/soak.cpp)

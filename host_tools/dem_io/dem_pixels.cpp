@@ -134,8 +134,11 @@ void read_dem_pixel_rows(void *handle, int y0, int n, std::vector<double> &h)
         if (t0 != y0)
             std::memmove(ri.buf.data(), ri.buf.data() + (size_t)(y0 - t0) * spec.width * px, count * px);
     } else {
+        // the native reader: read_scanlines would stage each call through
+        // a 64 MB buffer of its own (OpenImageIO 2.4), for samples that are
+        // already in the format asked for
         ri.buf.resize(count * px);
-        ok = ri.in->read_scanlines(0, 0, spec.y + y0, spec.y + y0 + n, spec.z, 0, 1, spec.format, ri.buf.data());
+        ok = ri.in->read_native_scanlines(0, 0, spec.y + y0, spec.y + y0 + n, spec.z, 0, 1, ri.buf.data());
     }
     if (!ok || ri.in->has_error()) {
         std::string e = clipped(one_line(ri.in->geterror()));

@@ -8,9 +8,9 @@
 # sanitizers; OpenImageIO, libtiff, libgeotiff and libmrcal are the system's
 # (not instrumented for coverage; ASan still sees their heap).  Seeds:
 # tests/fuzz/corpus_host/.  `make test` runs 20,000 inputs or 60 s from the
-# seeds with a fixed seed (one process; the DEM reader makes it ~400 inputs
-# per second); `make fuzz` runs long (FUZZ_HOST_SECONDS, default 900) in fork
-# mode with one worker per core (FUZZ_JOBS) and keeps its corpus in
+# seeds with a fixed seed (one process; the DEM reader makes it ~2,000 inputs
+# per second); `make fuzz` runs 10^7 inputs (or FUZZ_HOST_SECONDS, default
+# 3600) in fork mode with one worker per core (FUZZ_JOBS) and keeps its corpus in
 # <build-dir>/fuzz_host_corpus.  Each input's file lives in
 # $CT_FUZZ_TMPDIR (default /tmp) as ct_fuzz_host.<pid>.<ext>, removed after it.
 # Exit 0: no finding; 1: a finding (the input saved in <build-dir>/fuzz_host/
