@@ -31,9 +31,14 @@
  *     tolerance, at most twice as long, up to 30 km (the image's cubic term
  *     the quarter points see is then well under the tolerance);
  *   - a hit beyond the piece's end belongs to the next piece.
- * Pieces off the tile (horizontally, or above the tallest post) are not
- * traced and need no tolerance: they double in length.  The walk ends when
- * the path has left the tile for good, at tmax, or after EARTH_MAX_PIECES.
+ * The pieces start where the interpolated path may first come over the tile
+ * and end where it has left it for good (path_span: the polynomial's linear
+ * part and a bound of the rest).  Pieces off the tile in between
+ * (horizontally, or above the tallest post) are not traced and need no
+ * tolerance: they double in length.  The walk ends when the path has left
+ * the tile for good, at the span's end, or after EARTH_MAX_PIECES.
+ * CT_BELOW means the camera is over the tile and under its surface; a path
+ * entering the tile's side below the surface meets the side there.
  *
  * Formats: ECEF nm (|.| < 2^55), directions Q39 (unit = 2^39), t nm
  * (< 2^48: 281 km), grid Q16 as everywhere.
@@ -950,9 +955,10 @@ CT_NOINLINE static ct_status quarter_errors(const path *pa, int64_t ta, int64_t 
 /* One piece traced: the line from A to B less the lowering at B, against
  * the terrain lowered by lw (NULL: the chord against the terrain).  CT_MISS
  * when the path goes on to the next piece; a hit (in *h, with the steps and
- * iterations so far), CT_BELOW (the first piece starting below the
- * surface) or an error otherwise.  Out of line: the prepared ray and the
- * piece's hit are on the stack only while it runs. */
+ * iterations so far), CT_BELOW (first: the camera's own piece, the camera
+ * over the tile, starting below the surface) or an error otherwise.  Out
+ * of line: the prepared ray and the piece's hit are on the stack only while
+ * it runs. */
 CT_NOINLINE static ct_status trace_piece(const ct_package *p, ct_tileset *ts, const gv *A, const gv *B,
                                          const fit *f, const ct_lower *lw, int64_t dB, int first, ct_method m,
                                          ct_hit *h, uint32_t *steps, uint32_t *iters)
@@ -1135,8 +1141,8 @@ static int check_piece(const ct_package *p, const path *pa, const ct_earth *es, 
     return ok;
 }
 
-/* The next piece from A (at ta): *L long at most (and no longer than the
- * rest of the path), shortened until its model is within the tolerances
+/* The next piece from A (at ta): *L long at most (and not beyond tend),
+ * shortened until its model is within the tolerances
  * or it is PIECE_MIN_NM long; *L is left at the length of the last try.
  * A piece with a point beyond the projection's domain (its end, middle or
  * quarter points) is shortened to 1/8 too: the tile lies inside the
@@ -1144,14 +1150,14 @@ static int check_piece(const ct_package *p, const path *pa, const ct_earth *es, 
  * zone's edge).  CT_MISS when even PIECE_MIN_NM reaches beyond the domain
  * (or the tries run out on such a piece), else CT_OK. */
 static ct_status next_piece(const ct_package *p, const path *pa, const ct_earth *es, const gv *A, int64_t ta,
-                            int64_t *L, piece *pc)
+                            int64_t tend, int64_t *L, piece *pc)
 {
     uint32_t r;
     int ok = -1;
     pc->dB = 0;
     /* bound: EARTH_MAX_RETRIES + 1 tries */
     for (r = 0u; r <= EARTH_MAX_RETRIES; ++r) {
-        pc->Lc = ct_min64(*L, es->tmax_nm - ta);
+        pc->Lc = ct_min64(*L, tend - ta);
         ok = -1;
         if (vertex(pa, ta + pc->Lc, &pc->B) == CT_OK && vertex(pa, ta + pc->Lc / 2, &pc->M) == CT_OK) {
             ok = check_piece(p, pa, es, A, ta, pc);
@@ -1193,6 +1199,77 @@ static int64_t next_length(const ct_earth *es, const piece *pc)
     return ct_min64(PIECE_MAX_NM, ct_max64(PIECE_MIN_NM, ct_mul_shr(pc->Lc, fr, 15u)));
 }
 
+/* sigma's bounds (Q30) from one axis of the interpolated image: where its
+ * linear part b + c1 sigma lies in [lo, hi] (lo_open: no lower bound);
+ * 0 when nowhere (c1 = 0 and b out of range).  |b| < 2^64 (base < 2^63
+ * plus c_0 < 2^49), |lo|, |hi| < 2^62: differences times 2^30 < 2^95. */
+static int span_axis(ct_i128 b, int64_t c1, int64_t lo, int lo_open, int64_t hi, int64_t *s0, int64_t *s1)
+{
+    ct_i128 up = ct_i128_sub(ct_i128_from64(hi), b), dn = ct_i128_sub(ct_i128_from64(lo), b);
+    if (c1 == 0) {
+        return ct_i128_sign(up) >= 0 && (lo_open || ct_i128_sign(dn) <= 0);
+    }
+    up = ct_i128_shl(up, 30u);
+    dn = ct_i128_shl(dn, 30u);
+    if (c1 > 0) {
+        /* s in [(lo - b) / c1, (hi - b) / c1], the ends rounded outwards */
+        *s1 = ct_min64(*s1, -ct_i128_floor_div_sat(ct_i128_neg(up), c1));
+        if (!lo_open) {
+            *s0 = ct_max64(*s0, ct_i128_floor_div_sat(dn, c1));
+        }
+    } else {
+        /* s in [(b - hi) / |c1|, (b - lo) / |c1|] */
+        *s0 = ct_max64(*s0, ct_i128_floor_div_sat(ct_i128_neg(up), -c1));
+        if (!lo_open) {
+            *s1 = ct_min64(*s1, -ct_i128_floor_div_sat(dn, -c1));
+        }
+    }
+    return 1;
+}
+
+/* The part [*t0, *t1] of [0, tmax] outside which the interpolated path is
+ * off the tile as piece_off sees it (beyond 2 cells of an edge, or above
+ * the tallest post by the height tolerance): per axis the polynomial is its
+ * linear part b + c_1 sigma within E = the sum of |c_j|, j >= 2 (|sigma| <=
+ * 1; < 2^52), plus one unit per Horner rounding.  0 when it is off
+ * everywhere.  Pieces then start at t0 (no off pieces before it, each two
+ * vertices and a fit) and end by t1. */
+static int path_span(const path *pa, const ct_package *p, const ct_earth *es, int64_t *t0, int64_t *t1)
+{
+    int64_t s0 = -(INT64_C(1) << 30), s1 = INT64_C(1) << 30;
+    int j, k;
+    for (k = 0; k < 3; ++k) { /* bound: 3 coordinates */
+        int64_t e = NODES, lo, hi;
+        for (j = 2; j < pa->nodes; ++j) { /* bound: NODES - 2; |c_j| < 2^49 */
+            e += ct_abs64(pa->cf[j][k]);
+        }
+        if (k < 2) {
+            /* cells <= 2^31: < 2^56 */
+            lo = -2 * ONE16 * 256 - e;
+            hi = ((int64_t)(k == 0 ? p->cells_x : p->cells_y) + 2) * ONE16 * 256 + e;
+        } else {
+            /* hmax < 2^16; the tolerance capped at 2^36 Q16 units (2^20
+             * height units) */
+            lo = 0;
+            hi = (((int64_t)p->hmax + 1) * ONE16 + ct_min64(es->tolz_q16, INT64_C(1) << 36)) * 256 + e;
+        }
+        if (!span_axis(ct_i128_add(ct_i128_from64(pa->base[k]), ct_i128_from64(pa->cf[0][k])), pa->cf[1][k], lo,
+                       k == 2, hi, &s0, &s1)) {
+            return 0;
+        }
+    }
+    if (s0 > s1 || s0 > (INT64_C(1) << 30) || s1 < -(INT64_C(1) << 30)) {
+        return 0;
+    }
+    s0 = ct_max64(s0, -(INT64_C(1) << 30));
+    s1 = ct_min64(s1, INT64_C(1) << 30);
+    /* t = tmax (sigma + 1) / 2, t0 rounded down and t1 up: tmax < 2^49,
+     * sigma + 2^30 <= 2^31 */
+    *t0 = ct_i128_to64(ct_i128_sar(ct_i128_mul(pa->tmax, s0 + (INT64_C(1) << 30)), 31u));
+    *t1 = -ct_i128_to64(ct_i128_sar(ct_i128_neg(ct_i128_mul(pa->tmax, s1 + (INT64_C(1) << 30))), 31u));
+    return 1;
+}
+
 /* The line of sight as pieces of lowered walks from the camera: each piece
  * chosen (next_piece), traced unless off the tile (trace_piece), until a
  * hit, an error, the path's end or a path gone from the tile. */
@@ -1202,8 +1279,9 @@ ct_status ct_trace_earth_set(const ct_package *p, ct_tileset *ts, const ct_earth
     path pa;
     gv A;
     piece pc;
-    int64_t ta = 0, L = PIECE_FIRST_NM;
+    int64_t ta = 0, tend, L = PIECE_FIRST_NM;
     uint32_t n, steps = 0u, iters = 0u;
+    int over;
     ct_status st;
     if (p == NULL || es == NULL || dg == NULL || h == NULL) {
         return CT_ERR_ARG;
@@ -1218,16 +1296,32 @@ ct_status ct_trace_earth_set(const ct_package *p, ct_tileset *ts, const ct_earth
     A.fx = es->ox * 256; /* |ox| <= 2^46 */
     A.fy = es->oy * 256;
     A.fz = es->oz * 256;
+    /* CT_BELOW: the camera over the tile and under its surface; a path
+     * entering the tile's side below the surface meets the side there */
+    over = es->ox >= 0 && es->oy >= 0 && es->ox <= (int64_t)p->cells_x * ONE16 && es->oy <= (int64_t)p->cells_y * ONE16;
+    tend = es->tmax_nm;
+    if (pa.interp) {
+        int64_t t0 = tend, t1 = tend;
+        if (!path_span(&pa, p, es, &t0, &t1)) {
+            t0 = tend; /* off everywhere: no piece */
+        }
+        tend = ct_min64(tend, t1);
+        if (t0 > 0 && t0 < tend && vertex(&pa, t0, &A) == CT_OK) {
+            ta = t0;
+        } else if (t0 >= tend) {
+            ta = tend;
+        }
+    }
     /* bound: EARTH_MAX_PIECES pieces (each with at most EARTH_MAX_RETRIES
      * + 1 tries in next_piece) */
-    for (n = 0u; n < EARTH_MAX_PIECES && ta < es->tmax_nm; ++n) {
-        if (next_piece(p, &pa, es, &A, ta, &L, &pc) != CT_OK) {
+    for (n = 0u; n < EARTH_MAX_PIECES && ta < tend; ++n) {
+        if (next_piece(p, &pa, es, &A, ta, tend, &L, &pc) != CT_OK) {
             h->steps = steps;
             h->iters = iters;
             return CT_MISS;
         }
         if (!pc.off) {
-            st = trace_piece(p, ts, &A, &pc.B, &pc.f, pc.lwp, pc.dB, ta == 0, m, h, &steps, &iters);
+            st = trace_piece(p, ts, &A, &pc.B, &pc.f, pc.lwp, pc.dB, ta == 0 && over, m, h, &steps, &iters);
             if (st != CT_MISS) {
                 return st; /* a hit, the camera below the surface, or an error */
             }
