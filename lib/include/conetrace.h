@@ -1031,7 +1031,11 @@ ct_status ct_pose_rotate(const ct_pose *pose, const int32_t ray_cam_q30[3],
  * out->dir_map_q39, so it can be formed again from the pose and *out.
  * Returns (and stores in out->status)
  * CT_HIT or CT_HIT_VOID (out->hit.e_nm, n_nm, h_nm valid), CT_MISS,
- * CT_BELOW, or an error: CT_ERR_UNPROJECT for the pixel; CT_ERR_ARG /
+ * CT_BELOW (the ray's first point over the tile below the surface; on the
+ * true Earth, where the line of sight is traced in pieces, only when the
+ * camera is over the tile and under its surface -- a line of sight from
+ * off the tile entering its side below the surface hits the side there),
+ * or an error: CT_ERR_UNPROJECT for the pixel; CT_ERR_ARG /
  * CT_ERR_METHOD / CT_ERR_EFFECTS for the arguments; CT_ERR_RAY when the
  * camera centre is beyond CT_MAX_ORIGIN_Q16 of the tile; CT_ERR_RANGE when
  * a bent ray would need more than CT_BEND_MAX_SEGMENTS segments or the

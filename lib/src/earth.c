@@ -1258,13 +1258,12 @@ static int path_span(const path *pa, const ct_package *p, const ct_earth *es, in
             return 0;
         }
     }
-    if (s0 > s1 || s0 > (INT64_C(1) << 30) || s1 < -(INT64_C(1) << 30)) {
+    /* s0 only rose from -2^30 and s1 only fell from 2^30 */
+    if (s0 > s1) {
         return 0;
     }
-    s0 = ct_max64(s0, -(INT64_C(1) << 30));
-    s1 = ct_min64(s1, INT64_C(1) << 30);
     /* t = tmax (sigma + 1) / 2, t0 rounded down and t1 up: tmax < 2^49,
-     * sigma + 2^30 <= 2^31 */
+     * sigma + 2^30 in [0, 2^31]: 0 <= t0 <= t1 <= tmax */
     *t0 = ct_i128_to64(ct_i128_sar(ct_i128_mul(pa->tmax, s0 + (INT64_C(1) << 30)), 31u));
     *t1 = -ct_i128_to64(ct_i128_sar(ct_i128_neg(ct_i128_mul(pa->tmax, s1 + (INT64_C(1) << 30))), 31u));
     return 1;
@@ -1298,18 +1297,21 @@ ct_status ct_trace_earth_set(const ct_package *p, ct_tileset *ts, const ct_earth
     A.fz = es->oz * 256;
     /* CT_BELOW: the camera over the tile and under its surface; a path
      * entering the tile's side below the surface meets the side there */
-    over = es->ox >= 0 && es->oy >= 0 && es->ox <= (int64_t)p->cells_x * ONE16 && es->oy <= (int64_t)p->cells_y * ONE16;
+    over = (uint64_t)es->ox <= (uint64_t)p->cells_x * (uint64_t)ONE16 &&
+           (uint64_t)es->oy <= (uint64_t)p->cells_y * (uint64_t)ONE16; /* negative: huge */
     tend = es->tmax_nm;
     if (pa.interp) {
-        int64_t t0 = tend, t1 = tend;
-        if (!path_span(&pa, p, es, &t0, &t1)) {
-            t0 = tend; /* off everywhere: no piece */
-        }
-        tend = ct_min64(tend, t1);
-        if (t0 > 0 && t0 < tend && vertex(&pa, t0, &A) == CT_OK) {
+        int64_t t0, t1;
+        if (path_span(&pa, p, es, &t0, &t1)) {
+            tend = t1;
             ta = t0;
-        } else if (t0 >= tend) {
-            ta = tend;
+        } else {
+            ta = tend; /* off everywhere: no piece */
+        }
+        if (ta > 0) {
+            /* the first piece's start, off the tile (an interpolated vertex
+             * is always CT_OK); at 0 the camera's own grid point */
+            (void)vertex(&pa, ta, &A);
         }
     }
     /* bound: EARTH_MAX_PIECES pieces (each with at most EARTH_MAX_RETRIES
