@@ -1514,50 +1514,64 @@ void test_tiny_height_scale()
     TEST_ASSERT(T.bad == 0 && T.domain_miss == 0 && T.hits >= 50 && T.misses >= 50);
 }
 
-// A line of sight that follows the ellipsoid to a micrometre over a 4 km
-// piece of 2^19.6 posts, so that the piece's fitted vertical quadratic rises
-// by less than 2^-96 Q16 height units per squared Q16 cell: earth.c's
+// A line of sight whose 16 km piece's fitted vertical quadratic rises by
+// less than 2^-96 Q16 height units per squared Q16 cell: earth.c's
 // rise_coeff refuses it (check_piece) and the piece is traced as its
 // straight chord.  A 1 x 1 m tile of 5 mm posts (201 x 201) in zone 17 at
-// 36.7 deg N, flat but for a step of one height code (0.65536 m: a Q16
-// height unit of 10 um) over its eastern half; a map pose 3 km south-west
-// of the tile's centre (grid azimuth 42 deg; every input an integer), 0.3 m
-// over the lower half, looking level, with refraction k = 1: the path bends
-// with the 6371 km sphere, about the ellipsoid's radius of curvature in
-// that azimuth there, and keeps its height over the ellipsoid.  Its first
-// piece (4 km: l = 2^35.6 Q16, den = sm l (l - sm) = 2^104.x) meets the
-// step.  For the rows 1 .. 4 units (of 1/65536 px) under the centre the
-// rounded heights fall by exactly 2k and 4k units (k = 1 .. 4) to the
-// middle and the end of the piece, and the middle lies 14.5 .. 15 Q16 units
-// (1.1 um) short of the chord's half -- the tile is 2.29 km west of the
-// central meridian for that: the point scale's change along the chord
-// moves 2 sm - l by about 860 units per km east -- so num = zb sm - zm l =
-// 2k (l - 2 sm) = 58 .. 240 (measured with a probe in earth.c) and num /
-// den < 2^-96.  Every row of the fan hits the step's face where the
-// reference does, within the chord tolerance (the face rises 131 m per m:
-// the path's height error moves the hit by as much, along the face).
+// 36.7 deg N, 13.9 km west of the central meridian, flat but for a step of
+// one height code (0.65536 m: a Q16 height unit of 10 um) over its eastern
+// half; a map pose 26 km west of the tile's centre (every input an
+// integer), 0.3 m over the lower half, looking grid east, level, with
+// refraction k = 65381 / 65536: the path bends with the 6371 km sphere
+// widened by 1 / k to 6386.1 km, about the ellipsoid's radius in that
+// azimuth (the prime vertical's, 6385.8 km; k found by a search: the
+// rounded heights along the piece then stay within a unit of a straight
+// line).  The path's image spans 27 km of x between its first and last
+// interpolation nodes (tmax 29.6 km), over 2^22 cells: its vertices are
+// computed exactly (set_nodes) and -- path_span trims only interpolated
+// paths -- its pieces start from the camera and double off the tile: 4 km,
+// 8 km, then 12 .. 28 km over the tile: l = 2^37.6 Q16, den = sm l (l - sm)
+// = 2^110.8.  (An interpolated path cannot take the branch: its nodes lie
+// within 2^22 cells of each other on each axis, and a level line of
+// sight's higher terms are a few 10^-5 of that -- E = 83 cells measured 300
+// km from the meridian, 18 km out --, so its pieces, within the tile
+// widened by 2 cells and E, span under 2^15.1 cells an axis: den < 2^93,
+// where a refusal needs 2^97.)  The middle lies 11 .. 24 Q16 units beyond
+// the chord's half (2 sm - l = 22 .. 47): along the refracted path the
+// parameter's speed grows as t / R^2, which alone would put it 206,000
+// units short for this piece, and the point scale's fall towards the
+// meridian takes that back (the piece's middle 20 km west of it; 2 sm - l
+// about 21 units less per metre east).  The rows 4 .. 20 units (of 1/65536 px) above the centre
+// climb 9 height units more each to the piece's middle; for 10 of the 17
+// the rounded heights rise by exactly zm and 2 zm to the middle and the
+// end (zm = 13 .. 152), so num = zb sm - zm l = zm (2 sm - l) = 312 ..
+// 7,144 (measured with a probe in earth.c) and num / den < 2^-96 (for the
+// others zb - 2 zm = +-1: a rise rise_coeff takes, or a negative one).
+// Every row hits the step's face (2.3 mm east of the tile's centre, 0.3 m
+// up) where the reference does.
 void test_level_rise_refused()
 {
     earth_ref::Proj &pj = proj();
     static World *w = nullptr;
     if (!w)
-        w = synthetic(32617, 497710 - 0.5025L, 4065840 + 0.5025L, 0.005, 201, 201,
+        w = synthetic(32617, 486103 - 0.5025L, 4068000 + 0.5025L, 0.005, 201, 201,
                       [](int i, int) { return i > 100 ? 400.65536 : 400.0; }, 0.65536);
     TEST_ASSERT(w->p.height_scale_nm == 655360000 && w->p.posting_e_nm == 5000000 && w->p.hmax == 1);
     Cam cam = make_camera();
     Pose p;
-    p.def = {"level", 495702.608L, 4063610.566L, 0, 42, 0};
-    const int64_t yaw42_q61 = INT64_C(1690271206884661997);  // 42 deg
-    TEST_ASSERT(ct_quat_from_ypr(yaw42_q61, 0, 0, p.q) == CT_OK);
-    TEST_ASSERT(ct_pose_from_map(&p.pose, INT64_C(495702608000000), INT64_C(4063610566000000), INT64_C(400300000000),
+    p.def = {"level", 460103, 4068000, 0, 90, 0};
+    const int64_t yaw90_q61 = INT64_C(3622009729038561421);  // 90 deg
+    TEST_ASSERT(ct_quat_from_ypr(yaw90_q61, 0, 0, p.q) == CT_OK);
+    TEST_ASSERT(ct_pose_from_map(&p.pose, INT64_C(460103000000000), INT64_C(4068000000000000), INT64_C(400300000000),
                                  p.q) == CT_OK);
-    const ct_effects fx = {CT_EFFECT_CURVATURE | CT_EFFECT_REFRACTION, 65536, 0, 0, nullptr};
+    const ct_effects fx = {CT_EFFECT_CURVATURE | CT_EFFECT_REFRACTION, 65381, 0, 0, nullptr};
     const int64_t u0 = (int64_t)1023 << 15, v0 = (int64_t)767 << 15;
     DomainTally T;
-    for (int dv = -4; dv <= 6; ++dv) judge_domain(w, pj, -81, cam, p, fx, u0, v0 + dv, T, 0);
-    std::printf("  a level line of sight under k = 1 over 5 mm posts, its 4 km piece's rise below 2^-96: %ld pixels, "
-                "%ld hits as the reference's (within %.5f m); %ld wrong\n", T.n, T.hits, T.worst, T.bad);
-    TEST_ASSERT(T.bad == 0 && T.n == 11 && T.hits == 11 && T.worst <= 0.001);
+    for (int dv = -20; dv <= -4; ++dv) judge_domain(w, pj, -81, cam, p, fx, u0, v0 + dv, T, 0);
+    std::printf("  a level line of sight (k = 0.9977) 26 km from a tile of 5 mm posts, its 16 km piece's rise below "
+                "2^-96: %ld pixels, %ld hits as the reference's (within %.5f m); %ld wrong\n", T.n, T.hits, T.worst,
+                T.bad);
+    TEST_ASSERT(T.bad == 0 && T.n == 17 && T.hits == 17 && T.worst <= 0.001);
 }
 
 void test_exact_curvature() { compare(CT_EFFECT_CURVATURE); }
