@@ -1200,19 +1200,15 @@ static int64_t next_length(const ct_earth *es, const piece *pc)
 }
 
 /* sigma's bounds (Q30) from one axis of the interpolated image: where its
- * linear part b + c1 sigma lies in [lo, hi] (lo_open: no lower bound);
- * 0 when nowhere (c1 = 0 and b out of range).  |b| < 2^64 (base < 2^63
- * plus c_0 < 2^49), |lo|, |hi| < 2^62: differences times 2^30 < 2^95. */
-static int span_axis(ct_i128 b, int64_t c1, int64_t lo, int lo_open, int64_t hi, int64_t *s0, int64_t *s1)
+ * linear part b + c1 sigma (c1 != 0) lies in [lo, hi] (lo_open: no lower
+ * bound), the ends rounded outwards.  |b| < 2^64 (base < 2^63 plus c_0 <
+ * 2^49), |lo|, |hi| < 2^62: differences times 2^30 < 2^95. */
+static void span_axis(ct_i128 b, int64_t c1, int64_t lo, int lo_open, int64_t hi, int64_t *s0, int64_t *s1)
 {
-    ct_i128 up = ct_i128_sub(ct_i128_from64(hi), b), dn = ct_i128_sub(ct_i128_from64(lo), b);
-    if (c1 == 0) {
-        return ct_i128_sign(up) >= 0 && (lo_open || ct_i128_sign(dn) <= 0);
-    }
-    up = ct_i128_shl(up, 30u);
-    dn = ct_i128_shl(dn, 30u);
+    ct_i128 up = ct_i128_shl(ct_i128_sub(ct_i128_from64(hi), b), 30u);
+    ct_i128 dn = ct_i128_shl(ct_i128_sub(ct_i128_from64(lo), b), 30u);
     if (c1 > 0) {
-        /* s in [(lo - b) / c1, (hi - b) / c1], the ends rounded outwards */
+        /* s in [(lo - b) / c1, (hi - b) / c1] */
         *s1 = ct_min64(*s1, -ct_i128_floor_div_sat(ct_i128_neg(up), c1));
         if (!lo_open) {
             *s0 = ct_max64(*s0, ct_i128_floor_div_sat(dn, c1));
@@ -1224,22 +1220,21 @@ static int span_axis(ct_i128 b, int64_t c1, int64_t lo, int lo_open, int64_t hi,
             *s1 = ct_min64(*s1, -ct_i128_floor_div_sat(dn, -c1));
         }
     }
-    return 1;
 }
 
 /* The part [*t0, *t1] of [0, tmax] outside which the interpolated path is
  * off the tile as piece_off sees it (beyond 2 cells of an edge, or above
  * the tallest post by the height tolerance): per axis the polynomial is its
  * linear part b + c_1 sigma within E = the sum of |c_j|, j >= 2 (|sigma| <=
- * 1; < 2^52), plus one unit per Horner rounding.  0 when it is off
- * everywhere.  Pieces then start at t0 (no off pieces before it, each two
- * vertices and a fit) and end by t1. */
+ * 1; < 2^52), plus one unit per Horner rounding and one for c_1 = 0 taken
+ * as 1.  0 when it is off everywhere.  Pieces then start at t0 (no off
+ * pieces before it, each two vertices and a fit) and end by t1. */
 static int path_span(const path *pa, const ct_package *p, const ct_earth *es, int64_t *t0, int64_t *t1)
 {
     int64_t s0 = -(INT64_C(1) << 30), s1 = INT64_C(1) << 30;
     int j, k;
     for (k = 0; k < 3; ++k) { /* bound: 3 coordinates */
-        int64_t e = NODES, lo, hi;
+        int64_t e = NODES + 1, lo, hi;
         for (j = 2; j < pa->nodes; ++j) { /* bound: NODES - 2; |c_j| < 2^49 */
             e += ct_abs64(pa->cf[j][k]);
         }
@@ -1253,10 +1248,8 @@ static int path_span(const path *pa, const ct_package *p, const ct_earth *es, in
             lo = 0;
             hi = (((int64_t)p->hmax + 1) * ONE16 + ct_min64(es->tolz_q16, INT64_C(1) << 36)) * 256 + e;
         }
-        if (!span_axis(ct_i128_add(ct_i128_from64(pa->base[k]), ct_i128_from64(pa->cf[0][k])), pa->cf[1][k], lo,
-                       k == 2, hi, &s0, &s1)) {
-            return 0;
-        }
+        span_axis(ct_i128_add(ct_i128_from64(pa->base[k]), ct_i128_from64(pa->cf[0][k])),
+                  pa->cf[1][k] + (pa->cf[1][k] == 0), lo, k == 2, hi, &s0, &s1);
     }
     /* s0 only rose from -2^30 and s1 only fell from 2^30 */
     if (s0 > s1) {
