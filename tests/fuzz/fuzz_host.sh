@@ -7,7 +7,7 @@
 # The readers' sources (host_tools/) and lib/ are compiled here with the
 # sanitizers; OpenImageIO, libtiff, libgeotiff and libmrcal are the system's
 # (not instrumented for coverage; ASan still sees their heap).  Seeds:
-# tests/fuzz/corpus_host/.  `make test` runs 20,000 inputs or 60 s from the
+# tests/fuzz/corpus_host/.  `make test` runs 100,000 inputs or 120 s from the
 # seeds with a fixed seed (one process; the DEM reader makes it ~2,000 inputs
 # per second); `make fuzz` runs 10^7 inputs (or FUZZ_HOST_SECONDS, default
 # 3600) in fork mode with one worker per core (FUZZ_JOBS) and keeps its corpus in
