@@ -543,6 +543,40 @@ static void test_png16(void)
 // ---------------------------------------------------------------------------
 // errors
 
+// A little-endian TIFF of w x h float32 posts, deflated, in tiles of tw x
+// th posts (one tile: its offset and a 16-byte count), written byte by byte:
+// libtiff would not write a header that promises tiles it was not given.
+static bool write_tiled_header(const std::string &path, uint32_t w, uint32_t h, uint32_t tw, uint32_t th)
+{
+    struct Entry {
+        uint16_t tag, type;
+        uint32_t value;
+    };
+    const Entry e[] = {{256, 4, w},   {257, 4, h},   {258, 3, 32}, {259, 3, 8},  {262, 3, 1},  {277, 3, 1},
+                       {284, 3, 1},   {322, 4, tw},  {323, 4, th}, {324, 4, 0},  {325, 4, 16}, {339, 3, 3}};
+    const uint32_t n = (uint32_t)(sizeof e / sizeof e[0]), data = 8 + 2 + 12 * n + 4;
+    std::vector<unsigned char> b;
+    auto put = [&b](uint32_t v, int bytes) {
+        for (int k = 0; k < bytes; ++k) b.push_back((unsigned char)(v >> (8 * k)));
+    };
+    put(0x4949, 2);
+    put(42, 2);
+    put(8, 4);
+    put(n, 2);
+    for (const Entry &x : e) {
+        put(x.tag, 2);
+        put(x.type, 2);
+        put(1, 4);
+        put(x.tag == 324 ? data : x.value, x.type == 3 ? 2 : 4);
+        if (x.type == 3) put(0, 2);
+    }
+    put(0, 4);
+    for (int k = 0; k < 16; ++k) put(0x5a, 1);
+    std::ofstream f(path, std::ios::binary);
+    f.write((const char *)b.data(), (std::streamsize)b.size());
+    return (bool)f;
+}
+
 static void test_read_errors(void)
 {
     StderrCapture cap(tmp_path("stderr_read.txt"));
@@ -551,6 +585,22 @@ static void test_read_errors(void)
     EXPECT_DEM_ERROR(ct_host::read_dem(missing), missing, "No such file");
 
     EXPECT_DEM_ERROR(ct_host::read_dem(g_dir), g_dir, "directory");
+
+    // tiles far larger than the image (fuzz_host's finding: OpenImageIO
+    // allocates a whole tile, 7.6 GB here, before reading a byte of it)
+    const std::string huge_tiles = tmp_path("huge_tiles.tif");
+    TEST_ASSERT(write_tiled_header(huge_tiles, 8, 8, 28944, 65520));
+    EXPECT_DEM_ERROR(ct_host::read_dem(huge_tiles), huge_tiles, "tiles of 28944 x 65520 posts for a 8 x 8 image");
+    EXPECT_DEM_ERROR(ct_host::DemRows rows(huge_tiles), huge_tiles, "tiles of 28944 x 65520 posts");
+    // tiles of 256 x 256 for a 8 x 8 image are ordinary: read (the data
+    // itself is garbage here, so the error is the decoder's, not the tiles')
+    const std::string small_tiles = tmp_path("small_tiles.tif");
+    TEST_ASSERT(write_tiled_header(small_tiles, 8, 8, 256, 256));
+    try {
+        (void)ct_host::read_dem(small_tiles);
+    } catch (const Error &ex) {
+        TEST_ASSERT_MSG(std::string(ex.what()).find("tiles of") == std::string::npos, "%s", ex.what());
+    }
 
     const std::string garbage = tmp_path("garbage.tif");
     {

@@ -69,6 +69,17 @@ std::unique_ptr<OIIO::ImageInput> open_checked(const std::string &path, DemRaste
     if (bits != 0 && bits != (int)(fmt.size() * 8))
         throw fail("unsupported bit depth " + std::to_string(bits) + " (stored as " +
                    fmt.c_str() + ")");
+    if (spec.tile_width > 0 && spec.tile_height > 0) {
+        // OpenImageIO reads a tile whole, into a buffer of the tile's size:
+        // a header whose tiles hold far more posts than the image (a 8 x 8
+        // image in tiles of 28944 x 65521, 7.6 GB each) is refused before
+        // that is allocated
+        const double tile = (double)spec.tile_width * (double)spec.tile_height * (double)std::max(1, spec.tile_depth);
+        if (tile > std::max(4.0 * (double)spec.width * (double)spec.height, 16777216.0))
+            throw fail("tiles of " + std::to_string(spec.tile_width) + " x " + std::to_string(spec.tile_height) +
+                       " posts for a " + std::to_string(spec.width) + " x " + std::to_string(spec.height) +
+                       " image");
+    }
     const size_t n = (size_t)spec.width * (size_t)spec.height;
     {
         // uncompressed pixels must be in the file: a header that promises
