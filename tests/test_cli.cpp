@@ -821,6 +821,14 @@ static void test_bad_inputs(void)
     }
     spit(in + "/empty.csv", "");
     spit(in + "/lie.tif", lying_tiff(30000, 30000));  // 1.8 GB promised, 64 bytes there
+    {
+        // fuzz_host's finding as it found it (less its first byte, the
+        // harness's choice of reader): 8 x 8 posts in tiles of 28,944 x
+        // 65,521, a 7.6 GB tile for OpenImageIO to allocate
+        const std::string seed = slurp(std::string(CT_FIXTURES_DIR) + "/../tests/fuzz/corpus_host/dem_huge_tiles");
+        TEST_ASSERT_MSG(seed.size() > 100, "no corpus_host/dem_huge_tiles");
+        spit(in + "/tiles.tif", seed.substr(1));
+    }
     const std::string pkg = fixture_package();
     TEST_ASSERT_MSG(!pkg.empty(), "no fixture package");
     std::string bytes = slurp(pkg);
@@ -842,6 +850,8 @@ static void test_bad_inputs(void)
         {"nonsquare", {"build", "@nonsq.tif", "-o", "X.ctp"}, "nonsq.tif", "non-square", false, ""},
         {"onepost", {"build", "@one.tif", "-o", "X.ctp"}, "one.tif", "", false, ""},
         {"lie", {"build", "@lie.tif", "-o", "X.ctp", "--posting", "30"}, "lie.tif", "promises", false, ""},
+        {"hugetiles", {"build", "@tiles.tif", "-o", "X.ctp", "--posting", "30"}, "tiles.tif", "tiles of 28944 x 65521",
+         false, ""},
         // output problems
         {"nodir", {"build", "@ok.tif", "-o", "nodir/X.ctp"}, "nodir/X.ctp", "", false, ""},
         {"outisdir", {"build", "@ok.tif", "-o", "adir"}, "adir", "", false, ""},
