@@ -32,3 +32,10 @@ fuzz_summary() {
     grep -E "^(stat::number_of_executed_units|stat::new_units_added)|^#[0-9]+.*DONE|Done [0-9]+ runs|fuzzed for [0-9]+ iterations" "$1"
     grep -E "oom/timeout/crash" "$1" | tail -n 1
 }
+
+# fuzz_forked_findings LOG: 1 when fork mode's workers counted an OOM, a
+# timeout or a crash (the parent goes on past them and exits 0: a finding
+# all the same, its input saved as oom-*, timeout-* or crash-*)
+fuzz_forked_findings() {
+    grep -a -E "oom/timeout/crash: ([1-9]|0/[1-9]|0/0/[1-9])" "$1" >/dev/null
+}

@@ -42,6 +42,9 @@ fuzz_limits
 ./fuzz_lib $FORK -runs="$RUNS" $LIMIT -seed=1 -max_len=512 -len_control=0 -print_final_stats=1 "$CORPUS" >"$OUT/run.log" 2>&1
 rc=$?
 fuzz_summary "$OUT/run.log"
+if [ $rc -eq 0 ] && fuzz_forked_findings "$OUT/run.log"; then
+    rc=1
+fi
 if [ $rc -ne 0 ]; then
     tail -40 "$OUT/run.log"
     echo "fuzz: FINDING (input saved in $OUT, see run.log)"

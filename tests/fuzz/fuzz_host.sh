@@ -67,6 +67,9 @@ ASAN_OPTIONS=${ASAN_OPTIONS:-log_path=$OUT/san} UBSAN_OPTIONS=${UBSAN_OPTIONS:-l
     -print_final_stats=1 "$CORPUS" >"$OUT/run.log" 2>&1
 rc=$?
 fuzz_summary "$OUT/run.log"
+if [ $rc -eq 0 ] && fuzz_forked_findings "$OUT/run.log"; then
+    rc=1
+fi
 if [ $rc -ne 0 ]; then
     grep -a -v -E "^#[0-9]+ +(NEW|REDUCE|pulse)|NEW_FUNC" "$OUT/run.log" | tail -30
     grep -a "FINDING" "$OUT/run.log" | cut -c1-500
