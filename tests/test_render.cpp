@@ -521,12 +521,8 @@ static void test_errors(void)
     // a DEM wider than a package may be (40,000 x 2 posts): refused from its
     // header, as build refuses it
     {
-        ct_host::Georef g;
-        g.origin_e = 500000;
-        g.origin_n = 4000000;
-        g.posting_e = 30.0;
-        g.posting_n = -30.0;
-        g.epsg = 32617;
+        ct_host::Georef g;  // 30 m posts by default
+        g.origin_e = 500000, g.origin_n = 4000000, g.epsg = 32617;
         ct_host::write_geotiff(g_dir + "/wide.tif", 40000, 2, std::vector<double>(80000, 100.0),
                                ct_host::SampleType::Int16, g);
     }
