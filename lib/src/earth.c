@@ -16,7 +16,10 @@
  * [ta, tb] of the range:
  *   - the images A, M, B of the ends and the middle (Q16 grid, and x, y in
  *     Q24 for the checks);
- *   - horizontally the chord A -> B;
+ *   - horizontally the chord A -> B shifted sideways towards M by half M's
+ *     deviation (chord_shift; the sideways bend is about a parabola, so the
+ *     shifted chord's error is half the chord's, at its ends and middle
+ *     alike); the camera's own piece over the tile is not shifted;
  *   - vertically the quadratic z(s) = zA + b s + a s^2 in the range s along
  *     the chord through A, M and B: the straight line from A to B lowered
  *     by a s^2 at B, traced against the terrain lowered post by post by
@@ -27,7 +30,7 @@
  *     the quarter points (sideways, and in height at their range along the
  *     chord): within the chord tolerance the piece is traced, otherwise
  *     shortened by 0.8 sqrt(tol / error) (errors grow as the length
- *     squared) and checked again; the next piece aims at 0.6 of the
+ *     squared) and checked again; the next piece aims at 0.8 of the
  *     tolerance, at most twice as long, up to 30 km (the image's cubic term
  *     the quarter points see is then well under the tolerance);
  *   - a hit beyond the piece's end belongs to the next piece.
@@ -683,18 +686,26 @@ static int64_t chord24(const gv *A, const gv *B)
     return (int64_t)ct_i128_isqrt(ct_i128_add(ct_i128_mul(ux, ux), ct_i128_mul(uy, uy)));
 }
 
-/* The sideways distance (Q24) of Q from the chord A -> B of Q24 length l24
- * (from A when the chord is vertical). */
-static int64_t lateral24(const gv *A, const gv *B, int64_t l24, const gv *Q)
+/* The sideways distance (Q24) of Q from the chord A -> B of Q24 length l24,
+ * signed: positive to the left of A -> B (from A, and positive, when the
+ * chord is vertical). */
+static int64_t side24(const gv *A, const gv *B, int64_t l24, const gv *Q)
 {
-    int64_t ux = B->fx - A->fx, uy = B->fy - A->fy, qx = Q->fx - A->fx, qy = Q->fy - A->fy;
+    int64_t ux = B->fx - A->fx, uy = B->fy - A->fy, qx = Q->fx - A->fx, qy = Q->fy - A->fy, d;
     ct_i128 cross;
     if (l24 < 256) {
         /* shorter than a Q16 unit: as good as vertical */
         return (int64_t)ct_i128_isqrt(ct_i128_add(ct_i128_mul(qx, qx), ct_i128_mul(qy, qy)));
     }
     cross = ct_i128_sub(ct_i128_mul(ux, qy), ct_i128_mul(uy, qx));
-    return ct_i128_floor_div_sat(ct_i128_sign(cross) < 0 ? ct_i128_neg(cross) : cross, l24);
+    d = ct_i128_floor_div_sat(ct_i128_sign(cross) < 0 ? ct_i128_neg(cross) : cross, l24);
+    return ct_i128_sign(cross) < 0 ? -d : d;
+}
+
+/* Its magnitude. */
+static int64_t lateral24(const gv *A, const gv *B, int64_t l24, const gv *Q)
+{
+    return ct_abs64(side24(A, B, l24, Q));
 }
 
 /* The piece A -> B (middle M): chord length l, the middle's sideways
@@ -708,19 +719,28 @@ typedef struct {
     int64_t dip; /* |a| l^2 / 4, Q16 height units (saturated) */
 } fit;
 
-CT_NOINLINE static void fit_piece(const gv *A, const gv *B, const gv *M, fit *f)
+/* The chord's part of the fit: u, l, l24. */
+static void fit_chord(const gv *A, const gv *B, fit *f)
 {
-    int64_t mx = M->x - A->x, my = M->y - A->y;
-    ct_i128 dot, l2;
+    ct_i128 l2;
     f->ux = B->x - A->x;
     f->uy = B->y - A->y;
-    /* pieces are at most 30 km: |u|, |m| < 2^42 Q16 at 1 cm posting or
-     * more; squares and products in 128 bits */
+    /* pieces are at most 30 km: |u| < 2^42 Q16 at 1 cm posting or more;
+     * squares in 128 bits */
     l2 = ct_i128_add(ct_i128_mul(f->ux, f->ux), ct_i128_mul(f->uy, f->uy));
     f->l = (int64_t)ct_i128_isqrt(l2);
+    f->l24 = chord24(A, B);
+}
+
+/* The middle's part of the fit (u, l and l24 set by fit_chord: a chord
+ * shifted sideways keeps them). */
+CT_NOINLINE static void fit_middle(const gv *A, const gv *B, const gv *M, fit *f)
+{
+    int64_t mx = M->x - A->x, my = M->y - A->y;
+    ct_i128 dot;
+    /* |m| < 2^42 as |u|: products in 128 bits */
     dot = ct_i128_add(ct_i128_mul(f->ux, mx), ct_i128_mul(f->uy, my));
     f->sm = f->l == 0 ? 0 : ct_i128_floor_div_sat(dot, f->l);
-    f->l24 = chord24(A, B);
     f->dev = lateral24(A, B, f->l24, M);
     f->den = ct_i128_from64(0);
     f->num = ct_i128_from64(0);
@@ -742,6 +762,26 @@ CT_NOINLINE static void fit_piece(const gv *A, const gv *B, const gv *M, fit *f)
         q1 = ct_i128_floor_div_sat(ct_i128_sign(f->num) < 0 ? ct_i128_neg(f->num) : f->num, f->sm);
         f->dip = ct_i128_floor_div_sat(ct_i128_mul(q1, f->l), 4 * (f->l - f->sm));
     }
+}
+
+/* The shift (Q16, horizontal) that moves the chord A -> B towards its
+ * middle M by half M's sideways deviation: the image bends sideways about
+ * as a parabola (the transverse Mercator's bend, nearly constant along a
+ * piece), so the shifted line lies within half the middle's deviation of
+ * it at the ends and the middle alike -- a piece may be sqrt(2) times as
+ * long for the same tolerance.  The signed deviation dv (side24, Q24,
+ * |dv| <= |M - A| < 2^46) along the unit normal (-uy, ux) / l24, halved:
+ * |dv u| < 2^92 in 128 bits, over 2 l24.  0 (no shift) for a chord
+ * shorter than a Q16 unit or a shift that rounds to nothing. */
+static int chord_shift(const gv *A, const gv *B, int64_t dv, int64_t l24, int64_t *sx, int64_t *sy)
+{
+    int64_t ux = B->fx - A->fx, uy = B->fy - A->fy;
+    if (l24 < 256) {
+        return 0;
+    }
+    *sx = q24_to_16(ct_i128_floor_div_sat(ct_i128_mul(-dv, uy), 2 * l24));
+    *sy = q24_to_16(ct_i128_floor_div_sat(ct_i128_mul(dv, ux), 2 * l24));
+    return *sx != 0 || *sy != 0;
 }
 
 /* The model's distance from the exact image Q (a quarter point): its
@@ -1086,13 +1126,15 @@ static void path_init(path *pa, const ct_package *p, const ct_earth *es, const i
 }
 
 /* One piece of the path, from A (at ta) to B (at ta + Lc) through its
- * middle M: the chord and quadratic fitted through them (f), 1 when it
+ * middle M: the model's ends As, Bs (A and B shifted sideways towards M,
+ * chord_shift) and the chord and quadratic fitted through As, M, Bs (f), 1 when it
  * is off the tile (nothing to trace), the lowering it is traced against
  * (lwp: &lw or NULL) and its value at B (dB), the model's largest errors
  * sideways and vertically (elat, Q24; evert, Q16 height units).  Not to be
  * copied: lwp points into it. */
 typedef struct {
     gv B, M;
+    gv As, Bs; /* the model's ends: A and B, shifted sideways (chord_shift) */
     fit f;
     int64_t Lc, elat, evert, dB;
     int off;
@@ -1113,27 +1155,48 @@ static int64_t excess_1024(const ct_earth *es, int64_t elat, int64_t evert)
  * it must be shorter, -1 when a quarter point is beyond the projection's
  * domain.  Sets f, off, lwp (and lw), dB (0 without a lowering), elat,
  * evert. */
-static int check_piece(const ct_package *p, const path *pa, const ct_earth *es, const gv *A, int64_t ta, piece *pc)
+static int check_piece(const ct_package *p, const path *pa, const ct_earth *es, const gv *A, int64_t ta, int shift,
+                       piece *pc)
 {
     int ok;
-    fit_piece(A, &pc->B, &pc->M, &pc->f);
-    pc->off = piece_off(p, A, &pc->B, &pc->M, &pc->f, es->tolz_q16);
+    int64_t sx, sy;
+    fit_chord(A, &pc->B, &pc->f);
+    pc->As = *A;
+    pc->Bs = pc->B;
+    pc->elat = 0;
+    if (shift && chord_shift(A, &pc->B, side24(A, &pc->B, pc->f.l24, &pc->M), pc->f.l24, &sx, &sy)) {
+        /* |s| <= |dv| / 2 + 1 < 2^45: the ends stay within the walks'
+         * range where A and B are (ct_map_to_grid's 2^55) */
+        pc->As.x += sx;
+        pc->As.y += sy;
+        pc->As.fx += sx * 256;
+        pc->As.fy += sy * 256;
+        pc->Bs.x += sx;
+        pc->Bs.y += sy;
+        pc->Bs.fx += sx * 256;
+        pc->Bs.fy += sy * 256;
+        /* the ends' own distance from the shifted line (the same at both) */
+        pc->elat = lateral24(&pc->As, &pc->Bs, pc->f.l24, A);
+    }
+    fit_middle(&pc->As, &pc->Bs, &pc->M, &pc->f);
+    pc->off = piece_off(p, &pc->As, &pc->Bs, &pc->M, &pc->f, es->tolz_q16);
     pc->lwp = NULL;
     pc->dB = 0; /* with lwp: a try that fails before the quarter points
                    must not keep an earlier, longer try's lowering */
-    pc->elat = pc->f.dev;
+    pc->elat = ct_max64(pc->elat, pc->f.dev);
     pc->evert = 0;
-    ok = pc->off || pc->f.dev <= es->tol_q24;
+    ok = pc->off || pc->elat <= es->tol_q24;
     if (ok && !pc->off) {
         uint64_t kf;
         uint32_t ks;
         if (ct_i128_sign(pc->f.num) > 0 && ct_i128_sign(pc->f.den) > 0 && rise_coeff(pc->f.num, pc->f.den, &kf, &ks) &&
-            ct_lower_setup_k(p, A->x, A->y, kf, ks, es->cull, &pc->lw) == CT_OK) {
+            ct_lower_setup_k(p, pc->As.x, pc->As.y, kf, ks, es->cull, &pc->lw) == CT_OK) {
             pc->lwp = &pc->lw;
         }
-        pc->dB = pc->lwp != NULL ? ct_lower_at(pc->lwp, pc->B.x, pc->B.y) : 0;
+        pc->dB = pc->lwp != NULL ? ct_lower_at(pc->lwp, pc->Bs.x, pc->Bs.y) : 0;
         /* the model against the exact image at the quarter points */
-        if (quarter_errors(pa, ta, pc->Lc, A, &pc->B, &pc->f, pc->lwp, pc->dB, &pc->elat, &pc->evert) != CT_OK) {
+        if (quarter_errors(pa, ta, pc->Lc, &pc->As, &pc->Bs, &pc->f, pc->lwp, pc->dB, &pc->elat, &pc->evert) !=
+            CT_OK) {
             return -1;
         }
         ok = pc->elat <= es->tol_q24 && pc->evert <= es->tolz_q16;
@@ -1150,7 +1213,7 @@ static int check_piece(const ct_package *p, const path *pa, const ct_earth *es, 
  * zone's edge).  CT_MISS when even PIECE_MIN_NM reaches beyond the domain
  * (or the tries run out on such a piece), else CT_OK. */
 static ct_status next_piece(const ct_package *p, const path *pa, const ct_earth *es, const gv *A, int64_t ta,
-                            int64_t tend, int64_t *L, piece *pc)
+                            int64_t tend, int shift, int64_t *L, piece *pc)
 {
     uint32_t r;
     int ok = -1;
@@ -1160,7 +1223,7 @@ static ct_status next_piece(const ct_package *p, const path *pa, const ct_earth 
         pc->Lc = ct_min64(*L, tend - ta);
         ok = -1;
         if (vertex(pa, ta + pc->Lc, &pc->B) == CT_OK && vertex(pa, ta + pc->Lc / 2, &pc->M) == CT_OK) {
-            ok = check_piece(p, pa, es, A, ta, pc);
+            ok = check_piece(p, pa, es, A, ta, shift, pc);
         }
         if (ok < 0) {
             /* beyond the domain: a shorter piece, down to PIECE_MIN_NM */
@@ -1191,11 +1254,13 @@ static int64_t next_length(const ct_earth *es, const piece *pc)
     if (pc->off) {
         return ct_min64(PIECE_MAX_NM, 2 * pc->Lc);
     }
-    /* the errors grow as the square of the length: aim at 0.6 of the
-     * tolerance, by a factor in [1/2, 2] */
+    /* the errors grow as the square of the length: aim at 0.8 of the
+     * tolerance ((29/32)^2 = 0.82: the sideways bend, which sets most
+     * pieces' lengths, changes little from one piece to the next), by a
+     * factor in [1/2, 2] */
     fr = (int64_t)ct_isqrt64(
         (uint64_t)((INT64_C(1) << 40) / ct_max64(excess_1024(es, pc->elat, pc->evert), 64))); /* Q15 */
-    fr = ct_min64(INT64_C(2) << 15, ct_max64(INT64_C(1) << 14, fr * 25 / 32));
+    fr = ct_min64(INT64_C(2) << 15, ct_max64(INT64_C(1) << 14, fr * 29 / 32));
     return ct_min64(PIECE_MAX_NM, ct_max64(PIECE_MIN_NM, ct_mul_shr(pc->Lc, fr, 15u)));
 }
 
@@ -1310,13 +1375,16 @@ ct_status ct_trace_earth_set(const ct_package *p, ct_tileset *ts, const ct_earth
     /* bound: EARTH_MAX_PIECES pieces (each with at most EARTH_MAX_RETRIES
      * + 1 tries in next_piece) */
     for (n = 0u; n < EARTH_MAX_PIECES && ta < tend; ++n) {
-        if (next_piece(p, &pa, es, &A, ta, tend, &L, &pc) != CT_OK) {
+        /* the camera's own piece over the tile starts at the camera (its
+         * CT_BELOW is the camera's); the others are shifted sideways */
+        int first = ta == 0 && over;
+        if (next_piece(p, &pa, es, &A, ta, tend, !first, &L, &pc) != CT_OK) {
             h->steps = steps;
             h->iters = iters;
             return CT_MISS;
         }
         if (!pc.off) {
-            st = trace_piece(p, ts, &A, &pc.B, &pc.f, pc.lwp, pc.dB, ta == 0 && over, m, h, &steps, &iters);
+            st = trace_piece(p, ts, &pc.As, &pc.Bs, &pc.f, pc.lwp, pc.dB, first, m, h, &steps, &iters);
             if (st != CT_MISS) {
                 return st; /* a hit, the camera below the surface, or an error */
             }
