@@ -124,6 +124,8 @@ typedef struct {
      * fitted per call around the camera) or the caller's.                 */
     const ct_earth_map *map;
     int64_t moff[3];       /* c - map->c, ECEF nm                            */
+    int64_t cam24[3];      /* the camera's image, Q24 (every path's node 0)  */
+    int32_t cam_ok;        /* 0: not found (each path finds it again)        */
     ct_earth_map fit;
 } ct_earth;
 
@@ -161,6 +163,14 @@ int ct_earth_map_fits(const ct_package *pkg, const ct_earth_map *map);
  * frame, Q24: fitted (CT_ERR_RANGE when there is no fit or D is outside
  * its cube) or exact (for tests of the fit).                              */
 ct_status ct_earth_image24(const ct_package *pkg, const ct_earth *es, const int64_t D[3], int fitted, int64_t g[3]);
+
+/* The image (Q24) of the line of sight with grid direction dg (Q39, as
+ * ct_trace_earth_set's) at range t (0 <= t <= es->tmax_nm): interpolated
+ * between its nodes (interp != 0; CT_ERR_RANGE when they could not be
+ * set) or found as a node is (the map, or the exact conversions); *nodes
+ * the number of nodes (0: none).  For tests of the interpolation.        */
+ct_status ct_earth_path_image24(const ct_package *pkg, const ct_earth *es, const int64_t dg[3], int64_t t, int interp,
+                                int64_t g[3], int32_t *nodes);
 
 /* ct_trace_prepared for a ray this library prepared itself (skips the
  * re-validation of the caller-visible struct). */

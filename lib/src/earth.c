@@ -65,53 +65,58 @@ typedef struct {
                            the node polynomial's precision                  */
 } gv;
 
-/* The image is interpolated between n exact images at the Chebyshev
- * nodes of [0, tmax] (a polynomial of degree n - 1): n = 4 up to 35 km, 5
- * up to 150 km, 6 beyond (to 281 km).  Against PROJ's exact image
- * (measured, docs/geolocation.md) that stays within 0.02 mm: the image's
- * k-th derivative scales as R^(1-k).  The polynomial is kept per ray in
- * powers of sigma = 2 t / tmax - 1 in [-1, 1]: c = V^-1 X, V the nodes'
- * Vandermonde matrix (sigma_j = -cos((2j + 1) pi / 2n)), V^-1 in Q40
- * (|entries| < 8, generated with mpmath at 60 digits); X the nodes' images
- * less node 0's in Q24, required below 2^46 (else every vertex is computed
- * exactly): c < 2^49, V^-1 X formed in 128 bits.  A vertex is then
- * Horner's rule in sigma (Q60): n - 1 products < 2^110 per coordinate.   */
+/* The image is interpolated between n exact images at the Chebyshev-
+ * Lobatto nodes of [0, tmax] (a polynomial of degree n - 1; sigma_j =
+ * -cos(j pi / (n - 1)), the ends included): node 0 is the camera, whose
+ * image is found once per call (ct_earth_setup: cam24), so a ray pays n - 1
+ * images; n = 4 up to 35 km, 5 up to 130 km, 6 beyond (to 281 km).  Against
+ * the fitted map's images (within 2 um of PROJ's) that stays within 0.02
+ * mm (measured, docs/geolocation.md: these nodes' error is about twice the
+ * Gauss-Chebyshev nodes' at the same n; the image's k-th derivative scales
+ * as R^(1-k)).  The polynomial is kept per ray in powers of sigma = 2 t /
+ * tmax - 1 in [-1, 1]: c = V^-1 X, V the nodes' Vandermonde matrix, V^-1
+ * in Q40 (|entries| < 8, generated with mpmath at 60 digits); X the nodes'
+ * images less node 0's in Q24, required below 2^46 (else every vertex is
+ * computed exactly): c < 2^49, V^-1 X formed in 128 bits.  A vertex is
+ * then Horner's rule in sigma (Q60): n - 1 products < 2^110 per
+ * coordinate.  tau_j = (1 + sigma_j) / 2 in Q60 (tau_0 = 0, tau_(n-1) =
+ * 1). */
 #define NODES 6
 #define NODES_4_NM (35 * KM_NM)
-#define NODES_5_NM (150 * KM_NM)
+#define NODES_5_NM (130 * KM_NM)
 static const int64_t tau_q60[3][NODES] = {
-    {INT64_C(43880461954231926), INT64_C(355858772988187558), INT64_C(797062731618659418),
-     INT64_C(1109041042652615050), 0, 0},
-    {INT64_C(28213997436846120), INT64_C(237625623574046853), INT64_C(576460752303423488),
-     INT64_C(915295881032800123), INT64_C(1124707507170000856), 0},
-    {INT64_C(19642423811521231), INT64_C(168841445261774044), INT64_C(427261730853170675),
-     INT64_C(725659773753676301), INT64_C(984080059345072932), INT64_C(1133279080795325745)}};
+    {INT64_C(0), INT64_C(288230376151711744), INT64_C(864691128455135232), INT64_C(1152921504606846976), INT64_C(0),
+     INT64_C(0)},
+    {INT64_C(0), INT64_C(168841445261774044), INT64_C(576460752303423488), INT64_C(984080059345072932),
+     INT64_C(1152921504606846976), INT64_C(0)},
+    {INT64_C(0), INT64_C(110094207099786768), INT64_C(398324583251498512), INT64_C(754596921355348464),
+     INT64_C(1042827297507060208), INT64_C(1152921504606846976)}};
 static const int64_t vinv4_q40[4][4] = {
-    {-INT64_C(113858157053), INT64_C(663613970941), INT64_C(663613970941), -INT64_C(113858157053)},
-    {INT64_C(123239181134), -INT64_C(1734106874812), INT64_C(1734106874812), -INT64_C(123239181134)},
-    {INT64_C(777472127994), -INT64_C(777472127994), -INT64_C(777472127994), INT64_C(777472127994)},
-    {-INT64_C(841529767285), INT64_C(2031632577321), -INT64_C(2031632577321), INT64_C(841529767285)}};
+    {-INT64_C(183251937963), INT64_C(733007751851), INT64_C(733007751851), -INT64_C(183251937963)},
+    {INT64_C(183251937963), -INT64_C(1466015503701), INT64_C(1466015503701), -INT64_C(183251937963)},
+    {INT64_C(733007751851), -INT64_C(733007751851), -INT64_C(733007751851), INT64_C(733007751851)},
+    {-INT64_C(733007751851), INT64_C(1466015503701), -INT64_C(1466015503701), INT64_C(733007751851)}};
 static const int64_t vinv5_q40[5][5] = {
     {INT64_C(0), INT64_C(0), INT64_C(1099511627776), INT64_C(0), INT64_C(0)},
-    {INT64_C(357252984102), -INT64_C(1513347925819), INT64_C(0), INT64_C(1513347925819), -INT64_C(357252984102)},
-    {-INT64_C(375638017279), INT64_C(2574661272831), -INT64_C(4398046511104), INT64_C(2574661272831),
-     -INT64_C(375638017279)},
-    {-INT64_C(1034042751249), INT64_C(1673116317342), INT64_C(0), -INT64_C(1673116317342), INT64_C(1034042751249)},
-    {INT64_C(1087256891186), -INT64_C(2846475495628), INT64_C(3518437208883), -INT64_C(2846475495628),
-     INT64_C(1087256891186)}};
+    {INT64_C(549755813888), -INT64_C(1554944255988), INT64_C(0), INT64_C(1554944255988), -INT64_C(549755813888)},
+    {-INT64_C(549755813888), INT64_C(2199023255552), -INT64_C(3298534883328), INT64_C(2199023255552),
+     -INT64_C(549755813888)},
+    {-INT64_C(1099511627776), INT64_C(1554944255988), INT64_C(0), -INT64_C(1554944255988), INT64_C(1099511627776)},
+    {INT64_C(1099511627776), -INT64_C(2199023255552), INT64_C(2199023255552), -INT64_C(2199023255552),
+     INT64_C(1099511627776)}};
 static const int64_t vinv6_q40[6][6] = {
-    {INT64_C(49102208789), -INT64_C(183251937963), INT64_C(683905543062), INT64_C(683905543062),
-     -INT64_C(183251937963), INT64_C(49102208789)},
-    {-INT64_C(50834347164), INT64_C(259157375998), -INT64_C(2642408107144), INT64_C(2642408107144),
-     -INT64_C(259157375998), INT64_C(50834347164)},
-    {-INT64_C(831212169428), INT64_C(2932031007403), -INT64_C(2100818837975), -INT64_C(2100818837975),
-     INT64_C(2932031007403), -INT64_C(831212169428)},
-    {INT64_C(860534159876), -INT64_C(4146518015967), INT64_C(8116940687818), -INT64_C(8116940687818),
-     INT64_C(4146518015967), -INT64_C(860534159876)},
-    {INT64_C(1466015503701), -INT64_C(2932031007403), INT64_C(1466015503701), INT64_C(1466015503701),
-     -INT64_C(2932031007403), INT64_C(1466015503701)},
-    {-INT64_C(1517730931094), INT64_C(4146518015967), -INT64_C(5664248947061), INT64_C(5664248947061),
-     -INT64_C(4146518015967), INT64_C(1517730931094)}};
+    {INT64_C(109951162778), -INT64_C(271814222797), INT64_C(711618873907), INT64_C(711618873907),
+     -INT64_C(271814222797), INT64_C(109951162778)},
+    {-INT64_C(109951162778), INT64_C(335980856628), -INT64_C(2302847050035), INT64_C(2302847050035),
+     -INT64_C(335980856628), INT64_C(109951162778)},
+    {-INT64_C(1319413953331), INT64_C(3118289718424), -INT64_C(1798875765093), -INT64_C(1798875765093),
+     INT64_C(3118289718424), -INT64_C(1319413953331)},
+    {INT64_C(1319413953331), -INT64_C(3854418065511), INT64_C(5821284258918), -INT64_C(5821284258918),
+     INT64_C(3854418065511), -INT64_C(1319413953331)},
+    {INT64_C(1759218604442), -INT64_C(2846475495628), INT64_C(1087256891186), INT64_C(1087256891186),
+     -INT64_C(2846475495628), INT64_C(1759218604442)},
+    {-INT64_C(1759218604442), INT64_C(3518437208883), -INT64_C(3518437208883), INT64_C(3518437208883),
+     -INT64_C(3518437208883), INT64_C(1759218604442)}};
 
 static int64_t vinv(int n, int k, int j)
 {
@@ -648,9 +653,14 @@ CT_NOINLINE static void set_nodes(path *pa, int64_t tmax)
     pa->tinv = ct_i128_floor_div(ct_i128_shl(ct_i128_shl(ct_i128_from64(1), 60u), pa->tsh), tmax);
     pa->nodes = tmax <= NODES_4_NM ? 4 : (tmax <= NODES_5_NM ? 5 : 6);
     for (j = 0; j < pa->nodes; ++j) { /* bound: NODES */
-        /* t_j = tmax tau_j: < 2^48 2^60 in 128 bits */
+        /* t_j = tmax tau_j: < 2^48 2^60 in 128 bits; node 0 (t = 0) is
+         * the camera, its image the call's */
         int64_t t = ct_mul_shr(tmax, tau_q60[pa->nodes - 4][j], 60u);
-        if (vertex_exact(pa, t, &v) != CT_OK) {
+        if (j == 0 && pa->es->cam_ok) {
+            v.fx = pa->es->cam24[0];
+            v.fy = pa->es->cam24[1];
+            v.fz = pa->es->cam24[2];
+        } else if (vertex_exact(pa, t, &v) != CT_OK) {
             return;
         }
         if (j == 0) {
@@ -941,6 +951,23 @@ ct_status ct_earth_setup(const ct_package *p, const ct_pose *pose, int32_t refr_
                 break;
             }
         }
+    }
+    {
+        /* every path's first node: the camera's image (t = 0: no direction
+         * and no bend), as vertex_exact finds it */
+        path pa;
+        gv v;
+        pa.p = p;
+        pa.es = es;
+        pa.zone = es->zone;
+        pa.d[0] = pa.d[1] = pa.d[2] = 0;
+        pa.w[0] = pa.w[1] = pa.w[2] = 0;
+        pa.refract = 0;
+        pa.interp = 0;
+        es->cam_ok = vertex_exact(&pa, 0, &v) == CT_OK;
+        es->cam24[0] = es->cam_ok ? v.fx : 0;
+        es->cam24[1] = es->cam_ok ? v.fy : 0;
+        es->cam24[2] = es->cam_ok ? v.fz : 0;
     }
     return CT_OK;
 }
@@ -1325,6 +1352,27 @@ static int path_span(const path *pa, const ct_package *p, const ct_earth *es, in
     *t0 = ct_i128_to64(ct_i128_sar(ct_i128_mul(pa->tmax, s0 + (INT64_C(1) << 30)), 31u));
     *t1 = -ct_i128_to64(ct_i128_sar(ct_i128_neg(ct_i128_mul(pa->tmax, s1 + (INT64_C(1) << 30))), 31u));
     return 1;
+}
+
+ct_status ct_earth_path_image24(const ct_package *p, const ct_earth *es, const int64_t dg[3], int64_t t, int interp,
+                                int64_t g[3], int32_t *nodes)
+{
+    path pa;
+    gv v;
+    ct_status st;
+    if (p == NULL || es == NULL || dg == NULL || g == NULL || nodes == NULL || t < 0 || t > es->tmax_nm) {
+        return CT_ERR_ARG;
+    }
+    path_init(&pa, p, es, dg);
+    *nodes = pa.interp ? pa.nodes : 0;
+    if (interp && !pa.interp) {
+        return CT_ERR_RANGE;
+    }
+    st = interp ? vertex(&pa, t, &v) : vertex_exact(&pa, t, &v);
+    g[0] = st == CT_OK ? v.fx : 0;
+    g[1] = st == CT_OK ? v.fy : 0;
+    g[2] = st == CT_OK ? v.fz : 0;
+    return st;
 }
 
 /* The line of sight as pieces of lowered walks from the camera: each piece
