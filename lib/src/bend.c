@@ -115,8 +115,8 @@ static int64_t mip_max(const ct_package *p, uint32_t l, int64_t bi, int64_t bj)
  * box meets the tile at all.  At most four mipmap reads: the level is the
  * first whose blocks are at least as wide as the box (the box top hmax when
  * none is). */
-static int box_above_terrain(const ct_package *p, int64_t x0, int64_t x1, int64_t y0, int64_t y1, int64_t zmin,
-                             int *over_tile)
+int ct_box_above_terrain(const ct_package *p, int64_t x0, int64_t x1, int64_t y0, int64_t y1, int64_t zmin,
+                         int *over_tile)
 {
     int64_t i0, i1, j0, j1, top, bi, bj;
     uint32_t l = 1u;
@@ -191,9 +191,9 @@ static int run_above_terrain(const ct_package *p, const v3 *a, const v3 *b, int 
     m = absdiff64(a->y, b->y) > m ? absdiff64(a->y, b->y) : m;
     m = absdiff64(a->z, b->z) > m ? absdiff64(a->z, b->z) : m;
     slack = 2 + (int64_t)(m >> 24);
-    return box_above_terrain(p, ct_min64(a->x, b->x) - slack, ct_max64(a->x, b->x) + slack,
-                             ct_min64(a->y, b->y) - slack, ct_max64(a->y, b->y) + slack,
-                             run_floor(a, b, run, chord_q16) - slack - ((int64_t)1 << p->zshift_max), over_tile);
+    return ct_box_above_terrain(p, ct_min64(a->x, b->x) - slack, ct_max64(a->x, b->x) + slack,
+                                ct_min64(a->y, b->y) - slack, ct_max64(a->y, b->y) + slack,
+                                run_floor(a, b, run, chord_q16) - slack - ((int64_t)1 << p->zshift_max), over_tile);
 }
 
 /* Both ends of the run inside the tile's closed box (so the polyline over

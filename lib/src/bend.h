@@ -164,6 +164,13 @@ int ct_earth_map_fits(const ct_package *pkg, const ct_earth_map *map);
  * its cube) or exact (for tests of the fit).                              */
 ct_status ct_earth_image24(const ct_package *pkg, const ct_earth *es, const int64_t D[3], int fitted, int64_t g[3]);
 
+/* Culling (bend.c): 1 when zmin (Q16) is above the max-mipmap's maximum
+ * over the fine cells the horizontal box [x0, x1] x [y0, y1] (Q16) touches
+ * (the package's tallest post when no stored level covers it in 2 x 2
+ * blocks), or the box misses the tile (*over_tile 0).  At most four reads. */
+int ct_box_above_terrain(const ct_package *p, int64_t x0, int64_t x1, int64_t y0, int64_t y1, int64_t zmin,
+                         int *over_tile);
+
 /* The image (Q24) of the line of sight with grid direction dg (Q39, as
  * ct_trace_earth_set's) at range t (0 <= t <= es->tmax_nm): interpolated
  * between its nodes (interp != 0; CT_ERR_RANGE when they could not be

@@ -137,6 +137,8 @@ typedef struct {
     unsigned tsh;  /* bit length of tmax                              */
     int64_t base[3];      /* image of node 0, Q24 (x, y) and Q24 height   */
     int64_t cf[NODES][3]; /* polynomial in sigma, Q24, lowest power first */
+    int64_t b3z;          /* sum of j (j - 1) (j - 2) |c_j| of the height:
+                             |z'''(sigma)| <= b3z on [-1, 1] (< 2^57)      */
 } path;
 
 /* round(v / 256) */
@@ -686,6 +688,10 @@ CT_NOINLINE static void set_nodes(path *pa, int64_t tmax)
             pa->cf[k][j] = ct_i128_round_shr(acc, 40u);
         }
     }
+    pa->b3z = 0;
+    for (k = 3; k < pa->nodes; ++k) { /* bound: NODES - 3; |c| < 2^49, k (k-1) (k-2) <= 60 */
+        pa->b3z += (int64_t)(k * (k - 1) * (k - 2)) * ct_abs64(pa->cf[k][2]);
+    }
     pa->interp = 1;
 }
 
@@ -972,19 +978,71 @@ ct_status ct_earth_setup(const ct_package *p, const ct_pose *pose, int32_t refr_
     return CT_OK;
 }
 
+/* A bound (Q16 height units) of how far the path's height over a piece of
+ * length Lc may fall below the quadratic in sigma through its ends and
+ * middle: |z'''| h^3 / (72 sqrt 3), h = 2 Lc / tmax the piece in sigma
+ * (the error of interpolation at three equally spaced points), rounded
+ * up: hq = h 2^30 <= 2^31, b3z hq < 2^88 in 128 bits, each product
+ * shifted back; 526 / 2^16 > 1 / (72 sqrt 3); 2 units for the rounding of
+ * the vertices' heights to Q16.  Without the polynomial
+ * (the exact vertices), pieces up to PIECE_FIRST_NM bend by far less than
+ * the tolerance the callers subtract as well (the image's third derivative
+ * scales as 1 / R^2: 0.03 mm at 4 km), longer ones are never off. */
+static int64_t cubic_drop(const path *pa, int64_t Lc)
+{
+    int64_t hq, e;
+    if (!pa->interp) {
+        return Lc <= PIECE_FIRST_NM ? 0 : INT64_C(1) << 60;
+    }
+    hq = -ct_i128_floor_div_sat(ct_i128_neg(ct_i128_shl(ct_i128_from64(2 * Lc), 30u)), pa->tmax);
+    e = -ct_i128_to64(ct_i128_sar(ct_i128_neg(ct_i128_mul(pa->b3z, hq)), 30u));
+    e = -ct_i128_to64(ct_i128_sar(ct_i128_neg(ct_i128_mul(e, hq)), 30u));
+    e = -ct_i128_to64(ct_i128_sar(ct_i128_neg(ct_i128_mul(e, hq)), 30u));
+    /* e <= b3z (hq / 2^30)^3 < 2^60: in Q16 (< 2^52) before the factor */
+    return ((((e >> 8) + 1) * 526) >> 16) + 2;
+}
+
 /* 1 when nothing of the piece can touch terrain: off the tile
- * horizontally (the box of A, B, M widened by the deviation and 2 cells)
- * or above the tallest post. */
-static int piece_off(const ct_package *p, const gv *A, const gv *B, const gv *M, const fit *f, int64_t tolz)
+ * horizontally (the box of A, B, M widened by the deviation and 2 cells:
+ * the sideways bend beyond the middle's deviation is far smaller) or, by
+ * the tolerance, above the tallest post -- its lowest point bounded from
+ * the quadratic in sigma through A, M, B (at least min(zA, zB) less (zA +
+ * zB - 2 zM) / 2 when convex) less the path's distance from it (cubic_drop;
+ * unchecked pieces may be up to 30 km long) and as the model sees it (the
+ * quadratic along the chord, less its dip). */
+static int piece_off(const ct_package *p, const path *pa, const gv *A, const gv *B, const gv *M, const fit *f,
+                     int64_t Lc, int64_t tolz)
 {
     int64_t m = f->dev / 256 + 2 * ONE16;
     int64_t x0 = ct_min64(A->x, ct_min64(B->x, M->x)) - m, x1 = ct_max64(A->x, ct_max64(B->x, M->x)) + m;
     int64_t y0 = ct_min64(A->y, ct_min64(B->y, M->y)) - m, y1 = ct_max64(A->y, ct_max64(B->y, M->y)) + m;
     int64_t zlow = ct_min64(A->z, ct_min64(B->z, M->z)) - f->dip - tolz;
+    /* |z| < 2^55 (ct_map_to_grid's range): sums < 2^57 */
+    int64_t zsig = ct_min64(A->z, B->z) - ct_max64(0, (A->z + B->z - 2 * M->z) / 2) - cubic_drop(pa, Lc) - tolz;
+    zlow = ct_min64(zlow, zsig);
     if (x1 < 0 || y1 < 0 || x0 > (int64_t)p->cells_x * ONE16 || y0 > (int64_t)p->cells_y * ONE16) {
         return 1;
     }
     return zlow > ((int64_t)p->hmax + 1) * ONE16;
+}
+
+/* 1 when the piece's walk cannot meet the surface (CT_BEND_NO_CULL turns
+ * this off): its straight line, from A to B less the lowering dB (the walk
+ * traces it against the terrain lowered by a >= 0, so below the terrain),
+ * lies above the max-mipmap's maximum under its box, with the polyline
+ * culling's slack for the prepared segment's rounding (bend.c: 2 + |B -
+ * A| / 2^24 Q16 units, and 2^zshift_max more vertically).  The walk would
+ * find no hit, so skipping it changes no result.  |B - A| < 2^43 (pieces
+ * of at most 30 km at 1 cm posting or more; the lowering < 2^48). */
+static int piece_culled(const ct_package *p, const gv *A, const gv *B, int64_t dB)
+{
+    int64_t zb = B->z - dB, m, slack;
+    int over;
+    m = ct_max64(ct_abs64(B->x - A->x), ct_max64(ct_abs64(B->y - A->y), ct_abs64(zb - A->z)));
+    slack = 2 + (m >> 24);
+    return ct_box_above_terrain(p, ct_min64(A->x, B->x) - slack, ct_max64(A->x, B->x) + slack,
+                                ct_min64(A->y, B->y) - slack, ct_max64(A->y, B->y) + slack,
+                                ct_min64(A->z, zb) - slack - ((int64_t)1 << p->zshift_max), &over);
 }
 
 /* 1 when the path never comes back over the tile: beyond an edge and
@@ -1206,7 +1264,7 @@ static int check_piece(const ct_package *p, const path *pa, const ct_earth *es, 
         pc->elat = lateral24(&pc->As, &pc->Bs, pc->f.l24, A);
     }
     fit_middle(&pc->As, &pc->Bs, &pc->M, &pc->f);
-    pc->off = piece_off(p, &pc->As, &pc->Bs, &pc->M, &pc->f, es->tolz_q16);
+    pc->off = piece_off(p, pa, A, &pc->B, &pc->M, &pc->f, pc->Lc, es->tolz_q16);
     pc->lwp = NULL;
     pc->dB = 0; /* with lwp: a try that fails before the quarter points
                    must not keep an earlier, longer try's lowering */
@@ -1431,7 +1489,7 @@ ct_status ct_trace_earth_set(const ct_package *p, ct_tileset *ts, const ct_earth
             h->iters = iters;
             return CT_MISS;
         }
-        if (!pc.off) {
+        if (!pc.off && !(es->cull && piece_culled(p, &pc.As, &pc.Bs, pc.dB))) {
             st = trace_piece(p, ts, &pc.As, &pc.Bs, &pc.f, pc.lwp, pc.dB, first, m, h, &steps, &iters);
             if (st != CT_MISS) {
                 return st; /* a hit, the camera below the surface, or an error */
