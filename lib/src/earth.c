@@ -1433,6 +1433,36 @@ ct_status ct_earth_path_image24(const ct_package *p, const ct_earth *es, const i
     return st;
 }
 
+/* The first piece's length to try: where the path's sideways bend, as its
+ * polynomial's second-degree term shows it (k = 2 |c1 x c2| / |c1|, the
+ * sideways second derivative in sigma at its middle; x, y of |c| < 2^49:
+ * the cross product < 2^99 in 128 bits, k < 2^51), puts the chord at 0.8
+ * of the tolerance: k h^2 / 16 (shifted: half the deviation; else / 8) =
+ * 0.8 tol, h = 2 L / tmax the piece in sigma.  A guess (next_piece checks
+ * the piece): PIECE_FIRST_NM without a bend, and within [PIECE_MIN_NM,
+ * PIECE_FIRST_NM] (longer pieces grow from there). */
+static int64_t first_length(const path *pa, const ct_earth *es, int shift)
+{
+    ct_i128 cross = ct_i128_sub(ct_i128_mul(pa->cf[1][0], pa->cf[2][1]), ct_i128_mul(pa->cf[1][1], pa->cf[2][0]));
+    int64_t n1 = (int64_t)ct_i128_isqrt(
+        ct_i128_add(ct_i128_mul(pa->cf[1][0], pa->cf[1][0]), ct_i128_mul(pa->cf[1][1], pa->cf[1][1])));
+    int64_t k, h2, L;
+    if (n1 == 0) {
+        return PIECE_FIRST_NM;
+    }
+    k = ct_i128_floor_div_sat(ct_i128_shl(ct_i128_abs(cross), 1u), n1);
+    if (k <= 0) {
+        return PIECE_FIRST_NM;
+    }
+    /* h^2 in Q60 = (12.8 or 6.4) tol 2^60 / k: tol capped at 2^48, 13 tol
+     * 2^60 < 2^112; saturated at 2^62 (h = 2, the whole path), so h in Q30
+     * <= 2^31 and h tmax < 2^80 */
+    h2 = ct_i128_floor_div_sat(
+        ct_i128_shl(ct_i128_from64(ct_min64(es->tol_q24, INT64_C(1) << 48) * (shift ? 64 : 32) / 5), 60u), k);
+    L = ct_i128_to64(ct_i128_sar(ct_i128_mul((int64_t)ct_isqrt64((uint64_t)h2), pa->tmax), 31u));
+    return ct_min64(PIECE_FIRST_NM, ct_max64(PIECE_MIN_NM, L));
+}
+
 /* The line of sight as pieces of lowered walks from the camera: each piece
  * chosen (next_piece), traced unless off the tile (trace_piece), until a
  * hit, an error, the path's end or a path gone from the tile. */
@@ -1477,6 +1507,7 @@ ct_status ct_trace_earth_set(const ct_package *p, ct_tileset *ts, const ct_earth
              * is always CT_OK); at 0 the camera's own grid point */
             (void)vertex(&pa, ta, &A);
         }
+        L = first_length(&pa, es, !(ta == 0 && over));
     }
     /* bound: EARTH_MAX_PIECES pieces (each with at most EARTH_MAX_RETRIES
      * + 1 tries in next_piece) */
