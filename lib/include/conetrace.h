@@ -926,7 +926,7 @@ ct_status ct_locate_inverse(const ct_package *pkg, const ct_camera *cam, const c
 
 /* Fit a ct_earth_map for `pkg` (on a UTM zone) over the cube of half-width
  * 2^q nm >= radius_nm (q = 44..47: 17.6 .. 141 km) around the map point
- * (e, n, h): (d + 1)^3 exact conversions, d = 4, 5, 6 for q = 44, 45, >= 46
+ * (e, n, h): (d + 1)^3 exact conversions, d = 4, 5, 6 for q = 44, 45..46, 47
  * (125 .. 343; 9.4M instructions at q = 44 on Cortex-M4).  CT_OK;
  * CT_ERR_ARG (NULL), CT_ERR_CRS (not UTM), CT_ERR_RANGE (radius beyond
  * 2^47 nm or not positive, the point off the zone or the grid's range, or
