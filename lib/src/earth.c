@@ -1299,7 +1299,7 @@ static int check_piece(const ct_package *p, const path *pa, const ct_earth *es, 
  * domain, so the path may still meet it before leaving (a tile near the
  * zone's edge).  CT_MISS when even PIECE_MIN_NM reaches beyond the domain
  * (or the tries run out on such a piece), else CT_OK. */
-static ct_status next_piece(const ct_package *p, const path *pa, const ct_earth *es, const gv *A, int64_t ta,
+CT_NOINLINE static ct_status next_piece(const ct_package *p, const path *pa, const ct_earth *es, const gv *A, int64_t ta,
                             int64_t tend, int shift, int64_t *L, piece *pc)
 {
     uint32_t r;
@@ -1443,7 +1443,7 @@ ct_status ct_earth_path_image24(const ct_package *p, const ct_earth *es, const i
  * 0.8 tol, h = 2 L / tmax the piece in sigma.  A guess (next_piece checks
  * the piece): PIECE_FIRST_NM without a bend, and within [PIECE_MIN_NM,
  * PIECE_FIRST_NM] (longer pieces grow from there). */
-static int64_t first_length(const path *pa, const ct_earth *es, int shift)
+CT_NOINLINE static int64_t first_length(const path *pa, const ct_earth *es, int shift)
 {
     ct_i128 cross = ct_i128_sub(ct_i128_mul(pa->cf[1][0], pa->cf[2][1]), ct_i128_mul(pa->cf[1][1], pa->cf[2][0]));
     int64_t n1 = (int64_t)ct_i128_isqrt(
