@@ -1009,7 +1009,7 @@ static int64_t cubic_drop(const path *pa, int64_t Lc)
  * the sideways bend beyond the middle's deviation is far smaller) or, by
  * the tolerance, above the tallest post -- its lowest point bounded from
  * the quadratic in sigma through A, M, B (at least min(zA, zB) less (zA +
- * zB - 2 zM) / 2 when convex) less the path's distance from it (cubic_drop;
+ * zB - 2 zM) / 2, rounded up, when convex) less the path's distance from it (cubic_drop;
  * unchecked pieces may be up to 30 km long) and as the model sees it (the
  * quadratic along the chord, less its dip). */
 static int piece_off(const ct_package *p, const path *pa, const gv *A, const gv *B, const gv *M, const fit *f,
@@ -1018,9 +1018,12 @@ static int piece_off(const ct_package *p, const path *pa, const gv *A, const gv 
     int64_t m = f->dev / 256 + 2 * ONE16;
     int64_t x0 = ct_min64(A->x, ct_min64(B->x, M->x)) - m, x1 = ct_max64(A->x, ct_max64(B->x, M->x)) + m;
     int64_t y0 = ct_min64(A->y, ct_min64(B->y, M->y)) - m, y1 = ct_max64(A->y, ct_max64(B->y, M->y)) + m;
-    int64_t zlow = ct_min64(A->z, ct_min64(B->z, M->z)) - f->dip - tolz;
-    /* |z| < 2^55 (ct_map_to_grid's range): sums < 2^57 */
-    int64_t zsig = ct_min64(A->z, B->z) - ct_max64(0, (A->z + B->z - 2 * M->z) / 2) - cubic_drop(pa, Lc) - tolz;
+    /* |z| < 2^56 (ct_map_to_grid's range, and the interpolation's 2^49):
+     * sums < 2^58; the tolerance and the dip (saturated at 2^62) capped at
+     * 2^60, still far below any tile; cubic_drop <= 2^60 + 2^44 */
+    int64_t tz = ct_min64(tolz, INT64_C(1) << 60);
+    int64_t zlow = ct_min64(A->z, ct_min64(B->z, M->z)) - ct_min64(f->dip, INT64_C(1) << 60) - tz;
+    int64_t zsig = ct_min64(A->z, B->z) - ct_max64(0, (A->z + B->z - 2 * M->z + 1) / 2) - cubic_drop(pa, Lc) - tz;
     zlow = ct_min64(zlow, zsig);
     if (x1 < 0 || y1 < 0 || x0 > (int64_t)p->cells_x * ONE16 || y0 > (int64_t)p->cells_y * ONE16) {
         return 1;
