@@ -1302,8 +1302,8 @@ static int check_piece(const ct_package *p, const path *pa, const ct_earth *es, 
  * domain, so the path may still meet it before leaving (a tile near the
  * zone's edge).  CT_MISS when even PIECE_MIN_NM reaches beyond the domain
  * (or the tries run out on such a piece), else CT_OK. */
-CT_NOINLINE static ct_status next_piece(const ct_package *p, const path *pa, const ct_earth *es, const gv *A, int64_t ta,
-                            int64_t tend, int shift, int64_t *L, piece *pc)
+CT_NOINLINE static ct_status next_piece(const ct_package *p, const path *pa, const ct_earth *es, const gv *A,
+                                        int64_t ta, int64_t tend, int shift, int64_t *L, piece *pc)
 {
     uint32_t r;
     int ok = -1;
