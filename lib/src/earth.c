@@ -897,11 +897,9 @@ ct_status ct_earth_setup(const ct_package *p, const ct_pose *pose, int32_t refr_
     es->tol_q24 = ct_max64(2, ct_i128_floor_div_sat(ct_i128_shl(ct_i128_from64(chord_nm), 24), post));
     es->tolz_q16 = ct_max64(2, ct_i128_floor_div_sat(ct_i128_shl(ct_i128_from64(chord_nm), 16), p->height_scale_nm));
     es->cull = (bend_flags & CT_BEND_NO_CULL) == 0u;
-    /* no terrain beyond the farthest tile corner: the range to it plus the
-     * height down to the lowest post, with 2 % and 1 km to spare (a map
-     * metre is at least 0.9996 ground metres, the transverse Mercator's
-     * central scale, and a line of sight's horizontal progress falls
-     * behind its range by R / (R + h): 0.3 % at 20 km up) */
+    /* no terrain beyond the farthest tile corner: the range to it (map
+     * metres are ground metres within 0.1 %) plus the height down to the
+     * lowest post, with 10 % and 1 km to spare */
     far2x = ct_max64(ct_abs64(es->ox), ct_abs64(es->ox - (int64_t)p->cells_x * ONE16));
     far2y = ct_max64(ct_abs64(es->oy), ct_abs64(es->oy - (int64_t)p->cells_y * ONE16));
     dz = ct_abs64(es->oz - (int64_t)p->hmin * ONE16);
@@ -918,7 +916,7 @@ ct_status ct_earth_setup(const ct_package *p, const ct_pose *pose, int32_t refr_
         if (dist > TMAX_LIMIT_NM) {
             dist = TMAX_LIMIT_NM;
         }
-        es->tmax_nm = ct_min64(TMAX_LIMIT_NM, dist + dist / 50 + KM_NM);
+        es->tmax_nm = ct_min64(TMAX_LIMIT_NM, dist + dist / 10 + KM_NM);
     }
     es->map = NULL;
     es->moff[0] = es->moff[1] = es->moff[2] = 0;
