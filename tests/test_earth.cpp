@@ -1156,6 +1156,25 @@ void test_path_interpolation()
     }
     TEST_ASSERT_MSG(counts == (1u << 4) + (1u << 5) + (1u << 6), "the cameras did not make every node count (%x)",
                     counts);
+    // the hook's refusals: each argument missing, t outside [0, tmax]
+    {
+        Pose p;
+        TEST_ASSERT(make_pose(w->sf, {"far", 201045, 4065840, 3000, 270, -10}, &p));
+        ct_earth es;
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_earth_setup(&pk, &p.pose, 0, CT_EARTH_RADIUS_NM, CT_EFFECTS_CHORD_NM, 0u, 1,
+                                                    nullptr, &es));
+        const int64_t dg[3] = {INT64_C(1) << 39, 0, 0};
+        int64_t g[3];
+        int32_t n;
+        TEST_ASSERT_EQUAL_INT(CT_ERR_ARG, ct_earth_path_image24(nullptr, &es, dg, 0, 1, g, &n));
+        TEST_ASSERT_EQUAL_INT(CT_ERR_ARG, ct_earth_path_image24(&pk, nullptr, dg, 0, 1, g, &n));
+        TEST_ASSERT_EQUAL_INT(CT_ERR_ARG, ct_earth_path_image24(&pk, &es, nullptr, 0, 1, g, &n));
+        TEST_ASSERT_EQUAL_INT(CT_ERR_ARG, ct_earth_path_image24(&pk, &es, dg, 0, 1, nullptr, &n));
+        TEST_ASSERT_EQUAL_INT(CT_ERR_ARG, ct_earth_path_image24(&pk, &es, dg, 0, 1, g, nullptr));
+        TEST_ASSERT_EQUAL_INT(CT_ERR_ARG, ct_earth_path_image24(&pk, &es, dg, -1, 1, g, &n));
+        TEST_ASSERT_EQUAL_INT(CT_ERR_ARG, ct_earth_path_image24(&pk, &es, dg, es.tmax_nm + 1, 1, g, &n));
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_earth_path_image24(&pk, &es, dg, es.tmax_nm, 1, g, &n));
+    }
     TEST_ASSERT_MSG(worst <= kInterpM, "interpolated path off its node images by %.3g m (> %.3g m)", worst, kInterpM);
 }
 
@@ -1211,6 +1230,47 @@ void test_piece_culling()
                     culled += h[0].steps < h[1].steps;
                 }
             }
+        }
+    }
+    // lines of sight along each of the tile's four edges, a cell outside it
+    // (the east-west ones drift 9 m south over the tile: the transverse
+    // Mercator's image of a great circle), level 1 m over its lowest post:
+    // pieces within 2 cells of the tile and below its tallest post (so not
+    // off), whose own boxes miss it -- culled as such
+    {
+        const ct_package &pk = w->p;
+        const ld pe = pk.posting_e_nm * 1e-9L, pn = pk.posting_n_nm * 1e-9L;
+        const ld e0 = pk.origin_e_nm * 1e-9L, n0 = pk.origin_n_nm * 1e-9L;
+        const ld e1 = e0 + pe * pk.cells_x, n1 = n0 + pn * pk.cells_y;
+        const ld west = std::min(e0, e1) - 30, east = std::max(e0, e1) + 30;
+        const ld south = std::min(n0, n1) - 30, north = std::max(n0, n1) + 30;
+        const ld h = (pk.height_offset_nm + (int64_t)pk.hmin * pk.height_scale_nm) * 1e-9L + 1;
+        const struct {
+            ld e, n;
+            int yaw;
+        } edge[4] = {{west, south - 300, 0}, {east, south - 300, 0}, {west - 300, south, 90}, {west - 300, north, 90}};
+        for (const auto &ed : edge) {
+            int32_t q[4];
+            ct_pose pose;
+            const ld yaw = ed.yaw * kPi / 180;
+            TEST_ASSERT(ct_quat_from_ypr(q61(ed.yaw), 0, 0, q) == CT_OK);
+            TEST_ASSERT(ct_pose_from_map(&pose, std::llround(ed.e * 1e9L), std::llround(ed.n * 1e9L),
+                                         std::llround(h * 1e9L), q) == CT_OK);
+            ct_earth es[2];
+            for (int nc = 0; nc < 2; ++nc) {
+                TEST_ASSERT_EQUAL_INT(CT_OK, ct_earth_setup(&pk, &pose, 0, CT_EARTH_RADIUS_NM, CT_EFFECTS_CHORD_NM,
+                                                            nc ? CT_BEND_NO_CULL : 0u, 1, nullptr, &es[nc]));
+            }
+            const ld one = 549755813888.0L;
+            const int64_t dg[3] = {std::llround(std::sin(yaw) * one), std::llround(std::cos(yaw) * one), 0};
+            ct_hit h2[2];
+            ct_status st[2];
+            for (int nc = 0; nc < 2; ++nc) {
+                st[nc] = ct_trace_earth_set(&pk, nullptr, &es[nc], dg, CT_METHOD_DIRECTIONAL, &h2[nc]);
+            }
+            TEST_ASSERT_MSG(st[0] == CT_MISS && st[1] == CT_MISS, "along an edge (yaw %d): %d, %d", ed.yaw, (int)st[0],
+                            (int)st[1]);
+            culled += h2[0].steps < h2[1].steps;
         }
     }
     std::printf("  %ld traces (%ld hits): the same with and without culling; %ld took fewer steps with it\n", rays, hits,
@@ -1684,6 +1744,19 @@ void test_level_rise_refused()
                                  p.q) == CT_OK);
     const ct_effects fx = {CT_EFFECT_CURVATURE | CT_EFFECT_REFRACTION, 65381, 0, 0, nullptr};
     const int64_t u0 = (int64_t)1023 << 15, v0 = (int64_t)767 << 15;
+    // the premise: the path is not interpolated (its nodes span over 2^22
+    // cells), so its pieces start at the camera: 4, 8, then 16 km
+    {
+        ct_earth es;
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_earth_setup(&w->p, &p.pose, fx.refraction_k_q16, CT_EARTH_RADIUS_NM,
+                                                    CT_EFFECTS_CHORD_NM, 0u, 0, nullptr, &es));
+        const int64_t east[3] = {INT64_C(1) << 39, 0, 0};
+        int64_t g[3];
+        int32_t nodes = -1;
+        TEST_ASSERT_EQUAL_INT(CT_ERR_RANGE, ct_earth_path_image24(&w->p, &es, east, 0, 1, g, &nodes));
+        TEST_ASSERT_EQUAL_INT(0, nodes);
+        TEST_ASSERT(es.tmax_nm >= INT64_C(28000) * 1000000000);  // the third piece whole: 12 .. 28 km
+    }
     DomainTally T;
     for (int dv = -20; dv <= -4; ++dv) judge_domain(w, pj, -81, cam, p, fx, u0, v0 + dv, T, 0);
     std::printf("  a level line of sight (k = 0.9977) 26 km from a tile of 5 mm posts, its 16 km piece's rise below "

@@ -125,7 +125,6 @@ typedef struct {
     const ct_earth_map *map;
     int64_t moff[3];       /* c - map->c, ECEF nm                            */
     int64_t cam24[3];      /* the camera's image, Q24 (every path's node 0)  */
-    int32_t cam_ok;        /* 0: not found (each path finds it again)        */
     ct_earth_map fit;
 } ct_earth;
 

@@ -658,7 +658,7 @@ CT_NOINLINE static void set_nodes(path *pa, int64_t tmax)
         /* t_j = tmax tau_j: < 2^48 2^60 in 128 bits; node 0 (t = 0) is
          * the camera, its image the call's */
         int64_t t = ct_mul_shr(tmax, tau_q60[pa->nodes - 4][j], 60u);
-        if (j == 0 && pa->es->cam_ok) {
+        if (j == 0) {
             v.fx = pa->es->cam24[0];
             v.fy = pa->es->cam24[1];
             v.fz = pa->es->cam24[2];
@@ -960,7 +960,10 @@ ct_status ct_earth_setup(const ct_package *p, const ct_pose *pose, int32_t refr_
     }
     {
         /* every path's first node: the camera's image (t = 0: no direction
-         * and no bend), as vertex_exact finds it */
+         * and no bend), as vertex_exact finds it -- the camera's map point
+         * through ECEF and back, so it fails only for a camera on the
+         * projection domain's very edge (as the pose's own point is
+         * checked above): CT_ERR_RANGE */
         path pa;
         gv v;
         pa.p = p;
@@ -970,10 +973,13 @@ ct_status ct_earth_setup(const ct_package *p, const ct_pose *pose, int32_t refr_
         pa.w[0] = pa.w[1] = pa.w[2] = 0;
         pa.refract = 0;
         pa.interp = 0;
-        es->cam_ok = vertex_exact(&pa, 0, &v) == CT_OK;
-        es->cam24[0] = es->cam_ok ? v.fx : 0;
-        es->cam24[1] = es->cam_ok ? v.fy : 0;
-        es->cam24[2] = es->cam_ok ? v.fz : 0;
+        st = vertex_exact(&pa, 0, &v);
+        if (st != CT_OK) {
+            return st;
+        }
+        es->cam24[0] = v.fx;
+        es->cam24[1] = v.fy;
+        es->cam24[2] = v.fz;
     }
     return CT_OK;
 }
@@ -1419,21 +1425,28 @@ ct_status ct_earth_path_image24(const ct_package *p, const ct_earth *es, const i
                                 int64_t g[3], int32_t *nodes)
 {
     path pa;
-    gv v;
+    gv v = {0, 0, 0, 0, 0, 0};
     ct_status st;
     if (p == NULL || es == NULL || dg == NULL || g == NULL || nodes == NULL || t < 0 || t > es->tmax_nm) {
         return CT_ERR_ARG;
     }
     path_init(&pa, p, es, dg);
-    *nodes = pa.interp ? pa.nodes : 0;
+    *nodes = pa.nodes * pa.interp;
     if (interp && !pa.interp) {
         return CT_ERR_RANGE;
     }
     st = interp ? vertex(&pa, t, &v) : vertex_exact(&pa, t, &v);
-    g[0] = st == CT_OK ? v.fx : 0;
-    g[1] = st == CT_OK ? v.fy : 0;
-    g[2] = st == CT_OK ? v.fz : 0;
+    g[0] = v.fx;
+    g[1] = v.fy;
+    g[2] = v.fz;
     return st;
+}
+
+/* 1 for the camera's own piece over the tile: it starts at the camera (its
+ * CT_BELOW is the camera's) and is not shifted sideways. */
+static int camera_piece(int64_t ta, int over)
+{
+    return ta == 0 && over;
 }
 
 /* The first piece's length to try: where the path's sideways bend, as its
@@ -1510,14 +1523,12 @@ ct_status ct_trace_earth_set(const ct_package *p, ct_tileset *ts, const ct_earth
              * is always CT_OK); at 0 the camera's own grid point */
             (void)vertex(&pa, ta, &A);
         }
-        L = first_length(&pa, es, !(ta == 0 && over));
+        L = first_length(&pa, es, !camera_piece(ta, over));
     }
     /* bound: EARTH_MAX_PIECES pieces (each with at most EARTH_MAX_RETRIES
      * + 1 tries in next_piece) */
     for (n = 0u; n < EARTH_MAX_PIECES && ta < tend; ++n) {
-        /* the camera's own piece over the tile starts at the camera (its
-         * CT_BELOW is the camera's); the others are shifted sideways */
-        int first = ta == 0 && over;
+        int first = camera_piece(ta, over);
         if (next_piece(p, &pa, es, &A, ta, tend, !first, &L, &pc) != CT_OK) {
             h->steps = steps;
             h->iters = iters;
