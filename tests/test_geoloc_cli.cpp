@@ -613,15 +613,21 @@ void test_geoloc_earth_map()
     TEST_ASSERT_EQUAL_INT(CT_OK, ct_utm_inverse(&z, std::llround(E0 * 1e9), std::llround(N0 * 1e9), &la, &lo));
     const long double lat = (long double)la / std::ldexp(1.0L, 61) * 180 / M_PIl;
     const long double lon = (long double)lo / std::ldexp(1.0L, 61) * 180 / M_PIl;
-    char arg[160];
-    std::snprintf(arg, sizeof arg, "%.12Lf,%.12Lf,%.9f,-45,-40,0", lat, lon, H0);
+    char arg[160], slat[40], slon[40];
+    std::snprintf(slat, sizeof slat, "%.12Lf", lat);
+    std::snprintf(slon, sizeof slon, "%.12Lf", lon);
+    std::snprintf(arg, sizeof arg, "%s,%s,%.9f,-45,-40,0", slat, slon, H0);
     int32_t q[4];
     TEST_ASSERT_EQUAL_INT(CT_OK, ct_quat_from_ypr(q61(-45), q61(-40), 0, q));
     ct_host::CameraModel cm = ct_host::read_cameramodel(g_dir + "/cam.cameramodel");
     ct_host::LibCamera lc = ct_host::lib_camera(cm, "cam");
+    // the pose the command makes of the text it is given (its latitude
+    // and longitude to 12 decimals, read back as doubles): the rows are
+    // then the library's own answers to the bit (a pose 10^-7 m away moves
+    // an unlucky hit by a Q16 unit)
     ct_pose pose;
-    TEST_ASSERT_EQUAL_INT(CT_OK, ct_pose_from_wgs84(&pose, &z, q61((double)lat), q61((double)lon),
-                                                   std::llround(H0 * 1e9), q));
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_pose_from_wgs84(&pose, &z, q61(std::strtod(slat, nullptr)),
+                                                   q61(std::strtod(slon, nullptr)), std::llround(H0 * 1e9), q));
     auto geoloc = [&](const char *map, const char *threads) -> std::string {
         std::vector<std::string> args = {"geoloc", "tm.ctp", "--camera", "cam.cameramodel", "--pixels", "pxe.csv",
                                          "--pose-wgs84", arg, "--effects", "curvature,refraction", "-o", "ge.csv"};
