@@ -1247,7 +1247,7 @@ static int64_t excess_1024(const ct_earth *es, int64_t elat, int64_t evert)
 /* The model of the piece from A with its B and M set, checked against the
  * exact image: 1 when it is within the tolerances or off the tile, 0 when
  * it must be shorter, -1 when a quarter point is beyond the projection's
- * domain.  Sets f, off, lwp (and lw), dB (0 without a lowering), elat,
+ * domain.  Sets As, Bs, f, off, lwp (and lw), dB (0 without a lowering), elat,
  * evert. */
 static int check_piece(const ct_package *p, const path *pa, const ct_earth *es, const gv *A, int64_t ta, int shift,
                        piece *pc)
