@@ -87,6 +87,15 @@ const ld kPi = earth_ref::kPi;
 
 int64_t q61(ld deg) { return (int64_t)std::llround(deg * kPi / 180 * std::ldexp(1.0L, 61)); }
 ld deg_of_q61(int64_t v) { return (ld)v / std::ldexp(1.0L, 61) * 180 / kPi; }
+// A unit grid direction (east, north, up) in Q39, ct_trace_earth_set's:
+// yaw clockwise from grid north, pitch up from the horizontal (degrees).
+void grid_dir_q39(ld yaw_deg, ld pitch_deg, int64_t dg[3])
+{
+    const ld y = yaw_deg * kPi / 180, p = pitch_deg * kPi / 180, one = std::ldexp(1.0L, 39);
+    dg[0] = std::llround(std::sin(y) * std::cos(p) * one);
+    dg[1] = std::llround(std::cos(y) * std::cos(p) * one);
+    dg[2] = std::llround(std::sin(p) * one);
+}
 
 struct Cam {
     ct_camera cam;
@@ -1132,9 +1141,8 @@ void test_path_interpolation()
         int32_t nodes = 0;
         for (int az = 200; az <= 340; az += 35) {
             for (int dep : {1, 4, 12}) {
-                const ld a = az * kPi / 180, d = dep * kPi / 180, one = 549755813888.0L;  // Q39
-                const int64_t dg[3] = {std::llround(std::sin(a) * std::cos(d) * one),
-                                       std::llround(std::cos(a) * std::cos(d) * one), std::llround(-std::sin(d) * one)};
+                int64_t dg[3];
+                grid_dir_q39(az, -dep, dg);
                 for (int i = 0; i <= 1000; ++i) {
                     const int64_t t = (int64_t)((ld)es.tmax_nm * i / 1000);
                     int64_t gi[3], ge[3];
@@ -1205,12 +1213,10 @@ void test_piece_culling()
             }
             TEST_ASSERT_MSG(ok, "pose %s: no set-up", d.family);
             for (int k = 0; k < 30; ++k) {
-                const ld yaw = (d.yaw + ct_rng_range(&rng, -20000, 20000) * 1e-3L) * kPi / 180;
-                const ld pitch = std::max(-89.0L, d.pitch + ct_rng_range(&rng, -20000, 20000) * 1e-3L) * kPi / 180;
-                const ld one = 549755813888.0L;  // Q39: grid east, north, up
-                const int64_t dg[3] = {std::llround(std::sin(yaw) * std::cos(pitch) * one),
-                                       std::llround(std::cos(yaw) * std::cos(pitch) * one),
-                                       std::llround(std::sin(pitch) * one)};
+                const ld yaw = d.yaw + ct_rng_range(&rng, -20000, 20000) * 1e-3L;
+                const ld pitch = std::max(-89.0L, d.pitch + ct_rng_range(&rng, -20000, 20000) * 1e-3L);
+                int64_t dg[3];
+                grid_dir_q39(yaw, pitch, dg);
                 for (int m = 0; m < 4; ++m) {
                     ct_hit h[2];
                     ct_status st[2];
@@ -1252,7 +1258,6 @@ void test_piece_culling()
         for (const auto &ed : edge) {
             int32_t q[4];
             ct_pose pose;
-            const ld yaw = ed.yaw * kPi / 180;
             TEST_ASSERT(ct_quat_from_ypr(q61(ed.yaw), 0, 0, q) == CT_OK);
             TEST_ASSERT(ct_pose_from_map(&pose, std::llround(ed.e * 1e9L), std::llround(ed.n * 1e9L),
                                          std::llround(h * 1e9L), q) == CT_OK);
@@ -1261,8 +1266,8 @@ void test_piece_culling()
                 TEST_ASSERT_EQUAL_INT(CT_OK, ct_earth_setup(&pk, &pose, 0, CT_EARTH_RADIUS_NM, CT_EFFECTS_CHORD_NM,
                                                             nc ? CT_BEND_NO_CULL : 0u, 1, nullptr, &es[nc]));
             }
-            const ld one = 549755813888.0L;
-            const int64_t dg[3] = {std::llround(std::sin(yaw) * one), std::llround(std::cos(yaw) * one), 0};
+            int64_t dg[3];
+            grid_dir_q39(ed.yaw, 0, dg);
             ct_hit h2[2];
             ct_status st[2];
             for (int nc = 0; nc < 2; ++nc) {

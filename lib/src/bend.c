@@ -115,8 +115,8 @@ static int64_t mip_max(const ct_package *p, uint32_t l, int64_t bi, int64_t bj)
  * box meets the tile at all.  At most four mipmap reads: the level is the
  * first whose blocks are at least as wide as the box (the box top hmax when
  * none is). */
-int ct_box_above_terrain(const ct_package *p, int64_t x0, int64_t x1, int64_t y0, int64_t y1, int64_t zmin,
-                         int *over_tile)
+static int box_above_terrain(const ct_package *p, int64_t x0, int64_t x1, int64_t y0, int64_t y1, int64_t zmin,
+                             int *over_tile)
 {
     int64_t i0, i1, j0, j1, top, bi, bj;
     uint32_t l = 1u;
@@ -181,19 +181,25 @@ static int64_t run_floor(const v3 *a, const v3 *b, int run, int64_t chord_q16)
     return ct_min64(a->z, b->z);
 }
 
-static int run_above_terrain(const ct_package *p, const v3 *a, const v3 *b, int run, int64_t chord_q16,
-                             int *over_tile)
+int ct_segment_above_terrain(const ct_package *p, int64_t ax, int64_t ay, int64_t az, int64_t bx, int64_t by,
+                             int64_t bz, int64_t zfloor, int *over_tile)
 {
     /* |b - a| as unsigned differences (vertices lie within +-(2^62 + 2^46),
      * so a difference may not fit an int64); the slack <= 2 + 2^40 */
-    uint64_t m = absdiff64(a->x, b->x);
+    uint64_t m = absdiff64(ax, bx);
     int64_t slack;
-    m = absdiff64(a->y, b->y) > m ? absdiff64(a->y, b->y) : m;
-    m = absdiff64(a->z, b->z) > m ? absdiff64(a->z, b->z) : m;
+    m = absdiff64(ay, by) > m ? absdiff64(ay, by) : m;
+    m = absdiff64(az, bz) > m ? absdiff64(az, bz) : m;
     slack = 2 + (int64_t)(m >> 24);
-    return ct_box_above_terrain(p, ct_min64(a->x, b->x) - slack, ct_max64(a->x, b->x) + slack,
-                                ct_min64(a->y, b->y) - slack, ct_max64(a->y, b->y) + slack,
-                                run_floor(a, b, run, chord_q16) - slack - ((int64_t)1 << p->zshift_max), over_tile);
+    return box_above_terrain(p, ct_min64(ax, bx) - slack, ct_max64(ax, bx) + slack, ct_min64(ay, by) - slack,
+                                ct_max64(ay, by) + slack, zfloor - slack - ((int64_t)1 << p->zshift_max), over_tile);
+}
+
+static int run_above_terrain(const ct_package *p, const v3 *a, const v3 *b, int run, int64_t chord_q16,
+                             int *over_tile)
+{
+    return ct_segment_above_terrain(p, a->x, a->y, a->z, b->x, b->y, b->z, run_floor(a, b, run, chord_q16),
+                                    over_tile);
 }
 
 /* Both ends of the run inside the tile's closed box (so the polyline over

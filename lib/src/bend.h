@@ -163,12 +163,15 @@ int ct_earth_map_fits(const ct_package *pkg, const ct_earth_map *map);
  * its cube) or exact (for tests of the fit).                              */
 ct_status ct_earth_image24(const ct_package *pkg, const ct_earth *es, const int64_t D[3], int fitted, int64_t g[3]);
 
-/* Culling (bend.c): 1 when zmin (Q16) is above the max-mipmap's maximum
- * over the fine cells the horizontal box [x0, x1] x [y0, y1] (Q16) touches
- * (the package's tallest post when no stored level covers it in 2 x 2
- * blocks), or the box misses the tile (*over_tile 0).  At most four reads. */
-int ct_box_above_terrain(const ct_package *p, int64_t x0, int64_t x1, int64_t y0, int64_t y1, int64_t zmin,
-                         int *over_tile);
+/* Culling (bend.c): 1 when no prepared segment from a to b (Q16, z in Q16
+ * height units) whose lowest point is zfloor can meet the surface: zfloor,
+ * less the segment's rounding slack (2 + max|b - a| / 2^24 units, and
+ * 2^zshift_max more vertically), is above the max-mipmap's maximum under
+ * the box of a and b widened by the slack (at most four reads), or that
+ * box misses the tile (*over_tile 0).  The walk would find no hit there,
+ * so skipping it changes no result.                                       */
+int ct_segment_above_terrain(const ct_package *p, int64_t ax, int64_t ay, int64_t az, int64_t bx, int64_t by,
+                             int64_t bz, int64_t zfloor, int *over_tile);
 
 /* The image (Q24) of the line of sight with grid direction dg (Q39, as
  * ct_trace_earth_set's) at range t (0 <= t <= es->tmax_nm): interpolated

@@ -800,6 +800,15 @@ static int chord_shift(const gv *A, const gv *B, int64_t dv, int64_t l24, int64_
     return *sx != 0 || *sy != 0;
 }
 
+/* v moved sideways by (sx, sy) Q16 cells (its Q24 copy with it). */
+static void gv_shift(gv *v, int64_t sx, int64_t sy)
+{
+    v->x += sx;
+    v->y += sy;
+    v->fx += sx * 256;
+    v->fy += sy * 256;
+}
+
 /* The model's distance from the exact image Q (a quarter point): its
  * sideways distance from the chord (Q24 cells) and the height difference
  * at its range along the chord (Q16 height units): the chord's height
@@ -1025,33 +1034,25 @@ static int piece_off(const ct_package *p, const path *pa, const gv *A, const gv 
     /* |z| < 2^56 (ct_map_to_grid's range, and the interpolation's 2^49):
      * sums < 2^58; the tolerance and the dip (saturated at 2^62) capped at
      * 2^60, still far below any tile; cubic_drop <= 2^60 + 2^44 */
-    int64_t tz = ct_min64(tolz, INT64_C(1) << 60);
-    int64_t zlow = ct_min64(A->z, ct_min64(B->z, M->z)) - ct_min64(f->dip, INT64_C(1) << 60) - tz;
-    int64_t zsig = ct_min64(A->z, B->z) - ct_max64(0, (A->z + B->z - 2 * M->z + 1) / 2) - cubic_drop(pa, Lc) - tz;
-    zlow = ct_min64(zlow, zsig);
+    int64_t tz = ct_min64(tolz, INT64_C(1) << 60), top = ((int64_t)p->hmax + 1) * ONE16;
     if (x1 < 0 || y1 < 0 || x0 > (int64_t)p->cells_x * ONE16 || y0 > (int64_t)p->cells_y * ONE16) {
         return 1;
     }
-    return zlow > ((int64_t)p->hmax + 1) * ONE16;
+    /* both bounds above the top (the path's, with its 128-bit cubic_drop,
+     * only for a piece the model's already puts there) */
+    return ct_min64(A->z, ct_min64(B->z, M->z)) - ct_min64(f->dip, INT64_C(1) << 60) - tz > top &&
+           ct_min64(A->z, B->z) - ct_max64(0, (A->z + B->z - 2 * M->z + 1) / 2) - cubic_drop(pa, Lc) - tz > top;
 }
 
 /* 1 when the piece's walk cannot meet the surface (CT_BEND_NO_CULL turns
  * this off): its straight line, from A to B less the lowering dB (the walk
  * traces it against the terrain lowered by a >= 0, so below the terrain),
- * lies above the max-mipmap's maximum under its box, with the polyline
- * culling's slack for the prepared segment's rounding (bend.c: 2 + |B -
- * A| / 2^24 Q16 units, and 2^zshift_max more vertically).  The walk would
- * find no hit, so skipping it changes no result.  |B - A| < 2^43 (pieces
- * of at most 30 km at 1 cm posting or more; the lowering < 2^48). */
+ * culled as the polyline's segments are (ct_segment_above_terrain). */
 static int piece_culled(const ct_package *p, const gv *A, const gv *B, int64_t dB)
 {
-    int64_t zb = B->z - dB, m, slack;
+    int64_t zb = B->z - dB;
     int over;
-    m = ct_max64(ct_abs64(B->x - A->x), ct_max64(ct_abs64(B->y - A->y), ct_abs64(zb - A->z)));
-    slack = 2 + (m >> 24);
-    return ct_box_above_terrain(p, ct_min64(A->x, B->x) - slack, ct_max64(A->x, B->x) + slack,
-                                ct_min64(A->y, B->y) - slack, ct_max64(A->y, B->y) + slack,
-                                ct_min64(A->z, zb) - slack - ((int64_t)1 << p->zshift_max), &over);
+    return ct_segment_above_terrain(p, A->x, A->y, A->z, B->x, B->y, zb, ct_min64(A->z, zb), &over);
 }
 
 /* 1 when the path never comes back over the tile: beyond an edge and
@@ -1261,14 +1262,8 @@ static int check_piece(const ct_package *p, const path *pa, const ct_earth *es, 
     if (shift && chord_shift(A, &pc->B, side24(A, &pc->B, pc->f.l24, &pc->M), pc->f.l24, &sx, &sy)) {
         /* |s| <= |dv| / 2 + 1 < 2^45: the ends stay within the walks'
          * range where A and B are (ct_map_to_grid's 2^55) */
-        pc->As.x += sx;
-        pc->As.y += sy;
-        pc->As.fx += sx * 256;
-        pc->As.fy += sy * 256;
-        pc->Bs.x += sx;
-        pc->Bs.y += sy;
-        pc->Bs.fx += sx * 256;
-        pc->Bs.fy += sy * 256;
+        gv_shift(&pc->As, sx, sy);
+        gv_shift(&pc->Bs, sx, sy);
         /* the ends' own distance from the shifted line (the same at both) */
         pc->elat = lateral24(&pc->As, &pc->Bs, pc->f.l24, A);
     }
