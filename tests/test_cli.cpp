@@ -14,6 +14,7 @@
 
 #include "dem_io.hpp"
 #include "harness.h"
+#include "tiff_bytes.hpp"
 
 #include <geotiffio.h>
 #include <geovalues.h>
@@ -774,27 +775,9 @@ struct BadCase {
 // in one strip but holds 64 bytes of pixels.
 static std::string lying_tiff(uint32_t w, uint32_t h)
 {
-    std::string b("II*\0", 4);
-    auto u16 = [&](uint32_t v) { b += (char)(v & 255); b += (char)((v >> 8) & 255); };
-    auto u32 = [&](uint32_t v) { u16(v & 0xffff); u16(v >> 16); };
-    u32(8 + 64);               // the IFD after the pixels
-    b += std::string(64, '\0');  // the pixels there are
-    const uint32_t tags[][3] = {{256, 4, w},  {257, 4, h}, {258, 3, 16},      {259, 3, 1},    {262, 3, 1},
-                                {273, 4, 8},  {277, 3, 1}, {278, 4, h},       {279, 4, w * h * 2}, {339, 3, 2}};
-    u16(10);
-    for (const auto &t : tags) {
-        u16(t[0]);
-        u16(t[1]);
-        u32(1);
-        if (t[1] == 3) {
-            u16(t[2]);
-            u16(0);
-        } else {
-            u32(t[2]);
-        }
-    }
-    u32(0);
-    return b;
+    return tiff_bytes::make({{256, 4, w}, {257, 4, h}, {258, 3, 16}, {259, 3, 1}, {262, 3, 1},
+                             {273, 4, tiff_bytes::kData}, {277, 3, 1}, {278, 4, h}, {279, 4, w * h * 2}, {339, 3, 2}},
+                            std::string(64, '\0'));
 }
 
 static void test_bad_inputs(void)

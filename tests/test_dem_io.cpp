@@ -3,6 +3,7 @@
 
 #include "dem_io.hpp"
 #include "harness.h"
+#include "tiff_bytes.hpp"
 
 #include <OpenImageIO/imageio.h>
 #include <geotiffio.h>
@@ -543,37 +544,16 @@ static void test_png16(void)
 // ---------------------------------------------------------------------------
 // errors
 
-// A little-endian TIFF of w x h float32 posts, deflated, in tiles of tw x
-// th posts (one tile: its offset and a 16-byte count), written byte by byte:
-// libtiff would not write a header that promises tiles it was not given.
+// A TIFF of w x h float32 posts, deflated, in tiles of tw x th posts (one
+// tile: its offset and a 16-byte count).
 static bool write_tiled_header(const std::string &path, uint32_t w, uint32_t h, uint32_t tw, uint32_t th)
 {
-    struct Entry {
-        uint16_t tag, type;
-        uint32_t value;
-    };
-    const Entry e[] = {{256, 4, w},   {257, 4, h},   {258, 3, 32}, {259, 3, 8},  {262, 3, 1},  {277, 3, 1},
-                       {284, 3, 1},   {322, 4, tw},  {323, 4, th}, {324, 4, 0},  {325, 4, 16}, {339, 3, 3}};
-    const uint32_t n = (uint32_t)(sizeof e / sizeof e[0]), data = 8 + 2 + 12 * n + 4;
-    std::vector<unsigned char> b;
-    auto put = [&b](uint32_t v, int bytes) {
-        for (int k = 0; k < bytes; ++k) b.push_back((unsigned char)(v >> (8 * k)));
-    };
-    put(0x4949, 2);
-    put(42, 2);
-    put(8, 4);
-    put(n, 2);
-    for (const Entry &x : e) {
-        put(x.tag, 2);
-        put(x.type, 2);
-        put(1, 4);
-        put(x.tag == 324 ? data : x.value, x.type == 3 ? 2 : 4);
-        if (x.type == 3) put(0, 2);
-    }
-    put(0, 4);
-    for (int k = 0; k < 16; ++k) put(0x5a, 1);
+    const std::string b = tiff_bytes::make({{256, 4, w}, {257, 4, h}, {258, 3, 32}, {259, 3, 8}, {262, 3, 1},
+                                            {277, 3, 1}, {284, 3, 1}, {322, 4, tw}, {323, 4, th},
+                                            {324, 4, tiff_bytes::kData}, {325, 4, 16}, {339, 3, 3}},
+                                           std::string(16, '\x5a'));
     std::ofstream f(path, std::ios::binary);
-    f.write((const char *)b.data(), (std::streamsize)b.size());
+    f.write(b.data(), (std::streamsize)b.size());
     return (bool)f;
 }
 
