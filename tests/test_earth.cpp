@@ -1283,6 +1283,102 @@ void test_piece_culling()
     TEST_ASSERT_MSG(culled > rays / 20, "culling skipped too little to test (%ld of %ld traces)", culled, rays);
 }
 
+// The pieces' error bounds (earth.c side_rem, bound_vert) hold: for every
+// pose of pose_defs(), exact and fitted map, with and without refraction,
+// 12 seeded lines of sight each, every piece whose errors were bounded
+// (not sampled) is compared with the interpolated path at 49 points along
+// it, in long double: the path's sideways distance from the shifted chord
+// (Q24) within the piece's sideways bound, and its height less the walk's
+// model there (the walk line's height at the point's range along it, plus
+// the lowering at the point) within the height bound plus 1.25 times the
+// largest of that difference at the piece's ends and middle (the bound
+// leaves out the vertices' Q16 rounding: its interpolation at three
+// equally spaced points is within 1.25 times its largest value).  And the
+// sideways bound is tight (some piece's path comes within 10 % of it).
+void test_piece_bounds()
+{
+    World *w = jacksboro();
+    const ct_package &pk = w->p;
+    ct_rng rng;
+    ct_rng_seed(&rng, ct_test_seed() * 29 + 11);
+    static ct_earth_piece pcs[2048];
+    long pieces = 0, bounded = 0, points = 0, over_tol = 0;
+    double tight = 0, vratio = 0, worst_lat = 0, worst_v = 0;
+    for (const PoseDef &d : pose_defs()) {
+        Pose p;
+        TEST_ASSERT_MSG(make_pose(w->sf, d, &p), "pose %s", d.family);
+        for (int mode = 0; mode < 4; ++mode) {
+            const int fitted = mode & 1;
+            const int32_t k = (mode & 2) ? CT_REFRACTION_K_STD_Q16 : 0;
+            ct_earth es;
+            TEST_ASSERT_EQUAL_INT(CT_OK, ct_earth_setup(&pk, &p.pose, k, CT_EARTH_RADIUS_NM, CT_EFFECTS_CHORD_NM, 0u,
+                                                        fitted, nullptr, &es));
+            for (int r = 0; r < 12; ++r) {
+                const ld yaw = d.yaw + ct_rng_range(&rng, -20000, 20000) * 1e-3L;
+                const ld pitch = std::max(-89.0L, std::min(-0.2L, d.pitch + ct_rng_range(&rng, -3000, 3000) * 1e-3L));
+                int64_t dg[3];
+                grid_dir_q39(yaw, pitch, dg);
+                uint32_t n = 0;
+                (void)ct_earth_pieces(&pk, &es, dg, pcs, 2048u, &n);
+                TEST_ASSERT_MSG(n <= 2048u, "pose %s: %u pieces", d.family, n);
+                for (uint32_t i = 0; i < n; ++i) {
+                    const ct_earth_piece &e = pcs[i];
+                    pieces++;
+                    if (e.off || !e.bounded) {
+                        continue;
+                    }
+                    bounded++;
+                    over_tol += e.elat_q24 > es.tol_q24 || e.evert_q16 > es.tolz_q16;
+                    // the shifted chord in Q24: A's and B's images moved by the walk's shift
+                    const ld sx = (ld)(e.walk_q16[0] - (int64_t)std::floor((e.a24[0] + 128) / 256.0L));
+                    const ld sy = (ld)(e.walk_q16[1] - (int64_t)std::floor((e.a24[1] + 128) / 256.0L));
+                    const ld ax = e.a24[0] + 256 * sx, ay = e.a24[1] + 256 * sy;
+                    const ld ux = e.b24[0] + 256 * sx - ax, uy = e.b24[1] + 256 * sy - ay;
+                    const ld l24 = std::sqrt(ux * ux + uy * uy);
+                    // the walk's model (Q16)
+                    const ld wx = (ld)e.walk_q16[0], wy = (ld)e.walk_q16[1], wz = (ld)e.walk_q16[2];
+                    const ld vx = (ld)e.walk_q16[3] - wx, vy = (ld)e.walk_q16[4] - wy, vz = (ld)e.walk_q16[5] - wz;
+                    const ld l16 = std::sqrt(vx * vx + vy * vy);
+                    const ld a = std::ldexp((ld)e.kf, -(int)e.kshift);
+                    ld lat[49], dz[49];
+                    for (int q = 0; q <= 48; ++q) {
+                        const int64_t t = e.ta_nm + (int64_t)((ld)e.lc_nm * q / 48);
+                        int64_t g[3];
+                        int32_t nodes = 0;
+                        TEST_ASSERT_EQUAL_INT(CT_OK, ct_earth_path_image24(&pk, &es, dg, t, 1, g, &nodes));
+                        lat[q] = std::fabs(ux * (g[1] - ay) - uy * (g[0] - ax)) / l24;
+                        const ld px = g[0] / 256.0L, py = g[1] / 256.0L;
+                        const ld sq = (vx * (px - wx) + vy * (py - wy)) / l16;
+                        const ld zl = wz + vz * sq / l16 + a * ((px - wx) * (px - wx) + (py - wy) * (py - wy));
+                        dz[q] = g[2] / 256.0L - zl;
+                        points++;
+                    }
+                    const ld node = std::max(std::fabs(dz[0]), std::max(std::fabs(dz[24]), std::fabs(dz[48])));
+                    ld mlat = 0, mv = 0;
+                    for (int q = 0; q <= 48; ++q) {
+                        mlat = std::max(mlat, lat[q]);
+                        mv = std::max(mv, std::fabs(dz[q]) - 1.25L * node);
+                        TEST_ASSERT_MSG(lat[q] <= e.elat_q24 + 2, "pose %s, piece %u at %d/48: %.1Lf Q24 sideways, bound %lld",
+                                        d.family, i, q, lat[q], (long long)e.elat_q24);
+                        TEST_ASSERT_MSG(std::fabs(dz[q]) <= e.evert_q16 + 1.25L * node + 1,
+                                        "pose %s, piece %u at %d/48: %.2Lf Q16 in height (vertices %.2Lf), bound %lld",
+                                        d.family, i, q, dz[q], node, (long long)e.evert_q16);
+                    }
+                    tight = std::max(tight, (double)(mlat / (ld)e.elat_q24));
+                    vratio = std::max(vratio, (double)(mv / (ld)e.evert_q16));
+                    worst_lat = std::max(worst_lat, (double)(mlat * pk.posting_e_nm * 1e-9L / 16777216.0L));
+                    worst_v = std::max(worst_v, (double)((mv + 1.25L * node) * pk.height_scale_nm * 1e-9L / 65536.0L));
+                }
+            }
+        }
+    }
+    std::printf("  %ld pieces, %ld with bounded errors (%ld over the tolerance), %ld points: sideways up to %.4f mm "
+                "(%.3f of its bound at most), in height up to %.4f mm (less the vertices' rounding: %.3f of its bound)\n",
+                pieces, bounded, over_tol, points, worst_lat * 1e3, tight, worst_v * 1e3, vratio);
+    TEST_ASSERT_MSG(bounded > 500, "too few bounded pieces (%ld)", bounded);
+    TEST_ASSERT_MSG(tight > 0.9, "the sideways bound is loose: the path came within %.3f of it at most", tight);
+}
+
 // Regression: a 3 x 3 km tile (gentle hills) whose west edge lies 1 km
 // inside the projection's domain (9 deg west of zone 17's meridian),
 // cameras 0.5, 3 and 17 km east of it looking west 3 deg down: the lines of
@@ -1785,6 +1881,7 @@ int main()
     RUN_TEST(test_fitted_map);
     RUN_TEST(test_path_interpolation);
     RUN_TEST(test_piece_culling);
+    RUN_TEST(test_piece_bounds);
     RUN_TEST(test_exact_curvature);
     RUN_TEST(test_exact_curvature_refraction);
     RUN_TEST(test_zone_edge);

@@ -181,6 +181,30 @@ int ct_segment_above_terrain(const ct_package *p, int64_t ax, int64_t ay, int64_
 ct_status ct_earth_path_image24(const ct_package *pkg, const ct_earth *es, const int64_t dg[3], int64_t t, int interp,
                                 int64_t g[3], int32_t *nodes);
 
+/* One piece of a true-Earth line of sight as ct_trace_earth_set chooses it
+ * (earth.c), for tests of its error bounds.                               */
+typedef struct {
+    int64_t ta_nm, lc_nm;      /* its range along the line of sight          */
+    int64_t a24[3], m24[3], b24[3]; /* the path's images at its start (the
+                                  camera's grid point on the first piece from
+                                  the camera), middle and end, Q24          */
+    int64_t walk_q16[6];       /* the walk line: from (x, y, z) to (x, y, z),
+                                  Q16, against the terrain lowered by kf    */
+    uint64_t kf;               /* the lowering's rise (ct_lower), when lowered */
+    uint32_t kshift;
+    int32_t lowered;           /* 1: the walk is lowered                     */
+    int64_t elat_q24;          /* the sideways error it was accepted with     */
+    int64_t evert_q16;         /* the height error it was accepted with       */
+    int32_t off;               /* 1: off the tile, neither checked nor traced */
+    int32_t bounded;           /* 1: errors bounded, 0: sampled at quarters   */
+} ct_earth_piece;
+
+/* The pieces of the line of sight with grid direction dg (as
+ * ct_trace_earth_set's, without tracing them: every piece to the path's
+ * end, the first cap in out), *n of them; the walk's status.              */
+ct_status ct_earth_pieces(const ct_package *pkg, const ct_earth *es, const int64_t dg[3], ct_earth_piece *out,
+                          uint32_t cap, uint32_t *n);
+
 /* ct_trace_prepared for a ray this library prepared itself (skips the
  * re-validation of the caller-visible struct). */
 ct_status ct_trace_prepared_own(const ct_package *pkg, const ct_prepared *ray, ct_method method, ct_hit *hit);

@@ -139,6 +139,9 @@ typedef struct {
     int64_t cf[NODES][3]; /* polynomial in sigma, Q24, lowest power first */
     int64_t b3z;          /* sum of j (j - 1) (j - 2) |c_j| of the height:
                              |z'''(sigma)| <= b3z on [-1, 1] (< 2^57)      */
+    int64_t b1h, b2h, b3h; /* the same of x and y together (|c_j,x| +
+                             |c_j,y|): |p^(k)(sigma)| <= bkh on [-1, 1] for
+                             the horizontal image p (< 2^55, 2^57, 2^58)  */
 } path;
 
 /* round(v / 256) */
@@ -688,8 +691,12 @@ CT_NOINLINE static void set_nodes(path *pa, int64_t tmax)
             pa->cf[k][j] = ct_i128_round_shr(acc, 40u);
         }
     }
-    pa->b3z = 0;
-    for (k = 3; k < pa->nodes; ++k) { /* bound: NODES - 3; |c| < 2^49, k (k-1) (k-2) <= 60 */
+    pa->b3z = pa->b1h = pa->b2h = pa->b3h = 0;
+    for (k = 1; k < pa->nodes; ++k) { /* bound: NODES - 1; |c| < 2^49, k (k-1) (k-2) <= 60 */
+        int64_t ch = ct_abs64(pa->cf[k][0]) + ct_abs64(pa->cf[k][1]);
+        pa->b1h += (int64_t)k * ch;
+        pa->b2h += (int64_t)(k * (k - 1)) * ch;
+        pa->b3h += (int64_t)(k * (k - 1) * (k - 2)) * ch;
         pa->b3z += (int64_t)(k * (k - 1) * (k - 2)) * ct_abs64(pa->cf[k][2]);
     }
     pa->interp = 1;
@@ -993,6 +1000,24 @@ ct_status ct_earth_setup(const ct_package *p, const ct_pose *pose, int32_t refr_
     return CT_OK;
 }
 
+/* The piece [ta, ta + Lc] in sigma: h = 2 Lc / tmax in Q30, rounded up
+ * (Lc <= tmax: h <= 2^31; 2 Lc 2^30 < 2^80). */
+static int64_t piece_hq(const path *pa, int64_t Lc)
+{
+    return -ct_i128_floor_div_sat(ct_i128_neg(ct_i128_shl(ct_i128_from64(2 * Lc), 30u)), pa->tmax);
+}
+
+/* b (hq / 2^30)^k rounded up, k <= 3, for 0 <= b < 2^58 and hq <= 2^31:
+ * each product < 2^90 in 128 bits, each step at most doubles (< 2^61). */
+static int64_t pow_h(int64_t b, int64_t hq, int k)
+{
+    int i;
+    for (i = 0; i < k; ++i) { /* bound: 3 */
+        b = -ct_i128_to64(ct_i128_sar(ct_i128_neg(ct_i128_mul(b, hq)), 30u));
+    }
+    return b;
+}
+
 /* A bound (Q16 height units) of how far the path's height over a piece of
  * length Lc may fall below the quadratic in sigma through its ends and
  * middle: |z'''| h^3 / (72 sqrt 3), h = 2 Lc / tmax the piece in sigma
@@ -1005,14 +1030,11 @@ ct_status ct_earth_setup(const ct_package *p, const ct_pose *pose, int32_t refr_
  * scales as 1 / R^2: 0.03 mm at 4 km), longer ones are never off. */
 static int64_t cubic_drop(const path *pa, int64_t Lc)
 {
-    int64_t hq, e;
+    int64_t e;
     if (!pa->interp) {
         return Lc <= PIECE_FIRST_NM ? 0 : INT64_C(1) << 60;
     }
-    hq = -ct_i128_floor_div_sat(ct_i128_neg(ct_i128_shl(ct_i128_from64(2 * Lc), 30u)), pa->tmax);
-    e = -ct_i128_to64(ct_i128_sar(ct_i128_neg(ct_i128_mul(pa->b3z, hq)), 30u));
-    e = -ct_i128_to64(ct_i128_sar(ct_i128_neg(ct_i128_mul(e, hq)), 30u));
-    e = -ct_i128_to64(ct_i128_sar(ct_i128_neg(ct_i128_mul(e, hq)), 30u));
+    e = pow_h(pa->b3z, piece_hq(pa, Lc), 3);
     /* e <= b3z (hq / 2^30)^3 < 2^60: in Q16 (< 2^52) before the factor */
     return ((((e >> 8) + 1) * 526) >> 16) + 2;
 }
@@ -1233,6 +1255,7 @@ typedef struct {
     fit f;
     int64_t Lc, elat, evert, dB;
     int off;
+    int bounded; /* 1: elat, evert bounded (side_rem, bound_vert), 0: sampled */
     ct_lower lw;
     const ct_lower *lwp;
 } piece;
@@ -1245,6 +1268,112 @@ static int64_t excess_1024(const ct_earth *es, int64_t elat, int64_t evert)
                     ct_min64(evert, INT64_C(1) << 40) * 1024 / ct_max64(es->tolz_q16, 1));
 }
 
+#define BOUND_CAP (INT64_C(1) << 60)
+
+/* ceil(v / 2^n) for 0 <= v < 2^126 and n < 128, saturated at BOUND_CAP. */
+static int64_t shr_up_sat(ct_i128 v, unsigned n)
+{
+    unsigned b = ct_i128_bits(v);
+    if (b > n + 60u) {
+        return BOUND_CAP;
+    }
+    if (b <= n) {
+        return b == 0u ? 0 : 1;
+    }
+    /* n < b <= n + 60: ceil(v / 2^n) = floor((v - 1) / 2^n) + 1 < 2^60 */
+    v = ct_i128_sub(v, ct_i128_from64(1));
+    /* bound: 2 shifts of 63 */
+    while (n >= 63u) {
+        v = ct_i128_sar(v, 63u);
+        n -= 63u;
+    }
+    if (n > 0u) {
+        v = ct_i128_sar(v, n);
+    }
+    return ct_i128_to64(v) + 1;
+}
+
+/* e 526 / 2^16 rounded up (526 / 2^16 > 1 / (72 sqrt 3), the remainder
+ * of quadratic interpolation at three equally spaced points), for 0 <= e
+ * < 2^61: (e >> 8) 526 < 2^62. */
+static int64_t rem3(int64_t e)
+{
+    return ((((e >> 8) + 1) * 526) >> 8) + 1;
+}
+
+/* The model's largest errors over a piece of the interpolated path,
+ * bounded from the path polynomial's derivatives (not sampled): q, the
+ * quadratic in sigma through the path's images A, M, B, differs from the
+ * path by at most rem3 of |f'''| h^3 per coordinate.
+ *   - Sideways (here: check_piece adds it to the larger of the ends' and
+ *     M's distances from the shifted chord): q's distance from the chord A
+ *     -> B is 4 s (1 - s) times M's (s in [0, 1] along the piece), so from
+ *     the shifted chord, parallel to it, at most the larger of the ends'
+ *     and M's; the path is within the remainder of q (Q24 cells; |x'''| +
+ *     |y'''| <= b3h).  8 units for the polynomial's roundings and, on the
+ *     first piece from the camera (ta = 0), whose A is the camera's grid
+ *     point, A's distance from the path's own image there.
+ *   - In height: bound_vert. */
+static int64_t side_rem(const path *pa, const ct_earth *es, int64_t ta, int64_t hq, const gv *A)
+{
+    int64_t r = rem3(pow_h(pa->b3h, hq, 3)) + 8;
+    if (ta == 0) {
+        /* |cam24 - A| <= 2^7 + 1 per axis (A = cam24 rounded to Q16) */
+        r += ct_abs64(es->cam24[0] - A->fx) + ct_abs64(es->cam24[1] - A->fy);
+    }
+    return r;
+}
+
+/* The height part (Q16 height units) for a piece traced as a lowered walk
+ * (pc->lwp set; rh = side_rem, pc->elat the sideways bound):
+ *   - at the path's range s(sigma) along the chord, the walk's
+ *     model Z(s) = zA + b s + a s^2 (b the walk line's slope dz / l, a =
+ *     kf / 2^kshift the lowering's rise) meets the path at A, M and B up to
+ *     the vertices' Q16 rounding (which the tolerance's quarter is for), so
+ *     g = z - Z(s(sigma)) has three equally spaced zeros and is within
+ *     rem3 of |g'''| h^3, where |g'''| <= |z'''| + |Z'(s)| |s'''| + 6 a |s'|
+ *     |s''|, |s^(k)| <= b_kh, |Z'| <= |b| + 2 a S (S = l + rh + 3 Q16, the
+ *     farthest range along the chord).  The last term, 6 rem3(1) a (b1h h)
+ *     (b2h h^2) < a L1 L2 / 16 (in Q24: a / 256 per Q24 cell squared).  A
+ *     point of the path off the walk line by lambda <= elat is lowered by a
+ *     lambda^2 more.  3 Q16 units for the lowering's floors, and dip / 2^28
+ *     for kf's truncation (relative 2^-30 of a).
+ * Each term saturates at BOUND_CAP (the piece then fails its check). */
+static int64_t bound_vert(const path *pa, const ct_earth *es, int64_t ta, int64_t hq, int64_t rh, const gv *A,
+                          const piece *pc)
+{
+    const ct_lower *lw = &pc->lw;
+    int64_t l = pc->f.l, rhc = ct_min64(rh, BOUND_CAP), lam, S, L1, L2, sum, t;
+    int64_t adz = ct_abs64(pc->Bs.z - pc->dB - A->z); /* |z| < 2^56 */
+    /* height: z''' (and the camera's grid point's height on the first piece) */
+    sum = rem3(pow_h(pa->b3z, hq, 3)) + 8 + (ta == 0 ? ct_abs64(es->cam24[2] - A->fz) : 0);
+    /* |b| rh = |dz| rh / l (l >= 2^16 with a lowering; < 2^56 2^60) */
+    t = ct_i128_floor_div_sat(ct_i128_add(ct_i128_mul(adz, rhc), ct_i128_from64(l - 1)), l);
+    sum += ct_min64(t, BOUND_CAP);
+    /* 2 a S rh: kf < 2^32, S < 2^44, rh < 2^40: < 2^117 */
+    S = l + rhc / 256 + 3;
+    t = BOUND_CAP;
+    if (rhc < (INT64_C(1) << 40) && S < (INT64_C(1) << 44)) {
+        t = shr_up_sat(ct_i128_mul128_64(ct_i128_mul((int64_t)lw->kf, S), 2 * rhc), lw->kshift);
+    }
+    sum += t;
+    /* a L1 L2 / 16, in Q24 a further / 256: L1, L2 < 2^44, kf < 2^32 */
+    L1 = pow_h(pa->b1h, hq, 1);
+    L2 = pow_h(pa->b2h, hq, 2);
+    t = BOUND_CAP;
+    if (L1 < (INT64_C(1) << 44) && L2 < (INT64_C(1) << 44)) {
+        t = shr_up_sat(ct_i128_mul128_64(ct_i128_mul(L1, L2), (int64_t)lw->kf), lw->kshift + 12u);
+    }
+    sum += t; /* four terms each <= 2^60 + 8 */
+    /* a lambda^2, lambda <= elat (Q16, rounded up; < 2^40: < 2^112) */
+    lam = pc->elat / 256 + 1;
+    t = BOUND_CAP;
+    if (lam < (INT64_C(1) << 40)) {
+        t = shr_up_sat(ct_i128_mul128_64(ct_i128_mul(lam, lam), (int64_t)lw->kf), lw->kshift);
+    }
+    return (sum + 255) / 256 + 3 + (ct_min64(pc->f.dip, BOUND_CAP) >> 28) + 1 + t;
+}
+
 /* The model of the piece from A with its B and M set, checked against the
  * exact image: 1 when it is within the tolerances or off the tile, 0 when
  * it must be shorter, -1 when a quarter point is beyond the projection's
@@ -1254,7 +1383,7 @@ static int check_piece(const ct_package *p, const path *pa, const ct_earth *es, 
                        piece *pc)
 {
     int ok;
-    int64_t sx, sy;
+    int64_t sx, sy, hq = 0, rh = 0;
     fit_chord(A, &pc->B, &pc->f);
     pc->As = *A;
     pc->Bs = pc->B;
@@ -1274,6 +1403,13 @@ static int check_piece(const ct_package *p, const path *pa, const ct_earth *es, 
                    must not keep an earlier, longer try's lowering */
     pc->elat = ct_max64(pc->elat, pc->f.dev);
     pc->evert = 0;
+    pc->bounded = 0;
+    if (pa->interp) {
+        /* the sideways bound (side_rem) */
+        hq = piece_hq(pa, pc->Lc);
+        rh = ct_min64(side_rem(pa, es, ta, hq, A), BOUND_CAP);
+        pc->elat = ct_min64(pc->elat, BOUND_CAP) + rh;
+    }
     ok = pc->off || pc->elat <= es->tol_q24;
     if (ok && !pc->off) {
         uint64_t kf;
@@ -1283,9 +1419,13 @@ static int check_piece(const ct_package *p, const path *pa, const ct_earth *es, 
             pc->lwp = &pc->lw;
         }
         pc->dB = pc->lwp != NULL ? ct_lower_at(pc->lwp, pc->Bs.x, pc->Bs.y) : 0;
-        /* the model against the exact image at the quarter points */
-        if (quarter_errors(pa, ta, pc->Lc, &pc->As, &pc->Bs, &pc->f, pc->lwp, pc->dB, &pc->elat, &pc->evert) !=
-            CT_OK) {
+        if (pa->interp && pc->lwp != NULL) {
+            /* the interpolated path and a lowered walk: the errors bounded */
+            pc->evert = bound_vert(pa, es, ta, hq, rh, A, pc);
+            pc->bounded = 1;
+        } else if (quarter_errors(pa, ta, pc->Lc, &pc->As, &pc->Bs, &pc->f, pc->lwp, pc->dB, &pc->elat,
+                                  &pc->evert) != CT_OK) {
+            /* otherwise the model against the image at the quarter points */
             return -1;
         }
         ok = pc->elat <= es->tol_q24 && pc->evert <= es->tolz_q16;
@@ -1474,11 +1614,51 @@ CT_NOINLINE static int64_t first_length(const path *pa, const ct_earth *es, int 
     return ct_min64(PIECE_FIRST_NM, ct_max64(PIECE_MIN_NM, L));
 }
 
+/* The pieces' record for ct_earth_pieces (a test hook): NULL when tracing. */
+typedef struct {
+    ct_earth_piece *out;
+    uint32_t cap, n;
+} piece_log;
+
+static void log_piece(piece_log *lg, const gv *A, int64_t ta, const piece *pc)
+{
+    ct_earth_piece *e;
+    if (lg->n >= lg->cap) {
+        return;
+    }
+    e = &lg->out[lg->n++];
+    e->ta_nm = ta;
+    e->lc_nm = pc->Lc;
+    e->a24[0] = A->fx;
+    e->a24[1] = A->fy;
+    e->a24[2] = A->fz;
+    e->m24[0] = pc->M.fx;
+    e->m24[1] = pc->M.fy;
+    e->m24[2] = pc->M.fz;
+    e->b24[0] = pc->B.fx;
+    e->b24[1] = pc->B.fy;
+    e->b24[2] = pc->B.fz;
+    e->walk_q16[0] = pc->As.x;
+    e->walk_q16[1] = pc->As.y;
+    e->walk_q16[2] = pc->As.z;
+    e->walk_q16[3] = pc->Bs.x;
+    e->walk_q16[4] = pc->Bs.y;
+    e->walk_q16[5] = pc->Bs.z - pc->dB;
+    e->lowered = pc->lwp != NULL;
+    e->kf = pc->lwp != NULL ? pc->lw.kf : 0u;
+    e->kshift = pc->lwp != NULL ? pc->lw.kshift : 0u;
+    e->elat_q24 = pc->elat;
+    e->evert_q16 = pc->evert;
+    e->off = pc->off;
+    e->bounded = pc->bounded;
+}
+
 /* The line of sight as pieces of lowered walks from the camera: each piece
  * chosen (next_piece), traced unless off the tile (trace_piece), until a
- * hit, an error, the path's end or a path gone from the tile. */
-ct_status ct_trace_earth_set(const ct_package *p, ct_tileset *ts, const ct_earth *es, const int64_t dg[3], ct_method m,
-                             ct_hit *h)
+ * hit, an error, the path's end or a path gone from the tile.  With lg,
+ * every piece is logged and none traced. */
+static ct_status earth_walk(const ct_package *p, ct_tileset *ts, const ct_earth *es, const int64_t dg[3], ct_method m,
+                            ct_hit *h, piece_log *lg)
 {
     path pa;
     gv A;
@@ -1487,12 +1667,6 @@ ct_status ct_trace_earth_set(const ct_package *p, ct_tileset *ts, const ct_earth
     uint32_t n, steps = 0u, iters = 0u;
     int over;
     ct_status st;
-    if (p == NULL || es == NULL || dg == NULL || h == NULL) {
-        return CT_ERR_ARG;
-    }
-    if ((uint32_t)m >= (uint32_t)CT_METHOD_COUNT) {
-        return CT_ERR_METHOD;
-    }
     path_init(&pa, p, es, dg);
     A.x = es->ox;
     A.y = es->oy;
@@ -1529,7 +1703,9 @@ ct_status ct_trace_earth_set(const ct_package *p, ct_tileset *ts, const ct_earth
             h->iters = iters;
             return CT_MISS;
         }
-        if (!pc.off && !(es->cull && piece_culled(p, &pc.As, &pc.Bs, pc.dB))) {
+        if (lg != NULL) {
+            log_piece(lg, &A, ta, &pc);
+        } else if (!pc.off && !(es->cull && piece_culled(p, &pc.As, &pc.Bs, pc.dB))) {
             st = trace_piece(p, ts, &pc.As, &pc.Bs, &pc.f, pc.lwp, pc.dB, first, m, h, &steps, &iters);
             if (st != CT_MISS) {
                 return st; /* a hit, the camera below the surface, or an error */
@@ -1550,4 +1726,33 @@ ct_status ct_trace_earth_set(const ct_package *p, ct_tileset *ts, const ct_earth
     h->e_nm = h->n_nm = h->h_nm = 0;
     h->cell_x = h->cell_y = -1;
     return CT_MISS;
+}
+
+ct_status ct_trace_earth_set(const ct_package *p, ct_tileset *ts, const ct_earth *es, const int64_t dg[3], ct_method m,
+                             ct_hit *h)
+{
+    if (p == NULL || es == NULL || dg == NULL || h == NULL) {
+        return CT_ERR_ARG;
+    }
+    if ((uint32_t)m >= (uint32_t)CT_METHOD_COUNT) {
+        return CT_ERR_METHOD;
+    }
+    return earth_walk(p, ts, es, dg, m, h, NULL);
+}
+
+ct_status ct_earth_pieces(const ct_package *p, const ct_earth *es, const int64_t dg[3], ct_earth_piece *out,
+                          uint32_t cap, uint32_t *n)
+{
+    piece_log lg;
+    ct_hit h;
+    ct_status st;
+    if (p == NULL || es == NULL || dg == NULL || out == NULL || n == NULL) {
+        return CT_ERR_ARG;
+    }
+    lg.out = out;
+    lg.cap = cap;
+    lg.n = 0u;
+    st = earth_walk(p, NULL, es, dg, CT_METHOD_INCREMENTAL, &h, &lg);
+    *n = lg.n;
+    return st;
 }
