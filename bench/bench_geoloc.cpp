@@ -135,10 +135,14 @@ int main(int argc, char **argv)
         ct_effects fx = scene::lib_effects(w->s, w->s.effects);
         ct_effects fx_true = fx;
         fx_true.earth_radius_nm = 0;
+        if (profile > 0) {
+            // --profile: the true Earth with curvature whether or not the scene asks for it
+            fx_true.flags |= CT_EFFECT_CURVATURE;
+        }
         ct_effects fx_fit = fx_true;
         fx_fit.flags |= CT_EFFECT_EARTH_FIT;
         ct_utm zone;
-        const bool true_earth = (fx.flags & CT_EFFECT_CURVATURE) != 0u &&
+        const bool true_earth = (fx_true.flags & CT_EFFECT_CURVATURE) != 0u &&
                                 ct_utm_zone_of_epsg((int32_t)w->p.epsg, &zone) == CT_OK;
         std::vector<ct_geo> gd, gi, gs, gt, gf;
         // This machine's speed drifts by tens of percent within seconds: the

@@ -1302,7 +1302,7 @@ void test_piece_bounds()
     ct_rng rng;
     ct_rng_seed(&rng, ct_test_seed() * 29 + 11);
     static ct_earth_piece pcs[2048];
-    long pieces = 0, bounded = 0, points = 0, over_tol = 0;
+    long pieces = 0, bounded = 0, sampled = 0, points = 0, over_tol = 0;
     double tight = 0, vratio = 0, worst_lat = 0, worst_v = 0;
     for (const PoseDef &d : pose_defs()) {
         Pose p;
@@ -1324,16 +1324,20 @@ void test_piece_bounds()
                 for (uint32_t i = 0; i < n; ++i) {
                     const ct_earth_piece &e = pcs[i];
                     pieces++;
+                    sampled += !e.off && !e.bounded;
                     if (e.off || !e.bounded) {
                         continue;
                     }
                     bounded++;
                     over_tol += e.elat_q24 > es.tol_q24 || e.evert_q16 > es.tolz_q16;
                     // the shifted chord in Q24: A's and B's images moved by the walk's shift
-                    const ld sx = (ld)(e.walk_q16[0] - (int64_t)std::floor((e.a24[0] + 128) / 256.0L));
-                    const ld sy = (ld)(e.walk_q16[1] - (int64_t)std::floor((e.a24[1] + 128) / 256.0L));
-                    const ld ax = e.a24[0] + 256 * sx, ay = e.a24[1] + 256 * sy;
-                    const ld ux = e.b24[0] + 256 * sx - ax, uy = e.b24[1] + 256 * sy - ay;
+                    const ld ax = (ld)(e.a24[0] + e.shift_q24[0]), ay = (ld)(e.a24[1] + e.shift_q24[1]);
+                    const ld ux = (ld)(e.b24[0] - e.a24[0]), uy = (ld)(e.b24[1] - e.a24[1]);
+                    // the walk's ends within half a Q16 unit of the shifted chord's
+                    TEST_ASSERT(std::fabs(e.walk_q16[0] * 256.0L - ax) <= 128 &&
+                                std::fabs(e.walk_q16[1] * 256.0L - ay) <= 128 &&
+                                std::fabs(e.walk_q16[3] * 256.0L - (e.b24[0] + e.shift_q24[0])) <= 128 &&
+                                std::fabs(e.walk_q16[4] * 256.0L - (e.b24[1] + e.shift_q24[1])) <= 128);
                     const ld l24 = std::sqrt(ux * ux + uy * uy);
                     // the walk's model (Q16)
                     const ld wx = (ld)e.walk_q16[0], wy = (ld)e.walk_q16[1], wz = (ld)e.walk_q16[2];
@@ -1372,9 +1376,10 @@ void test_piece_bounds()
             }
         }
     }
-    std::printf("  %ld pieces, %ld with bounded errors (%ld over the tolerance), %ld points: sideways up to %.4f mm "
-                "(%.3f of its bound at most), in height up to %.4f mm (less the vertices' rounding: %.3f of its bound)\n",
-                pieces, bounded, over_tol, points, worst_lat * 1e3, tight, worst_v * 1e3, vratio);
+    std::printf("  %ld pieces (off the tile but %ld), %ld with bounded errors (%ld over the tolerance), %ld points: "
+                "sideways up to %.4f mm (%.3f of its bound at most), in height up to %.4f mm (less the vertices' "
+                "rounding: %.3f of its bound)\n",
+                pieces, bounded + sampled, bounded, over_tol, points, worst_lat * 1e3, tight, worst_v * 1e3, vratio);
     TEST_ASSERT_MSG(bounded > 500, "too few bounded pieces (%ld)", bounded);
     TEST_ASSERT_MSG(tight > 0.9, "the sideways bound is loose: the path came within %.3f of it at most", tight);
 }

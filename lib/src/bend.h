@@ -188,6 +188,7 @@ typedef struct {
     int64_t a24[3], m24[3], b24[3]; /* the path's images at its start (the
                                   camera's grid point on the first piece from
                                   the camera), middle and end, Q24          */
+    int64_t shift_q24[2];      /* the chord's sideways shift, Q24           */
     int64_t walk_q16[6];       /* the walk line: from (x, y, z) to (x, y, z),
                                   Q16, against the terrain lowered by kf    */
     uint64_t kf;               /* the lowering's rise (ct_lower), when lowered */

@@ -787,7 +787,7 @@ CT_NOINLINE static void fit_middle(const gv *A, const gv *B, const gv *M, fit *f
     }
 }
 
-/* The shift (Q16, horizontal) that moves the chord A -> B towards its
+/* The shift (Q24, horizontal) that moves the chord A -> B towards its
  * middle M by half M's sideways deviation: the image bends sideways about
  * as a parabola (the transverse Mercator's bend, nearly constant along a
  * piece), so the shifted line lies within half the middle's deviation of
@@ -802,44 +802,61 @@ static int chord_shift(const gv *A, const gv *B, int64_t dv, int64_t l24, int64_
     if (l24 < 256) {
         return 0;
     }
-    *sx = q24_to_16(ct_i128_floor_div_sat(ct_i128_mul(-dv, uy), 2 * l24));
-    *sy = q24_to_16(ct_i128_floor_div_sat(ct_i128_mul(dv, ux), 2 * l24));
+    *sx = ct_i128_floor_div_sat(ct_i128_mul(-dv, uy), 2 * l24);
+    *sy = ct_i128_floor_div_sat(ct_i128_mul(dv, ux), 2 * l24);
     return *sx != 0 || *sy != 0;
 }
 
-/* v moved sideways by (sx, sy) Q16 cells (its Q24 copy with it). */
+/* v moved sideways by (sx, sy) Q24 cells, its Q16 point the nearest to
+ * that (as a vertex's: q24_to_16). */
 static void gv_shift(gv *v, int64_t sx, int64_t sy)
 {
-    v->x += sx;
-    v->y += sy;
-    v->fx += sx * 256;
-    v->fy += sy * 256;
+    v->fx += sx;
+    v->fy += sy;
+    v->x = q24_to_16(v->fx);
+    v->y = q24_to_16(v->fy);
 }
 
 /* The model's distance from the exact image Q (a quarter point): its
- * sideways distance from the chord (Q24 cells) and the height difference
- * at its range along the chord (Q16 height units): the chord's height
- * there plus the lowering (lw) or the straight chord (lw = NULL).       */
+ * sideways distance from the chord (Q24 cells) and, in the chord's
+ * vertical plane, the height difference at Q's range along the chord (Q16
+ * height units: the chord's height there plus the lowering (lw) or the
+ * straight chord (lw = NULL)) -- for a chord steeper than 45 degrees (in
+ * metres: its rise dzc, in Q16 cells, above its length l) the range
+ * difference at Q's height instead, which is the height difference times
+ * l / dzc: the smaller of the two, both at least Q's distance from the
+ * model across it (the height difference times the cosine of the chord's
+ * elevation), and neither growing without bound as the chord steepens.
+ * Ranges and heights at Q24 (a Q16 range along a steep chord would put
+ * its rounding times the slope into the height). */
 static void model_error(const gv *A, const gv *B, const gv *Q, const fit *f, const ct_lower *lw, int64_t dB,
-                        int64_t *lat, int64_t *vert)
+                        int64_t dzc, int64_t *lat, int64_t *vert)
 {
-    int64_t qx = Q->x - A->x, qy = Q->y - A->y, sq, zl;
+    int64_t ux = B->fx - A->fx, uy = B->fy - A->fy, qx = Q->fx - A->fx, qy = Q->fy - A->fy, sq, zl, v;
     ct_i128 dot;
     *lat = lateral24(A, B, f->l24, Q);
-    if (f->l == 0) {
+    if (f->l == 0 || f->l24 == 0) {
         *vert = 0; /* a vertical chord: the sideways distance only */
         return;
     }
-    dot = ct_i128_add(ct_i128_mul(f->ux, qx), ct_i128_mul(f->uy, qy));
-    /* sq: Q's range along the chord (within the piece: |sq| <= 2 l) */
-    sq = ct_i128_floor_div_sat(dot, f->l);
-    sq = ct_max64(-2 * f->l, ct_min64(2 * f->l, sq));
-    /* the line's height at sq: (B.z - dB - A.z) sq / l, |.| < 2^48 2^44 */
-    zl = A->z + ct_i128_floor_div_sat(ct_i128_mul(B->z - dB - A->z, sq), f->l);
+    /* |u|, |q| < 2^50 (pieces <= 30 km): the dot product < 2^101 */
+    dot = ct_i128_add(ct_i128_mul(ux, qx), ct_i128_mul(uy, qy));
+    /* sq: Q's range along the chord, Q24 (within the piece: |sq| <= 2 l24) */
+    sq = ct_i128_floor_div_sat(dot, f->l24);
+    sq = ct_max64(-2 * f->l24, ct_min64(2 * f->l24, sq));
+    /* the line's height at sq, Q24: 256 (B.z - dB - A.z) sq / l24, |dz sq|
+     * < 2^57 2^47, times 2^8 < 2^113 */
+    zl = A->z * 256 +
+         ct_i128_floor_div_sat(ct_i128_mul128_64(ct_i128_mul(B->z - dB - A->z, sq), 256), f->l24);
     if (lw != NULL) {
-        zl += ct_lower_at(lw, Q->x, Q->y);
+        zl += ct_lower_at(lw, Q->x, Q->y) * 256;
     }
-    *vert = ct_abs64(Q->z - zl);
+    v = ct_min64(ct_abs64(Q->fz - zl), INT64_C(1) << 60);
+    if (dzc > f->l) {
+        /* times l / dzc (l < 2^40; dzc capped at 2^52 by the caller) */
+        v = ct_i128_floor_div_sat(ct_i128_mul(v, f->l), dzc);
+    }
+    *vert = (v + 255) / 256;
 }
 
 /* kf, kshift with kf 2^-kshift = num / den (num, den > 0), kf in
@@ -1098,12 +1115,17 @@ CT_NOINLINE static ct_status quarter_errors(const path *pa, int64_t ta, int64_t 
                                             int64_t *evert)
 {
     gv Q1, Q3;
-    int64_t l1, v1, l3, v3;
+    int64_t l1, v1, l3, v3, dzc;
     if (vertex(pa, ta + Lc / 4, &Q1) != CT_OK || vertex(pa, ta + Lc - Lc / 4, &Q3) != CT_OK) {
         return CT_ERR_RANGE;
     }
-    model_error(A, B, &Q1, f, lw, dB, &l1, &v1);
-    model_error(A, B, &Q3, f, lw, dB, &l3, &v3);
+    /* the chord's rise in Q16 cells (rounded down: the smaller, the larger
+     * the error; |dz| < 2^57, height scale < 2^50 nm: < 2^107) */
+    dzc = ct_min64(ct_i128_floor_div_sat(ct_i128_mul(ct_abs64(B->z - dB - A->z), pa->p->height_scale_nm),
+                                         ct_abs64(pa->p->posting_e_nm)),
+                   INT64_C(1) << 52);
+    model_error(A, B, &Q1, f, lw, dB, dzc, &l1, &v1);
+    model_error(A, B, &Q3, f, lw, dB, dzc, &l3, &v3);
     *elat = ct_max64(*elat, ct_max64(l1, l3));
     *evert = ct_max64(v1, v3);
     return CT_OK;
@@ -1314,14 +1336,26 @@ static int64_t rem3(int64_t e)
  *     first piece from the camera (ta = 0), whose A is the camera's grid
  *     point, A's distance from the path's own image there.
  *   - In height: bound_vert. */
-static int64_t side_rem(const path *pa, const ct_earth *es, int64_t ta, int64_t hq, const gv *A)
+static int64_t side_rem(const path *pa, int64_t hq, int64_t l24)
 {
-    int64_t r = rem3(pow_h(pa->b3h, hq, 3)) + 8;
-    if (ta == 0) {
-        /* |cam24 - A| <= 2^7 + 1 per axis (A = cam24 rounded to Q16) */
-        r += ct_abs64(es->cam24[0] - A->fx) + ct_abs64(es->cam24[1] - A->fy);
+    /* a chord shorter than a Q16 unit: distances from A, not from the
+     * line, which q may pass by B's (< 2^8; Lagrange weights in [-1/8, 1]) */
+    return rem3(pow_h(pa->b3h, hq, 3)) + 8 + (l24 < 256 ? 256 : 0);
+}
+
+/* The largest |g(s)| over s in [0, 1] of the quadratic with g(0) = y0,
+ * g(1/2) = ym, g(1) = y1 (|y| < 2^47), rounded up: g = y0 + b s + c s^2,
+ * b = 4 ym - 3 y0 - y1, c = 2 (y0 + y1 - 2 ym); at the ends, or y0 - b^2
+ * / 4c where -b / 2c lies inside (b^2 < 2^100, 4 |c| < 2^51). */
+static int64_t quad_max(int64_t y0, int64_t ym, int64_t y1)
+{
+    int64_t b = 4 * ym - 3 * y0 - y1, c = 2 * (y0 + y1 - 2 * ym);
+    int64_t m = ct_max64(ct_abs64(y0), ct_abs64(y1));
+    if (c != 0 && (b < 0) == (c > 0) && b != 0 && ct_abs64(b) < 2 * ct_abs64(c)) {
+        int64_t q = ct_i128_floor_div_sat(ct_i128_mul(b, b), 4 * ct_abs64(c));
+        m = ct_max64(m, ct_abs64(c > 0 ? y0 - q : y0 + q) + 1);
     }
-    return r;
+    return m;
 }
 
 /* The height part (Q16 height units) for a piece traced as a lowered walk
@@ -1393,6 +1427,15 @@ static int check_piece(const ct_package *p, const path *pa, const ct_earth *es, 
          * range where A and B are (ct_map_to_grid's 2^55) */
         gv_shift(&pc->As, sx, sy);
         gv_shift(&pc->Bs, sx, sy);
+        /* the walk's chord between the shifted Q16 ends, when their
+         * rounding changed it (the Q24 one is parallel to A -> B, of the
+         * same l24) */
+        if (pc->Bs.x - pc->As.x != pc->f.ux || pc->Bs.y - pc->As.y != pc->f.uy) {
+            pc->f.ux = pc->Bs.x - pc->As.x;
+            pc->f.uy = pc->Bs.y - pc->As.y;
+            pc->f.l = (int64_t)ct_i128_isqrt(
+                ct_i128_add(ct_i128_mul(pc->f.ux, pc->f.ux), ct_i128_mul(pc->f.uy, pc->f.uy)));
+        }
         /* the ends' own distance from the shifted line (the same at both) */
         pc->elat = lateral24(&pc->As, &pc->Bs, pc->f.l24, A);
     }
@@ -1407,7 +1450,22 @@ static int check_piece(const ct_package *p, const path *pa, const ct_earth *es, 
     if (pa->interp) {
         /* the sideways bound (side_rem) */
         hq = piece_hq(pa, pc->Lc);
-        rh = ct_min64(side_rem(pa, es, ta, hq, A), BOUND_CAP);
+        rh = ct_min64(side_rem(pa, hq, pc->f.l24), BOUND_CAP);
+        if (ta == 0 && pc->f.l24 >= 256) {
+            /* the first piece from the camera: its A is the camera's grid
+             * point, within a Q16 unit of the path's own start cam24 --
+             * the quadratic through cam24, M and B (signed distances from
+             * the chord, < 2^47 as |M - A|) */
+            gv C = *A;
+            C.fx = es->cam24[0];
+            C.fy = es->cam24[1];
+            pc->elat = ct_max64(pc->elat, quad_max(side24(&pc->As, &pc->Bs, pc->f.l24, &C),
+                                                   side24(&pc->As, &pc->Bs, pc->f.l24, &pc->M),
+                                                   side24(&pc->As, &pc->Bs, pc->f.l24, &pc->B)));
+        } else if (ta == 0) {
+            /* (distances from A: cam24 within 2^8 + 2 of it) */
+            pc->elat += ct_abs64(es->cam24[0] - A->fx) + ct_abs64(es->cam24[1] - A->fy);
+        }
         pc->elat = ct_min64(pc->elat, BOUND_CAP) + rh;
     }
     ok = pc->off || pc->elat <= es->tol_q24;
@@ -1644,6 +1702,8 @@ static void log_piece(piece_log *lg, const gv *A, int64_t ta, const piece *pc)
     e->walk_q16[3] = pc->Bs.x;
     e->walk_q16[4] = pc->Bs.y;
     e->walk_q16[5] = pc->Bs.z - pc->dB;
+    e->shift_q24[0] = pc->As.fx - A->fx;
+    e->shift_q24[1] = pc->As.fy - A->fy;
     e->lowered = pc->lwp != NULL;
     e->kf = pc->lwp != NULL ? pc->lw.kf : 0u;
     e->kshift = pc->lwp != NULL ? pc->lw.kshift : 0u;
