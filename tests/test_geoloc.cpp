@@ -558,7 +558,10 @@ void test_effects_choice()
          nullptr},
         {"k = -2, 30 deg down", &pin, hi + 1000000000000, -30, -2 * 65536, CT_OK, nullptr},
         {"k = 0.13, 5 deg down", &pin, hi + 1000000000000, -5, CT_REFRACTION_K_STD_Q16, CT_OK, nullptr},
+        {"k = 0.13, looking down", &pin, hi + 1000000000000, -90, CT_REFRACTION_K_STD_Q16, CT_OK,
+         [](const ct_effects_choice &c) { TEST_ASSERT(c.tan_min_q30 > INT64_C(1) << 30); }},
     };
+    int capped = 0;
     for (const Case &c : cases) {
         int32_t q[4];
         ct_pose pose;
@@ -585,11 +588,28 @@ void test_effects_choice()
                                 c2.flags, want);
                 if (b == 2 && tol == ch.bound_nm[2] && c.k_q16 == -2 * 65536)
                     TEST_ASSERT_EQUAL_INT(CT_EFFECT_REFRACTION, (int)c2.flags);  // |1 - k| = 3 > |k| = 2 > 1
-                // the chord: at least 2^10 nm, at most 2^50
+                // the chord: at least 2^10 nm, at most 2^50; between, the
+                // largest whose effect on flat ground, chord / tan(dep) in
+                // height and the chord itself sideways, fits in what the
+                // set's bound leaves of the tolerance
                 TEST_ASSERT(c2.chord_nm >= 1024 && c2.chord_nm <= INT64_C(1) << 50);
+                if (c2.tan_min_q30 > 0 && c2.tan_min_q30 < UNB && c2.chord_nm > 1024 &&
+                    c2.chord_nm < INT64_C(1) << 50) {
+                    const int64_t used =
+                        c2.flags == CT_EFFECT_ALL
+                            ? 0
+                            : c2.bound_nm[c2.flags == 0u ? 0 : (c2.flags == CT_EFFECT_CURVATURE ? 1 : 2)];
+                    const long double f = std::max(1.0L, std::ldexp(1.0L, 30) / (long double)c2.tan_min_q30);
+                    TEST_ASSERT_MSG((long double)c2.chord_nm * f <= (long double)(tol - used) + 1 &&
+                                        (long double)(c2.chord_nm + 2) * f > (long double)(tol - used),
+                                    "%s, tol %lld: chord %lld nm, tan %lld, rest %lld", c.name, (long long)tol,
+                                    (long long)c2.chord_nm, (long long)c2.tan_min_q30, (long long)(tol - used));
+                    capped += f == 1.0L;
+                }
             }
         }
     }
+    TEST_ASSERT_MSG(capped > 0, "no choice had tan(dep) > 1 (the sideways bound untested)");
     // a camera 2^50 nm (1,126 km) east of the tile: each corner's offset
     // capped at 2^49 nm, so the range is at most 2^49.5 nm
     {

@@ -834,15 +834,18 @@ typedef struct {
  * below the lowest post, is unbounded (2^62).  Bounds are for flat ground:
  * where the ground falls away from the ray (incidence below the
  * depression) the error grows as 1 / sin(incidence).  The chord (the
- * polyline's and the true Earth's pieces' tolerance) moves a hit by at most
- * chord / tan(depression) on flat ground: the largest chord within what
- * the chosen set's bound leaves of the tolerance.                         */
+ * polyline's and the true Earth's pieces' tolerance) moves a hit on flat
+ * ground by at most chord / tan(depression) in height and by the chord
+ * itself sideways or along the track (the true Earth's pieces): the
+ * largest chord whose larger effect is within what the chosen set's bound
+ * leaves of the tolerance.                                                */
 typedef struct {
     uint32_t flags;            /* the least set: 0, CURVATURE, REFRACTION or
                                   both (the first, in that order, whose bound
                                   is within the tolerance; both otherwise)  */
-    int64_t chord_nm;          /* the largest chord with chord / tan(dep) <=
-                                  tol - the set's bound, in [2^10, 2^50] nm
+    int64_t chord_nm;          /* the largest chord with chord max(1,
+                                  1 / tan(dep)) <= tol - the set's bound,
+                                  in [2^10, 2^50] nm
                                   (2^10 when nothing is left: the finest;
                                   CT_EFFECTS_CHORD_NM when a level or rising
                                   ray reaches the tile: no such bound)      */

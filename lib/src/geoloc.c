@@ -389,14 +389,17 @@ ct_status ct_effects_for_tolerance(const ct_package *p, const ct_camera *cam, co
                  : out->bound_nm[2] <= tol_nm ? CT_EFFECT_REFRACTION
                                               : CT_EFFECT_ALL;
     {
-        /* the chord: (tol - bound) tan_min, the rest of the tolerance on
-         * the most grazing ray (tan_min Q30; none reaching: the coarsest) */
+        /* the chord: (tol - bound) min(tan_min, 1), the rest of the
+         * tolerance on the most grazing ray (tan_min Q30; none reaching:
+         * the coarsest) -- a chord's height error moves a hit on flat
+         * ground by chord / tan(depression), its sideways or along-track
+         * error (the true Earth's pieces) by up to the chord itself */
         int64_t used = out->flags == CT_EFFECT_ALL ? 0
                        : out->bound_nm[out->flags == 0u ? 0 : (out->flags == CT_EFFECT_CURVATURE ? 1 : 2)];
         int64_t rest = tol_nm - used;
         int64_t ch = out->tan_min_q30 >= UNBOUNDED
                          ? INT64_C(1) << 50
-                         : ct_i128_floor_div_sat(ct_i128_mul(ct_max64(rest, 0), ct_min64(out->tan_min_q30, INT64_C(1) << 40)),
+                         : ct_i128_floor_div_sat(ct_i128_mul(ct_max64(rest, 0), ct_min64(out->tan_min_q30, INT64_C(1) << 30)),
                                                  INT64_C(1) << 30);
         out->chord_nm = ct_max64(INT64_C(1) << 10, ct_min64(INT64_C(1) << 50, ch));
         if (out->tan_min_q30 == 0) {
