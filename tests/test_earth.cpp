@@ -1285,7 +1285,8 @@ void test_piece_culling()
 
 // The pieces' error bounds (earth.c side_rem, bound_vert) hold: for every
 // pose of pose_defs(), exact and fitted map, with and without refraction,
-// 12 seeded lines of sight each, every piece whose errors were bounded
+// 12 seeded lines of sight each and one straight down, every piece whose
+// errors were bounded
 // (not sampled) is compared with the interpolated path at 49 points along
 // it, in long double: the path's sideways distance from the shifted chord
 // (Q24) within the piece's sideways bound, and its height less the walk's
@@ -1302,7 +1303,7 @@ void test_piece_bounds()
     ct_rng rng;
     ct_rng_seed(&rng, ct_test_seed() * 29 + 11);
     static ct_earth_piece pcs[2048];
-    long pieces = 0, bounded = 0, sampled = 0, points = 0, over_tol = 0;
+    long lines = 0, pieces = 0, bounded = 0, sampled = 0, points = 0, over_tol = 0;
     double tight = 0, vratio = 0, worst_lat = 0, worst_v = 0;
     for (const PoseDef &d : pose_defs()) {
         Pose p;
@@ -1313,13 +1314,20 @@ void test_piece_bounds()
             ct_earth es;
             TEST_ASSERT_EQUAL_INT(CT_OK, ct_earth_setup(&pk, &p.pose, k, CT_EARTH_RADIUS_NM, CT_EFFECTS_CHORD_NM, 0u,
                                                         fitted, nullptr, &es));
-            for (int r = 0; r < 12; ++r) {
+            for (int r = 0; r < 13; ++r) {
                 const ld yaw = d.yaw + ct_rng_range(&rng, -20000, 20000) * 1e-3L;
                 const ld pitch = std::max(-89.0L, std::min(-0.2L, d.pitch + ct_rng_range(&rng, -3000, 3000) * 1e-3L));
                 int64_t dg[3];
                 grid_dir_q39(yaw, pitch, dg);
+                if (r == 12) {
+                    // straight down the ellipsoid's normal: the camera's
+                    // piece less than a Q16 unit long horizontally
+                    dg[0] = dg[1] = 0;
+                    dg[2] = -(INT64_C(1) << 39);
+                }
                 uint32_t n = 0;
                 (void)ct_earth_pieces(&pk, &es, dg, pcs, 2048u, &n);
+                lines++;
                 TEST_ASSERT_MSG(n <= 2048u, "pose %s: %u pieces", d.family, n);
                 for (uint32_t i = 0; i < n; ++i) {
                     const ct_earth_piece &e = pcs[i];
@@ -1376,11 +1384,32 @@ void test_piece_bounds()
             }
         }
     }
-    std::printf("  %ld pieces (off the tile but %ld), %ld with bounded errors (%ld over the tolerance), %ld points: "
+    std::printf("  %ld lines of sight, %ld pieces (off the tile but %ld), %ld with bounded errors (%ld over the tolerance), %ld points: "
                 "sideways up to %.4f mm (%.3f of its bound at most), in height up to %.4f mm (less the vertices' "
                 "rounding: %.3f of its bound)\n",
-                pieces, bounded + sampled, bounded, over_tol, points, worst_lat * 1e3, tight, worst_v * 1e3, vratio);
+                lines, pieces, bounded + sampled, bounded, over_tol, points, worst_lat * 1e3, tight, worst_v * 1e3, vratio);
     TEST_ASSERT_MSG(bounded > 500, "too few bounded pieces (%ld)", bounded);
+    // the hook's refusals, and its cap: the first pieces only, the walk's status
+    {
+        Pose p;
+        TEST_ASSERT(make_pose(w->sf, pose_defs()[0], &p));
+        ct_earth es;
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_earth_setup(&pk, &p.pose, 0, CT_EARTH_RADIUS_NM, CT_EFFECTS_CHORD_NM, 0u, 1,
+                                                    nullptr, &es));
+        int64_t dg[3];
+        grid_dir_q39(30, -45, dg);
+        uint32_t n = 0, n1 = 0;
+        TEST_ASSERT_EQUAL_INT(CT_ERR_ARG, ct_earth_pieces(nullptr, &es, dg, pcs, 2048u, &n));
+        TEST_ASSERT_EQUAL_INT(CT_ERR_ARG, ct_earth_pieces(&pk, nullptr, dg, pcs, 2048u, &n));
+        TEST_ASSERT_EQUAL_INT(CT_ERR_ARG, ct_earth_pieces(&pk, &es, nullptr, pcs, 2048u, &n));
+        TEST_ASSERT_EQUAL_INT(CT_ERR_ARG, ct_earth_pieces(&pk, &es, dg, nullptr, 2048u, &n));
+        TEST_ASSERT_EQUAL_INT(CT_ERR_ARG, ct_earth_pieces(&pk, &es, dg, pcs, 2048u, nullptr));
+        const ct_status st = ct_earth_pieces(&pk, &es, dg, pcs, 2048u, &n);
+        const ct_earth_piece first = pcs[0];
+        TEST_ASSERT_EQUAL_INT(st, ct_earth_pieces(&pk, &es, dg, pcs, 1u, &n1));
+        TEST_ASSERT_MSG(n > 1 && n1 == 1 && pcs[0].lc_nm == first.lc_nm && pcs[0].elat_q24 == first.elat_q24,
+                        "capped log: %u of %u pieces (status %d)", n1, n, (int)st);
+    }
     TEST_ASSERT_MSG(tight > 0.9, "the sideways bound is loose: the path came within %.3f of it at most", tight);
 }
 

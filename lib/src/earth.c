@@ -14,8 +14,8 @@
  * the ellipsoid's radius in its azimuth.  The image is interpolated per
  * ray through exact ones at Chebyshev nodes (below) and traced in pieces
  * [ta, tb] of the range:
- *   - the images A, M, B of the ends and the middle (Q16 grid, and x, y in
- *     Q24 for the checks);
+ *   - the images A, M, B of the ends and the middle (Q16 grid, and in Q24
+ *     for the checks);
  *   - horizontally the chord A -> B shifted sideways towards M by half M's
  *     deviation (chord_shift; the sideways bend is about a parabola, so the
  *     shifted chord's error is half the chord's, at its ends and middle
@@ -26,13 +26,14 @@
  *     a ((x - xA)^2 + (y - yA)^2) (the lowered walk of trace.c, ct_lower);
  *     a < 0 (a path bending down faster than the Earth: refraction k > 1)
  *     traces the chord itself;
- *   - the model is checked against the images at the middle (sideways) and
- *     the quarter points (sideways, and in height at their range along the
- *     chord): within the chord tolerance the piece is traced, otherwise
- *     shortened by 0.8 sqrt(tol / error) (errors grow as the length
- *     squared) and checked again; the next piece aims at 0.8 of the
- *     tolerance, at most twice as long, up to 30 km (the image's cubic term
- *     the quarter points see is then well under the tolerance);
+ *   - the model's errors over the piece are bounded from the interpolated
+ *     image's derivatives (side_rem, bound_vert: sideways, and in height at
+ *     the image's range along the chord), or, for a piece without a
+ *     lowered walk or an image without its polynomial, sampled at the
+ *     quarter points (model_error): within the chord tolerance the piece is
+ *     traced, otherwise shortened by 0.8 sqrt(tol / error) (errors grow as
+ *     the length squared) and checked again; the next piece aims at 0.8 of
+ *     the tolerance, at most twice as long, up to 30 km;
  *   - a hit beyond the piece's end belongs to the next piece.
  * The pieces start where the interpolated path may first come over the tile
  * and end where it has left it for good (path_span: the polynomial's linear
@@ -835,8 +836,10 @@ static void model_error(const gv *A, const gv *B, const gv *Q, const fit *f, con
     int64_t ux = B->fx - A->fx, uy = B->fy - A->fy, qx = Q->fx - A->fx, qy = Q->fy - A->fy, sq, zl, v;
     ct_i128 dot;
     *lat = lateral24(A, B, f->l24, Q);
-    if (f->l == 0 || f->l24 == 0) {
-        *vert = 0; /* a vertical chord: the sideways distance only */
+    if (f->l == 0) {
+        /* a vertical chord: the sideways distance only (l24 > 0 with l > 0:
+         * the Q16 ends are the Q24 ones rounded) */
+        *vert = 0;
         return;
     }
     /* |u|, |q| < 2^50 (pieces <= 30 km): the dot product < 2^101 */
@@ -1327,14 +1330,15 @@ static int64_t rem3(int64_t e)
  * bounded from the path polynomial's derivatives (not sampled): q, the
  * quadratic in sigma through the path's images A, M, B, differs from the
  * path by at most rem3 of |f'''| h^3 per coordinate.
- *   - Sideways (here: check_piece adds it to the larger of the ends' and
+ *   - Sideways (here; check_piece adds it to the larger of the ends' and
  *     M's distances from the shifted chord): q's distance from the chord A
  *     -> B is 4 s (1 - s) times M's (s in [0, 1] along the piece), so from
  *     the shifted chord, parallel to it, at most the larger of the ends'
  *     and M's; the path is within the remainder of q (Q24 cells; |x'''| +
- *     |y'''| <= b3h).  8 units for the polynomial's roundings and, on the
- *     first piece from the camera (ta = 0), whose A is the camera's grid
- *     point, A's distance from the path's own image there.
+ *     |y'''| <= b3h).  8 units for the polynomial's roundings.  (The first
+ *     piece from the camera starts at the camera's grid point, not at the
+ *     path's image cam24: check_piece takes the largest distance of the
+ *     quadratic through cam24, M and B instead, quad_max.)
  *   - In height: bound_vert. */
 static int64_t side_rem(const path *pa, int64_t hq, int64_t l24)
 {
@@ -1366,8 +1370,8 @@ static int64_t quad_max(int64_t y0, int64_t ym, int64_t y1)
  *     the vertices' Q16 rounding (which the tolerance's quarter is for), so
  *     g = z - Z(s(sigma)) has three equally spaced zeros and is within
  *     rem3 of |g'''| h^3, where |g'''| <= |z'''| + |Z'(s)| |s'''| + 6 a |s'|
- *     |s''|, |s^(k)| <= b_kh, |Z'| <= |b| + 2 a S (S = l + rh + 3 Q16, the
- *     farthest range along the chord).  The last term, 6 rem3(1) a (b1h h)
+ *     |s''|, |s^(k)| <= b_kh, |Z'| <= |b| + 2 a S (S = l + rh / 256 + 3,
+ *     Q16: the farthest range along the chord).  The last term, 6 rem3(1) a (b1h h)
  *     (b2h h^2) < a L1 L2 / 16 (in Q24: a / 256 per Q24 cell squared).  A
  *     point of the path off the walk line by lambda <= elat is lowered by a
  *     lambda^2 more.  3 Q16 units for the lowering's floors, and dip / 2^28
