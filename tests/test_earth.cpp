@@ -1286,9 +1286,8 @@ void test_piece_culling()
 // The pieces' error bounds (earth.c side_rem, bound_vert) hold: for every
 // pose of pose_defs(), exact and fitted map, with and without refraction,
 // 12 seeded lines of sight each and one straight down, every piece whose
-// errors were bounded
-// (not sampled) is compared with the interpolated path at 49 points along
-// it, in long double: the path's sideways distance from the shifted chord
+// errors were bounded (not sampled) is compared with the interpolated path
+// at 49 points along it, in long double: the path's sideways distance from the shifted chord
 // (Q24) within the piece's sideways bound, and its height less the walk's
 // model there (the walk line's height at the point's range along it, plus
 // the lowering at the point) within the height bound plus 1.25 times the
@@ -1328,7 +1327,7 @@ void test_piece_bounds()
                 uint32_t n = 0;
                 (void)ct_earth_pieces(&pk, &es, dg, pcs, 2048u, &n);
                 lines++;
-                TEST_ASSERT_MSG(n <= 2048u, "pose %s: %u pieces", d.family, n);
+                TEST_ASSERT_MSG(n < 2048u, "pose %s: the log of pieces is full (%u)", d.family, n);
                 for (uint32_t i = 0; i < n; ++i) {
                     const ct_earth_piece &e = pcs[i];
                     pieces++;
@@ -1370,8 +1369,9 @@ void test_piece_bounds()
                     for (int q = 0; q <= 48; ++q) {
                         mlat = std::max(mlat, lat[q]);
                         mv = std::max(mv, std::fabs(dz[q]) - 1.25L * node);
-                        TEST_ASSERT_MSG(lat[q] <= e.elat_q24 + 2, "pose %s, piece %u at %d/48: %.1Lf Q24 sideways, bound %lld",
-                                        d.family, i, q, lat[q], (long long)e.elat_q24);
+                        TEST_ASSERT_MSG(lat[q] <= e.elat_q24 + 2,
+                                        "pose %s, piece %u at %d/48: %.1Lf Q24 sideways, bound %lld", d.family, i, q,
+                                        lat[q], (long long)e.elat_q24);
                         TEST_ASSERT_MSG(std::fabs(dz[q]) <= e.evert_q16 + 1.25L * node + 1,
                                         "pose %s, piece %u at %d/48: %.2Lf Q16 in height (vertices %.2Lf), bound %lld",
                                         d.family, i, q, dz[q], node, (long long)e.evert_q16);
@@ -1384,10 +1384,11 @@ void test_piece_bounds()
             }
         }
     }
-    std::printf("  %ld lines of sight, %ld pieces (off the tile but %ld), %ld with bounded errors (%ld over the tolerance), %ld points: "
-                "sideways up to %.4f mm (%.3f of its bound at most), in height up to %.4f mm (less the vertices' "
-                "rounding: %.3f of its bound)\n",
-                lines, pieces, bounded + sampled, bounded, over_tol, points, worst_lat * 1e3, tight, worst_v * 1e3, vratio);
+    std::printf("  %ld lines of sight, %ld pieces (off the tile but %ld), %ld with bounded errors (%ld over the "
+                "tolerance), %ld points: sideways up to %.4f mm (%.3f of its bound at most), in height up to %.4f mm "
+                "(less the vertices' rounding: %.3f of its bound)\n",
+                lines, pieces, bounded + sampled, bounded, over_tol, points, worst_lat * 1e3, tight, worst_v * 1e3,
+                vratio);
     TEST_ASSERT_MSG(bounded > 500, "too few bounded pieces (%ld)", bounded);
     // the hook's refusals, and its cap: the first pieces only, the walk's status
     {
