@@ -1284,10 +1284,11 @@ void test_piece_culling()
 }
 
 // The pieces' error bounds (earth.c side_rem, bound_vert) hold: for every
-// pose of pose_defs(), exact and fitted map, with and without refraction,
-// 12 seeded lines of sight each and one straight down, every piece whose
-// errors were bounded (not sampled) is compared with the interpolated path
-// at 49 points along it, in long double: the path's sideways distance from the shifted chord
+// pose of pose_defs() and a camera 5 m over the tile, with the exact and
+// the fitted map, with and without refraction, 12 seeded lines of sight
+// and one straight down, every piece whose errors were bounded (not
+// sampled) is compared with the interpolated path at 49 points along it,
+// in long double: the path's sideways distance from the shifted chord
 // (Q24) within the piece's sideways bound, and its height less the walk's
 // model there (the walk line's height at the point's range along it, plus
 // the lowering at the point) within the height bound plus 1.25 times the
@@ -1304,7 +1305,11 @@ void test_piece_bounds()
     static ct_earth_piece pcs[2048];
     long lines = 0, pieces = 0, bounded = 0, sampled = 0, points = 0, over_tol = 0;
     double tight = 0, vratio = 0, worst_lat = 0, worst_v = 0;
-    for (const PoseDef &d : pose_defs()) {
+    // and a camera 5 m over the middle of the tile, below its tallest post,
+    // whose first piece starts at the camera however steep
+    std::vector<PoseDef> defs = pose_defs();
+    defs.push_back({"low", 201045, 4065840, 5, 0, -90});
+    for (const PoseDef &d : defs) {
         Pose p;
         TEST_ASSERT_MSG(make_pose(w->sf, d, &p), "pose %s", d.family);
         for (int mode = 0; mode < 4; ++mode) {
