@@ -1384,14 +1384,14 @@ void test_piece_bounds()
                     tight = std::max(tight, (double)(mlat / (ld)e.elat_q24));
                     vratio = std::max(vratio, (double)(mv / (ld)e.evert_q16));
                     worst_lat = std::max(worst_lat, (double)(mlat * pk.posting_e_nm * 1e-9L / 16777216.0L));
-                    worst_v = std::max(worst_v, (double)((mv + 1.25L * node) * pk.height_scale_nm * 1e-9L / 65536.0L));
+                    worst_v = std::max(worst_v, (double)(mv * pk.height_scale_nm * 1e-9L / 65536.0L));
                 }
             }
         }
     }
     std::printf("  %ld lines of sight, %ld pieces (off the tile but %ld), %ld with bounded errors (%ld over the "
-                "tolerance), %ld points: sideways up to %.4f mm (%.3f of its bound at most), in height up to %.4f mm "
-                "(less the vertices' rounding: %.3f of its bound)\n",
+                "tolerance), %ld points: sideways up to %.4f mm (%.3f of its bound at most), in height beyond "
+                "1.25 x the vertices' rounding up to %.4f mm (%.3f of its bound)\n",
                 lines, pieces, bounded + sampled, bounded, over_tol, points, worst_lat * 1e3, tight, worst_v * 1e3,
                 vratio);
     TEST_ASSERT_MSG(bounded > 500, "too few bounded pieces (%ld)", bounded);
