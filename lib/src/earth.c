@@ -738,21 +738,24 @@ static int64_t lateral24(const gv *A, const gv *B, int64_t l24, const gv *Q)
 typedef struct {
     int64_t ux, uy, l, sm;
     int64_t l24; /* the chord's length, Q24 */
-    int64_t dev; /* the middle's sideways deviation, Q24 */
+    int64_t sdev, dev; /* the middle's sideways deviation, Q24: signed (side24), its magnitude */
     ct_i128 num, den;
     int64_t dip; /* |a| l^2 / 4, Q16 height units (saturated) */
 } fit;
 
+/* The Q16 chord A -> B: u and its length l (pieces are at most 30 km: |u|
+ * < 2^42 Q16 at 1 cm posting or more; squares in 128 bits). */
+static void fit_u(const gv *A, const gv *B, fit *f)
+{
+    f->ux = B->x - A->x;
+    f->uy = B->y - A->y;
+    f->l = (int64_t)ct_i128_isqrt(ct_i128_add(ct_i128_mul(f->ux, f->ux), ct_i128_mul(f->uy, f->uy)));
+}
+
 /* The chord's part of the fit: u, l, l24. */
 static void fit_chord(const gv *A, const gv *B, fit *f)
 {
-    ct_i128 l2;
-    f->ux = B->x - A->x;
-    f->uy = B->y - A->y;
-    /* pieces are at most 30 km: |u| < 2^42 Q16 at 1 cm posting or more;
-     * squares in 128 bits */
-    l2 = ct_i128_add(ct_i128_mul(f->ux, f->ux), ct_i128_mul(f->uy, f->uy));
-    f->l = (int64_t)ct_i128_isqrt(l2);
+    fit_u(A, B, f);
     f->l24 = chord24(A, B);
 }
 
@@ -765,7 +768,8 @@ CT_NOINLINE static void fit_middle(const gv *A, const gv *B, const gv *M, fit *f
     /* |m| < 2^42 as |u|: products in 128 bits */
     dot = ct_i128_add(ct_i128_mul(f->ux, mx), ct_i128_mul(f->uy, my));
     f->sm = f->l == 0 ? 0 : ct_i128_floor_div_sat(dot, f->l);
-    f->dev = lateral24(A, B, f->l24, M);
+    f->sdev = side24(A, B, f->l24, M);
+    f->dev = ct_abs64(f->sdev);
     f->den = ct_i128_from64(0);
     f->num = ct_i128_from64(0);
     f->dip = 0;
@@ -1020,6 +1024,14 @@ ct_status ct_earth_setup(const ct_package *p, const ct_pose *pose, int32_t refr_
     return CT_OK;
 }
 
+/* e 526 / 2^16 rounded up (526 / 2^16 > 1 / (72 sqrt 3), the remainder
+ * of quadratic interpolation at three equally spaced points), for 0 <= e
+ * < 2^61: (e >> 8) 526 < 2^62. */
+static int64_t rem3(int64_t e)
+{
+    return ((((e >> 8) + 1) * 526) >> 8) + 1;
+}
+
 /* The piece [ta, ta + Lc] in sigma: h = 2 Lc / tmax in Q30, rounded up
  * (Lc <= tmax: h <= 2^31; 2 Lc 2^30 < 2^80). */
 static int64_t piece_hq(const path *pa, int64_t Lc)
@@ -1055,8 +1067,8 @@ static int64_t cubic_drop(const path *pa, int64_t Lc)
         return Lc <= PIECE_FIRST_NM ? 0 : INT64_C(1) << 60;
     }
     e = pow_h(pa->b3z, piece_hq(pa, Lc), 3);
-    /* e <= b3z (hq / 2^30)^3 < 2^60: in Q16 (< 2^52) before the factor */
-    return ((((e >> 8) + 1) * 526) >> 16) + 2;
+    /* e <= b3z (hq / 2^30)^3 < 2^60, the remainder in Q24 (rem3), then Q16 */
+    return ((rem3(e) - 1) >> 8) + 2;
 }
 
 /* 1 when nothing of the piece can touch terrain: off the tile
@@ -1280,7 +1292,6 @@ typedef struct {
     fit f;
     int64_t Lc, elat, evert, dB;
     int off;
-    int bounded; /* 1: elat, evert bounded (side_rem, bound_vert), 0: sampled */
     ct_lower lw;
     const ct_lower *lwp;
 } piece;
@@ -1316,14 +1327,6 @@ static int64_t shr_up_sat(ct_i128 v, unsigned n)
         v = ct_i128_sar(v, n);
     }
     return ct_i128_to64(v) + 1;
-}
-
-/* e 526 / 2^16 rounded up (526 / 2^16 > 1 / (72 sqrt 3), the remainder
- * of quadratic interpolation at three equally spaced points), for 0 <= e
- * < 2^61: (e >> 8) 526 < 2^62. */
-static int64_t rem3(int64_t e)
-{
-    return ((((e >> 8) + 1) * 526) >> 8) + 1;
 }
 
 /* The model's largest errors over a piece of the interpolated path,
@@ -1435,10 +1438,7 @@ static int check_piece(const ct_package *p, const path *pa, const ct_earth *es, 
          * rounding changed it (the Q24 one is parallel to A -> B, of the
          * same l24) */
         if (pc->Bs.x - pc->As.x != pc->f.ux || pc->Bs.y - pc->As.y != pc->f.uy) {
-            pc->f.ux = pc->Bs.x - pc->As.x;
-            pc->f.uy = pc->Bs.y - pc->As.y;
-            pc->f.l = (int64_t)ct_i128_isqrt(
-                ct_i128_add(ct_i128_mul(pc->f.ux, pc->f.ux), ct_i128_mul(pc->f.uy, pc->f.uy)));
+            fit_u(&pc->As, &pc->Bs, &pc->f);
         }
         /* the ends' own distance from the shifted line (the same at both) */
         pc->elat = lateral24(&pc->As, &pc->Bs, pc->f.l24, A);
@@ -1450,7 +1450,6 @@ static int check_piece(const ct_package *p, const path *pa, const ct_earth *es, 
                    must not keep an earlier, longer try's lowering */
     pc->elat = ct_max64(pc->elat, pc->f.dev);
     pc->evert = 0;
-    pc->bounded = 0;
     if (pa->interp) {
         /* the sideways bound (side_rem) */
         hq = piece_hq(pa, pc->Lc);
@@ -1463,8 +1462,7 @@ static int check_piece(const ct_package *p, const path *pa, const ct_earth *es, 
             gv C = *A;
             C.fx = es->cam24[0];
             C.fy = es->cam24[1];
-            pc->elat = ct_max64(pc->elat, quad_max(side24(&pc->As, &pc->Bs, pc->f.l24, &C),
-                                                   side24(&pc->As, &pc->Bs, pc->f.l24, &pc->M),
+            pc->elat = ct_max64(pc->elat, quad_max(side24(&pc->As, &pc->Bs, pc->f.l24, &C), pc->f.sdev,
                                                    side24(&pc->As, &pc->Bs, pc->f.l24, &pc->B)));
         } else if (ta == 0) {
             /* (distances from A: cam24 within 2^8 + 2 of it) */
@@ -1484,7 +1482,6 @@ static int check_piece(const ct_package *p, const path *pa, const ct_earth *es, 
         if (pa->interp && pc->lwp != NULL) {
             /* the interpolated path and a lowered walk: the errors bounded */
             pc->evert = bound_vert(pa, es, ta, hq, rh, A, pc);
-            pc->bounded = 1;
         } else if (quarter_errors(pa, ta, pc->Lc, &pc->As, &pc->Bs, &pc->f, pc->lwp, pc->dB, &pc->elat,
                                   &pc->evert) != CT_OK) {
             /* otherwise the model against the image at the quarter points */
@@ -1682,7 +1679,7 @@ typedef struct {
     uint32_t cap, n;
 } piece_log;
 
-static void log_piece(piece_log *lg, const gv *A, int64_t ta, const piece *pc)
+static void log_piece(piece_log *lg, const path *pa, const gv *A, int64_t ta, const piece *pc)
 {
     ct_earth_piece *e;
     if (lg->n >= lg->cap) {
@@ -1714,7 +1711,7 @@ static void log_piece(piece_log *lg, const gv *A, int64_t ta, const piece *pc)
     e->elat_q24 = pc->elat;
     e->evert_q16 = pc->evert;
     e->off = pc->off;
-    e->bounded = pc->bounded;
+    e->bounded = (int32_t)((pa->interp != 0) & (pc->lwp != NULL)); /* check_piece bounds these */
 }
 
 /* The line of sight as pieces of lowered walks from the camera: each piece
@@ -1768,7 +1765,7 @@ static ct_status earth_walk(const ct_package *p, ct_tileset *ts, const ct_earth 
             return CT_MISS;
         }
         if (lg != NULL) {
-            log_piece(lg, &A, ta, &pc);
+            log_piece(lg, &pa, &A, ta, &pc);
         } else if (!pc.off && !(es->cull && piece_culled(p, &pc.As, &pc.Bs, pc.dB))) {
             st = trace_piece(p, ts, &pc.As, &pc.Bs, &pc.f, pc.lwp, pc.dB, first, m, h, &steps, &iters);
             if (st != CT_MISS) {
