@@ -1186,6 +1186,69 @@ void test_path_interpolation()
     TEST_ASSERT_MSG(worst <= kInterpM, "interpolated path off its node images by %.3g m (> %.3g m)", worst, kInterpM);
 }
 
+// A map fitted per call (CT_EFFECT_EARTH_FIT) gives the path's polynomial
+// from the fit's own Taylor terms at the camera plus one image at the far
+// end (up to 35 km) or two (to 130 km) -- earth.c taylor_nodes -- instead
+// of the Lobatto nodes' three or four.  The same cameras as above (ranges
+// 13-141 km), a fit per call each, with and without refraction, lines of
+// sight in every direction the cameras see, against the fit's own images
+// every 1/1000 of the range (ct_earth_path_image24 with interp = 0: the fit
+// evaluated at the exact point C + t d - bend w): within the same 0.02 mm
+// as the Lobatto nodes, and each regime taken (5 coefficients up to 35 km,
+// 6 to 130 km, beyond that the 6 Lobatto nodes).  Breaking a Taylor term
+// (a cubic monomial's axis in taylor_nodes) fails it.
+void test_taylor_path()
+{
+    World *w = jacksboro();
+    const ct_package &pk = w->p;
+    const double kInterpM = 2e-5;
+    double worst = 0;
+    uint32_t counts = 0;
+    for (ld back_km : {0.0L, 24.0L, 40.0L, 111.0L, 116.0L}) {
+        Pose p;
+        TEST_ASSERT(make_pose(w->sf, {"far", 201045 + back_km * 1000, 4065840, 3000, 270, -10}, &p));
+        for (int32_t k : {0, CT_REFRACTION_K_STD_Q16, -2 * CT_REFRACTION_K_STD_Q16}) {
+            ct_earth es;
+            TEST_ASSERT_EQUAL_INT(CT_OK, ct_earth_setup(&pk, &p.pose, k, CT_EARTH_RADIUS_NM, CT_EFFECTS_CHORD_NM, 0u,
+                                                        1, nullptr, &es));
+            TEST_ASSERT(es.map == &es.fit);
+            double err = 0;
+            int32_t nodes = 0;
+            for (int az = 0; az < 360; az += 45) {
+                for (int dep : {1, 4, 12}) {
+                    int64_t dg[3];
+                    grid_dir_q39(az, -dep, dg);
+                    for (int i = 0; i <= 1000; ++i) {
+                        const int64_t t = (int64_t)((ld)es.tmax_nm * i / 1000);
+                        int64_t gi[3], ge[3];
+                        TEST_ASSERT_EQUAL_INT(CT_OK, ct_earth_path_image24(&pk, &es, dg, t, 1, gi, &nodes));
+                        TEST_ASSERT_EQUAL_INT(CT_OK, ct_earth_path_image24(&pk, &es, dg, t, 0, ge, &nodes));
+                        const double ex =
+                            std::fabs((double)(gi[0] - ge[0])) * (double)pk.posting_e_nm * 1e-9 / 16777216.0;
+                        const double ey = std::fabs((double)(gi[1] - ge[1])) * std::fabs((double)pk.posting_n_nm) *
+                                          1e-9 / 16777216.0;
+                        const double ez =
+                            std::fabs((double)(gi[2] - ge[2])) * (double)pk.height_scale_nm * 1e-9 / 16777216.0;
+                        err = std::max(err, std::max(ex, std::max(ey, ez)));
+                    }
+                }
+            }
+            const int regime = es.tmax_nm <= INT64_C(35) * 1000000000000    ? 5
+                               : es.tmax_nm <= INT64_C(130) * 1000000000000 ? 6
+                                                                            : 7;
+            TEST_ASSERT_MSG(nodes == (regime == 7 ? 6 : regime), "range %.1f km: %d coefficients", es.tmax_nm * 1e-12,
+                            (int)nodes);
+            counts |= 1u << regime;
+            std::printf("  camera %3.0Lf km east, k = %+.2f: range %.1f km, %d coefficients: path vs the fit's images "
+                        "max %.4f mm\n",
+                        back_km, k / 65536.0, es.tmax_nm * 1e-12, (int)nodes, err * 1e3);
+            worst = std::max(worst, err);
+        }
+    }
+    TEST_ASSERT_MSG(counts == (1u << 5) + (1u << 6) + (1u << 7), "the cameras did not take every regime (%x)", counts);
+    TEST_ASSERT_MSG(worst <= kInterpM, "path off the fit's images by %.3g m (> %.3g m)", worst, kInterpM);
+}
+
 // Culling (earth.c piece_culled: a piece whose walk line is above the
 // max-mipmap under it is not walked) changes no result: every pose of
 // pose_defs(), 30 seeded lines of sight each with the exact map and 30 with
@@ -1920,6 +1983,7 @@ int main()
     RUN_TEST(test_reference_flat);
     RUN_TEST(test_fitted_map);
     RUN_TEST(test_path_interpolation);
+    RUN_TEST(test_taylor_path);
     RUN_TEST(test_piece_culling);
     RUN_TEST(test_piece_bounds);
     RUN_TEST(test_exact_curvature);

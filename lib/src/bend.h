@@ -126,6 +126,13 @@ typedef struct {
     int64_t moff[3];       /* c - map->c, ECEF nm                            */
     int64_t cam24[3];      /* the camera's image, Q24 (every path's node 0)  */
     ct_earth_map fit;
+    /* The fit's Taylor terms of degrees 1..3 at the camera (a fit per call
+     * is centred there: moff = 0), the coefficients of s^alpha in the
+     * fit's term order (earth.c term_abc, terms 1..19), in the units of
+     * its cf (Q(fb - 2)); tay_ok = 0: none (a kept map, no fit, or a term
+     * out of range), the path then takes Lobatto nodes only.            */
+    int32_t tay_ok;
+    int64_t tay[19][3];
 } ct_earth;
 
 /* Library-internal helpers shared between files.                          */
@@ -177,7 +184,9 @@ int ct_segment_above_terrain(const ct_package *p, int64_t ax, int64_t ay, int64_
  * ct_trace_earth_set's) at range t (0 <= t <= es->tmax_nm): interpolated
  * between its nodes (interp != 0; CT_ERR_RANGE when they could not be
  * set) or found as a node is (the map, or the exact conversions); *nodes
- * the number of nodes (0: none).  For tests of the interpolation.        */
+ * the number of the path polynomial's coefficients (0: none): the Lobatto
+ * nodes' count, or with a fit per call 5 or 6 (earth.c taylor_nodes).
+ * For tests of the interpolation.                                        */
 ct_status ct_earth_path_image24(const ct_package *pkg, const ct_earth *es, const int64_t dg[3], int64_t t, int interp,
                                 int64_t g[3], int32_t *nodes);
 

@@ -81,7 +81,9 @@ typedef struct {
  * computed exactly): c < 2^49, V^-1 X formed in 128 bits.  A vertex is
  * then Horner's rule in sigma (Q60): n - 1 products < 2^110 per
  * coordinate.  tau_j = (1 + sigma_j) / 2 in Q60 (tau_0 = 0, tau_(n-1) =
- * 1). */
+ * 1).  With a map fitted per call the polynomial comes instead from the
+ * fit's derivatives at the camera and one or two images (taylor_nodes):
+ * degree 4 up to 35 km, 5 up to 130 km, the same representation. */
 #define NODES 6
 #define NODES_4_NM (35 * KM_NM)
 #define NODES_5_NM (130 * KM_NM)
@@ -132,7 +134,7 @@ typedef struct {
     int64_t w[3];  /* refraction's bending direction, Q30 (0: none) */
     int refract;
     int interp;    /* 1: the nodes below are set */
-    int nodes;     /* n: 4, 5 or 6 */
+    int nodes;     /* coefficients: 4, 5 or 6 (Lobatto: the nodes) */
     int64_t tmax;
     int64_t tinv;  /* floor(2^(60 + tsh) / tmax), in (2^60, 2^61]    */
     unsigned tsh;  /* bit length of tmax                              */
@@ -265,18 +267,30 @@ static int64_t rshr64(int64_t v, unsigned n)
     return (int64_t)(((u ^ neg) >> n) ^ neg);
 }
 
-/* round(x y / 2^62) and round(x y / 2^30) for |x|, |y| <= 2^62 + 2^8
- * (resp. 2^30 + 2^8), skipping the product when a factor is exactly one
- * (T_0, or T_n(s) = 1): the same value, no multiplication. */
+/* round(x y / 2^62) for |x|, |y| <= 2^62 + 2^8, skipping the product when
+ * a factor is exactly one (T_0, or T_n(s) = 1): the same value, no
+ * multiplication. */
 static int64_t mul62(int64_t x, int64_t y)
 {
     return x == T_ONE_Q62 ? y : (y == T_ONE_Q62 ? x : ct_mul_shr(x, y, 62u));
 }
 
-static int64_t mul30(int64_t x, int64_t y)
-{
-    return x == (INT64_C(1) << 30) ? y : (y == (INT64_C(1) << 30) ? x : rshr64(x * y, 30u));
-}
+/* The map's terms T_a(s_x) T_b(s_y) T_c(s_z), a + b + c <= deg, in the order
+ * the coefficients are stored: by total degree, then a, then b (the first
+ * n(deg) = (deg + 1)(deg + 2)(deg + 3) / 6 entries are those of degree <=
+ * deg: 35, 56, 84 for deg 4, 5, 6).  deg_start[k]: the first term of
+ * degree k. */
+static const uint8_t term_abc[CT_EARTH_MAP_TERMS][3] = {
+    {0, 0, 0}, {0, 0, 1}, {0, 1, 0}, {1, 0, 0}, {0, 0, 2}, {0, 1, 1}, {0, 2, 0}, {1, 0, 1}, {1, 1, 0}, {2, 0, 0},
+    {0, 0, 3}, {0, 1, 2}, {0, 2, 1}, {0, 3, 0}, {1, 0, 2}, {1, 1, 1}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}, {3, 0, 0},
+    {0, 0, 4}, {0, 1, 3}, {0, 2, 2}, {0, 3, 1}, {0, 4, 0}, {1, 0, 3}, {1, 1, 2}, {1, 2, 1}, {1, 3, 0}, {2, 0, 2},
+    {2, 1, 1}, {2, 2, 0}, {3, 0, 1}, {3, 1, 0}, {4, 0, 0}, {0, 0, 5}, {0, 1, 4}, {0, 2, 3}, {0, 3, 2}, {0, 4, 1},
+    {0, 5, 0}, {1, 0, 4}, {1, 1, 3}, {1, 2, 2}, {1, 3, 1}, {1, 4, 0}, {2, 0, 3}, {2, 1, 2}, {2, 2, 1}, {2, 3, 0},
+    {3, 0, 2}, {3, 1, 1}, {3, 2, 0}, {4, 0, 1}, {4, 1, 0}, {5, 0, 0}, {0, 0, 6}, {0, 1, 5}, {0, 2, 4}, {0, 3, 3},
+    {0, 4, 2}, {0, 5, 1}, {0, 6, 0}, {1, 0, 5}, {1, 1, 4}, {1, 2, 3}, {1, 3, 2}, {1, 4, 1}, {1, 5, 0}, {2, 0, 4},
+    {2, 1, 3}, {2, 2, 2}, {2, 3, 1}, {2, 4, 0}, {3, 0, 3}, {3, 1, 2}, {3, 2, 1}, {3, 3, 0}, {4, 0, 2}, {4, 1, 1},
+    {4, 2, 0}, {5, 0, 1}, {5, 1, 0}, {6, 0, 0}};
+static const uint8_t deg_start[CT_EARTH_MAP_DEG + 2] = {0, 1, 4, 10, 20, 35, 56, 84};
 
 /* The fitted image of c + D (|D| <= 2^qrho per axis, checked by the
  * caller), Q24: the base plus the sum of cf T_a(s_x) T_b(s_y) T_c(s_z), s
@@ -291,15 +305,13 @@ static int64_t mul30(int64_t x, int64_t y)
  *     2^62, then times 2^(32 + sh[k]) (sh <= 29: < 2^123) into the 128-bit
  *     sum.
  *   The sum (Q(fb + 60), < 2^125) is rounded once to Q24.  The rounding of
- *   cf' (2^(sh - 1) per term) costs under 2 um at 141 km (fit_map). */
+ *   cf' (2^(sh - 1) per term) costs under 2 um at 141 km (fit_map).  The
+ *   terms run in their stored order (term_abc), one flat loop per degree. */
 static void fit_eval(const ct_earth_map *mp, const int64_t D[3], int64_t g[3])
 {
-    /* gs[o][k]: the degree-k sum of coordinate o (each coordinate's sums
-     * apart: adjacent ones invite x86's SLP vectoriser to emulate 64-bit
-     * products with 32-bit vector ones, 6x the instructions) */
-    int64_t T[3][3], U[3][CT_EARTH_MAP_DEG + 1], gs[3][CT_EARTH_MAP_DEG + 1];
+    int64_t T[3][3], U[3][CT_EARTH_MAP_DEG + 1], V[CT_EARTH_MAP_DEG + 1][CT_EARTH_MAP_DEG + 1];
     ct_i128 acc[3];
-    int a, b, c, k, o, t = 0, deg = mp->deg;
+    int k, o, t, deg = mp->deg;
     unsigned q = mp->qrho;
     for (k = 0; k < 3; ++k) { /* bound: 3 axes */
         int n;
@@ -313,41 +325,34 @@ static void fit_eval(const ct_earth_map *mp, const int64_t D[3], int64_t g[3])
         }
         acc[k] = ct_i128_from64(0);
     }
-    for (k = 0; k <= deg; ++k) { /* bound: CT_EARTH_MAP_DEG + 1 */
-        gs[0][k] = gs[1][k] = gs[2][k] = 0;
+    for (t = 0; t < deg_start[3]; ++t) { /* bound: 10 terms of degree <= 2 */
+        const uint8_t *e = term_abc[t];
+        int64_t ttt = mul62(mul62(T[0][e[0]], T[1][e[1]]), T[2][e[2]]);
+        acc[0] = ct_i128_add(acc[0], ct_i128_mul(mp->cf[t][0], ttt));
+        acc[1] = ct_i128_add(acc[1], ct_i128_mul(mp->cf[t][1], ttt));
+        acc[2] = ct_i128_add(acc[2], ct_i128_mul(mp->cf[t][2], ttt));
     }
-    /* the terms in the stored order (a, then b, then c); T_a T_b and U_a
-     * U_b formed once per (a, b), the degree <= 2 terms (c <= 2 - a - b)
-     * before the others */
-    for (a = 0; a <= deg; ++a) {         /* bound: CT_EARTH_MAP_DEG + 1 */
-        for (b = 0; a + b <= deg; ++b) { /* bound: CT_EARTH_MAP_DEG + 1 */
-            const int64_t *cf = mp->cf[t];
-            int64_t uab = mul30(U[0][a], U[1][b]);
-            c = 0;
-            if (a + b <= 2) {
-                int64_t tab = mul62(T[0][a], T[1][b]);
-                for (; a + b + c <= 2; ++c) { /* bound: 3 */
-                    int64_t ttt = mul62(tab, T[2][c]);
-                    acc[0] = ct_i128_add(acc[0], ct_i128_mul(cf[0], ttt));
-                    acc[1] = ct_i128_add(acc[1], ct_i128_mul(cf[1], ttt));
-                    acc[2] = ct_i128_add(acc[2], ct_i128_mul(cf[2], ttt));
-                    cf += 3;
-                }
-            }
-            for (; a + b + c <= deg; ++c) { /* bound: CT_EARTH_MAP_DEG + 1 */
-                int64_t ttt = mul30(uab, U[2][c]);
-                gs[0][a + b + c] += cf[0] * ttt;
-                gs[1][a + b + c] += cf[1] * ttt;
-                gs[2][a + b + c] += cf[2] * ttt;
-                cf += 3;
-            }
-            t += deg + 1 - a - b;
+    /* V[a][b] = round(U_a(s_x) U_b(s_y) / 2^30) for a + b <= deg (|U| <=
+     * 2^30 + 2^8: products < 2^61, |V| <= 2^30 + 2^9) */
+    for (t = 0; t <= deg; ++t) {         /* bound: CT_EARTH_MAP_DEG + 1 */
+        for (k = 0; t + k <= deg; ++k) { /* bound: CT_EARTH_MAP_DEG + 1 */
+            V[t][k] = rshr64(U[0][t] * U[1][k], 30u);
         }
+    }
+    for (k = 3; k <= deg; ++k) { /* bound: CT_EARTH_MAP_DEG - 2 */
+        int64_t s0 = 0, s1 = 0, s2 = 0;
+        for (t = deg_start[k]; t < deg_start[k + 1]; ++t) { /* bound: 28 terms of degree k */
+            const uint8_t *e = term_abc[t];
+            int64_t ttt = rshr64(V[e[0]][e[1]] * U[2][e[2]], 30u);
+            s0 += mp->cf[t][0] * ttt;
+            s1 += mp->cf[t][1] * ttt;
+            s2 += mp->cf[t][2] * ttt;
+        }
+        acc[0] = ct_i128_add(acc[0], ct_i128_shl(ct_i128_from64(s0), 32u + mp->sh[k][0]));
+        acc[1] = ct_i128_add(acc[1], ct_i128_shl(ct_i128_from64(s1), 32u + mp->sh[k][1]));
+        acc[2] = ct_i128_add(acc[2], ct_i128_shl(ct_i128_from64(s2), 32u + mp->sh[k][2]));
     }
     for (o = 0; o < 3; ++o) { /* bound: 3 coordinates */
-        for (k = 3; k <= deg; ++k) { /* bound: CT_EARTH_MAP_DEG - 2 */
-            acc[o] = ct_i128_add(acc[o], ct_i128_shl(ct_i128_from64(gs[o][k]), 32u + mp->sh[k][o]));
-        }
         g[o] = mp->g16[o] * 256 + ct_i128_round_shr(acc[o], 36u + mp->fb[o]);
     }
 }
@@ -366,7 +371,7 @@ static void fit_eval(const ct_earth_map *mp, const int64_t D[3], int64_t g[3])
 static void fit_map(const ct_package *p, const ct_utm *zone, ct_earth_map *mp, uint32_t qrho)
 {
     int deg = qrho <= 44u ? 4 : (qrho <= 46u ? 5 : 6); /* 1.7, 1.0, 13 and 14 um off PROJ (test_earth) */
-    int m = deg + 1, i, j, k, a, b, c, t, o;
+    int m = deg + 1, nt = deg_start[deg + 1], i, j, k, t, o;
     mp->ready = 0u;
     mp->deg = 0;
     mp->qrho = qrho;
@@ -396,34 +401,23 @@ static void fit_map(const ct_package *p, const ct_utm *zone, ct_earth_map *mp, u
                 if (image_rel(p, zone, mp, P, f) != CT_OK) {
                     return;
                 }
-                t = 0;
-                for (a = 0; a <= deg; ++a) {             /* bound: CT_EARTH_MAP_DEG + 1 */
-                    for (b = 0; a + b <= deg; ++b) {     /* bound: CT_EARTH_MAP_DEG + 1 */
-                        int64_t tt = ct_mul_shr(cheb_at_node(deg, a, i), cheb_at_node(deg, b, j), 62u);
-                        for (c = 0; a + b + c <= deg; ++c) { /* bound: CT_EARTH_MAP_DEG + 1 */
-                            int64_t ttt = ct_mul_shr(tt, cheb_at_node(deg, c, k), 62u);
-                            for (o = 0; o < 3; ++o) { /* bound: 3 coordinates */
-                                mp->cf[t][o] += ct_i128_round_shr(ct_i128_mul(f[o], ttt), 64u);
-                            }
-                            t++;
-                        }
+                for (t = 0; t < nt; ++t) { /* bound: CT_EARTH_MAP_TERMS */
+                    const uint8_t *e = term_abc[t];
+                    int64_t ttt = ct_mul_shr(ct_mul_shr(cheb_at_node(deg, e[0], i), cheb_at_node(deg, e[1], j), 62u),
+                                             cheb_at_node(deg, e[2], k), 62u);
+                    for (o = 0; o < 3; ++o) { /* bound: 3 coordinates */
+                        mp->cf[t][o] += ct_i128_round_shr(ct_i128_mul(f[o], ttt), 64u);
                     }
                 }
             }
         }
     }
-    t = 0;
-    for (a = 0; a <= deg; ++a) {             /* bound: CT_EARTH_MAP_DEG + 1 */
-        for (b = 0; a + b <= deg; ++b) {     /* bound: CT_EARTH_MAP_DEG + 1 */
-            for (c = 0; a + b + c <= deg; ++c) { /* bound: CT_EARTH_MAP_DEG + 1 */
-                /* 8 g_a g_b g_c = 2^(3 - zeros) */
-                unsigned sh = 3u - (unsigned)((a == 0) + (b == 0) + (c == 0));
-                for (o = 0; o < 3; ++o) { /* bound: 3 coordinates */
-                    mp->cf[t][o] =
-                        ct_i128_round_div(ct_i128_shl(ct_i128_from64(mp->cf[t][o]), sh), (int64_t)(m * m * m));
-                }
-                t++;
-            }
+    for (t = 0; t < nt; ++t) { /* bound: CT_EARTH_MAP_TERMS */
+        /* 8 g_a g_b g_c = 2^(3 - zeros) */
+        const uint8_t *e = term_abc[t];
+        unsigned sh = 3u - (unsigned)((e[0] == 0u) + (e[1] == 0u) + (e[2] == 0u));
+        for (o = 0; o < 3; ++o) { /* bound: 3 coordinates */
+            mp->cf[t][o] = ct_i128_round_div(ct_i128_shl(ct_i128_from64(mp->cf[t][o]), sh), (int64_t)(m * m * m));
         }
     }
     /* degrees >= 3: cf' = round(cf / 2^sh) with sh the least making every
@@ -432,32 +426,16 @@ static void fit_map(const ct_package *p, const ct_utm *zone, ct_earth_map *mp, u
         for (o = 0; o < 3; ++o) { /* bound: 3 coordinates */
             int64_t mx = 0;
             unsigned sh = 0u;
-            t = 0;
-            for (a = 0; a <= deg; ++a) {             /* bound: CT_EARTH_MAP_DEG + 1 */
-                for (b = 0; a + b <= deg; ++b) {     /* bound: CT_EARTH_MAP_DEG + 1 */
-                    for (c = 0; a + b + c <= deg; ++c) { /* bound: CT_EARTH_MAP_DEG + 1 */
-                        if (a + b + c == k) {
-                            mx = ct_max64(mx, ct_abs64(mp->cf[t][o]));
-                        }
-                        t++;
-                    }
-                }
+            for (t = deg_start[k]; t < deg_start[k + 1]; ++t) { /* bound: 28 terms of degree k */
+                mx = ct_max64(mx, ct_abs64(mp->cf[t][o]));
             }
             /* bound: 30 halvings */
             while ((mx >> sh) >= (INT64_C(1) << 27)) {
                 sh++;
             }
             mp->sh[k][o] = sh;
-            t = 0;
-            for (a = 0; a <= deg; ++a) {             /* bound: CT_EARTH_MAP_DEG + 1 */
-                for (b = 0; a + b <= deg; ++b) {     /* bound: CT_EARTH_MAP_DEG + 1 */
-                    for (c = 0; a + b + c <= deg; ++c) { /* bound: CT_EARTH_MAP_DEG + 1 */
-                        if (a + b + c == k && sh > 0u) {
-                            mp->cf[t][o] = rshr64(mp->cf[t][o], sh);
-                        }
-                        t++;
-                    }
-                }
+            for (t = deg_start[k]; t < deg_start[k + 1] && sh > 0u; ++t) { /* bound: 28 terms of degree k */
+                mp->cf[t][o] = rshr64(mp->cf[t][o], sh);
             }
         }
     }
@@ -482,6 +460,42 @@ int ct_earth_map_fits(const ct_package *p, const ct_earth_map *mp)
            mp->georef[1] == p->origin_n_nm && mp->georef[2] == p->posting_e_nm && mp->georef[3] == p->posting_n_nm &&
            mp->georef[4] == p->height_offset_nm && mp->georef[5] == p->height_scale_nm &&
            mp->georef[6] == (int64_t)p->epsg;
+}
+
+/* The coefficient of s^k in T_n (n, k <= 6). */
+static const int8_t cheb_pow[CT_EARTH_MAP_DEG + 1][CT_EARTH_MAP_DEG + 1] = {
+    {1, 0, 0, 0, 0, 0, 0},  {0, 1, 0, 0, 0, 0, 0},   {-1, 0, 2, 0, 0, 0, 0},   {0, -3, 0, 4, 0, 0, 0},
+    {1, 0, -8, 0, 8, 0, 0}, {0, 5, 0, -20, 0, 16, 0}, {-1, 0, 18, 0, -48, 0, 32}};
+
+/* The fit's Taylor terms of degrees 1..3 at the cube's centre (s = 0):
+ * for each such term s^alpha (term_abc 1..19), the sum over the fit's
+ * terms of cf 2^sh C_a C_b C_c, C the power coefficients of its Chebyshev
+ * factors (exact integers: |cf 2^sh| < 2^56, |C C C| <= 48^3 < 2^17, <= 84
+ * terms: < 2^80 in 128 bits).  0 when one reaches 2^58 (taylor_nodes'
+ * range). */
+static int map_taylor(const ct_earth_map *mp, int64_t tay[19][3])
+{
+    int t, u, o, nt = deg_start[mp->deg + 1];
+    for (t = 1; t < 20; ++t) { /* bound: 19 terms */
+        const uint8_t *e = term_abc[t];
+        for (o = 0; o < 3; ++o) { /* bound: 3 coordinates */
+            ct_i128 acc = ct_i128_from64(0);
+            for (u = 0; u < nt; ++u) { /* bound: CT_EARTH_MAP_TERMS */
+                const uint8_t *f = term_abc[u];
+                int64_t cc = (int64_t)cheb_pow[f[0]][e[0]] * cheb_pow[f[1]][e[1]] * cheb_pow[f[2]][e[2]];
+                int k = f[0] + f[1] + f[2];
+                if (cc != 0) {
+                    ct_i128 v = ct_i128_mul(mp->cf[u][o], cc);
+                    acc = ct_i128_add(acc, k >= 3 ? ct_i128_shl(v, mp->sh[k][o]) : v);
+                }
+            }
+            if (ct_i128_cmp(ct_i128_abs(acc), ct_i128_shl(ct_i128_from64(1), 58u)) >= 0) {
+                return 0;
+            }
+            tay[t - 1][o] = ct_i128_to64(acc);
+        }
+    }
+    return 1;
 }
 
 /* the least q in [44, 47] with 2^q >= need; 48 when none */
@@ -564,6 +578,15 @@ ct_status ct_earth_image24(const ct_package *p, const ct_earth *es, const int64_
     return st;
 }
 
+/* The bend of refraction at range t, nm: k t^2 / 2R (t < 2^48, t^2 <
+ * 2^96, |k| <= 2^17: < 2^113; / 2R (>= 2^41) leaves < 2^72 -- saturated
+ * at 2^62, then / 2^16). */
+static int64_t bend_at(const path *pa, int64_t t)
+{
+    ct_i128 num = ct_i128_mul128_64(ct_umul64((uint64_t)t, (uint64_t)t), pa->es->refr_k_q16);
+    return ct_floor_div(ct_i128_floor_div_sat(num, 2 * pa->es->radius_nm), ONE16);
+}
+
 /* The image of P(t) in the grid frame: exact, or by the fitted map when
  * there is one and P is in its cube. */
 static ct_status vertex_exact(const path *pa, int64_t t, gv *v)
@@ -572,10 +595,7 @@ static ct_status vertex_exact(const path *pa, int64_t t, gv *v)
     int k, in = pa->es->map != NULL;
     ct_status st;
     if (pa->refract) {
-        /* k t^2 / 2R: t < 2^48, t^2 < 2^96, |k| <= 2^17: < 2^113; / 2R
-         * (>= 2^41) leaves < 2^72 -- saturated at 2^62, then / 2^16 */
-        ct_i128 num = ct_i128_mul128_64(ct_umul64((uint64_t)t, (uint64_t)t), pa->es->refr_k_q16);
-        bend = ct_floor_div(ct_i128_floor_div_sat(num, 2 * pa->es->radius_nm), ONE16);
+        bend = bend_at(pa, t);
     }
     /* bound: 3 axes.  t d: < 2^48 2^40 = 2^88 (128-bit) / 2^39; bend w:
      * < 2^46 2^31 / 2^30 */
@@ -644,6 +664,144 @@ CT_NOINLINE static ct_status vertex(const path *pa, int64_t t, gv *v)
     return CT_OK;
 }
 
+/* The bounds of the path's derivatives from its polynomial (|c| < 2^49,
+ * k (k-1) (k-2) <= 60). */
+static void path_bounds(path *pa)
+{
+    int k;
+    pa->b3z = pa->b1h = pa->b2h = pa->b3h = 0;
+    for (k = 1; k < pa->nodes; ++k) { /* bound: NODES - 1 */
+        int64_t ch = ct_abs64(pa->cf[k][0]) + ct_abs64(pa->cf[k][1]);
+        pa->b1h += (int64_t)k * ch;
+        pa->b2h += (int64_t)(k * (k - 1)) * ch;
+        pa->b3h += (int64_t)(k * (k - 1) * (k - 2)) * ch;
+        pa->b3z += (int64_t)(k * (k - 1) * (k - 2)) * ct_abs64(pa->cf[k][2]);
+    }
+}
+
+/* For the terms 4..19 of term_abc (degrees 2 and 3): the term whose
+ * monomial times s along tay_axis is this one's (for a quadratic term e_i +
+ * e_j, i = tay_axis, the parent is e_j, term 3 - j). */
+static const uint8_t tay_parent[20] = {0, 0, 0, 0, 1, 1, 2, 1, 2, 3, 4, 4, 5, 6, 4, 5, 6, 7, 8, 9};
+static const uint8_t tay_axis[20] = {0, 0, 0, 0, 2, 1, 1, 0, 0, 0, 2, 1, 1, 1, 0, 0, 0, 0, 0, 0};
+
+/* binom(k, j) for k <= 5 */
+static const uint8_t binom5[6][6] = {{1, 0, 0, 0, 0, 0},  {1, 1, 0, 0, 0, 0},  {1, 2, 1, 0, 0, 0},
+                                     {1, 3, 3, 1, 0, 0},  {1, 4, 6, 4, 1, 0},  {1, 5, 10, 10, 5, 1}};
+
+/* Taylor-Lobatto nodes (a fit per call, es->tay_ok, tmax <= NODES_5_NM):
+ * the path's polynomial in tau = t / tmax through the camera's image with
+ * the fit's own first three derivatives there, and the fit's images at
+ * tau = 1 (up to 35 km: degree 4) or at tau = 3/4 and 1 (degree 5) -- one
+ * or two images a line of sight instead of the Lobatto nodes' three or
+ * four.  Along the line x(tau) = tau a - tau^2 b (x = (P - c) / 2^q, a =
+ * tmax d / 2^q, b = bend(tmax) w / 2^q: refraction's bend is k t^2 / 2R
+ * exactly, vertex_exact's within a nanometre) the fit G has the Taylor
+ * terms p1 = G_1 a, p2 = G_2(a) - G_1 b, p3 = G_3(a) - G_2'(a) b (G_k its
+ * terms of degree k, b^2 in the quartic term and beyond): exact for the
+ * fit along a straight line up to the degree, and otherwise off by its
+ * terms of degree 5 (6) times at most max |tau^4 (tau - 1)| = 0.082 (max
+ * |tau^4 (tau - 3/4) (tau - 1)| = 0.0099): micrometres, where the Lobatto
+ * nodes' error is their polynomial's degree's (test_earth
+ * test_path_interpolation).  Units: a, b and their products Q62, the
+ * terms' sums Q(fb + 60) in 128 bits (|tay| < 2^58: 20 products < 2^125),
+ * rounded to Q30; the images X in Q24 less the camera's, |X| < 2^46.
+ * Returns 0 (the Lobatto nodes then) when an image is missing or too far,
+ * or a coefficient reaches 2^49. */
+static int taylor_nodes(path *pa, int64_t tmax)
+{
+    const ct_earth *es = pa->es;
+    const ct_earth_map *mp = es->map;
+    int64_t a[3], b[3], am[20], db[6], p[6][3], X[2][3];
+    int deg = tmax <= NODES_4_NM ? 4 : 5, nf = deg - 3, i, j, k, t, o;
+    unsigned q = mp->qrho;
+    int64_t bmax = pa->refract ? bend_at(pa, tmax) : 0;
+    for (j = 0; j < nf; ++j) { /* bound: 2 far nodes */
+        gv v;
+        /* tau = 3/4 (3 tmax < 2^50) and 1 */
+        if (vertex_exact(pa, j == nf - 1 ? tmax : (3 * tmax) >> 2, &v) != CT_OK) {
+            return 0;
+        }
+        X[j][0] = v.fx - es->cam24[0];
+        X[j][1] = v.fy - es->cam24[1];
+        X[j][2] = v.fz - es->cam24[2];
+        if (ct_abs64(X[j][0]) >= (INT64_C(1) << 46) || ct_abs64(X[j][1]) >= (INT64_C(1) << 46) ||
+            ct_abs64(X[j][2]) >= (INT64_C(1) << 46)) {
+            return 0;
+        }
+    }
+    /* a: tmax |d| < 2^48 2^40 over 2^(q - 23) (q >= 44): |a| <= 2^62 as
+     * tmax < 2^q; b: |bend| < 2^47 (the cube holds it), |w| <= 2^30 + 2,
+     * over 2^(q - 32): |b| < 2^62 */
+    for (i = 0; i < 3; ++i) { /* bound: 3 axes */
+        a[i] = ct_i128_round_shr(ct_i128_mul(tmax, pa->d[i]), q - 23u);
+        b[i] = ct_i128_round_shr(ct_i128_mul(bmax, pa->w[i]), q - 32u);
+    }
+    /* a^alpha for the terms of degrees 1..3 (Q62): a term's monomial is
+     * its parent's (tay_parent) times a along tay_axis; and each quadratic
+     * one's derivative along b, e_i b_i a^(alpha - e_i) (|.| < 2^63) */
+    am[1] = a[2];
+    am[2] = a[1];
+    am[3] = a[0];
+    for (t = 4; t < 20; ++t) { /* bound: 16 terms */
+        am[t] = ct_mul_shr(am[tay_parent[t]], a[tay_axis[t]], 62u);
+    }
+    for (t = 4; t < 10; ++t) { /* bound: 6 terms: alpha = e_i + e_j, parent e_j */
+        int ax = tay_axis[t], ox = 3 - (int)tay_parent[t]; /* term 3 - i is e_i's */
+        db[t - 4] = ct_mul_shr(b[ax], a[ox], 62u) + ct_mul_shr(b[ox], a[ax], 62u);
+    }
+    for (o = 0; o < 3; ++o) { /* bound: 3 coordinates */
+        ct_i128 s1 = ct_i128_from64(0), s2 = ct_i128_from64(0), s3 = ct_i128_from64(0);
+        for (t = 1; t < 4; ++t) { /* bound: 3 terms: G_1 a; - G_1 b */
+            s1 = ct_i128_add(s1, ct_i128_mul(es->tay[t - 1][o], am[t]));
+            s2 = ct_i128_sub(s2, ct_i128_mul(es->tay[t - 1][o], b[3 - t]));
+        }
+        for (t = 4; t < 10; ++t) { /* bound: 6 terms: G_2(a); - G_2'(a) b */
+            s2 = ct_i128_add(s2, ct_i128_mul(es->tay[t - 1][o], am[t]));
+            s3 = ct_i128_sub(s3, ct_i128_mul(es->tay[t - 1][o], db[t - 4]));
+        }
+        for (t = 10; t < 20; ++t) { /* bound: 10 terms: G_3(a) */
+            s3 = ct_i128_add(s3, ct_i128_mul(es->tay[t - 1][o], am[t]));
+        }
+        /* Q(fb + 60) -> Q30 */
+        p[0][o] = 0;
+        p[1][o] = ct_i128_round_shr(s1, mp->fb[o] + 30u);
+        p[2][o] = ct_i128_round_shr(s2, mp->fb[o] + 30u);
+        p[3][o] = ct_i128_round_shr(s3, mp->fb[o] + 30u);
+        if (deg == 4) {
+            p[4][o] = X[0][o] * 64 - p[1][o] - p[2][o] - p[3][o];
+        } else {
+            /* r0 + r1 tau through tau = 3/4 and 1 of (X - p1 tau - p2 tau^2
+             * - p3 tau^3) / tau^4: R1 at 1; at 3/4 its 64-fold M and V =
+             * r0 + 3 r1 / 4 = 4 M / 81 (|M| < 2^59) */
+            int64_t r1s = X[1][o] * 64 - p[1][o] - p[2][o] - p[3][o];
+            int64_t m64 = X[0][o] * 4096 - (48 * p[1][o] + 36 * p[2][o] + 27 * p[3][o]);
+            int64_t vq = ct_floor_div(8 * m64 + 81, 162);
+            p[5][o] = 4 * (r1s - vq);
+            p[4][o] = r1s - p[5][o];
+        }
+    }
+    pa->nodes = deg + 1;
+    /* in powers of sigma = 2 tau - 1: c_j = sum_k p_k binom(k, j) / 2^k
+     * (Q30 -> Q24: / 2^(deg + 6)) */
+    for (j = 0; j <= deg; ++j) { /* bound: NODES */
+        for (o = 0; o < 3; ++o) { /* bound: 3 coordinates */
+            ct_i128 s = ct_i128_from64(0);
+            for (k = j; k <= deg; ++k) { /* bound: NODES */
+                s = ct_i128_add(s, ct_i128_mul(p[k][o], (int64_t)binom5[k][j] << (deg - k)));
+            }
+            pa->cf[j][o] = ct_i128_round_shr(s, (unsigned)deg + 6u);
+            if (ct_abs64(pa->cf[j][o]) >= (INT64_C(1) << 49)) {
+                return 0;
+            }
+        }
+    }
+    pa->base[0] = es->cam24[0];
+    pa->base[1] = es->cam24[1];
+    pa->base[2] = es->cam24[2];
+    return 1;
+}
+
 /* The nodes' exact images and the polynomial through them; pa->interp = 0
  * when one is outside the projection's domain (the vertices are then
  * computed exactly). */
@@ -657,6 +815,11 @@ CT_NOINLINE static void set_nodes(path *pa, int64_t tmax)
     /* tmax >= 1 km (set-up): tsh in [40, 49], 60 + tsh < 128 */
     pa->tsh = ct_bitlen64((uint64_t)tmax);
     pa->tinv = ct_i128_floor_div(ct_i128_shl(ct_i128_shl(ct_i128_from64(1), 60u), pa->tsh), tmax);
+    if (pa->es->tay_ok && tmax <= NODES_5_NM && taylor_nodes(pa, tmax)) {
+        path_bounds(pa);
+        pa->interp = 1;
+        return;
+    }
     pa->nodes = tmax <= NODES_4_NM ? 4 : (tmax <= NODES_5_NM ? 5 : 6);
     for (j = 0; j < pa->nodes; ++j) { /* bound: NODES */
         /* t_j = tmax tau_j: < 2^48 2^60 in 128 bits; node 0 (t = 0) is
@@ -692,14 +855,7 @@ CT_NOINLINE static void set_nodes(path *pa, int64_t tmax)
             pa->cf[k][j] = ct_i128_round_shr(acc, 40u);
         }
     }
-    pa->b3z = pa->b1h = pa->b2h = pa->b3h = 0;
-    for (k = 1; k < pa->nodes; ++k) { /* bound: NODES - 1; |c| < 2^49, k (k-1) (k-2) <= 60 */
-        int64_t ch = ct_abs64(pa->cf[k][0]) + ct_abs64(pa->cf[k][1]);
-        pa->b1h += (int64_t)k * ch;
-        pa->b2h += (int64_t)(k * (k - 1)) * ch;
-        pa->b3h += (int64_t)(k * (k - 1) * (k - 2)) * ch;
-        pa->b3z += (int64_t)(k * (k - 1) * (k - 2)) * ct_abs64(pa->cf[k][2]);
-    }
+    path_bounds(pa);
     pa->interp = 1;
 }
 
@@ -962,6 +1118,7 @@ ct_status ct_earth_setup(const ct_package *p, const ct_pose *pose, int32_t refr_
     es->moff[0] = es->moff[1] = es->moff[2] = 0;
     es->fit.ready = 0u;
     es->fit.deg = 0;
+    es->tay_ok = 0;
     if (map != NULL) {
         es->map = map;
     } else if (fitted) {
@@ -985,6 +1142,7 @@ ct_status ct_earth_setup(const ct_package *p, const ct_pose *pose, int32_t refr_
             fit_map(p, &es->zone, &es->fit, q);
             if (es->fit.deg > 0) {
                 es->map = &es->fit;
+                es->tay_ok = map_taylor(&es->fit, es->tay);
             }
         }
     }
