@@ -392,6 +392,14 @@ static void fit_map(const ct_package *p, const ct_utm *zone, ct_earth_map *mp, u
     }
     for (i = 0; i < m; ++i) {             /* bound: CT_EARTH_MAP_DEG + 1 */
         for (j = 0; j < m; ++j) {         /* bound: CT_EARTH_MAP_DEG + 1 */
+            /* T_a(x_i) T_b(x_j), a + b <= deg, once per (i, j) */
+            int64_t tab[CT_EARTH_MAP_DEG + 1][CT_EARTH_MAP_DEG + 1];
+            int a, b;
+            for (a = 0; a <= deg; ++a) {         /* bound: CT_EARTH_MAP_DEG + 1 */
+                for (b = 0; a + b <= deg; ++b) { /* bound: CT_EARTH_MAP_DEG + 1 */
+                    tab[a][b] = ct_mul_shr(cheb_at_node(deg, a, i), cheb_at_node(deg, b, j), 62u);
+                }
+            }
             for (k = 0; k < m; ++k) {     /* bound: CT_EARTH_MAP_DEG + 1 */
                 int64_t P[3], f[3];
                 /* the point: c + 2^qrho x (|x| <= 2^62 in Q62) */
@@ -403,8 +411,7 @@ static void fit_map(const ct_package *p, const ct_utm *zone, ct_earth_map *mp, u
                 }
                 for (t = 0; t < nt; ++t) { /* bound: CT_EARTH_MAP_TERMS */
                     const uint8_t *e = term_abc[t];
-                    int64_t ttt = ct_mul_shr(ct_mul_shr(cheb_at_node(deg, e[0], i), cheb_at_node(deg, e[1], j), 62u),
-                                             cheb_at_node(deg, e[2], k), 62u);
+                    int64_t ttt = ct_mul_shr(tab[e[0]][e[1]], cheb_at_node(deg, e[2], k), 62u);
                     for (o = 0; o < 3; ++o) { /* bound: 3 coordinates */
                         mp->cf[t][o] += ct_i128_round_shr(ct_i128_mul(f[o], ttt), 64u);
                     }
@@ -485,11 +492,11 @@ static int map_taylor(const ct_earth_map *mp, int64_t tay[19][3])
                 int64_t cc = (int64_t)cheb_pow[f[0]][e[0]] * cheb_pow[f[1]][e[1]] * cheb_pow[f[2]][e[2]];
                 int k = f[0] + f[1] + f[2];
                 if (cc != 0) {
-                    ct_i128 v = ct_i128_mul(mp->cf[u][o], cc);
-                    acc = ct_i128_add(acc, k >= 3 ? ct_i128_shl(v, mp->sh[k][o]) : v);
+                    /* cc 2^sh < 2^46 */
+                    acc = ct_i128_add(acc, ct_i128_mul(mp->cf[u][o], k >= 3 ? cc * (INT64_C(1) << mp->sh[k][o]) : cc));
                 }
             }
-            if (ct_i128_cmp(ct_i128_abs(acc), ct_i128_shl(ct_i128_from64(1), 58u)) >= 0) {
+            if (ct_i128_cmp(ct_i128_abs(acc), ct_i128_from64(INT64_C(1) << 58)) >= 0) {
                 return 0;
             }
             tay[t - 1][o] = ct_i128_to64(acc);
@@ -595,7 +602,8 @@ static ct_status vertex_exact(const path *pa, int64_t t, gv *v)
     int k, in = pa->es->map != NULL;
     ct_status st;
     if (pa->refract) {
-        bend = bend_at(pa, t);
+        ct_i128 num = ct_i128_mul128_64(ct_umul64((uint64_t)t, (uint64_t)t), pa->es->refr_k_q16);
+        bend = ct_floor_div(ct_i128_floor_div_sat(num, 2 * pa->es->radius_nm), ONE16);
     }
     /* bound: 3 axes.  t d: < 2^48 2^40 = 2^88 (128-bit) / 2^39; bend w:
      * < 2^46 2^31 / 2^30 */
