@@ -713,7 +713,8 @@ static const uint8_t binom5[6][6] = {{1, 0, 0, 0, 0, 0},  {1, 1, 0, 0, 0, 0},  {
  * nodes' error is their polynomial's degree's (test_earth
  * test_path_interpolation).  Units: a, b and their products Q62, the
  * terms' sums Q(fb + 60) in 128 bits (|tay| < 2^58: 20 products < 2^125),
- * rounded to Q30; the images X in Q24 less the camera's, |X| < 2^46.
+ * rounded to Q30 (below 2^54, else none); the images X in Q24 less the
+ * camera's, |X| < 2^46.
  * Returns 0 (the Lobatto nodes then) when an image is missing or too far,
  * or a coefficient reaches 2^49. */
 static int taylor_nodes(path *pa, int64_t tmax)
@@ -771,7 +772,12 @@ static int taylor_nodes(path *pa, int64_t tmax)
         for (t = 10; t < 20; ++t) { /* bound: 10 terms: G_3(a) */
             s3 = ct_i128_add(s3, ct_i128_mul(es->tay[t - 1][o], am[t]));
         }
-        /* Q(fb + 60) -> Q30 */
+        /* Q(fb + 60) -> Q30, each below 2^54 (p1 is about 64 X, < 2^52):
+         * the sums below stay within 64 bits */
+        if (ct_i128_bits(ct_i128_abs(s1)) > mp->fb[o] + 83u || ct_i128_bits(ct_i128_abs(s2)) > mp->fb[o] + 83u ||
+            ct_i128_bits(ct_i128_abs(s3)) > mp->fb[o] + 83u) {
+            return 0;
+        }
         p[0][o] = 0;
         p[1][o] = ct_i128_round_shr(s1, mp->fb[o] + 30u);
         p[2][o] = ct_i128_round_shr(s2, mp->fb[o] + 30u);
@@ -780,11 +786,12 @@ static int taylor_nodes(path *pa, int64_t tmax)
             p[4][o] = X[0][o] * 64 - p[1][o] - p[2][o] - p[3][o];
         } else {
             /* r0 + r1 tau through tau = 3/4 and 1 of (X - p1 tau - p2 tau^2
-             * - p3 tau^3) / tau^4: R1 at 1; at 3/4 its 64-fold M and V =
-             * r0 + 3 r1 / 4 = 4 M / 81 (|M| < 2^59) */
+             * - p3 tau^3) / tau^4: R1 at 1 (< 2^56); at 3/4 its 64-fold M
+             * (< 2^58 + 111 2^54 < 2^61) and V = r0 + 3 r1 / 4 = 4 M / 81
+             * rounded (8 M in 128 bits; |V| < 2^57); r1 = 4 (R1 - V) < 2^60 */
             int64_t r1s = X[1][o] * 64 - p[1][o] - p[2][o] - p[3][o];
             int64_t m64 = X[0][o] * 4096 - (48 * p[1][o] + 36 * p[2][o] + 27 * p[3][o]);
-            int64_t vq = ct_floor_div(8 * m64 + 81, 162);
+            int64_t vq = ct_i128_floor_div(ct_i128_add(ct_i128_mul(m64, 8), ct_i128_from64(81)), 162);
             p[5][o] = 4 * (r1s - vq);
             p[4][o] = r1s - p[5][o];
         }
