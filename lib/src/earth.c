@@ -602,8 +602,7 @@ static ct_status vertex_exact(const path *pa, int64_t t, gv *v)
     int k, in = pa->es->map != NULL;
     ct_status st;
     if (pa->refract) {
-        ct_i128 num = ct_i128_mul128_64(ct_umul64((uint64_t)t, (uint64_t)t), pa->es->refr_k_q16);
-        bend = ct_floor_div(ct_i128_floor_div_sat(num, 2 * pa->es->radius_nm), ONE16);
+        bend = bend_at(pa, t);
     }
     /* bound: 3 axes.  t d: < 2^48 2^40 = 2^88 (128-bit) / 2^39; bend w:
      * < 2^46 2^31 / 2^30 */
@@ -709,9 +708,8 @@ static const uint8_t binom5[6][6] = {{1, 0, 0, 0, 0, 0},  {1, 1, 0, 0, 0, 0},  {
  * terms of degree k, b^2 in the quartic term and beyond): exact for the
  * fit along a straight line up to the degree, and otherwise off by its
  * terms of degree 5 (6) times at most max |tau^4 (tau - 1)| = 0.082 (max
- * |tau^4 (tau - 3/4) (tau - 1)| = 0.0099): micrometres, where the Lobatto
- * nodes' error is their polynomial's degree's (test_earth
- * test_path_interpolation).  Units: a, b and their products Q62, the
+ * |tau^4 (tau - 3/4) (tau - 1)| = 0.0099): within 0.0054 mm of the fit's
+ * images (test_earth test_taylor_path; the Lobatto nodes' 0.0125 mm).  Units: a, b and their products Q62, the
  * terms' sums Q(fb + 60) in 128 bits (|tay| < 2^58: 20 products < 2^125),
  * rounded to Q30 (below 2^54, else none); the images X in Q24 less the
  * camera's, |X| < 2^46.
@@ -1167,6 +1165,7 @@ ct_status ct_earth_setup(const ct_package *p, const ct_pose *pose, int32_t refr_
             es->moff[k] = es->c[k] - es->map->c[k];
             if (ct_abs64(es->moff[k]) > (INT64_C(1) << 50)) {
                 es->map = NULL; /* the camera is 1,100 km from the map's cube: exact */
+                es->tay_ok = 0;
                 break;
             }
         }
