@@ -1195,7 +1195,8 @@ void test_path_interpolation()
 // every 1/1000 of the range (ct_earth_path_image24 with interp = 0: the fit
 // evaluated at the exact point C + t d - bend w): within the same 0.02 mm
 // as the Lobatto nodes, and each regime taken (5 coefficients up to 35 km,
-// 6 to 130 km, beyond that the 6 Lobatto nodes).  Breaking a Taylor term
+// 6 to 130 km, beyond that the 6 Lobatto nodes); a line whose image passes
+// the polynomial's range has none (exact vertices).  Breaking a Taylor term
 // (a cubic monomial's axis in taylor_nodes) fails it.
 void test_taylor_path()
 {
@@ -1239,6 +1240,18 @@ void test_taylor_path()
             TEST_ASSERT_MSG(nodes == (regime == 7 ? 6 : regime), "range %.1f km: %d coefficients", es.tmax_nm * 1e-12,
                             (int)nodes);
             counts |= 1u << regime;
+            if (back_km > 100 && k == 0) {
+                // a line 40 deg down over 130 km: its image passes 2^46 Q24
+                // units (100 km horizontally at 30 m posts), beyond the
+                // polynomial's range -- no polynomial (neither the Taylor
+                // terms' nor the Lobatto nodes'), every vertex found as a
+                // node is
+                int64_t dg[3], g[3];
+                grid_dir_q39(0, -40, dg);
+                TEST_ASSERT_EQUAL_INT(CT_ERR_RANGE, ct_earth_path_image24(&pk, &es, dg, es.tmax_nm, 1, g, &nodes));
+                TEST_ASSERT_EQUAL_INT(0, nodes);
+                TEST_ASSERT_EQUAL_INT(CT_OK, ct_earth_path_image24(&pk, &es, dg, es.tmax_nm, 0, g, &nodes));
+            }
             std::printf("  camera %3.0Lf km east, k = %+.2f: range %.1f km, %d coefficients: path vs the fit's images "
                         "max %.4f mm\n",
                         back_km, k / 65536.0, es.tmax_nm * 1e-12, (int)nodes, err * 1e3);
