@@ -1189,21 +1189,22 @@ void test_path_interpolation()
 // A map fitted per call (CT_EFFECT_EARTH_FIT) gives the path's polynomial
 // from the fit's own Taylor terms at the camera plus one image at the far
 // end (up to 35 km) or two (to 130 km) -- earth.c taylor_nodes -- instead
-// of the Lobatto nodes' three or four.  The same cameras as above (ranges
-// 13-141 km), a fit per call each, with and without refraction, lines of
-// sight in every direction the cameras see, against the fit's own images
-// every 1/1000 of the range (ct_earth_path_image24 with interp = 0: the fit
-// evaluated at the exact point C + t d - bend w): within the same 0.02 mm
-// as the Lobatto nodes, and each regime taken (5 coefficients up to 35 km,
-// 6 to 130 km, beyond that the 6 Lobatto nodes); a line whose image passes
-// the polynomial's range has none (exact vertices).  Breaking a Taylor term
+// of the Lobatto nodes' three or four, when the fit's degree is 5 or less
+// (its unused coefficients hold the terms).  The same cameras as above
+// (ranges 10-135 km), a fit per call each, with and without refraction,
+// lines of sight in every direction the cameras see, against the fit's own
+// images every 1/1000 of the range (ct_earth_path_image24 with interp = 0:
+// the fit evaluated at the exact point C + t d - bend w): within the same
+// 0.02 mm as the Lobatto nodes, and each regime taken (5 coefficients up to
+// 35 km, 6 beyond, the Lobatto nodes for a fit of degree 6); a line whose
+// image passes the polynomial's range has none (exact vertices).  Breaking a Taylor term
 // (a cubic monomial's axis in taylor_nodes) fails it.
 void test_taylor_path()
 {
     World *w = jacksboro();
     const ct_package &pk = w->p;
-    const double kInterpM = 2e-5;
-    double worst = 0;
+    const double kInterpM = 2e-5, kLobattoM = 4e-5;
+    double worst = 0, worst_lobatto = 0;
     uint32_t counts = 0;
     for (ld back_km : {0.0L, 24.0L, 40.0L, 111.0L, 116.0L}) {
         Pose p;
@@ -1234,12 +1235,21 @@ void test_taylor_path()
                     }
                 }
             }
-            const int regime = es.tmax_nm <= INT64_C(35) * 1000000000000    ? 5
-                               : es.tmax_nm <= INT64_C(130) * 1000000000000 ? 6
-                                                                            : 7;
-            TEST_ASSERT_MSG(nodes == (regime == 7 ? 6 : regime), "range %.1f km: %d coefficients", es.tmax_nm * 1e-12,
-                            (int)nodes);
+            // the Taylor terms (a fit of degree <= 5, to 130 km): 5 or 6
+            // coefficients; else the Lobatto nodes: 4, 5 or 6
+            const bool near = es.tmax_nm <= INT64_C(35) * 1000000000000;
+            const bool taylor = es.tay_ok != 0 && es.tmax_nm <= INT64_C(130) * 1000000000000;
+            const int want = taylor ? (near ? 5 : 6) : (near ? 4 : (es.tmax_nm <= INT64_C(130) * 1000000000000 ? 5 : 6));
+            TEST_ASSERT_MSG(es.tay_ok == (es.fit.deg <= 5), "range %.1f km: Taylor terms %d, the fit's degree %d",
+                            es.tmax_nm * 1e-12, (int)es.tay_ok, (int)es.fit.deg);
+            TEST_ASSERT_MSG(nodes == want, "range %.1f km: %d coefficients, not %d", es.tmax_nm * 1e-12, (int)nodes,
+                            want);
+            const int regime = taylor ? want : 7;
             counts |= 1u << regime;
+            std::printf("  camera %3.0Lf km east, k = %+.2f: range %.1f km, fit of degree %d, %d coefficients (%s): path vs "
+                        "the fit's images max %.4f mm\n",
+                        back_km, k / 65536.0, es.tmax_nm * 1e-12, (int)es.fit.deg, (int)nodes,
+                        taylor ? "Taylor terms" : "Lobatto nodes", err * 1e3);
             if (back_km > 100 && k == 0) {
                 // a line 40 deg down over 130 km: its image passes 2^46 Q24
                 // units (100 km horizontally at 30 m posts), beyond the
@@ -1252,14 +1262,18 @@ void test_taylor_path()
                 TEST_ASSERT_EQUAL_INT(0, nodes);
                 TEST_ASSERT_EQUAL_INT(CT_OK, ct_earth_path_image24(&pk, &es, dg, es.tmax_nm, 0, g, &nodes));
             }
-            std::printf("  camera %3.0Lf km east, k = %+.2f: range %.1f km, %d coefficients: path vs the fit's images "
-                        "max %.4f mm\n",
-                        back_km, k / 65536.0, es.tmax_nm * 1e-12, (int)nodes, err * 1e3);
-            worst = std::max(worst, err);
+            if (taylor)
+                worst = std::max(worst, err);
+            else
+                worst_lobatto = std::max(worst_lobatto, err);
         }
     }
     TEST_ASSERT_MSG(counts == (1u << 5) + (1u << 6) + (1u << 7), "the cameras did not take every regime (%x)", counts);
     TEST_ASSERT_MSG(worst <= kInterpM, "path off the fit's images by %.3g m (> %.3g m)", worst, kInterpM);
+    // the Lobatto nodes at 130 km with k = -0.26 (refraction bending the
+    // line up twice the standard amount) reach 0.03 mm
+    TEST_ASSERT_MSG(worst_lobatto <= kLobattoM, "Lobatto path off the fit's images by %.3g m (> %.3g m)",
+                    worst_lobatto, kLobattoM);
 }
 
 // Culling (earth.c piece_culled: a piece whose walk line is above the

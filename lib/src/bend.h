@@ -126,13 +126,12 @@ typedef struct {
     int64_t moff[3];       /* c - map->c, ECEF nm                            */
     int64_t cam24[3];      /* the camera's image, Q24 (every path's node 0)  */
     ct_earth_map fit;
-    /* The fit's Taylor terms of degrees 1..3 at the camera (a fit per call
-     * is centred there: moff = 0), the coefficients of s^alpha in the
-     * fit's term order (earth.c term_abc, terms 1..19), in the units of
-     * its cf (Q(fb - 2)); tay_ok = 0: none (a kept map, no fit, or a term
-     * out of range), the path then takes Lobatto nodes only.            */
+    /* 1: the fit (per call, centred at the camera: moff = 0) holds its
+     * Taylor terms of degrees 1..3 there in the tail of its coefficients,
+     * which a fit of degree <= 5 leaves unused (earth.c map_taylor); 0:
+     * none (a kept map, no fit, degree 6, or a term out of range), the
+     * path then takes Lobatto nodes only.                               */
     int32_t tay_ok;
-    int64_t tay[19][3];
 } ct_earth;
 
 /* Library-internal helpers shared between files.                          */

@@ -477,12 +477,17 @@ static const int8_t cheb_pow[CT_EARTH_MAP_DEG + 1][CT_EARTH_MAP_DEG + 1] = {
 /* The fit's Taylor terms of degrees 1..3 at the cube's centre (s = 0):
  * for each such term s^alpha (term_abc 1..19), the sum over the fit's
  * terms of cf 2^sh C_a C_b C_c, C the power coefficients of its Chebyshev
- * factors (exact integers: |cf 2^sh| < 2^56, |C C C| <= 48^3 < 2^17, <= 84
- * terms: < 2^80 in 128 bits).  0 when one reaches 2^58 (taylor_nodes'
- * range). */
-static int map_taylor(const ct_earth_map *mp, int64_t tay[19][3])
+ * factors (exact integers: |cf 2^sh| < 2^56, |C C C| <= 48^3 < 2^17, <= 56
+ * terms: < 2^80 in 128 bits), kept in cf[TAY0 + t - 1] (a fit of degree
+ * <= 5 uses cf[0 .. 55] only: no stack for them).  0 for degree 6, or when
+ * one reaches 2^58 (taylor_nodes' range). */
+#define TAY0 56
+static int map_taylor(ct_earth_map *mp)
 {
     int t, u, o, nt = deg_start[mp->deg + 1];
+    if (mp->deg > 5) {
+        return 0;
+    }
     for (t = 1; t < 20; ++t) { /* bound: 19 terms */
         const uint8_t *e = term_abc[t];
         for (o = 0; o < 3; ++o) { /* bound: 3 coordinates */
@@ -499,7 +504,7 @@ static int map_taylor(const ct_earth_map *mp, int64_t tay[19][3])
             if (ct_i128_cmp(ct_i128_abs(acc), ct_i128_from64(INT64_C(1) << 58)) >= 0) {
                 return 0;
             }
-            tay[t - 1][o] = ct_i128_to64(acc);
+            mp->cf[TAY0 + t - 1][o] = ct_i128_to64(acc);
         }
     }
     return 1;
@@ -760,15 +765,15 @@ static int taylor_nodes(path *pa, int64_t tmax)
     for (o = 0; o < 3; ++o) { /* bound: 3 coordinates */
         ct_i128 s1 = ct_i128_from64(0), s2 = ct_i128_from64(0), s3 = ct_i128_from64(0);
         for (t = 1; t < 4; ++t) { /* bound: 3 terms: G_1 a; - G_1 b */
-            s1 = ct_i128_add(s1, ct_i128_mul(es->tay[t - 1][o], am[t]));
-            s2 = ct_i128_sub(s2, ct_i128_mul(es->tay[t - 1][o], b[3 - t]));
+            s1 = ct_i128_add(s1, ct_i128_mul(mp->cf[TAY0 + t - 1][o], am[t]));
+            s2 = ct_i128_sub(s2, ct_i128_mul(mp->cf[TAY0 + t - 1][o], b[3 - t]));
         }
         for (t = 4; t < 10; ++t) { /* bound: 6 terms: G_2(a); - G_2'(a) b */
-            s2 = ct_i128_add(s2, ct_i128_mul(es->tay[t - 1][o], am[t]));
-            s3 = ct_i128_sub(s3, ct_i128_mul(es->tay[t - 1][o], db[t - 4]));
+            s2 = ct_i128_add(s2, ct_i128_mul(mp->cf[TAY0 + t - 1][o], am[t]));
+            s3 = ct_i128_sub(s3, ct_i128_mul(mp->cf[TAY0 + t - 1][o], db[t - 4]));
         }
         for (t = 10; t < 20; ++t) { /* bound: 10 terms: G_3(a) */
-            s3 = ct_i128_add(s3, ct_i128_mul(es->tay[t - 1][o], am[t]));
+            s3 = ct_i128_add(s3, ct_i128_mul(mp->cf[TAY0 + t - 1][o], am[t]));
         }
         /* Q(fb + 60) -> Q30, each below 2^54 (p1 is about 64 X, < 2^52):
          * the sums below stay within 64 bits */
@@ -1155,7 +1160,7 @@ ct_status ct_earth_setup(const ct_package *p, const ct_pose *pose, int32_t refr_
             fit_map(p, &es->zone, &es->fit, q);
             if (es->fit.deg > 0) {
                 es->map = &es->fit;
-                es->tay_ok = map_taylor(&es->fit, es->tay);
+                es->tay_ok = map_taylor(&es->fit);
             }
         }
     }
