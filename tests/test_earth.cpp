@@ -1109,6 +1109,33 @@ void test_fitted_map()
     }
 }
 
+// *err: the largest distance (m, per axis) between a line of sight's
+// interpolated path and the images it interpolates (the map's, or exact),
+// every 1/1000 of its range, over azimuths az0, az0 + step, ... <= az1 and
+// depressions 1, 4 and 12 deg; *nodes the last path's coefficient count.
+void path_vs_images(const ct_package &pk, const ct_earth &es, int az0, int az1, int step, int32_t *nodes,
+                    double *err)
+{
+    *err = 0;
+    for (int az = az0; az <= az1; az += step) {
+        for (int dep : {1, 4, 12}) {
+            int64_t dg[3];
+            grid_dir_q39(az, -dep, dg);
+            for (int i = 0; i <= 1000; ++i) {
+                const int64_t t = (int64_t)((ld)es.tmax_nm * i / 1000);
+                int64_t gi[3], ge[3];
+                TEST_ASSERT_EQUAL_INT(CT_OK, ct_earth_path_image24(&pk, &es, dg, t, 1, gi, nodes));
+                TEST_ASSERT_EQUAL_INT(CT_OK, ct_earth_path_image24(&pk, &es, dg, t, 0, ge, nodes));
+                const double ex = std::fabs((double)(gi[0] - ge[0])) * (double)pk.posting_e_nm * 1e-9 / 16777216.0;
+                const double ey =
+                    std::fabs((double)(gi[1] - ge[1])) * std::fabs((double)pk.posting_n_nm) * 1e-9 / 16777216.0;
+                const double ez = std::fabs((double)(gi[2] - ge[2])) * (double)pk.height_scale_nm * 1e-9 / 16777216.0;
+                *err = std::max(*err, std::max(ex, std::max(ey, ez)));
+            }
+        }
+    }
+}
+
 // The interpolated path (earth.c: the image of a line of sight through its
 // 4, 5 or 6 Chebyshev-Lobatto nodes, the camera's image node 0) against its
 // images found as the nodes are, every 1/1000 of the range: cameras 0 to
@@ -1137,25 +1164,9 @@ void test_path_interpolation()
         TEST_ASSERT_EQUAL_INT(CT_OK, ct_earth_setup(&pk, &p.pose, CT_REFRACTION_K_STD_Q16, CT_EARTH_RADIUS_NM,
                                                     CT_EFFECTS_CHORD_NM, 0u, 0, &km, &es));
         TEST_ASSERT(es.map == &km);
-        double err = 0;
         int32_t nodes = 0;
-        for (int az = 200; az <= 340; az += 35) {
-            for (int dep : {1, 4, 12}) {
-                int64_t dg[3];
-                grid_dir_q39(az, -dep, dg);
-                for (int i = 0; i <= 1000; ++i) {
-                    const int64_t t = (int64_t)((ld)es.tmax_nm * i / 1000);
-                    int64_t gi[3], ge[3];
-                    TEST_ASSERT_EQUAL_INT(CT_OK, ct_earth_path_image24(&pk, &es, dg, t, 1, gi, &nodes));
-                    TEST_ASSERT_EQUAL_INT(CT_OK, ct_earth_path_image24(&pk, &es, dg, t, 0, ge, &nodes));
-                    const double ex = std::fabs((double)(gi[0] - ge[0])) * (double)pk.posting_e_nm * 1e-9 / 16777216.0;
-                    const double ey =
-                        std::fabs((double)(gi[1] - ge[1])) * std::fabs((double)pk.posting_n_nm) * 1e-9 / 16777216.0;
-                    const double ez = std::fabs((double)(gi[2] - ge[2])) * (double)pk.height_scale_nm * 1e-9 / 16777216.0;
-                    err = std::max(err, std::max(ex, std::max(ey, ez)));
-                }
-            }
-        }
+        double err = 0;
+        path_vs_images(pk, es, 200, 340, 35, &nodes, &err);
         counts |= 1u << nodes;
         std::printf("  camera %3.0Lf km east of the tile: range %.1f km, %d nodes: interpolated vs node images max %.4f "
                     "mm\n",
@@ -1214,27 +1225,9 @@ void test_taylor_path()
             TEST_ASSERT_EQUAL_INT(CT_OK, ct_earth_setup(&pk, &p.pose, k, CT_EARTH_RADIUS_NM, CT_EFFECTS_CHORD_NM, 0u,
                                                         1, nullptr, &es));
             TEST_ASSERT(es.map == &es.fit);
-            double err = 0;
             int32_t nodes = 0;
-            for (int az = 0; az < 360; az += 45) {
-                for (int dep : {1, 4, 12}) {
-                    int64_t dg[3];
-                    grid_dir_q39(az, -dep, dg);
-                    for (int i = 0; i <= 1000; ++i) {
-                        const int64_t t = (int64_t)((ld)es.tmax_nm * i / 1000);
-                        int64_t gi[3], ge[3];
-                        TEST_ASSERT_EQUAL_INT(CT_OK, ct_earth_path_image24(&pk, &es, dg, t, 1, gi, &nodes));
-                        TEST_ASSERT_EQUAL_INT(CT_OK, ct_earth_path_image24(&pk, &es, dg, t, 0, ge, &nodes));
-                        const double ex =
-                            std::fabs((double)(gi[0] - ge[0])) * (double)pk.posting_e_nm * 1e-9 / 16777216.0;
-                        const double ey = std::fabs((double)(gi[1] - ge[1])) * std::fabs((double)pk.posting_n_nm) *
-                                          1e-9 / 16777216.0;
-                        const double ez =
-                            std::fabs((double)(gi[2] - ge[2])) * (double)pk.height_scale_nm * 1e-9 / 16777216.0;
-                        err = std::max(err, std::max(ex, std::max(ey, ez)));
-                    }
-                }
-            }
+            double err = 0;
+            path_vs_images(pk, es, 0, 315, 45, &nodes, &err);
             // the Taylor terms (a fit of degree <= 5, to 130 km): 5 or 6
             // coefficients; else the Lobatto nodes: 4, 5 or 6
             const bool near = es.tmax_nm <= INT64_C(35) * 1000000000000;
