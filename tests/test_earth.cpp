@@ -1205,11 +1205,12 @@ void test_path_interpolation()
 // (ranges 10-135 km), a fit per call each, with and without refraction,
 // lines of sight in every direction the cameras see, against the fit's own
 // images every 1/1000 of the range (ct_earth_path_image24 with interp = 0:
-// the fit evaluated at the exact point C + t d - bend w): within the same
-// 0.02 mm as the Lobatto nodes, and each regime taken (5 coefficients up to
-// 35 km, 6 beyond, the Lobatto nodes for a fit of degree 6); a line whose
-// image passes the polynomial's range has none (exact vertices).  Breaking a Taylor term
-// (a cubic monomial's axis in taylor_nodes) fails it.
+// the fit evaluated at the exact point C + t d - bend w): within 0.02 mm
+// (the Lobatto nodes, which the degree-6 fits of the farthest cameras
+// take, within 0.04 mm), and each regime taken (5 coefficients up to 35
+// km, 6 beyond, the Lobatto nodes); a line whose image passes the
+// polynomial's range has none (exact vertices).  Breaking a Taylor term (a
+// cubic monomial's axis in taylor_nodes) fails it.
 void test_taylor_path()
 {
     World *w = jacksboro();
@@ -1230,17 +1231,18 @@ void test_taylor_path()
             path_vs_images(pk, es, 0, 315, 45, &nodes, &err);
             // the Taylor terms (a fit of degree <= 5, to 130 km): 5 or 6
             // coefficients; else the Lobatto nodes: 4, 5 or 6
-            const bool near = es.tmax_nm <= INT64_C(35) * 1000000000000;
-            const bool taylor = es.tay_ok != 0 && es.tmax_nm <= INT64_C(130) * 1000000000000;
-            const int want = taylor ? (near ? 5 : 6) : (near ? 4 : (es.tmax_nm <= INT64_C(130) * 1000000000000 ? 5 : 6));
+            const int64_t km = 1000000000000;
+            const bool near = es.tmax_nm <= 35 * km, mid = es.tmax_nm <= 130 * km;
+            const bool taylor = es.tay_ok != 0 && mid;
+            const int want = taylor ? (near ? 5 : 6) : (near ? 4 : (mid ? 5 : 6));
             TEST_ASSERT_MSG(es.tay_ok == (es.fit.deg <= 5), "range %.1f km: Taylor terms %d, the fit's degree %d",
                             es.tmax_nm * 1e-12, (int)es.tay_ok, (int)es.fit.deg);
             TEST_ASSERT_MSG(nodes == want, "range %.1f km: %d coefficients, not %d", es.tmax_nm * 1e-12, (int)nodes,
                             want);
             const int regime = taylor ? want : 7;
             counts |= 1u << regime;
-            std::printf("  camera %3.0Lf km east, k = %+.2f: range %.1f km, fit of degree %d, %d coefficients (%s): path vs "
-                        "the fit's images max %.4f mm\n",
+            std::printf("  camera %3.0Lf km east, k = %+.2f: range %.1f km, fit of degree %d, %d coefficients (%s): "
+                        "path vs the fit's images max %.4f mm\n",
                         back_km, k / 65536.0, es.tmax_nm * 1e-12, (int)es.fit.deg, (int)nodes,
                         taylor ? "Taylor terms" : "Lobatto nodes", err * 1e3);
             if (back_km > 100 && k == 0) {
@@ -1860,8 +1862,9 @@ void test_tiny_posting()
             for (int iv = -1; iv <= 1; ++iv)
                 for (int iu = -1; iu <= 1; ++iu) judge_domain(w, pj, -81, cam, p, fx, u0 + iu * 40, v0 + iv * 40, T, 0);
         }
-    std::printf("  1 mm posts, cameras 60 km away (exact map) and 20 km (fitted): %ld pixels, %ld hits as the reference's (within "
-                "%.5f m), %ld misses as its; %ld wrong\n", T.n, T.hits, T.worst, T.misses, T.bad);
+    std::printf("  1 mm posts, cameras 60 km away (exact map) and 20 km (fitted): %ld pixels, %ld hits as the "
+                "reference's (within %.5f m), %ld misses as its; %ld wrong\n",
+                T.n, T.hits, T.worst, T.misses, T.bad);
     TEST_ASSERT(T.bad == 0 && T.domain_miss == 0 && T.hits >= 24 && T.n == 36);
     static World *wavy = nullptr;
     if (!wavy)
