@@ -132,6 +132,7 @@ typedef struct {
      * none (a kept map, no fit, degree 6, or a term out of range), the
      * path then takes Lobatto nodes only.                               */
     int32_t tay_ok;
+    int64_t tay_bend_nm;   /* with tay_ok: refraction's bend at tmax_nm (nm) */
 } ct_earth;
 
 /* Library-internal helpers shared between files.                          */

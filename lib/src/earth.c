@@ -593,10 +593,10 @@ ct_status ct_earth_image24(const ct_package *p, const ct_earth *es, const int64_
 /* The bend of refraction at range t, nm: k t^2 / 2R (t < 2^48, t^2 <
  * 2^96, |k| <= 2^17: < 2^113; / 2R (>= 2^41) leaves < 2^72 -- saturated
  * at 2^62, then / 2^16). */
-static int64_t bend_at(const path *pa, int64_t t)
+static int64_t bend_at(const ct_earth *es, int64_t t)
 {
-    ct_i128 num = ct_i128_mul128_64(ct_umul64((uint64_t)t, (uint64_t)t), pa->es->refr_k_q16);
-    return ct_floor_div(ct_i128_floor_div_sat(num, 2 * pa->es->radius_nm), ONE16);
+    ct_i128 num = ct_i128_mul128_64(ct_umul64((uint64_t)t, (uint64_t)t), es->refr_k_q16);
+    return ct_floor_div(ct_i128_floor_div_sat(num, 2 * es->radius_nm), ONE16);
 }
 
 /* The image of P(t) in the grid frame: exact, or by the fitted map when
@@ -607,7 +607,7 @@ static ct_status vertex_exact(const path *pa, int64_t t, gv *v)
     int k, in = pa->es->map != NULL;
     ct_status st;
     if (pa->refract) {
-        bend = bend_at(pa, t);
+        bend = bend_at(pa->es, t);
     }
     /* bound: 3 axes.  t d: < 2^48 2^40 = 2^88 (128-bit) / 2^39; bend w:
      * < 2^46 2^31 / 2^30 */
@@ -647,6 +647,27 @@ static ct_status vertex_exact(const path *pa, int64_t t, gv *v)
     v->fy = v->y * 256;
     v->fz = v->z * 256;
     return st;
+}
+
+/* A node's image for the path's polynomial: P(t)'s less the camera's (the
+ * polynomial's base), Q24, in X; 0 when it cannot be found or passes
+ * 2^46 (the polynomial's range: its coefficients then stay below 2^49). */
+static int node_image(const path *pa, int64_t t, int64_t X[3])
+{
+    gv v;
+    int k;
+    if (vertex_exact(pa, t, &v) != CT_OK) {
+        return 0;
+    }
+    X[0] = v.fx - pa->es->cam24[0];
+    X[1] = v.fy - pa->es->cam24[1];
+    X[2] = v.fz - pa->es->cam24[2];
+    for (k = 0; k < 3; ++k) { /* bound: 3 coordinates */
+        if (ct_abs64(X[k]) >= (INT64_C(1) << 46)) {
+            return 0;
+        }
+    }
+    return 1;
 }
 
 /* The image of P(t), 0 <= t <= tmax: interpolated when the nodes are set. */
@@ -701,7 +722,7 @@ static const uint8_t tay_axis[20] = {0, 0, 0, 0, 2, 1, 1, 0, 0, 0, 2, 1, 1, 1, 0
 static const uint8_t binom5[6][6] = {{1, 0, 0, 0, 0, 0},  {1, 1, 0, 0, 0, 0},  {1, 2, 1, 0, 0, 0},
                                      {1, 3, 3, 1, 0, 0},  {1, 4, 6, 4, 1, 0},  {1, 5, 10, 10, 5, 1}};
 
-/* Taylor-Lobatto nodes (a fit per call, es->tay_ok, tmax <= NODES_5_NM):
+/* Taylor-Lobatto nodes (a fit per call, es->tay_ok: tmax < 70 km):
  * the path's polynomial in tau = t / tmax through the camera's image with
  * the fit's own first three derivatives there, and the fit's images at
  * tau = 1 (up to 35 km: degree 4) or at tau = 3/4 and 1 (degree 5) -- one
@@ -727,18 +748,9 @@ static int taylor_nodes(path *pa, int64_t tmax)
     int64_t a[3], b[3], am[20], db[6], p[6][3], X[2][3];
     int deg = tmax <= NODES_4_NM ? 4 : 5, nf = deg - 3, i, j, k, t, o;
     unsigned q = mp->qrho;
-    int64_t bmax = pa->refract ? bend_at(pa, tmax) : 0;
-    for (j = 0; j < nf; ++j) { /* bound: 2 far nodes */
-        gv v;
-        /* tau = 3/4 (3 tmax < 2^50) and 1 */
-        if (vertex_exact(pa, j == nf - 1 ? tmax : (3 * tmax) >> 2, &v) != CT_OK) {
-            return 0;
-        }
-        X[j][0] = v.fx - es->cam24[0];
-        X[j][1] = v.fy - es->cam24[1];
-        X[j][2] = v.fz - es->cam24[2];
-        if (ct_abs64(X[j][0]) >= (INT64_C(1) << 46) || ct_abs64(X[j][1]) >= (INT64_C(1) << 46) ||
-            ct_abs64(X[j][2]) >= (INT64_C(1) << 46)) {
+    int64_t bmax = pa->refract ? es->tay_bend_nm : 0;
+    for (j = 0; j < nf; ++j) { /* bound: 2 far nodes: tau = 3/4 (3 tmax < 2^50) and 1 */
+        if (!node_image(pa, j == nf - 1 ? tmax : (3 * tmax) >> 2, X[j])) {
             return 0;
         }
     }
@@ -814,9 +826,6 @@ static int taylor_nodes(path *pa, int64_t tmax)
             }
         }
     }
-    pa->base[0] = es->cam24[0];
-    pa->base[1] = es->cam24[1];
-    pa->base[2] = es->cam24[2];
     return 1;
 }
 
@@ -826,40 +835,28 @@ static int taylor_nodes(path *pa, int64_t tmax)
 CT_NOINLINE static void set_nodes(path *pa, int64_t tmax)
 {
     int j, k;
-    gv v;
     int64_t X[NODES][3];
     pa->interp = 0;
     pa->tmax = tmax;
     /* tmax >= 1 km (set-up): tsh in [40, 49], 60 + tsh < 128 */
     pa->tsh = ct_bitlen64((uint64_t)tmax);
     pa->tinv = ct_i128_floor_div(ct_i128_shl(ct_i128_shl(ct_i128_from64(1), 60u), pa->tsh), tmax);
-    if (pa->es->tay_ok && tmax <= NODES_5_NM && taylor_nodes(pa, tmax)) {
+    /* every path's base: node 0, the camera's image (the call's) */
+    pa->base[0] = pa->es->cam24[0];
+    pa->base[1] = pa->es->cam24[1];
+    pa->base[2] = pa->es->cam24[2];
+    /* (tay_ok: a fit of degree <= 5, whose cube of at most 2^46 nm holds
+     * the range: tmax < 70 km, so within the Taylor terms' two regimes) */
+    if (pa->es->tay_ok && taylor_nodes(pa, tmax)) {
         path_bounds(pa);
         pa->interp = 1;
         return;
     }
     pa->nodes = tmax <= NODES_4_NM ? 4 : (tmax <= NODES_5_NM ? 5 : 6);
-    for (j = 0; j < pa->nodes; ++j) { /* bound: NODES */
-        /* t_j = tmax tau_j: < 2^48 2^60 in 128 bits; node 0 (t = 0) is
-         * the camera, its image the call's */
-        int64_t t = ct_mul_shr(tmax, tau_q60[pa->nodes - 4][j], 60u);
-        if (j == 0) {
-            v.fx = pa->es->cam24[0];
-            v.fy = pa->es->cam24[1];
-            v.fz = pa->es->cam24[2];
-        } else if (vertex_exact(pa, t, &v) != CT_OK) {
-            return;
-        }
-        if (j == 0) {
-            pa->base[0] = v.fx;
-            pa->base[1] = v.fy;
-            pa->base[2] = v.fz;
-        }
-        X[j][0] = v.fx - pa->base[0];
-        X[j][1] = v.fy - pa->base[1];
-        X[j][2] = v.fz - pa->base[2];
-        if (ct_abs64(X[j][0]) >= (INT64_C(1) << 46) || ct_abs64(X[j][1]) >= (INT64_C(1) << 46) ||
-            ct_abs64(X[j][2]) >= (INT64_C(1) << 46)) {
+    X[0][0] = X[0][1] = X[0][2] = 0;
+    for (j = 1; j < pa->nodes; ++j) { /* bound: NODES */
+        /* t_j = tmax tau_j: < 2^48 2^60 in 128 bits */
+        if (!node_image(pa, ct_mul_shr(tmax, tau_q60[pa->nodes - 4][j], 60u), X[j])) {
             return;
         }
     }
@@ -1137,6 +1134,7 @@ ct_status ct_earth_setup(const ct_package *p, const ct_pose *pose, int32_t refr_
     es->fit.ready = 0u;
     es->fit.deg = 0;
     es->tay_ok = 0;
+    es->tay_bend_nm = 0;
     if (map != NULL) {
         es->map = map;
     } else if (fitted) {
@@ -1161,6 +1159,7 @@ ct_status ct_earth_setup(const ct_package *p, const ct_pose *pose, int32_t refr_
             if (es->fit.deg > 0) {
                 es->map = &es->fit;
                 es->tay_ok = map_taylor(&es->fit);
+                es->tay_bend_nm = bend_at(es, es->tmax_nm);
             }
         }
     }
