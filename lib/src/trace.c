@@ -285,6 +285,38 @@ static ct_status walk_hierarchical(const ctx *c, ct_hit *h)
     return CT_ERR_INTERNAL;
 }
 
+/* Where the ray leaves the footprint of coarse cell (ci, cj) (the ray in
+ * it; r x r fine cells, clamped to the tile), on the far faces as
+ * cell_exit's: t_X = n / d with 0 <= n < 2^31 and d <= 2^26; for a rising
+ * ray tend when that comes first (n < 2^34).  (A level or descending ray
+ * above the apex at t_X is in the box there, t_X < 2^9: the dominant axis
+ * moves >= 2^25 per unit t, |z - apex| < 2^34 and a face is < 2^31 away.) */
+static rt footprint_exit(const ctx *c, uint32_t ci, uint32_t cj)
+{
+    const ct_package *p = c->p;
+    int64_t nx = 0, ny = 0;
+    rt tx;
+    if (c->sx > 0) {
+        nx = ct_min64((int64_t)(ci + 1u) * p->reduce, c->cx) * ONE16 - c->r->ox;
+    } else if (c->sx < 0) {
+        nx = c->r->ox - (int64_t)ci * p->reduce * ONE16;
+    }
+    if (c->sy > 0) {
+        ny = ct_min64((int64_t)(cj + 1u) * p->reduce, c->cy) * ONE16 - c->r->oy;
+    } else if (c->sy < 0) {
+        ny = c->r->oy - (int64_t)cj * p->reduce * ONE16;
+    }
+    /* 0 <= nx, ny < 2^31 and adx, ady <= 2^26: 32 x 32-bit products */
+    if (c->sy == 0 || (c->sx != 0 && (int64_t)(int32_t)nx * (int32_t)c->ady <= (int64_t)(int32_t)ny * (int32_t)c->adx)) {
+        tx.n = nx;
+        tx.d = c->adx;
+    } else {
+        tx.n = ny;
+        tx.d = c->ady;
+    }
+    return c->r->dz > 0 && rt_lt(c->tend, tx) ? c->tend : tx;
+}
+
 static ct_status walk_cones(const ctx *c, uint32_t plane, ct_hit *h)
 {
     const ct_package *p = c->p;
@@ -308,14 +340,16 @@ static ct_status walk_cones(const ctx *c, uint32_t plane, ct_hit *h)
     j = c->j0;
     /* bound: each iteration leaves at least one fine cell */
     for (it = 0u; it < bound; ++it) {
-        uint32_t code;
+        uint32_t code, ci, cj;
         size_t k;
         if (!inside(c, i, j)) {
             st = CT_MISS;
             break;
         }
         steps++;
-        k = ct_coarse_index(p, i, j);
+        ci = ct_coarse_of(p, i);
+        cj = ct_coarse_of(p, j);
+        k = (size_t)cj * p->coarse_x + ci;
         lb = -1;
         /* Below the apex of coarse cell k at an earlier fine cell of it (the
          * ray leaves a coarse cell once: it is a rectangle): the exact step
@@ -327,28 +361,68 @@ static ct_status walk_cones(const ctx *c, uint32_t plane, ct_hit *h)
             /* a bent ray: the apex less the lowering's bound ahead (the
              * cone of the lowered terrain; |a16| < 2^33) */
             int64_t a16 = zh(c, ct_ld16(p->apex + 2u * k));
+            int64_t T = 0, Tz, num = 0;
+            int go = 0;      /* a cone step from T */
+            int to_apex = 0; /* ... at most to the apex's height */
+            /* The cone holds from every point of the coarse cell's
+             * footprint (the promise): on its way to the footprint's exit
+             * t_X the ray is in the empty region while above the apex, and
+             * the cone's step counts from t_X. */
+            rt tx = footprint_exit(c, ci, cj);
             if (c->lw != NULL) {
                 lb = lower_ahead(c, i, j);
                 a16 -= lb;
             }
-            /* T = floor(t 2^26), and a lower bound of z(t) from a Q26 point
-             * (z at T for a rising ray, at T + 1 for a descending one unless
-             * t is exactly T / 2^26): t.n 2^26 < 2^60. */
-            int64_t T = t.d == T_ONE ? t.n : ct_floor_div(t.n * T_ONE, t.d);
-            int64_t Tz = (t.d != T_ONE && dz < 0) ? T + 1 : T;
-            int64_t num = oz + floor_shr(Tz * (int64_t)dz, CT_T_FRAC_BITS) - a16; /* < 2^34 */
-            if (num <= 0) {
+            /* the sign of z(t_X) - apex, exact: xd (z(t_X) - a16) with
+             * |oz - a16| < 2^34, so |(oz - a16) xd| < 2^60, |xn dz| < 2^60 */
+            if ((oz - a16) * tx.d + tx.n * (int64_t)dz > 0) {
+                /* above the apex at the exit, and so from t on unless the
+                 * ray rises: then z at T = floor(t 2^26) <= t (t.n 2^26 <
+                 * 2^60) must be above it too */
+                go = dz <= 0 ||
+                     oz + floor_shr((t.d == T_ONE ? t.n : (int64_t)((uint64_t)(t.n * T_ONE) / (uint64_t)t.d)) *
+                                        (int64_t)dz,
+                                    CT_T_FRAC_BITS) - a16 > 0;
+                /* the step from t_X: T = floor(t_X 2^26) (xn 2^26 <
+                 * 2^60), and a lower bound of z(t_X) - apex from a Q26
+                 * point (z at T for a rising ray, at T + 1 for a
+                 * descending one unless t_X is exactly T / 2^26), at
+                 * least 0 (< 2^34) */
+                {
+                    /* one division: quotient and remainder */
+                    uint64_t N = (uint64_t)tx.n << CT_T_FRAC_BITS;
+                    T = (int64_t)(N / (uint64_t)tx.d);
+                    Tz = (dz < 0 && N % (uint64_t)tx.d != 0u) ? T + 1 : T;
+                }
+                num = ct_max64(oz + floor_shr(Tz * (int64_t)dz, CT_T_FRAC_BITS) - a16, 0);
+            } else if (dz < 0) {
+                /* descending to the apex inside the footprint: from t,
+                 * with T = floor(t 2^26) and a lower bound of z(t) from a
+                 * Q26 point as above (t.n 2^26 < 2^60), up to the apex's
+                 * height (at or before t_X) unless the cone reaches
+                 * farther (cot < 0) */
+                T = t.d == T_ONE ? t.n : (int64_t)((uint64_t)(t.n * T_ONE) / (uint64_t)t.d);
+                Tz = t.d != T_ONE ? T + 1 : T;
+                num = oz + floor_shr(Tz * (int64_t)dz, CT_T_FRAC_BITS) - a16; /* < 2^34 */
+                go = num > 0;
+                to_apex = 1;
+            }
+            if (!go) {
+                /* at or below the apex: exact steps in this coarse cell */
                 below_k = k;
             } else {
                 int64_t cot = p->cot_q16[code];
                 int64_t len = cot >= 0 ? r->len_hi : r->len_lo;
-                /* in Q16 z units: num 2^k < 2^34 (a lower bound of the
-                 * height above the apex); len <= 2^26.5, |cot| <= 2^35:
-                 * < 2^61.5, ceil by 2^16 (cot is Q16 LSB per cell), minus
-                 * dz 2^k (<= 2^42).  den <= 0 iff the ray's rise per unit t
-                 * reaches the cone's, as in prepared z units. */
+                /* in Q16 z units: len <= 2^26.5, |cot| <= 2^35: < 2^61.5,
+                 * ceil by 2^16 (cot is Q16 LSB per cell), minus dz 2^k (<=
+                 * 2^42).  den <= 0 iff the ray's rise per unit t reaches
+                 * the cone's, as in prepared z units; to the apex's height
+                 * (cot 0): -dz 2^k. */
                 int64_t den = -floor_shr(-(len * cot), 16u) - c->dzf;
                 int64_t dt, tn;
+                if (to_apex && den > -c->dzf) {
+                    den = -c->dzf;
+                }
                 if (den <= 0) {
                     /* the ray never leaves the empty region: no hit ahead */
                     st = CT_MISS;

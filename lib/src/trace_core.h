@@ -59,13 +59,17 @@ static inline int32_t axis_cell(int64_t num, int64_t den16, int32_t s, int32_t n
     return cell_rule(k, k * den16 == num, s, ncell);
 }
 
-/* Coarse cell index of fine cell (i, j) (0 <= i, j < 2^16): i / r by the
- * multiplier (exact for i < 2^16, see ct_package.reduce_mul). */
+/* The coarse row or column of fine row or column i (0 <= i < 2^16): i / r
+ * by the multiplier (exact for i < 2^16, see ct_package.reduce_mul). */
+static inline uint32_t ct_coarse_of(const ct_package *p, int32_t i)
+{
+    return (uint32_t)(((uint64_t)(uint32_t)i * p->reduce_mul) >> 32);
+}
+
+/* Coarse cell index of fine cell (i, j) (0 <= i, j < 2^16). */
 static inline size_t ct_coarse_index(const ct_package *p, int32_t i, int32_t j)
 {
-    uint32_t ci = (uint32_t)(((uint64_t)(uint32_t)i * p->reduce_mul) >> 32);
-    uint32_t cj = (uint32_t)(((uint64_t)(uint32_t)j * p->reduce_mul) >> 32);
-    return (size_t)cj * p->coarse_x + ci;
+    return (size_t)ct_coarse_of(p, j) * p->coarse_x + ct_coarse_of(p, i);
 }
 
 typedef struct {
