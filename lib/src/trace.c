@@ -285,6 +285,13 @@ static ct_status walk_hierarchical(const ctx *c, ct_hit *h)
     return CT_ERR_INTERNAL;
 }
 
+/* floor(t 2^26) for the walk's t >= 0 (t.n 2^26 < 2^60): unsigned, a
+ * cheaper division on the MCUs. */
+static inline int64_t floor_q26(rt t)
+{
+    return t.d == T_ONE ? t.n : (int64_t)((uint64_t)(t.n * T_ONE) / (uint64_t)t.d);
+}
+
 /* Where the ray leaves the footprint of coarse cell (ci, cj) (the ray in
  * it; r x r fine cells, clamped to the tile), on the far faces as
  * cell_exit's: t_X = n / d with 0 <= n < 2^31 and d <= 2^26; for a rising
@@ -307,7 +314,8 @@ static rt footprint_exit(const ctx *c, uint32_t ci, uint32_t cj)
         ny = c->r->oy - (int64_t)cj * p->reduce * ONE16;
     }
     /* 0 <= nx, ny < 2^31 and adx, ady <= 2^26: 32 x 32-bit products */
-    if (c->sy == 0 || (c->sx != 0 && (int64_t)(int32_t)nx * (int32_t)c->ady <= (int64_t)(int32_t)ny * (int32_t)c->adx)) {
+    if (c->sy == 0 ||
+        (c->sx != 0 && (int64_t)(int32_t)nx * (int32_t)c->ady <= (int64_t)(int32_t)ny * (int32_t)c->adx)) {
         tx.n = nx;
         tx.d = c->adx;
     } else {
@@ -327,6 +335,10 @@ static ct_status walk_cones(const ctx *c, uint32_t plane, ct_hit *h)
     const int32_t dx = r->dx, dy = r->dy, dz = r->dz;
     int32_t i, j;
     uint32_t it, steps = h->steps, bound = CT_WCET_CELL_ITERS(c->cx, c->cy);
+    /* Cone steps from the coarse footprint's exit (below) at r > 1; at
+     * r = 1 the footprint is the fine cell, and the exit's division costs
+     * more than the one cell it adds to a step. */
+    const int from_exit = p->reduce > 1u;
     rt t = c->t0;   /* current point */
     rt tin = c->t0; /* canonical entry of the current cell */
     int tin_ok = 1;
@@ -364,30 +376,32 @@ static ct_status walk_cones(const ctx *c, uint32_t plane, ct_hit *h)
             int64_t T = 0, Tz, num = 0;
             int go = 0;      /* a cone step from T */
             int to_apex = 0; /* ... at most to the apex's height */
-            /* The cone holds from every point of the coarse cell's
-             * footprint (the promise): on its way to the footprint's exit
-             * t_X the ray is in the empty region while above the apex, and
-             * the cone's step counts from t_X. */
-            rt tx = footprint_exit(c, ci, cj);
+            int above_x = 0; /* above the apex at t_X */
+            rt tx;
             if (c->lw != NULL) {
                 lb = lower_ahead(c, i, j);
                 a16 -= lb;
             }
-            /* the sign of z(t_X) - apex, exact: xd (z(t_X) - a16) with
-             * |oz - a16| < 2^34, so |(oz - a16) xd| < 2^60, |xn dz| < 2^60 */
-            if ((oz - a16) * tx.d + tx.n * (int64_t)dz > 0) {
+            if (from_exit) {
+                /* The cone holds from every point of the coarse cell's
+                 * footprint (the promise): on its way to the footprint's
+                 * exit t_X the ray is in the empty region while above the
+                 * apex, and the cone's step counts from t_X.  The sign of
+                 * z(t_X) - apex, exact: xd (z(t_X) - a16) with |oz - a16| <
+                 * 2^34, so |(oz - a16) xd| < 2^60, |xn dz| < 2^60. */
+                tx = footprint_exit(c, ci, cj);
+                above_x = (oz - a16) * tx.d + tx.n * (int64_t)dz > 0;
+            }
+            if (above_x) {
                 /* above the apex at the exit, and so from t on unless the
-                 * ray rises: then z at T = floor(t 2^26) <= t (t.n 2^26 <
-                 * 2^60) must be above it too */
-                go = dz <= 0 ||
-                     oz + floor_shr((t.d == T_ONE ? t.n : (int64_t)((uint64_t)(t.n * T_ONE) / (uint64_t)t.d)) *
-                                        (int64_t)dz,
-                                    CT_T_FRAC_BITS) - a16 > 0;
-                /* the step from t_X: T = floor(t_X 2^26) (xn 2^26 <
-                 * 2^60), and a lower bound of z(t_X) - apex from a Q26
-                 * point (z at T for a rising ray, at T + 1 for a
-                 * descending one unless t_X is exactly T / 2^26), at
-                 * least 0 (< 2^34) */
+                 * ray rises: then z at floor(t 2^26) <= t must be above it
+                 * too */
+                go = dz <= 0 || oz + floor_shr(floor_q26(t) * (int64_t)dz, CT_T_FRAC_BITS) - a16 > 0;
+                /* the step from t_X: T = floor(t_X 2^26) (t_X.n 2^26 <
+                 * 2^60; T < 2^35, see footprint_exit), and a lower bound
+                 * of z(t_X) - apex from a Q26 point (z at T for a rising
+                 * ray, at T + 1 for a descending one unless t_X is exactly
+                 * T / 2^26), at least 0 (< 2^34) */
                 {
                     /* one division: quotient and remainder */
                     uint64_t N = (uint64_t)tx.n << CT_T_FRAC_BITS;
@@ -395,17 +409,18 @@ static ct_status walk_cones(const ctx *c, uint32_t plane, ct_hit *h)
                     Tz = (dz < 0 && N % (uint64_t)tx.d != 0u) ? T + 1 : T;
                 }
                 num = ct_max64(oz + floor_shr(Tz * (int64_t)dz, CT_T_FRAC_BITS) - a16, 0);
-            } else if (dz < 0) {
-                /* descending to the apex inside the footprint: from t,
-                 * with T = floor(t 2^26) and a lower bound of z(t) from a
-                 * Q26 point as above (t.n 2^26 < 2^60), up to the apex's
+            } else if (!from_exit || dz < 0) {
+                /* From t, with T = floor(t 2^26) and a lower bound of z(t)
+                 * from a Q26 point as above: at r = 1, or descending to
+                 * the apex inside the footprint, then up to the apex's
                  * height (at or before t_X) unless the cone reaches
-                 * farther (cot < 0) */
-                T = t.d == T_ONE ? t.n : (int64_t)((uint64_t)(t.n * T_ONE) / (uint64_t)t.d);
-                Tz = t.d != T_ONE ? T + 1 : T;
+                 * farther (cot < 0).  (A ray not descending is at or
+                 * below the apex at t as at t_X.) */
+                T = floor_q26(t);
+                Tz = (t.d != T_ONE && dz < 0) ? T + 1 : T;
                 num = oz + floor_shr(Tz * (int64_t)dz, CT_T_FRAC_BITS) - a16; /* < 2^34 */
                 go = num > 0;
-                to_apex = 1;
+                to_apex = from_exit;
             }
             if (!go) {
                 /* at or below the apex: exact steps in this coarse cell */
@@ -442,7 +457,7 @@ static ct_status walk_cones(const ctx *c, uint32_t plane, ct_hit *h)
                  * another cell, or on the exit face, which belongs to the
                  * next cell); otherwise the exact cell step below.  The cell
                  * at tn as locate's for a Q26 t: o 2^26 < 2^57 and tn |d| <
-                 * (2^34 + 2^35) 2^26 < 2^61.6 (T < 2^34, dt <= 2^35). */
+                 * (2^35 + 2^35) 2^26 = 2^62 (T < 2^35, dt <= 2^35). */
                 tn = T + dt - 1;
                 if (tn > T) {
                     int32_t ni = axis_cell_q26(ox * T_ONE + tn * (int64_t)dx, c->sx, c->cx);
@@ -451,8 +466,8 @@ static ct_status walk_cones(const ctx *c, uint32_t plane, ct_hit *h)
                         rt tj;
 #if CT_HAVE_PREFETCH
                         if (c->prefetch) {
-                            /* a hint only: T2 = tn + dt < 2^36, times |d| <=
-                             * 2^26; a cell off the tile is not asked for */
+                            /* a hint only: T2 = tn + dt < 2^36.6, times |d|
+                             * <= 2^26; a cell off the tile is not asked for */
                             int64_t T2 = tn + dt;
                             int64_t px = floor_shr(ox + floor_shr(T2 * (int64_t)dx, CT_T_FRAC_BITS), 16u);
                             int64_t py = floor_shr(oy + floor_shr(T2 * (int64_t)dy, CT_T_FRAC_BITS), 16u);
