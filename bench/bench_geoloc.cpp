@@ -29,7 +29,9 @@
 //          callgrind; prints ns per pixel of the best batch),
 //          --effects scene|straight|true|fit (what --profile traces: the
 //          scene's effects, none, the true Earth exact or with the map
-//          fitted per batch; default scene).
+//          fitted per batch; default scene),
+//          --method directional|incremental (--profile's method; default
+//          directional).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -77,6 +79,7 @@ int main(int argc, char **argv)
 {
     int stride = 1, samples = 2000, profile = 0;
     std::string only, prof_fx = "scene";
+    ct_method prof_m = CT_METHOD_DIRECTIONAL;
     for (int k = 1; k < argc; ++k) {
         if (!std::strcmp(argv[k], "--quick")) {
             stride = 4;
@@ -91,9 +94,12 @@ int main(int argc, char **argv)
                    (!std::strcmp(argv[k + 1], "scene") || !std::strcmp(argv[k + 1], "straight") ||
                     !std::strcmp(argv[k + 1], "true") || !std::strcmp(argv[k + 1], "fit"))) {
             prof_fx = argv[++k];
+        } else if (!std::strcmp(argv[k], "--method") && k + 1 < argc &&
+                   (!std::strcmp(argv[k + 1], "directional") || !std::strcmp(argv[k + 1], "incremental"))) {
+            prof_m = !std::strcmp(argv[++k], "directional") ? CT_METHOD_DIRECTIONAL : CT_METHOD_INCREMENTAL;
         } else {
             std::fprintf(stderr, "usage: ct_bench_geoloc [--quick] [--samples N] [--scene NAME] [--profile B] "
-                                 "[--effects scene|straight|true|fit]\n");
+                                 "[--effects scene|straight|true|fit] [--method directional|incremental]\n");
             return 2;
         }
     }
@@ -174,7 +180,7 @@ int main(int argc, char **argv)
             }
             double best = 1e30;
             for (int b = 0; b < profile; ++b)
-                best = std::min(best, geolocate(*w, uv, CT_METHOD_DIRECTIONAL, pf, &gg, &grid_cam).ns);
+                best = std::min(best, geolocate(*w, uv, prof_m, pf, &gg, &grid_cam).ns);
             // a digest of every result, to compare two builds' bits
             uint64_t digest = 1469598103934665603u;
             for (const ct_geo &g : gg) {
@@ -182,9 +188,10 @@ int main(int argc, char **argv)
                                       (int64_t)g.hit.steps};
                 for (int64_t x : v) digest = (digest ^ (uint64_t)x) * 1099511628211u;
             }
-            std::printf("%s: whole image, 8 px grid, directional, effects %s: %.0f ns per pixel (best of %d), results "
+            std::printf("%s: whole image, 8 px grid, %s, effects %s: %.0f ns per pixel (best of %d), results "
                         "digest %016llx\n",
-                        name, prof_fx.c_str(), best, profile, (unsigned long long)digest);
+                        name, prof_m == CT_METHOD_DIRECTIONAL ? "directional" : "incremental", prof_fx.c_str(), best,
+                        profile, (unsigned long long)digest);
             delete w;
             continue;
         }

@@ -377,7 +377,7 @@ static ct_status walk_cones(const ctx *c, uint32_t plane, ct_hit *h)
             int go = 0;      /* a cone step from T */
             int to_apex = 0; /* ... at most to the apex's height */
             int above_x = 0; /* above the apex at t_X */
-            rt tx;
+            rt tx = T_ZERO;  /* t_X, the footprint's exit (r > 1) */
             if (c->lw != NULL) {
                 lb = lower_ahead(c, i, j);
                 a16 -= lb;
