@@ -147,7 +147,6 @@ void run_cases(const std::vector<dem_cases::Case> &cases,
         check_case(cs, n, &st, &fam, gen_of ? gen_of(cs) : RayGen());
         if (rising_hits != nullptr) *rising_hits += st.rising_hits;
         if (ct_harness_g.current_failed) return;
-        if (ct_harness_g.current_failed) return;
         std::printf("  %-22s N=%-2d r=%d: %ld rays, %ld hit, %ld miss, %ld below, %ld never enter; "
                     "tangencies %ld, wrong %ld, max |err| %.2f q16; mean steps inc %.1f hier %.1f cone %.1f dir %.1f\n",
                     cs.name.c_str(), cs.opt.sectors, cs.opt.reduce, st.rays, st.hits, st.misses, st.below, st.prep_miss,
@@ -209,13 +208,15 @@ void test_builder_grid()
 }
 
 // Rays aimed at spikes from a few cells before them, from between the
-// ground and the spike's top, most of them rising.  A cone holds from every
-// point of its coarse cell, so the cone walk steps from the coarse cell's
-// exit when the ray is above the apex there -- and a rising ray must then be
-// above it where it is too: one that starts below the apex and leaves the
-// cell above it may meet a spike's flank in between.  Spikes of every height
-// on low hills at r = 2, 3, 4 make that case common; every method against
-// the reference, and enough rising hits that the case is exercised.
+// ground and the spike's top (every other one from just below the top),
+// most of them rising.  A cone holds from every point of its coarse cell,
+// so at r > 1 the cone walk steps from the coarse cell's exit when the ray
+// is above the apex there -- and a rising ray must then be above it where
+// it is too: one that starts below the apex and leaves the cell above it
+// may meet a spike's flank in between.  Spikes of every height on low
+// hills at r = 2, 3, 4, with apexes at the coarse cells' tops, make those
+// cases common; every method against the reference, and enough rising
+// hits that the case is exercised.
 void test_footprint_exits()
 {
     std::vector<dem_cases::Case> cases;
