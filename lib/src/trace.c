@@ -296,8 +296,8 @@ static inline int64_t floor_q26(rt t)
  * it; r x r fine cells, clamped to the tile), on the far faces as
  * cell_exit's: t_X = n / d with 0 <= n < 2^31 and d <= 2^26; for a rising
  * ray tend when that comes first (n < 2^34).  (A level or descending ray
- * above the apex at t_X is in the box there, t_X < 2^9: the dominant axis
- * moves >= 2^25 per unit t, |z - apex| < 2^34 and a face is < 2^31 away.) */
+ * is stepped from t_X only when above the apex there, which is above the
+ * box's floor, and no higher than at t: in the box, so t_X <= tend.) */
 static rt footprint_exit(const ctx *c, uint32_t ci, uint32_t cj)
 {
     const ct_package *p = c->p;
@@ -398,7 +398,7 @@ static ct_status walk_cones(const ctx *c, uint32_t plane, ct_hit *h)
                  * too */
                 go = dz <= 0 || oz + floor_shr(floor_q26(t) * (int64_t)dz, CT_T_FRAC_BITS) - a16 > 0;
                 /* the step from t_X: T = floor(t_X 2^26) (t_X.n 2^26 <
-                 * 2^60; T < 2^35, see footprint_exit), and a lower bound
+                 * 2^60; t_X <= tend, see footprint_exit), and a lower bound
                  * of z(t_X) - apex from a Q26 point (z at T for a rising
                  * ray, at T + 1 for a descending one unless t_X is exactly
                  * T / 2^26), at least 0 (< 2^34) */
@@ -457,7 +457,7 @@ static ct_status walk_cones(const ctx *c, uint32_t plane, ct_hit *h)
                  * another cell, or on the exit face, which belongs to the
                  * next cell); otherwise the exact cell step below.  The cell
                  * at tn as locate's for a Q26 t: o 2^26 < 2^57 and tn |d| <
-                 * (2^35 + 2^35) 2^26 = 2^62 (T < 2^35, dt <= 2^35). */
+                 * (2^34 + 2^35) 2^26 < 2^61.6 (T < 2^34, dt <= 2^35). */
                 tn = T + dt - 1;
                 if (tn > T) {
                     int32_t ni = axis_cell_q26(ox * T_ONE + tn * (int64_t)dx, c->sx, c->cx);
@@ -466,8 +466,8 @@ static ct_status walk_cones(const ctx *c, uint32_t plane, ct_hit *h)
                         rt tj;
 #if CT_HAVE_PREFETCH
                         if (c->prefetch) {
-                            /* a hint only: T2 = tn + dt < 2^36.6, times |d|
-                             * <= 2^26; a cell off the tile is not asked for */
+                            /* a hint only: T2 = tn + dt < 2^36, times |d| <=
+                             * 2^26; a cell off the tile is not asked for */
                             int64_t T2 = tn + dt;
                             int64_t px = floor_shr(ox + floor_shr(T2 * (int64_t)dx, CT_T_FRAC_BITS), 16u);
                             int64_t py = floor_shr(oy + floor_shr(T2 * (int64_t)dy, CT_T_FRAC_BITS), 16u);
