@@ -520,7 +520,7 @@ static ct_status walk_cones(const ctx *c, uint32_t plane, ct_hit *h)
 }
 
 /* A seam start's cheap proof of f(t0) > 0, as the cone walk's first test
- * (the same apex formula as walk_cones', kept out of that loop: one shared
+ * (the apex as walk_cones' takes it, kept out of that loop: one shared
  * helper cost the walk 11 % more instructions per horizontal ray):
  * the ray at t0 (a lower bound of its z) above the apex of its cell's cone
  * in plane, the apex being at or above every post under it (for a bent
@@ -531,7 +531,7 @@ static int above_apex(const ctx *c, uint32_t plane, int32_t i, int32_t j)
     const ct_prepared *r = c->r;
     size_t k = ct_coarse_index(p, i, j);
     uint32_t code = p->angles[(size_t)plane * p->coarse_x * p->coarse_y + k];
-    int64_t a16, T, Tz;
+    int64_t a16;
     if (!p->cot_ok[code]) {
         return 0;
     }
@@ -539,10 +539,9 @@ static int above_apex(const ctx *c, uint32_t plane, int32_t i, int32_t j)
     if (c->lw != NULL) {
         a16 -= lower_ahead(c, i, j);
     }
-    /* as walk_cones: t.n 2^26 < 2^60, the sum < 2^34 */
-    T = c->t0.d == T_ONE ? c->t0.n : ct_floor_div(c->t0.n * T_ONE, c->t0.d);
-    Tz = (c->t0.d != T_ONE && r->dz < 0) ? T + 1 : T;
-    return r->oz + floor_shr(Tz * (int64_t)r->dz, CT_T_FRAC_BITS) - a16 > 0;
+    /* the sign of z(t0) - apex, exact: t0.d (z(t0) - a16) with |oz - a16|
+     * < 2^34, t0.d <= 2^26 and t0.n < 2^34: products < 2^60 */
+    return (r->oz - a16) * c->t0.d + c->t0.n * (int64_t)r->dz > 0;
 }
 
 /* ------------------------------------------------------------------------ */
