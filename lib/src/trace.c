@@ -387,8 +387,8 @@ static ct_status walk_cones(const ctx *c, uint32_t plane, ct_hit *h)
                  * footprint (the promise): on its way to the footprint's
                  * exit t_X the ray is in the empty region while above the
                  * apex, and the cone's step counts from t_X.  The sign of
-                 * z(t_X) - apex, exact: xd (z(t_X) - a16) with |oz - a16| <
-                 * 2^34, so |(oz - a16) xd| < 2^60, |xn dz| < 2^60. */
+                 * z(t_X) - apex, exact: tx.d (z(t_X) - a16) with |oz - a16|
+                 * < 2^34, so |(oz - a16) tx.d| < 2^60, |tx.n dz| < 2^60. */
                 tx = footprint_exit(c, ci, cj);
                 above_x = (oz - a16) * tx.d + tx.n * (int64_t)dz > 0;
             }
@@ -451,8 +451,9 @@ static ct_status walk_cones(const ctx *c, uint32_t plane, ct_hit *h)
                 if (dt > (INT64_C(1) << 35)) {
                     dt = INT64_C(1) << 35;
                 }
-                /* T + dt - 1 < 2^26 times the exact exit of the cone, so the
-                 * ray on [t, tn] lies in the empty region.  The jump is taken
+                /* T + dt - 1 < 2^26 times where the ray leaves the empty
+                 * region (the cone from T's point, t or t_X, or the apex's
+                 * height), so the ray on [t, tn] lies in it.  The jump is taken
                  * when it leaves the fine cell (the point at tn lies in
                  * another cell, or on the exit face, which belongs to the
                  * next cell); otherwise the exact cell step below.  The cell
