@@ -27,6 +27,14 @@
 #define CT_NOINLINE
 #endif
 
+/* Inlines a small helper shared by a few hot loops even under -Os, where
+ * a call would cost more than the helper (a hint, as CT_NOINLINE).       */
+#if defined(__GNUC__)
+#define CT_ALWAYS_INLINE __attribute__((always_inline))
+#else
+#define CT_ALWAYS_INLINE
+#endif
+
 /* A hint to start loading a cache line, on hosts with caches (GCC and clang
  * on x86-64 and AArch64); nothing on the flight MCUs, which have none (the
  * code around it is compiled out there: CT_HAVE_PREFETCH 0).               */

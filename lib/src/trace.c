@@ -67,34 +67,47 @@ static int inside(const ctx *c, int32_t i, int32_t j)
     return i >= 0 && j >= 0 && i < c->cx && j < c->cy;
 }
 
-/* Exit of fine cell (i, j).  (face*2^16 - o) < 2^31, times |d| <= 2^26:
- * < 2^57. */
-static void cell_exit(const ctx *c, int32_t i, int32_t j, cexit *e)
+/* Where the ray leaves a rectangle of cells whose far faces (those it
+ * moves towards) are x = xf and y = yf: *face FACE_X, FACE_Y or FACE_XY
+ * (through the corner), and the parameter n / d there, d = |dx| or |dy|.
+ * Faces and origins lie in the tile, so |face 2^16 - o| < 2^31 and the
+ * face test is two 32 x 32-bit products (< 2^57). */
+CT_ALWAYS_INLINE static inline void rect_exit(const ctx *c, int32_t xf, int32_t yf, int *face, rt *t)
 {
     int64_t nx = 0, ny = 0;
-    e->xf = i + (c->sx > 0 ? 1 : 0);
-    e->yf = j + (c->sy > 0 ? 1 : 0);
-    if (c->sx != 0) {
-        nx = ((int64_t)e->xf * ONE16 - c->r->ox) * c->sx;
+    if (c->sx > 0) {
+        nx = (int64_t)xf * ONE16 - c->r->ox;
+    } else if (c->sx < 0) {
+        nx = c->r->ox - (int64_t)xf * ONE16;
     }
-    if (c->sy != 0) {
-        ny = ((int64_t)e->yf * ONE16 - c->r->oy) * c->sy;
+    if (c->sy > 0) {
+        ny = (int64_t)yf * ONE16 - c->r->oy;
+    } else if (c->sy < 0) {
+        ny = c->r->oy - (int64_t)yf * ONE16;
     }
     if (c->sy == 0) {
-        e->face = FACE_X;
+        *face = FACE_X;
     } else if (c->sx == 0) {
-        e->face = FACE_Y;
+        *face = FACE_Y;
     } else {
-        int64_t lx = nx * c->ady, ly = ny * c->adx;
-        e->face = lx < ly ? FACE_X : (ly < lx ? FACE_Y : FACE_XY);
+        int64_t lx = (int64_t)(int32_t)nx * (int32_t)c->ady, ly = (int64_t)(int32_t)ny * (int32_t)c->adx;
+        *face = lx < ly ? FACE_X : (ly < lx ? FACE_Y : FACE_XY);
     }
-    if (e->face == FACE_Y) {
-        e->t.n = ny;
-        e->t.d = c->ady;
+    if (*face == FACE_Y) {
+        t->n = ny;
+        t->d = c->ady;
     } else {
-        e->t.n = nx;
-        e->t.d = c->adx;
+        t->n = nx;
+        t->d = c->adx;
     }
+}
+
+/* Exit of fine cell (i, j). */
+static void cell_exit(const ctx *c, int32_t i, int32_t j, cexit *e)
+{
+    e->xf = i + (c->sx > 0 ? 1 : 0);
+    e->yf = j + (c->sy > 0 ? 1 : 0);
+    rect_exit(c, e->xf, e->yf, &e->face, &e->t);
 }
 
 /* Canonical entry parameter of cell (i, j): the later of its entry faces,
@@ -209,10 +222,10 @@ static ct_status walk_hierarchical(const ctx *c, ct_hit *h)
             lvl = p->levels > 0u ? 1u : 0u;
         } else {
             int32_t bi = i >> lvl, bj = j >> lvl, xf, yf;
-            int64_t bmax = (int64_t)mip_at(p, lvl, bi, bj), nx = 0, ny = 0;
+            int64_t bmax = (int64_t)mip_at(p, lvl, bi, bj);
             rt tx;
             int face;
-            /* block exit faces (cells); |face*2^16 - o| < 2^31 */
+            /* the block's exit faces (cells), clamped to the tile */
             xf = c->sx > 0 ? ((bi + 1) << lvl) : (bi << lvl);
             yf = c->sy > 0 ? ((bj + 1) << lvl) : (bj << lvl);
             if (xf > c->cx) {
@@ -221,27 +234,7 @@ static ct_status walk_hierarchical(const ctx *c, ct_hit *h)
             if (yf > c->cy) {
                 yf = c->cy;
             }
-            if (c->sx != 0) {
-                nx = ((int64_t)xf * ONE16 - c->r->ox) * c->sx;
-            }
-            if (c->sy != 0) {
-                ny = ((int64_t)yf * ONE16 - c->r->oy) * c->sy;
-            }
-            if (c->sy == 0) {
-                face = FACE_X;
-            } else if (c->sx == 0) {
-                face = FACE_Y;
-            } else {
-                int64_t lx = nx * c->ady, ly = ny * c->adx;
-                face = lx < ly ? FACE_X : (ly < lx ? FACE_Y : FACE_XY);
-            }
-            if (face == FACE_Y) {
-                tx.n = ny;
-                tx.d = c->ady;
-            } else {
-                tx.n = nx;
-                tx.d = c->adx;
-            }
+            rect_exit(c, xf, yf, &face, &tx);
             {
                 rt tl = c->r->dz <= 0 ? tx : t;
                 int64_t zlo = c->r->oz * tl.d + tl.n * (int64_t)c->r->dz, zb = zh(c, (uint32_t)bmax);
@@ -293,35 +286,19 @@ static inline int64_t floor_q26(rt t)
 }
 
 /* Where the ray leaves the footprint of coarse cell (ci, cj) (the ray in
- * it; r x r fine cells, clamped to the tile), on the far faces as
- * cell_exit's: t_X = n / d with 0 <= n < 2^31 and d <= 2^26; for a rising
+ * it; r x r fine cells, clamped to the tile), as rect_exit: t_X = n / d
+ * with 0 <= n < 2^31 and d <= 2^26; for a rising
  * ray tend when that comes first (n < 2^34).  (A level or descending ray
  * is stepped from t_X only when above the apex there, which is above the
  * box's floor, and no higher than at t: in the box, so t_X <= tend.) */
 static rt footprint_exit(const ctx *c, uint32_t ci, uint32_t cj)
 {
     const ct_package *p = c->p;
-    int64_t nx = 0, ny = 0;
+    int face;
+    int32_t xf = (int32_t)(c->sx > 0 ? ct_min64((int64_t)(ci + 1u) * p->reduce, c->cx) : (int64_t)ci * p->reduce);
+    int32_t yf = (int32_t)(c->sy > 0 ? ct_min64((int64_t)(cj + 1u) * p->reduce, c->cy) : (int64_t)cj * p->reduce);
     rt tx;
-    if (c->sx > 0) {
-        nx = ct_min64((int64_t)(ci + 1u) * p->reduce, c->cx) * ONE16 - c->r->ox;
-    } else if (c->sx < 0) {
-        nx = c->r->ox - (int64_t)ci * p->reduce * ONE16;
-    }
-    if (c->sy > 0) {
-        ny = ct_min64((int64_t)(cj + 1u) * p->reduce, c->cy) * ONE16 - c->r->oy;
-    } else if (c->sy < 0) {
-        ny = c->r->oy - (int64_t)cj * p->reduce * ONE16;
-    }
-    /* 0 <= nx, ny < 2^31 and adx, ady <= 2^26: 32 x 32-bit products */
-    if (c->sy == 0 ||
-        (c->sx != 0 && (int64_t)(int32_t)nx * (int32_t)c->ady <= (int64_t)(int32_t)ny * (int32_t)c->adx)) {
-        tx.n = nx;
-        tx.d = c->adx;
-    } else {
-        tx.n = ny;
-        tx.d = c->ady;
-    }
+    rect_exit(c, xf, yf, &face, &tx);
     return c->r->dz > 0 && rt_lt(c->tend, tx) ? c->tend : tx;
 }
 
@@ -523,9 +500,9 @@ static ct_status walk_cones(const ctx *c, uint32_t plane, ct_hit *h)
 /* A seam start's cheap proof of f(t0) > 0, as the cone walk's first test
  * (the apex as walk_cones' takes it, kept out of that loop: one shared
  * helper cost the walk 11 % more instructions per horizontal ray):
- * the ray at t0 (a lower bound of its z) above the apex of its cell's cone
- * in plane, the apex being at or above every post under it (for a bent
- * ray, less the lowering's bound ahead).  0: not shown (test the sign). */
+ * the ray at t0 above the apex of its cell's cone in plane (exactly), the
+ * apex being at or above every post under it (for a bent ray, less the
+ * lowering's bound ahead).  0: not shown (test the sign). */
 static int above_apex(const ctx *c, uint32_t plane, int32_t i, int32_t j)
 {
     const ct_package *p = c->p;
@@ -680,7 +657,7 @@ static int seam_start(ctx *c, ct_method m, const wstart *ws, ct_hit *h, ct_statu
         !above_apex(c, m == CT_METHOD_CONE ? (p->sectors == 1u ? 0u : p->sectors) : (uint32_t)r->sector, i,
                     j)) {
         if (ct_entry_sign(c, i, j, c->t0) <= 0) {
-            ct_fill_hit(c, c->t0.d == T_ONE ? c->t0.n : ct_floor_div(c->t0.n * T_ONE, c->t0.d), i, j, h);
+            ct_fill_hit(c, floor_q26(c->t0), i, j, h);
             h->steps = 1u;
             h->iters = 1u;
             *st = ct_hit_status(p, i, j);
