@@ -13,8 +13,10 @@
 //            radius; the world has the scene's own effects), and the true
 //            Earth (exact, fitted per call) for time (its error against the
 //            scenes' sphere-model truth is not comparable: NaN);
-//   chord    the true Earth's piece tolerance 0.1 mm .. 10 m, error against
-//            the same pixels at 1 um (err_ref = "finest chord");
+//   chord    the true Earth's piece tolerance 0.5 mm .. 10 m, error against
+//            the same pixels at 0.5 mm (err_ref = "finest chord": the finest
+//            whose pieces every scene proves; a finer one refuses pixels,
+//            docs/geolocation.md);
 //   grid     the lens baked into an unprojection grid, step 4 .. 64 px.
 // Per setting and scene: steps and ns per pixel (ct_geolocate_batch over
 // every 16th pixel of the 1024 x 768 image, best of 3 rounds), package
@@ -226,7 +228,7 @@ Row measure(scene::World &w, const std::vector<scene::Sample> &smp, const Settin
     const double posting = std::fabs(w.t.geo.posting_e);
     if (s.knob == "chord") {
         Setting fine = s;
-        fine.chord_m = std::ldexp(1.0, 10) * 1e-9;
+        fine.chord_m = 5e-4;
         const std::vector<ct_geo> gr = locate(pk->p, c, s.method, effects_for(w, fine), su);
         error_stats(smp, gs, &gr, posting, &r);
         r.err_ref = "finest chord";
@@ -345,7 +347,7 @@ int main(int argc, char **argv)
             s.effects = e;
             add(s);
         }
-        for (double c : {1e-4, 1e-3, 1e-2, 0.1, 1.0, 10.0}) {
+        for (double c : {5e-4, 1e-3, 1e-2, 0.1, 1.0, 10.0}) {
             Setting s;
             s.knob = "chord";
             char v[32];

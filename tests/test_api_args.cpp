@@ -1544,6 +1544,31 @@ std::vector<Case> cases()
         ct_effects_choice ch;
         return ct_effects_for_tolerance(&w.p, &w.cam, &q, CT_REFRACTION_K_STD_Q16, 0, 1000000, &ch);
     });
+    // the chord for the true Earth (curvature chosen, radius 0, a UTM
+    // package) is never below the default, whose pieces it proves; the
+    // sphere's (a radius given, or a package beyond the UTM codes) may be
+    // finer: at tolerance 0 nothing is left for it (2^10 nm)
+    add("effects_for_tolerance: the true Earth's chord at least 1 mm, the sphere's finer", CT_OK,
+        [](World &w) -> ct_status {
+            ct_package q = w.p;
+            q.epsg = 0x80000000u + 32617u;
+            int floored = 0;
+            for (int64_t tol : {INT64_C(0), INT64_C(1000000), INT64_C(100000000)}) {
+                ct_effects_choice te, sp, off;
+                if (ct_effects_for_tolerance(&w.p, &w.cam, &w.pose, CT_REFRACTION_K_STD_Q16, 0, tol, &te) != CT_OK ||
+                    ct_effects_for_tolerance(&w.p, &w.cam, &w.pose, CT_REFRACTION_K_STD_Q16, CT_EARTH_RADIUS_NM, tol,
+                                             &sp) != CT_OK ||
+                    ct_effects_for_tolerance(&q, &w.cam, &w.pose, CT_REFRACTION_K_STD_Q16, 0, tol, &off) != CT_OK)
+                    return CT_ERR_INTERNAL;
+                const int64_t want = (te.flags & CT_EFFECT_CURVATURE) != 0u
+                                         ? std::max<int64_t>(sp.chord_nm, CT_EFFECTS_CHORD_NM)
+                                         : sp.chord_nm;
+                if (te.flags != sp.flags || off.chord_nm != sp.chord_nm || te.chord_nm != want)
+                    return CT_ERR_INTERNAL;
+                floored += te.chord_nm != sp.chord_nm;
+            }
+            return floored > 0 ? CT_OK : CT_ERR_INTERNAL;
+        });
     // ---- a bend's ranges (ct_bend): each alone
     struct Bend {
         const char *name;

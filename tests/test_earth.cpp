@@ -1480,6 +1480,7 @@ void test_piece_bounds()
                 lines, pieces, bounded + sampled, bounded, over_tol, points, worst_lat * 1e3, tight, worst_v * 1e3,
                 vratio);
     TEST_ASSERT_MSG(bounded > 500, "too few bounded pieces (%ld)", bounded);
+    TEST_ASSERT_MSG(over_tol == 0, "%ld pieces over their tolerance were logged (never traced)", over_tol);
     // the hook's refusals, and its cap: the first pieces only, the walk's status
     {
         Pose p;
@@ -1999,6 +2000,71 @@ void test_level_rise_refused()
     TEST_ASSERT(T.bad == 0 && T.n == 17 && T.hits == 17 && T.worst <= 0.001);
 }
 
+// A chord finer than the pieces can prove is refused pixel by pixel, never
+// traced with pieces outside their tolerance.  A piece's bound holds terms
+// that do not shrink with its length -- on the camera's own piece (a camera
+// over the tile) the camera's rounding to its Q16 grid point, up to 258 Q24
+// units, 0.46 mm at 30 m posts: chords below about 0.62 mm (of which the
+// checks aim at 3/4) cannot be proven there, and none of 2^10 nm, the
+// finest ct_effects accepts, anywhere.  At 2^10 nm every pixel that hits at
+// the default (1 mm) is CT_ERR_EFFECTS and none hits; the piece log ends
+// with that status and holds no piece over its tolerance; at 0.8 mm every
+// pixel's status is the default's (a hit within 5 mm of its hit: two
+// chords' bounds and the walk's rounding on slopes).
+void test_chord_too_fine()
+{
+    World *w = jacksboro();
+    Cam cam = make_camera();
+    long pixels = 0, hits = 0, refused = 0, wrong = 0, agree = 0;
+    static ct_earth_piece pcs[2048];
+    for (const PoseDef &d : pose_defs()) {
+        Pose p;
+        TEST_ASSERT_MSG(make_pose(w->sf, d, &p), "pose %s", d.family);
+        std::vector<int64_t> uv;
+        for (int iv = 0; iv < cam.h; iv += 96)
+            for (int iu = 0; iu < cam.w; iu += 128) {
+                uv.push_back((int64_t)iu << 16);
+                uv.push_back((int64_t)iv << 16);
+            }
+        const size_t n = uv.size() / 2;
+        std::vector<ct_geo> g1(n), gf(n), g08(n);
+        ct_effects fx = {CT_EFFECT_CURVATURE | CT_EFFECT_REFRACTION, CT_REFRACTION_K_STD_Q16, 0, 0, nullptr};
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_geolocate_batch(&w->p, &cam.cam, &p.pose, CT_METHOD_DIRECTIONAL, &fx,
+                                                        uv.data(), n, g1.data(), n));
+        fx.chord_nm = INT64_C(1) << 10;
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_geolocate_batch(&w->p, &cam.cam, &p.pose, CT_METHOD_DIRECTIONAL, &fx,
+                                                        uv.data(), n, gf.data(), n));
+        fx.chord_nm = 800000;
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_geolocate_batch(&w->p, &cam.cam, &p.pose, CT_METHOD_DIRECTIONAL, &fx,
+                                                        uv.data(), n, g08.data(), n));
+        for (size_t k = 0; k < n; ++k) {
+            pixels++;
+            const bool hit1 = g1[k].status == CT_HIT || g1[k].status == CT_HIT_VOID;
+            hits += hit1;
+            refused += gf[k].status == CT_ERR_EFFECTS;
+            wrong += gf[k].status == CT_HIT || gf[k].status == CT_HIT_VOID || (hit1 && gf[k].status != CT_ERR_EFFECTS);
+            const ld de = (ld)(g08[k].hit.e_nm - g1[k].hit.e_nm), dn = (ld)(g08[k].hit.n_nm - g1[k].hit.n_nm),
+                     dh = (ld)(g08[k].hit.h_nm - g1[k].hit.h_nm);
+            agree += g08[k].status == g1[k].status && (!hit1 || std::sqrt(de * de + dn * dn + dh * dh) <= 5e6L);
+        }
+        // the piece log of a line of sight through the image's middle
+        ct_earth es;
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_earth_setup(&w->p, &p.pose, 0, CT_EARTH_RADIUS_NM, INT64_C(1) << 10, 0u, 0,
+                                                    nullptr, &es));
+        int64_t dg[3];
+        grid_dir_q39(d.yaw, std::max(-89.0L, d.pitch), dg);
+        uint32_t np = 0;
+        const ct_status st = ct_earth_pieces(&w->p, &es, dg, pcs, 2048u, &np);
+        for (uint32_t i = 0; i < np; ++i)
+            TEST_ASSERT_MSG(pcs[i].off || (pcs[i].elat_q24 <= es.tol_q24 && pcs[i].evert_q16 <= es.tolz_q16),
+                            "pose %s: piece %u of %u over its tolerance (status %d)", d.family, i, np, (int)st);
+        TEST_ASSERT_MSG(st == CT_ERR_EFFECTS || st == CT_MISS, "pose %s: piece log status %d", d.family, (int)st);
+    }
+    std::printf("  chord 2^10 nm on the true Earth: %ld pixels, %ld hit at 1 mm, %ld refused (CT_ERR_EFFECTS), %ld "
+                "wrong; at 0.8 mm %ld of %ld as at 1 mm\n", pixels, hits, refused, wrong, agree, pixels);
+    TEST_ASSERT(wrong == 0 && hits > 100 && refused >= hits && agree == pixels);
+}
+
 void test_exact_curvature() { compare(CT_EFFECT_CURVATURE); }
 void test_exact_curvature_refraction() { compare(CT_EFFECT_CURVATURE | CT_EFFECT_REFRACTION); }
 
@@ -2024,5 +2090,6 @@ int main()
     RUN_TEST(test_tiny_posting);
     RUN_TEST(test_tiny_height_scale);
     RUN_TEST(test_level_rise_refused);
+    RUN_TEST(test_chord_too_fine);
     return TEST_END();
 }

@@ -456,15 +456,27 @@ void test_effect_selection()
                             names[idx], got);
             row += std::string(" ") + names[idx];
             // the chord it chose: the true Earth's pieces (where curvature is
-            // simulated on this UTM package) at that chord against the finest
-            // one stay within what the set's bound leaves of the tolerance
-            // (no promise where a level ray reaches the tile: tan_min 0)
+            // simulated on this UTM package) at that chord against a fine one
+            // stay within what the set's bound leaves of the tolerance (no
+            // promise where a level ray reaches the tile: tan_min 0).  The
+            // fine one is the default, 1 mm: finer chords are refused where
+            // the camera is over the tile (its own rounding to a Q16 grid
+            // point, 0.46 mm at 30 m posts, counts against the chord of its
+            // own piece: test_earth test_chord_too_fine)
             if ((ch.flags & CT_EFFECT_CURVATURE) && tol >= 0.01 && ch.tan_min_q30 > 0) {
                 ct_effects a = both, b = both;
                 a.flags = b.flags = ch.flags;
                 a.earth_radius_nm = b.earth_radius_nm = 0;
-                a.chord_nm = ch.chord_nm;
-                b.chord_nm = INT64_C(1) << 10;
+                // the chord as chosen for the true Earth (radius 0): never
+                // below the default there
+                ct_effects_choice cht;
+                TEST_ASSERT_EQUAL_INT(CT_OK, ct_effects_for_tolerance(&w->p, &w->cam.cam, &w->cam.pose,
+                                                                      both.refraction_k_q16, 0, std::llround(tol * 1e9),
+                                                                      &cht));
+                TEST_ASSERT(cht.chord_nm == std::max(ch.chord_nm, CT_EFFECTS_CHORD_NM) ||
+                            !(cht.flags & CT_EFFECT_CURVATURE));
+                a.chord_nm = cht.chord_nm;
+                b.chord_nm = CT_EFFECTS_CHORD_NM;
                 const double used = idx == 3 ? 0 : ch.bound_nm[idx] * 1e-9;
                 double worst = 0;
                 for (const scene::Sample &sm : smp) {
@@ -481,10 +493,10 @@ void test_effect_selection()
                     worst = std::max(worst, d);
                 }
                 TEST_ASSERT_MSG(worst <= tol - used + 0.002, "%s: tolerance %g m, chord %.3g m: the true Earth moves by "
-                                "%.4g m (> %.4g m left by the set's bound)", name, tol, ch.chord_nm * 1e-9, worst,
+                                "%.4g m (> %.4g m left by the set's bound)", name, tol, a.chord_nm * 1e-9, worst,
                                 tol - used);
                 char cb[48];
-                std::snprintf(cb, sizeof cb, "(chord %.2g m: %.2g m)", ch.chord_nm * 1e-9, worst);
+                std::snprintf(cb, sizeof cb, "(chord %.2g m: %.2g m)", a.chord_nm * 1e-9, worst);
                 row += cb;
             }
             // each chosen effect left out: the subset's bound and measure

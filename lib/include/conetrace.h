@@ -817,7 +817,12 @@ typedef struct {
     int64_t chord_nm;          /* polyline tolerance; 0 = CT_EFFECTS_CHORD_NM;
                                   else [2^10, 2^50] nm, and the polyline's
                                   segment sqrt(8 chord R / |c|) must be at
-                                  least 1/64 of a cell (else CT_ERR_EFFECTS) */
+                                  least 1/64 of a cell (else CT_ERR_EFFECTS).
+                                  The true Earth's pieces: a pixel whose
+                                  piece cannot be proven within the chord
+                                  (its bound's rounding terms exceed it:
+                                  chords below about 0.5 mm looking down
+                                  at 30 m posts) is CT_ERR_EFFECTS      */
     const ct_earth_map *earth_map; /* NULL, or a map fitted for this package
                                   (ct_earth_map_init; else CT_ERR_EFFECTS),
                                   used with the true Earth (else ignored)   */
@@ -848,7 +853,11 @@ typedef struct {
                                   in [2^10, 2^50] nm
                                   (2^10 when nothing is left: the finest;
                                   CT_EFFECTS_CHORD_NM when a level or rising
-                                  ray reaches the tile: no such bound)      */
+                                  ray reaches the tile: no such bound); with
+                                  curvature chosen, radius_nm 0 and a UTM
+                                  package (the true Earth) never below
+                                  CT_EFFECTS_CHORD_NM, the finest its pieces
+                                  prove everywhere (see ct_effects)      */
     int64_t bound_nm[4];       /* bound with [0] nothing simulated (c = 1 -
                                   k), [1] curvature only (c = k), [2]
                                   refraction only (c = 1), [3] both (0);
@@ -893,7 +902,9 @@ ct_status ct_effects_for_tolerance(const ct_package *pkg, const ct_camera *cam, 
  * ct_geolocate refuses -- unknown flags, |k| > 2, R or chord out of range,
  * another package's earth_map -- or, on the sphere, c < 0 or a bend the
  * lowered walk cannot take from A; for the true Earth, A where the zone's
- * projection cannot take it, e.g. far off the zone).
+ * projection cannot take it, e.g. far off the zone, or a piece of the line
+ * of sight that cannot be proven within the chord), CT_ERR_RANGE (the true
+ * Earth's line of sight needs more than 8192 pieces over the tile).
  *   [in]  pkg        an opened package.
  *   [in]  a_nm, b_nm the two map points (E, N, h), nm.
  *   [in]  effects    NULL or as ct_geolocate's.
@@ -1039,9 +1050,12 @@ ct_status ct_pose_rotate(const ct_pose *pose, const int32_t ray_cam_q30[3],
  * camera is over the tile and under its surface -- a line of sight from
  * off the tile entering its side below the surface hits the side there),
  * or an error: CT_ERR_UNPROJECT for the pixel; CT_ERR_ARG /
- * CT_ERR_METHOD / CT_ERR_EFFECTS for the arguments; CT_ERR_RAY when the
- * camera centre is beyond CT_MAX_ORIGIN_Q16 of the tile; CT_ERR_RANGE when
- * a bent ray would need more than CT_BEND_MAX_SEGMENTS segments or the
+ * CT_ERR_METHOD / CT_ERR_EFFECTS for the arguments, and CT_ERR_EFFECTS
+ * for a pixel on the true Earth whose line of sight holds a piece that
+ * cannot be proven within the chord (ct_effects.chord_nm); CT_ERR_RAY when
+ * the camera centre is beyond CT_MAX_ORIGIN_Q16 of the tile; CT_ERR_RANGE
+ * when a bent ray would need more than CT_BEND_MAX_SEGMENTS segments, the
+ * true Earth's line of sight more than 8192 pieces over the tile, or the
  * camera is more than 2^52 nm (4500 km) from the tile.  With effects,
  * out->hit.t_q26 is the parameter on the prepared straight ray (lowered
  * walk) or on the polyline segment holding the hit, and steps/iters are

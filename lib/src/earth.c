@@ -1675,7 +1675,9 @@ static int check_piece(const ct_package *p, const path *pa, const ct_earth *es, 
  * quarter points) is shortened to 1/8 too: the tile lies inside the
  * domain, so the path may still meet it before leaving (a tile near the
  * zone's edge).  CT_MISS when even PIECE_MIN_NM reaches beyond the domain
- * (or the tries run out on such a piece), else CT_OK. */
+ * (or the tries run out on such a piece); CT_ERR_EFFECTS when the last try
+ * is still not within the tolerances (a chord finer than the pieces' own
+ * rounding allows: such a piece is never used); else CT_OK. */
 CT_NOINLINE static ct_status next_piece(const ct_package *p, const path *pa, const ct_earth *es, const gv *A,
                                         int64_t ta, int64_t tend, int shift, int64_t *L, piece *pc)
 {
@@ -1707,7 +1709,7 @@ CT_NOINLINE static ct_status next_piece(const ct_package *p, const path *pa, con
             *L = ct_max64(PIECE_MIN_NM, ct_max64(pc->Lc / 8, ct_mul_shr(pc->Lc, fr * 4 / 5, 15u)));
         }
     }
-    return ok < 0 ? CT_MISS : CT_OK;
+    return ok < 0 ? CT_MISS : (ok ? CT_OK : CT_ERR_EFFECTS);
 }
 
 /* The length to try for the piece after pc: longer where pc was well
@@ -1935,10 +1937,11 @@ static ct_status earth_walk(const ct_package *p, ct_tileset *ts, const ct_earth 
      * + 1 tries in next_piece) */
     for (n = 0u; n < EARTH_MAX_PIECES && ta < tend; ++n) {
         int first = camera_piece(ta, over);
-        if (next_piece(p, &pa, es, &A, ta, tend, !first, &L, &pc) != CT_OK) {
+        st = next_piece(p, &pa, es, &A, ta, tend, !first, &L, &pc);
+        if (st != CT_OK) {
             h->steps = steps;
             h->iters = iters;
-            return CT_MISS;
+            return st; /* CT_MISS: beyond the projection's domain */
         }
         if (lg != NULL) {
             log_piece(lg, &pa, &A, ta, &pc);
@@ -1951,6 +1954,7 @@ static ct_status earth_walk(const ct_package *p, ct_tileset *ts, const ct_earth 
         steps++;
         iters++;
         if (gone(p, &A, &pc.B, &pc.M, &pc.f)) {
+            ta = tend;
             break;
         }
         L = next_length(es, &pc);
@@ -1962,7 +1966,9 @@ static ct_status earth_walk(const ct_package *p, ct_tileset *ts, const ct_earth 
     h->x_q16 = h->y_q16 = h->z_q16 = 0;
     h->e_nm = h->n_nm = h->h_nm = 0;
     h->cell_x = h->cell_y = -1;
-    return CT_MISS;
+    /* EARTH_MAX_PIECES pieces while the path goes on over the tile: not a
+     * miss (a chord too fine for the path's length) */
+    return ta < tend ? CT_ERR_RANGE : CT_MISS;
 }
 
 ct_status ct_trace_earth_set(const ct_package *p, ct_tileset *ts, const ct_earth *es, const int64_t dg[3], ct_method m,

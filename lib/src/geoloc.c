@@ -292,6 +292,7 @@ ct_status ct_effects_for_tolerance(const ct_package *p, const ct_camera *cam, co
     int64_t lo_nm, hi_nm;
     uint32_t i, j, n;
     int top;
+    ct_utm zone;
     if (p == NULL || cam == NULL || pose == NULL || out == NULL || cam->ready == 0u || pose->ready == 0u) {
         return CT_ERR_ARG;
     }
@@ -402,6 +403,15 @@ ct_status ct_effects_for_tolerance(const ct_package *p, const ct_camera *cam, co
                          : ct_i128_floor_div_sat(ct_i128_mul(ct_max64(rest, 0), ct_min64(out->tan_min_q30, INT64_C(1) << 30)),
                                                  INT64_C(1) << 30);
         out->chord_nm = ct_max64(INT64_C(1) << 10, ct_min64(INT64_C(1) << 50, ch));
+        if ((out->flags & CT_EFFECT_CURVATURE) != 0u && radius_nm == 0 && p->epsg <= 0x7fffffffu &&
+            ct_utm_zone_of_epsg((int32_t)p->epsg, &zone) == CT_OK) {
+            /* the true Earth: its pieces' bounds keep terms that do not
+             * shrink with a piece (the camera's Q16 grid point on its own
+             * piece, the vertices' rounding), so a finer chord than the
+             * default is refused pixel by pixel where those exceed it
+             * (up to 0.5 mm looking down at 30 m posts): never below it */
+            out->chord_nm = ct_max64(out->chord_nm, CT_EFFECTS_CHORD_NM);
+        }
         if (out->tan_min_q30 == 0) {
             /* a level or rising ray can reach the tile: no flat-ground
              * bound at all, the default chord */
