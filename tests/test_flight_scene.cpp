@@ -183,6 +183,7 @@ World *world()
     w->t.geoid = std::move(geoid);
     BuildOptions o;
     o.sectors = 24;
+    o.reduce = 3;  // the CLI's defaults
     w->bytes = build_package(w->t, o);
     w->build_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (ct_package_open(&w->p, w->bytes.data(), w->bytes.size()) != CT_OK) {

@@ -295,7 +295,7 @@ int cmd_build(int argc, char **argv)
     if (!a.opt.count("-o")) usage("build needs -o OUT.ctp");
     BuildOptions o;
     o.sectors = to_int(a, "--sectors", 24);
-    o.reduce = to_int(a, "--reduce", 1);
+    o.reduce = to_int(a, "--reduce", 3);
     o.slices = to_int(a, "--slices", 0);
     o.threads = to_int(a, "--threads", 0);
     o.window = to_int(a, "--window", o.window);

@@ -165,10 +165,20 @@ ct_status ct_earth_setup(const ct_package *pkg, const ct_pose *pose, int32_t ref
 /* 1 when `map` is a fitted map for this package's georeference.          */
 int ct_earth_map_fits(const ct_package *pkg, const ct_earth_map *map);
 
+/* Test hooks (earth.c): compiled only with CT_TEST_HOOKS, which the host
+ * build of the whole project defines for the tests; a flight build (the
+ * standalone library, the Cortex-M builds) has none of them
+ * (tests/mcu/check_symbols.py refuses their symbols there).               */
+#ifndef CT_TEST_HOOKS
+#define CT_TEST_HOOKS 0
+#endif
+
+#if CT_TEST_HOOKS
 /* The image of the ECEF point c + D (|D| <= 2^50 nm per axis) in the grid
  * frame, Q24: fitted (CT_ERR_RANGE when there is no fit or D is outside
  * its cube) or exact (for tests of the fit).                              */
 ct_status ct_earth_image24(const ct_package *pkg, const ct_earth *es, const int64_t D[3], int fitted, int64_t g[3]);
+#endif
 
 /* Culling (bend.c): 1 when no prepared segment from a to b (Q16, z in Q16
  * height units) whose lowest point is zfloor can meet the surface: zfloor,
@@ -180,6 +190,7 @@ ct_status ct_earth_image24(const ct_package *pkg, const ct_earth *es, const int6
 int ct_segment_above_terrain(const ct_package *p, int64_t ax, int64_t ay, int64_t az, int64_t bx, int64_t by,
                              int64_t bz, int64_t zfloor, int *over_tile);
 
+#if CT_TEST_HOOKS
 /* The image (Q24) of the line of sight with grid direction dg (Q39, as
  * ct_trace_earth_set's) at range t (0 <= t <= es->tmax_nm): interpolated
  * between its nodes (interp != 0; CT_ERR_RANGE when they could not be
@@ -189,6 +200,7 @@ int ct_segment_above_terrain(const ct_package *p, int64_t ax, int64_t ay, int64_
  * For tests of the interpolation.                                        */
 ct_status ct_earth_path_image24(const ct_package *pkg, const ct_earth *es, const int64_t dg[3], int64_t t, int interp,
                                 int64_t g[3], int32_t *nodes);
+#endif
 
 /* One piece of a true-Earth line of sight as ct_trace_earth_set chooses it
  * (earth.c), for tests of its error bounds.                               */
@@ -212,8 +224,10 @@ typedef struct {
 /* The pieces of the line of sight with grid direction dg (as
  * ct_trace_earth_set's, without tracing them: every piece to the path's
  * end, the first cap in out), *n of them; the walk's status.              */
+#if CT_TEST_HOOKS
 ct_status ct_earth_pieces(const ct_package *pkg, const ct_earth *es, const int64_t dg[3], ct_earth_piece *out,
                           uint32_t cap, uint32_t *n);
+#endif
 
 /* ct_trace_prepared for a ray this library prepared itself (skips the
  * re-validation of the caller-visible struct). */

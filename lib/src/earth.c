@@ -306,8 +306,10 @@ static const uint8_t deg_start[CT_EARTH_MAP_DEG + 2] = {0, 1, 4, 10, 20, 35, 56,
  *     sum.
  *   The sum (Q(fb + 60), < 2^125) is rounded once to Q24.  The rounding of
  *   cf' (2^(sh - 1) per term) costs under 2 um at 141 km (fit_map).  The
- *   terms run in their stored order (term_abc), one flat loop per degree. */
-static void fit_eval(const ct_earth_map *mp, const int64_t D[3], int64_t g[3])
+ *   terms run in their stored order (term_abc), one flat loop per degree.
+ * Out of line: its 0.9 KB frame (M0) would otherwise join vertex_exact's
+ * on the true Earth's deepest path. */
+CT_NOINLINE static void fit_eval(const ct_earth_map *mp, const int64_t D[3], int64_t g[3])
 {
     int64_t T[3][3], U[3][CT_EARTH_MAP_DEG + 1], V[CT_EARTH_MAP_DEG + 1][CT_EARTH_MAP_DEG + 1];
     ct_i128 acc[3];
@@ -554,6 +556,7 @@ ct_status ct_earth_map_init(const ct_package *p, int64_t e_nm, int64_t n_nm, int
     return mp->deg > 0 ? CT_OK : CT_ERR_RANGE;
 }
 
+#if CT_TEST_HOOKS
 ct_status ct_earth_image24(const ct_package *p, const ct_earth *es, const int64_t D[3], int fitted, int64_t g[3])
 {
     int64_t P[3], f[3], Dm[3];
@@ -589,6 +592,7 @@ ct_status ct_earth_image24(const ct_package *p, const ct_earth *es, const int64_
     }
     return st;
 }
+#endif
 
 /* The bend of refraction at range t, nm: k t^2 / 2R (t < 2^48, t^2 <
  * 2^96, |k| <= 2^17: < 2^113; / 2R (>= 2^41) leaves < 2^72 -- saturated
@@ -1430,8 +1434,9 @@ static void refraction_axis(path *pa, const ct_earth *es)
 
 /* The path of the line of sight with grid direction dg (Q39): its
  * direction in Earth-fixed axes, refraction's bending direction, and the
- * interpolation nodes over [0, tmax]. */
-static void path_init(path *pa, const ct_package *p, const ct_earth *es, const int64_t dg[3])
+ * interpolation nodes over [0, tmax].  Out of line: inlined, its frame and
+ * set_nodes' would sit under earth_walk's on the deepest path (M0 +40 B). */
+CT_NOINLINE static void path_init(path *pa, const ct_package *p, const ct_earth *es, const int64_t dg[3])
 {
     int k;
     pa->p = p;
@@ -1793,6 +1798,7 @@ static int path_span(const path *pa, const ct_package *p, const ct_earth *es, in
     return 1;
 }
 
+#if CT_TEST_HOOKS
 ct_status ct_earth_path_image24(const ct_package *p, const ct_earth *es, const int64_t dg[3], int64_t t, int interp,
                                 int64_t g[3], int32_t *nodes)
 {
@@ -1813,6 +1819,7 @@ ct_status ct_earth_path_image24(const ct_package *p, const ct_earth *es, const i
     g[2] = v.fz;
     return st;
 }
+#endif
 
 /* 1 for the camera's own piece over the tile: it starts at the camera (its
  * CT_BELOW is the camera's) and is not shifted sideways. */
@@ -1851,12 +1858,14 @@ CT_NOINLINE static int64_t first_length(const path *pa, const ct_earth *es, int 
     return ct_min64(PIECE_FIRST_NM, ct_max64(PIECE_MIN_NM, L));
 }
 
-/* The pieces' record for ct_earth_pieces (a test hook): NULL when tracing. */
+/* The pieces' record for ct_earth_pieces (a test hook, compiled with
+ * CT_TEST_HOOKS only): NULL when tracing. */
 typedef struct {
     ct_earth_piece *out;
     uint32_t cap, n;
 } piece_log;
 
+#if CT_TEST_HOOKS
 static void log_piece(piece_log *lg, const path *pa, const gv *A, int64_t ta, const piece *pc)
 {
     ct_earth_piece *e;
@@ -1891,6 +1900,12 @@ static void log_piece(piece_log *lg, const path *pa, const gv *A, int64_t ta, co
     e->off = pc->off;
     e->bounded = (int32_t)((pa->interp != 0) & (pc->lwp != NULL)); /* check_piece bounds these */
 }
+#define LOGGING(lg) ((lg) != NULL)
+#else
+/* no log in a flight build: ct_earth_pieces is a test hook */
+#define LOGGING(lg) ((void)(lg), 0)
+#define log_piece(lg, pa, A, ta, pc) ((void)0)
+#endif
 
 /* The line of sight as pieces of lowered walks from the camera: each piece
  * chosen (next_piece), traced unless off the tile (trace_piece), until a
@@ -1943,7 +1958,7 @@ static ct_status earth_walk(const ct_package *p, ct_tileset *ts, const ct_earth 
             h->iters = iters;
             return st; /* CT_MISS: beyond the projection's domain */
         }
-        if (lg != NULL) {
+        if (LOGGING(lg)) {
             log_piece(lg, &pa, &A, ta, &pc);
         } else if (!pc.off && !(es->cull && piece_culled(p, &pc.As, &pc.Bs, pc.dB))) {
             st = trace_piece(p, ts, &pc.As, &pc.Bs, &pc.f, pc.lwp, pc.dB, first, m, h, &steps, &iters);
@@ -1983,6 +1998,7 @@ ct_status ct_trace_earth_set(const ct_package *p, ct_tileset *ts, const ct_earth
     return earth_walk(p, ts, es, dg, m, h, NULL);
 }
 
+#if CT_TEST_HOOKS
 ct_status ct_earth_pieces(const ct_package *p, const ct_earth *es, const int64_t dg[3], ct_earth_piece *out,
                           uint32_t cap, uint32_t *n)
 {
@@ -1999,3 +2015,4 @@ ct_status ct_earth_pieces(const ct_package *p, const ct_earth *es, const int64_t
     *n = lg.n;
     return st;
 }
+#endif

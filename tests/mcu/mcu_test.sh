@@ -72,7 +72,7 @@ symbols)
 symbols-selftest)
     need_arm; need_python; need_built
     exec "$PY" "$HERE/check_symbols.py" --nm "${PREFIX}nm" --objdump "${PREFIX}objdump" \
-        --expect heap,stdio,float "$DIR/libbad_flight.a"
+        --expect heap,stdio,float,testhook "$DIR/libbad_flight.a"
     ;;
 stack)
     need_arm; need_python; need_built
