@@ -2010,12 +2010,15 @@ void test_level_rise_refused()
 // the default (1 mm) is CT_ERR_EFFECTS and none hits; the piece log ends
 // with that status and holds no piece over its tolerance; at 0.8 mm every
 // pixel's status is the default's (a hit within 5 mm of its hit: two
-// chords' bounds and the walk's rounding on slopes).
+// chords' bounds and the walk's rounding on slopes); at 0.1 mm a pixel is
+// refused (the nadir poses: a piece whose bound stays just above the
+// tolerance through all its shortenings) or as at 1 mm (a hit within 1 cm:
+// 5.1 mm on a steep slope under a nadir pose).
 void test_chord_too_fine()
 {
     World *w = jacksboro();
     Cam cam = make_camera();
-    long pixels = 0, hits = 0, refused = 0, wrong = 0, agree = 0;
+    long pixels = 0, hits = 0, refused = 0, wrong = 0, agree = 0, fine_refused = 0, fine_bad = 0;
     static ct_earth_piece pcs[2048];
     for (const PoseDef &d : pose_defs()) {
         Pose p;
@@ -2027,7 +2030,7 @@ void test_chord_too_fine()
                 uv.push_back((int64_t)iv << 16);
             }
         const size_t n = uv.size() / 2;
-        std::vector<ct_geo> g1(n), gf(n), g08(n);
+        std::vector<ct_geo> g1(n), gf(n), g08(n), g01(n);
         ct_effects fx = {CT_EFFECT_CURVATURE | CT_EFFECT_REFRACTION, CT_REFRACTION_K_STD_Q16, 0, 0, nullptr};
         TEST_ASSERT_EQUAL_INT(CT_OK, ct_geolocate_batch(&w->p, &cam.cam, &p.pose, CT_METHOD_DIRECTIONAL, &fx,
                                                         uv.data(), n, g1.data(), n));
@@ -2037,6 +2040,9 @@ void test_chord_too_fine()
         fx.chord_nm = 800000;
         TEST_ASSERT_EQUAL_INT(CT_OK, ct_geolocate_batch(&w->p, &cam.cam, &p.pose, CT_METHOD_DIRECTIONAL, &fx,
                                                         uv.data(), n, g08.data(), n));
+        fx.chord_nm = 100000;
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_geolocate_batch(&w->p, &cam.cam, &p.pose, CT_METHOD_DIRECTIONAL, &fx,
+                                                        uv.data(), n, g01.data(), n));
         for (size_t k = 0; k < n; ++k) {
             pixels++;
             const bool hit1 = g1[k].status == CT_HIT || g1[k].status == CT_HIT_VOID;
@@ -2046,6 +2052,12 @@ void test_chord_too_fine()
             const ld de = (ld)(g08[k].hit.e_nm - g1[k].hit.e_nm), dn = (ld)(g08[k].hit.n_nm - g1[k].hit.n_nm),
                      dh = (ld)(g08[k].hit.h_nm - g1[k].hit.h_nm);
             agree += g08[k].status == g1[k].status && (!hit1 || std::sqrt(de * de + dn * dn + dh * dh) <= 5e6L);
+            // at 0.1 mm: refused, or as at 1 mm
+            const ld fe = (ld)(g01[k].hit.e_nm - g1[k].hit.e_nm), fn = (ld)(g01[k].hit.n_nm - g1[k].hit.n_nm),
+                     fh = (ld)(g01[k].hit.h_nm - g1[k].hit.h_nm);
+            fine_refused += g01[k].status == CT_ERR_EFFECTS;
+            fine_bad += g01[k].status != CT_ERR_EFFECTS &&
+                        (g01[k].status != g1[k].status || (hit1 && std::sqrt(fe * fe + fn * fn + fh * fh) > 1e7L));
         }
         // the piece log of a line of sight through the image's middle
         ct_earth es;
@@ -2061,8 +2073,9 @@ void test_chord_too_fine()
         TEST_ASSERT_MSG(st == CT_ERR_EFFECTS || st == CT_MISS, "pose %s: piece log status %d", d.family, (int)st);
     }
     std::printf("  chord 2^10 nm on the true Earth: %ld pixels, %ld hit at 1 mm, %ld refused (CT_ERR_EFFECTS), %ld "
-                "wrong; at 0.8 mm %ld of %ld as at 1 mm\n", pixels, hits, refused, wrong, agree, pixels);
-    TEST_ASSERT(wrong == 0 && hits > 100 && refused >= hits && agree == pixels);
+                "wrong; at 0.8 mm %ld of %ld as at 1 mm; at 0.1 mm %ld refused, the others as at 1 mm but %ld\n",
+                pixels, hits, refused, wrong, agree, pixels, fine_refused, fine_bad);
+    TEST_ASSERT(wrong == 0 && hits > 100 && refused >= hits && agree == pixels && fine_bad == 0);
 }
 
 void test_exact_curvature() { compare(CT_EFFECT_CURVATURE); }
