@@ -2005,8 +2005,9 @@ void test_level_rise_refused()
 // that do not shrink with its length -- on the camera's own piece (a camera
 // over the tile) the camera's rounding to its Q16 grid point, up to 258 Q24
 // units, 0.46 mm at 30 m posts: chords below about 0.62 mm (of which the
-// checks aim at 3/4) cannot be proven there, and none of 2^10 nm, the
-// finest ct_effects accepts, anywhere.  At 2^10 nm every pixel that hits at
+// checks aim at 3/4) may not be proven there, where that rounding is at
+// its largest, and none of 2^10 nm, the finest ct_effects accepts,
+// anywhere.  At 2^10 nm every pixel that hits at
 // the default (1 mm) is CT_ERR_EFFECTS and none hits; the piece log ends
 // with that status and holds no piece over its tolerance; at 0.8 mm every
 // pixel's status is the default's (a hit within 5 mm of its hit: two

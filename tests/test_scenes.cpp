@@ -459,10 +459,11 @@ void test_effect_selection()
             // simulated on this UTM package) at that chord against a fine one
             // stay within what the set's bound leaves of the tolerance (no
             // promise where a level ray reaches the tile: tan_min 0).  The
-            // fine one is the default, 1 mm: finer chords are refused where
-            // the camera is over the tile (its own rounding to a Q16 grid
-            // point, 0.46 mm at 30 m posts, counts against the chord of its
-            // own piece: test_earth test_chord_too_fine)
+            // fine one is the default, 1 mm: finer chords may be refused (a
+            // piece's bound keeps rounding terms -- the camera's Q16 grid
+            // point on its own piece, 0.46 mm at 30 m posts, the vertices'
+            // in height -- that no shortening removes: test_earth
+            // test_chord_too_fine)
             if ((ch.flags & CT_EFFECT_CURVATURE) && tol >= 0.01 && ch.tan_min_q30 > 0) {
                 ct_effects a = both, b = both;
                 a.flags = b.flags = ch.flags;
