@@ -580,13 +580,15 @@ static void geoloc_mode(const ct_vec_package *vp, const uint8_t *d, size_t n)
         B[1] = pkg.origin_n_nm + (int64_t)(int32_t)(pix >> 32) * 4096;
         B[2] = (int64_t)(b % INT64_C(4000000000000));
         l0 = ct_los(&pkg, A, B, &fx, (e >> 50) & 0xffffff, CT_METHOD_INCREMENTAL, &h0);
-        CHECK(l0 == CT_OK || l0 == CT_HIT || l0 == CT_BELOW || l0 == CT_ERR_RAY || l0 == CT_ERR_EFFECTS);
+        CHECK(l0 == CT_OK || l0 == CT_HIT || l0 == CT_BELOW || l0 == CT_ERR_RAY || l0 == CT_ERR_EFFECTS ||
+              l0 == CT_ERR_RANGE);
         for (m = 1; m < CT_METHOD_COUNT; ++m) { /* bound: 4 methods */
             l1 = ct_los(&pkg, A, B, &fx, (e >> 50) & 0xffffff, (ct_method)m, &h1);
             CHECK(l1 == l0);
         }
         l1 = ct_locate_inverse(&pkg, &cam, &pose, &fx, B, 0, &u2, &v2, &vis, &h1);
-        CHECK(l1 == CT_OK || l1 == CT_ERR_UNPROJECT || l1 == CT_ERR_RAY || l1 == CT_ERR_EFFECTS || l1 == CT_BELOW);
+        CHECK(l1 == CT_OK || l1 == CT_ERR_UNPROJECT || l1 == CT_ERR_RAY || l1 == CT_ERR_EFFECTS || l1 == CT_BELOW ||
+              l1 == CT_ERR_RANGE);
         CHECK(vis <= 1u);
     }
     {
