@@ -162,6 +162,16 @@ ct_status ct_grid_frame_ecef(const ct_utm *zone, int64_t e_nm, int64_t n_nm, int
 ct_status ct_earth_setup(const ct_package *pkg, const ct_pose *pose, int32_t refr_k_q16, int64_t radius_nm,
                          int64_t chord_nm, uint32_t bend_flags, int fitted, const ct_earth_map *map, ct_earth *es);
 
+/* The UTM zone of a package's EPSG code (a 32-bit unsigned header field):
+ * CT_OK, or CT_ERR_CRS for any other CRS, codes beyond INT32_MAX too.    */
+static inline ct_status ct_package_zone(const ct_package *pkg, ct_utm *z)
+{
+    if (pkg->epsg > 0x7fffffffu || ct_utm_zone_of_epsg((int32_t)pkg->epsg, z) != CT_OK) {
+        return CT_ERR_CRS;
+    }
+    return CT_OK;
+}
+
 /* 1 when `map` is a fitted map for this package's georeference.          */
 int ct_earth_map_fits(const ct_package *pkg, const ct_earth_map *map);
 

@@ -536,7 +536,7 @@ ct_status ct_earth_map_init(const ct_package *p, int64_t e_nm, int64_t n_nm, int
     }
     mp->ready = 0u;
     mp->deg = 0;
-    if (p->epsg > 0x7fffffffu || ct_utm_zone_of_epsg((int32_t)p->epsg, &zone) != CT_OK) {
+    if (ct_package_zone(p, &zone) != CT_OK) {
         return CT_ERR_CRS;
     }
     q = cube_q(radius_nm);
@@ -1087,7 +1087,7 @@ ct_status ct_earth_setup(const ct_package *p, const ct_pose *pose, int32_t refr_
     if (p == NULL || pose == NULL || es == NULL) {
         return CT_ERR_ARG;
     }
-    if (p->epsg > 0x7fffffffu || ct_utm_zone_of_epsg((int32_t)p->epsg, &es->zone) != CT_OK) {
+    if (ct_package_zone(p, &es->zone) != CT_OK) {
         return CT_ERR_CRS;
     }
     st = ct_grid_frame_ecef(&es->zone, pose->e_nm, pose->n_nm, &lat, &lon, es->frame_q30);
@@ -1859,13 +1859,12 @@ CT_NOINLINE static int64_t first_length(const path *pa, const ct_earth *es, int 
 }
 
 /* The pieces' record for ct_earth_pieces (a test hook, compiled with
- * CT_TEST_HOOKS only): NULL when tracing. */
+ * CT_TEST_HOOKS only): NULL when tracing, and always in a flight build. */
 typedef struct {
     ct_earth_piece *out;
     uint32_t cap, n;
 } piece_log;
 
-#if CT_TEST_HOOKS
 static void log_piece(piece_log *lg, const path *pa, const gv *A, int64_t ta, const piece *pc)
 {
     ct_earth_piece *e;
@@ -1900,12 +1899,6 @@ static void log_piece(piece_log *lg, const path *pa, const gv *A, int64_t ta, co
     e->off = pc->off;
     e->bounded = (int32_t)((pa->interp != 0) & (pc->lwp != NULL)); /* check_piece bounds these */
 }
-#define LOGGING(lg) ((lg) != NULL)
-#else
-/* no log in a flight build: ct_earth_pieces is a test hook */
-#define LOGGING(lg) ((void)(lg), 0)
-#define log_piece(lg, pa, A, ta, pc) ((void)0)
-#endif
 
 /* The line of sight as pieces of lowered walks from the camera: each piece
  * chosen (next_piece), traced unless off the tile (trace_piece), until a
@@ -1958,7 +1951,7 @@ static ct_status earth_walk(const ct_package *p, ct_tileset *ts, const ct_earth 
             h->iters = iters;
             return st; /* CT_MISS: beyond the projection's domain */
         }
-        if (LOGGING(lg)) {
+        if (CT_TEST_HOOKS && lg != NULL) { /* a flight build has no log: the compiler drops it */
             log_piece(lg, &pa, &A, ta, &pc);
         } else if (!pc.off && !(es->cull && piece_culled(p, &pc.As, &pc.Bs, pc.dB))) {
             st = trace_piece(p, ts, &pc.As, &pc.Bs, &pc.f, pc.lwp, pc.dB, first, m, h, &steps, &iters);
@@ -1969,7 +1962,6 @@ static ct_status earth_walk(const ct_package *p, ct_tileset *ts, const ct_earth 
         steps++;
         iters++;
         if (gone(p, &A, &pc.B, &pc.M, &pc.f)) {
-            ta = tend;
             break;
         }
         L = next_length(es, &pc);
@@ -1981,9 +1973,10 @@ static ct_status earth_walk(const ct_package *p, ct_tileset *ts, const ct_earth 
     h->x_q16 = h->y_q16 = h->z_q16 = 0;
     h->e_nm = h->n_nm = h->h_nm = 0;
     h->cell_x = h->cell_y = -1;
-    /* EARTH_MAX_PIECES pieces while the path goes on over the tile: not a
-     * miss (a chord too fine for the path's length) */
-    return ta < tend ? CT_ERR_RANGE : CT_MISS;
+    /* EARTH_MAX_PIECES pieces while the path goes on over the tile (not
+     * gone, which breaks out before n reaches the bound): not a miss (a
+     * chord too fine for the path's length) */
+    return n == EARTH_MAX_PIECES && ta < tend ? CT_ERR_RANGE : CT_MISS;
 }
 
 ct_status ct_trace_earth_set(const ct_package *p, ct_tileset *ts, const ct_earth *es, const int64_t dg[3], ct_method m,

@@ -810,7 +810,7 @@ ct_status ct_package_geoid(const ct_package *pkg, int64_t e_nm, int64_t n_nm, in
     if (pkg == NULL || n_geoid_nm == NULL) {
         return CT_ERR_ARG;
     }
-    if (pkg->epsg > 0x7fffffffu || ct_utm_zone_of_epsg((int32_t)pkg->epsg, &z) != CT_OK) {
+    if (ct_package_zone(pkg, &z) != CT_OK) {
         return CT_ERR_CRS;
     }
     st = ct_utm_inverse(&z, e_nm, n_nm, &lat, &lon);

@@ -403,8 +403,7 @@ ct_status ct_effects_for_tolerance(const ct_package *p, const ct_camera *cam, co
                          : ct_i128_floor_div_sat(ct_i128_mul(ct_max64(rest, 0), ct_min64(out->tan_min_q30, INT64_C(1) << 30)),
                                                  INT64_C(1) << 30);
         out->chord_nm = ct_max64(INT64_C(1) << 10, ct_min64(INT64_C(1) << 50, ch));
-        if ((out->flags & CT_EFFECT_CURVATURE) != 0u && radius_nm == 0 && p->epsg <= 0x7fffffffu &&
-            ct_utm_zone_of_epsg((int32_t)p->epsg, &zone) == CT_OK) {
+        if ((out->flags & CT_EFFECT_CURVATURE) != 0u && radius_nm == 0 && ct_package_zone(p, &zone) == CT_OK) {
             /* the true Earth: its pieces' bounds keep terms that do not
              * shrink with a piece (the camera's Q16 grid point on its own
              * piece, the vertices' rounding), so a finer chord than the
