@@ -181,17 +181,20 @@ int main(int argc, char **argv)
             double best = 1e30;
             for (int b = 0; b < profile; ++b)
                 best = std::min(best, geolocate(*w, uv, prof_m, pf, &gg, &grid_cam).ns);
-            // a digest of every result, to compare two builds' bits
+            // a digest of every result (not the steps: a batch's runs
+            // share their first stretch), to compare two builds' bits
             uint64_t digest = 1469598103934665603u;
+            double steps = 0;
             for (const ct_geo &g : gg) {
-                const int64_t v[6] = {(int64_t)g.status, g.hit.x_q16, g.hit.y_q16, g.hit.z_q16, g.hit.t_q26,
-                                      (int64_t)g.hit.steps};
+                const int64_t v[10] = {(int64_t)g.status, g.hit.x_q16, g.hit.y_q16, g.hit.z_q16, g.hit.t_q26,
+                                       g.hit.e_nm, g.hit.n_nm, g.hit.h_nm, g.hit.cell_x, g.hit.cell_y};
                 for (int64_t x : v) digest = (digest ^ (uint64_t)x) * 1099511628211u;
+                steps += g.hit.steps;
             }
-            std::printf("%s: whole image, 8 px grid, %s, effects %s: %.0f ns per pixel (best of %d), results "
-                        "digest %016llx\n",
+            std::printf("%s: whole image, 8 px grid, %s, effects %s: %.0f ns per pixel (best of %d), %.1f steps, "
+                        "results digest %016llx\n",
                         name, prof_m == CT_METHOD_DIRECTIONAL ? "directional" : "incremental", prof_fx.c_str(), best,
-                        profile, (unsigned long long)digest);
+                        profile, steps / (double)std::max<size_t>(1, gg.size()), (unsigned long long)digest);
             delete w;
             continue;
         }

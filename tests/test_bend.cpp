@@ -9,6 +9,7 @@
 // same sandwich, the four methods must agree bit for bit, and the bending
 // must matter (hits differ from the straight ray's).
 #include <cmath>
+#include <cstring>
 #include <vector>
 
 #include "bend.h"
@@ -744,6 +745,109 @@ void test_lowered_tangency()
     }
 }
 
+// ct_trace_run (the runs of ct_geolocate_batch) against each ray's own
+// trace, on rays aimed at spikes' tops.  Smooth terrain with single-post
+// spikes 50-150 m tall; an observer inside the tile or up to 50 cells
+// outside, high above the terrain or level with the spike's top (within
+// 30 m: a nearly level ray, whose height changes little across a cell or
+// a block, so the bounds' margin is small); runs of 8 rays aimed at the
+// spike's top (the lowered top with curvature) raised by a common offset
+// within +-1 m, 10 cm, 1 cm or 1 mm plus each ray's own jitter of a tenth
+// of that, and as far sideways as the spike's flank falls by about that
+// much.  The runs' shared walk must stop short of the spike exactly when a
+// ray of the run would meet it: a bound too loose by 8 mm fails this test.
+// Straight rays and the lowered model (spheres of 2^50 and 2^48 nm, the
+// lowering 5.7x and 23x the Earth's), the four methods: every status and
+// hit equal to the ray's own trace but for steps and iters, and the runs
+// engage (a run's rays take fewer steps in total than their own walks in
+// most runs).
+void test_runs_vs_own_trace()
+{
+    const int w = 300, h = 260;
+    std::vector<uint16_t> z = dem_cases::smooth(w, h, 31, 100, 2000);
+    ct_rng rng;
+    ct_rng_seed(&rng, ct_test_seed() * 7 + 3);
+    std::vector<std::pair<int, int>> spikes;
+    for (int k = 0; k < 120; ++k) {
+        const int i = (int)ct_rng_range(&rng, 2, w - 3), j = (int)ct_rng_range(&rng, 2, h - 3);
+        z[(size_t)j * w + i] = (uint16_t)(z[(size_t)j * w + i] + ct_rng_range(&rng, 400, 1200));
+        spikes.push_back({i, j});
+    }
+    const dem_cases::Case cs = dem_cases::make_case("spikes", dem_cases::make_terrain(w, h, z, 0.125), 16, 3);
+    ct_package p;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_package_open(&p, cs.pkg.data(), cs.pkg.size()));
+    long runs = 0, rays = 0, engaged = 0, hits = 0, differ = 0, lowered_runs = 0;
+    const long trials = (long)(400 * ct_test_scale());
+    for (long tr = 0; tr < trials; ++tr) {
+        const int64_t ox = ct_rng_range(&rng, -50, w + 50) * 65536 + ct_rng_range(&rng, 0, 65535);
+        const int64_t oy = ct_rng_range(&rng, -50, h + 50) * 65536 + ct_rng_range(&rng, 0, 65535);
+        const auto sp = spikes[(size_t)ct_rng_range(&rng, 0, (int64_t)spikes.size() - 1)];
+        const int64_t tx = (int64_t)sp.first * 65536, ty = (int64_t)sp.second * 65536;
+        const int64_t top = (int64_t)z[(size_t)sp.second * w + sp.first] * 65536;
+        const int64_t oz = tr % 2 ? (int64_t)(p.hmax + ct_rng_range(&rng, 50, 4000)) * 65536
+                                  : top + ct_rng_range(&rng, 0, 240) * 65536;
+        static const int64_t scales[4] = {8 * 65536, 52429, 5243, 524};  // 1 m, 10 cm, 1 cm, 1 mm in Q16 LSB (1/8 m)
+        const int64_t sc = scales[(tr / 2) % 4];
+        const int64_t base = ct_rng_range(&rng, -sc, sc);
+        for (int fx = 0; fx < 3; ++fx) {
+            ct_lower lw;
+            const ct_lower *plw = nullptr;
+            int64_t drop = 0;
+            if (fx > 0) {
+                ct_bend bd;
+                bd.coeff_q16 = 65536;
+                bd.radius_nm = INT64_C(1) << (fx == 1 ? 50 : 48);
+                bd.chord_nm = CT_EFFECTS_CHORD_NM;
+                bd.flags = 0u;
+                if (ct_lower_setup(&p, ox, oy, &bd, &lw) != CT_OK) continue;
+                plw = &lw;
+                drop = ct_lower_at(&lw, tx, ty);
+                lowered_runs++;
+            }
+            ct_prepared r[CT_RUN_MAX];
+            uint32_t n = 0;
+            for (uint32_t k = 0; k < CT_RUN_MAX; ++k) {
+                const int64_t ex = tx + ct_rng_range(&rng, -sc / 64, sc / 64), ey = ty + ct_rng_range(&rng, -sc / 64, sc / 64);
+                const int64_t ez = top - drop + base + ct_rng_range(&rng, -sc / 10, sc / 10);
+                const ct_ray ray = {ox, oy, oz, ex - ox, ey - oy, ez - oz};
+                if (ct_prepare_lowered(&p, &ray, 0, plw, &r[n]) == CT_OK) n++;
+            }
+            if (n == 0) continue;
+            for (int m = 0; m < CT_METHOD_COUNT; ++m) {
+                ct_hit own[CT_RUN_MAX], run[CT_RUN_MAX];
+                ct_hit *hp[CT_RUN_MAX];
+                ct_status so[CT_RUN_MAX], sr[CT_RUN_MAX];
+                long steps_own = 0, steps_run = 0;
+                for (uint32_t k = 0; k < n; ++k) {
+                    so[k] = ct_trace_prepared_lowered(&p, &r[k], plw, (ct_method)m, &own[k]);
+                    hp[k] = &run[k];
+                    steps_own += own[k].steps;
+                }
+                TEST_ASSERT_EQUAL_INT(CT_OK, ct_trace_run(&p, r, n, plw, (ct_method)m, hp, sr));
+                for (uint32_t k = 0; k < n; ++k) {
+                    ct_hit a = own[k], b = run[k];
+                    a.steps = b.steps = a.iters = b.iters = 0;
+                    const bool same = so[k] == sr[k] && std::memcmp(&a, &b, sizeof a) == 0;
+                    differ += !same;
+                    TEST_ASSERT_MSG(same, "trial %ld effects %d method %d ray %u: run status %d (%lld, %lld), own %d "
+                                    "(%lld, %lld)", tr, fx, m, k, sr[k], (long long)run[k].x_q16,
+                                    (long long)run[k].y_q16, so[k], (long long)own[k].x_q16, (long long)own[k].y_q16);
+                    hits += so[k] == CT_HIT;
+                    steps_run += run[k].steps;
+                }
+                runs++;
+                rays += n;
+                engaged += steps_run < steps_own;
+            }
+        }
+    }
+    printf("  %ld runs (%ld lowered), %ld rays, %ld hits; the run shortened the walks in %ld runs\n", runs,
+           lowered_runs, rays, hits, engaged);
+    TEST_ASSERT_EQUAL_INT(0, differ);
+    TEST_ASSERT(lowered_runs > trials);
+    TEST_ASSERT_MSG(2 * engaged > runs, "runs engaged in only %ld of %ld", engaged, runs);
+}
+
 int main()
 {
     TEST_BEGIN("test_bend");
@@ -755,6 +859,7 @@ int main()
     RUN_TEST(test_bent_vs_reference);
     RUN_TEST(test_bent_edge_packages);
     RUN_TEST(test_lowered_tangency);
+    RUN_TEST(test_runs_vs_own_trace);
     RUN_TEST(test_bent_saturated_vertices);
     RUN_TEST(test_bent_start_below_after_entered);
     return TEST_END();

@@ -23,6 +23,8 @@
 //   - the ray the library traces is within 5e-9 rad + 2^-15 px / f of the exact apparent
 //     line of sight (pixel round trip through mrcal);
 //   - the four methods and the batch form give identical hits with effects;
+//     the batch's runs (whole rows, in order, reversed and shuffled) give
+//     ct_geolocate's records in every field but the steps;
 //   - the error budget: the library run *without* each listed effect
 //     (distortion: the same camera as a pinhole) fails the acceptance above
 //     (the effect is needed), and each effect the scene does not list
@@ -45,6 +47,19 @@ namespace {
 using scene::ld;
 
 const char *kScenes[] = {"nadir", "oblique30", "grazing3", "long30km", "wide_opencv8"};
+
+// Two geolocation records equal in every field but the hit's steps and
+// iters (a batch's runs: those count the pixel's own walk).
+bool same_but_steps(const ct_geo &a, const ct_geo &b)
+{
+    ct_hit ha = a.hit, hb = b.hit;
+    ha.steps = hb.steps = 0;
+    ha.iters = hb.iters = 0;
+    return a.status == b.status && a.unproject_iters == b.unproject_iters &&
+           std::memcmp(a.ray_cam_q30, b.ray_cam_q30, sizeof a.ray_cam_q30) == 0 &&
+           std::memcmp(a.dir_map_q39, b.dir_map_q39, sizeof a.dir_map_q39) == 0 &&
+           std::memcmp(&ha, &hb, sizeof ha) == 0;
+}
 
 scene::World *world(const std::string &name)
 {
@@ -249,9 +264,95 @@ void test_scene_accuracy()
         TEST_ASSERT_EQUAL_INT(CT_OK, ct_geolocate_batch(&w->p, &w->cam.cam, &w->cam.pose, CT_METHOD_DIRECTIONAL, &fx,
                                                         uv.data(), smp.size(), batch.data(), batch.size()));
         for (size_t k = 0; k < smp.size(); ++k)
-            TEST_ASSERT(std::memcmp(&batch[k].hit, &geo[k].hit, sizeof(ct_hit)) == 0 && batch[k].status == geo[k].status);
+            TEST_ASSERT(same_but_steps(batch[k], geo[k]));
     }
     TEST_ASSERT_EQUAL_INT(0, total_wrong);
+}
+
+// A batch's runs (ct_geolocate_batch on one package, straight rays or the
+// lowered model, every method but the incremental one): whole rows of each
+// scene's image, so that consecutive pixels' rays run side by side, and the
+// same rows reversed and shuffled.  Every record equals ct_geolocate's for
+// that pixel in every field but hit.steps and hit.iters (the pixel's own
+// walk); the runs engage (the batch's cone walks take fewer steps than the
+// pixels' own, by at least a third on the oblique and grazing scenes, where
+// rays are long) and the incremental method's batch takes exactly its
+// per-pixel steps (no runs: the reference walk).
+void test_batch_runs()
+{
+    for (const char *name : kScenes) {
+        scene::World *w = world(name);
+        // none, the scene's, and curvature on a small sphere (2^50 nm =
+        // 1,126 km: the lowering 5.7x the Earth's)
+        for (int with_fx = 0; with_fx < 3; ++with_fx) {
+            ct_effects fx = scene::lib_effects(w->s, w->s.effects);
+            if (with_fx == 2) fx = ct_effects{CT_EFFECT_CURVATURE, 0, INT64_C(1) << 50, 0, nullptr};
+            const ct_effects *pf = with_fx ? &fx : nullptr;
+            std::vector<int64_t> uv;
+            const unsigned rows = (unsigned)std::max(3.0, 12 * ct_test_scale());
+            for (unsigned r = 0; r < rows; ++r) {
+                int64_t v = (int64_t)((r + 0.5) * w->s.height / rows * 65536.0);
+                for (unsigned u = 0; u < w->s.width; u += 1 + (r % 3)) {  // spacing 1, 2 and 3 px
+                    uv.push_back((int64_t)u * 65536 + 32768 * (r & 1));
+                    uv.push_back(v);
+                }
+            }
+            const size_t n = uv.size() / 2;
+            std::vector<ct_geo> single(n);
+            long own = 0;
+            for (size_t k = 0; k < n; ++k) {
+                ct_geolocate(&w->p, &w->cam.cam, &w->cam.pose, CT_METHOD_DIRECTIONAL, pf, uv[2 * k], uv[2 * k + 1],
+                             &single[k]);
+                own += single[k].hit.steps;
+            }
+            for (int order = 0; order < 3; ++order) {
+                // 0: rows in order, 1: reversed, 2: shuffled
+                std::vector<size_t> ix(n);
+                for (size_t k = 0; k < n; ++k) ix[k] = order == 1 ? n - 1 - k : k;
+                if (order == 2) {
+                    uint64_t st = ct_test_seed() * 77 + 5;
+                    for (size_t k = n - 1; k > 0; --k) {
+                        st = st * 6364136223846793005ull + 1442695040888963407ull;
+                        std::swap(ix[k], ix[(size_t)(st >> 33) % (k + 1)]);
+                    }
+                }
+                std::vector<int64_t> uvo(2 * n);
+                for (size_t k = 0; k < n; ++k) {
+                    uvo[2 * k] = uv[2 * ix[k]];
+                    uvo[2 * k + 1] = uv[2 * ix[k] + 1];
+                }
+                for (int m = 0; m < CT_METHOD_COUNT; ++m) {
+                    std::vector<ct_geo> batch(n);
+                    TEST_ASSERT_EQUAL_INT(CT_OK, ct_geolocate_batch(&w->p, &w->cam.cam, &w->cam.pose, (ct_method)m, pf,
+                                                                    uvo.data(), n, batch.data(), n));
+                    long steps = 0, differ = 0;
+                    for (size_t k = 0; k < n; ++k) {
+                        differ += !same_but_steps(batch[k], single[ix[k]]);
+                        steps += batch[k].hit.steps;
+                    }
+                    TEST_ASSERT_MSG(differ == 0, "%s, effects %d, order %d, method %d: %ld of %zu records differ",
+                                    name, with_fx, order, m, differ, n);
+                    if (m == CT_METHOD_INCREMENTAL) {
+                        long inc = 0;
+                        for (size_t k = 0; k < n; ++k) {
+                            ct_geo g;
+                            ct_geolocate(&w->p, &w->cam.cam, &w->cam.pose, CT_METHOD_INCREMENTAL, pf, uvo[2 * k],
+                                         uvo[2 * k + 1], &g);
+                            inc += g.hit.steps;
+                        }
+                        TEST_ASSERT_EQUAL_INT(inc, steps);
+                    } else if (m == CT_METHOD_DIRECTIONAL && order == 0) {
+                        printf("  %-13s %s: %zu pixels in rows, %.2f steps per pixel in the batch, %.2f alone\n",
+                               name, with_fx == 0 ? "straight" : (with_fx == 1 ? "scene's effects" : "small sphere"), n,
+                               (double)steps / n, (double)own / n);
+                        if (std::string(name) == "oblique30" || std::string(name) == "grazing3")
+                            TEST_ASSERT_MSG(3 * steps <= 2 * own, "%s: the runs did not engage (%ld vs %ld steps)",
+                                            name, steps, own);
+                    }
+                }
+            }
+        }
+    }
 }
 
 std::string cell(const Acc &a)
@@ -530,6 +631,7 @@ int main()
     TEST_BEGIN("test_scenes");
     RUN_TEST(test_scene_files);
     RUN_TEST(test_scene_accuracy);
+    RUN_TEST(test_batch_runs);
     RUN_TEST(test_error_budget);
     RUN_TEST(test_effect_selection);
     RUN_TEST(test_locate_inverse);

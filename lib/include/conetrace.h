@@ -1065,9 +1065,23 @@ ct_status ct_geolocate(const ct_package *pkg, const ct_camera *cam,
                        const ct_effects *effects, int64_t u_q16,
                        int64_t v_q16, ct_geo *out);
 
-/* Many pixels, each result bit-identical to ct_geolocate's; the per-call
- * set-up (argument checks, the camera centre in the grid frame, the bend's
- * or the true Earth's set-up) is done once.
+/* Many pixels, each result bit-identical to ct_geolocate's but for
+ * hit.steps and hit.iters where runs apply (below); the per-call set-up
+ * (argument checks, the camera centre in the grid frame, the bend's or the
+ * true Earth's set-up) is done once.
+ * Runs: on one package with straight rays or the lowered model (effects
+ * off, or c > 0 on a sphere; not the true Earth nor the polyline) and
+ * every method but CT_METHOD_INCREMENTAL (the plain reference walk), the
+ * pixels go in runs of up to 8 consecutive ones.  Where the run's rays
+ * share a horizontal axis and direction and each crosses the tile's
+ * relief over at least 16 cells, one max-mipmap walk over bounds holding
+ * all their paths shows a first stretch free of the surface for all of
+ * them (at most 2 w + levels + 2 iterations, w the tile's cells along that
+ * axis; for a run too wide to show anything, once more for each half),
+ * and each pixel's walk starts where that stretch ends.  Every status and
+ * hit is as ct_geolocate's; hit.steps and hit.iters count the pixel's own
+ * walk only.  Consecutive pixels of an image row (or column) make good
+ * runs; in any order the results are the same.
  *   [in]  pkg .. effects  as ct_geolocate.
  *   [in]  uv_q16          pixel k at uv_q16[2k], uv_q16[2k + 1], Q16 px.
  *   [in]  count           pixels.

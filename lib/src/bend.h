@@ -84,6 +84,29 @@ int64_t ct_lower_at(const ct_lower *lw, int64_t x, int64_t y);
 ct_status ct_trace_lowered(const ct_package *pkg, const ct_ray *ray, const ct_lower *lw, ct_method method,
                            ct_hit *hit);
 
+/* Ray preparation (prepare.c) for a straight ray or segment (seg) or, with
+ * lw, a bent ray's tangent against the lowered terrain. */
+ct_status ct_prepare_lowered(const ct_package *p, const ct_ray *ray, int seg, const ct_lower *lw, ct_prepared *out);
+
+/* Rays from one observer traced together (geoloc.c's batch): n <=
+ * CT_RUN_MAX prepared rays r[k] (lw: the lowered terrain of all, or NULL:
+ * straight), each one's status in st[k] and hit in *h[k], the same as
+ * its own trace from t = 0 (ct_trace_prepared_own / _lowered) in every
+ * field but steps and iters, which count only the ray's own walk.  Where
+ * the rays' paths share a primary axis, one walk of the max-mipmap over
+ * their common bounds shows a first stretch free of the surface for all
+ * of them (at most 2 w + levels + 2 iterations, w the tile's cells along
+ * that axis); each ray's walk then starts on the face where it ends, as
+ * a tile set's walk starts on a seam.  CT_ERR_ARG for a NULL argument or
+ * n > CT_RUN_MAX, else CT_OK.                                             */
+#define CT_RUN_MAX 8u
+ct_status ct_trace_run(const ct_package *pkg, const ct_prepared *r, uint32_t n, const ct_lower *lw, ct_method method,
+                       ct_hit *const *h, ct_status *st);
+
+/* 1 when ct_trace_bent_set_ts traces ray with the lowered model (bs->lowered,
+ * a ray from the observer that is not vertical and within its ranges).    */
+int ct_bent_takes_lowered(const ct_ray *ray, const ct_bent_setup *bs);
+
 /* A segment (origin to origin + direction) of a lowered ray: prepared as
  * ct_ray_prepare_segment, traced against the lowered terrain (lw = NULL:
  * the terrain itself).  A hit in the last cell beyond the segment's end

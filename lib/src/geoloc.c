@@ -116,12 +116,11 @@ static ct_status setup(const ct_package *p, const ct_camera *cam, const ct_pose 
     return CT_OK;
 }
 
-/* ts != NULL: trace over the tile set (p is its frame). */
-static ct_status one_pixel(const ct_package *p, ct_tileset *ts, const ct_camera *cam, const ct_pose *pose, ct_method m,
-                           const geo_setup *s, int64_t u, int64_t v, ct_geo *out)
+/* The pixel's record cleared, its ray unprojected and rotated into the
+ * map frame (out->ray_cam_q30, out->dir_map_q39). */
+static ct_status pixel_dir(const ct_camera *cam, const ct_pose *pose, int64_t u, int64_t v, ct_geo *out)
 {
     ct_status st;
-    ct_ray ray;
     uint32_t k;
     /* bound: 3 components */
     for (k = 0u; k < 3u; ++k) {
@@ -137,22 +136,36 @@ static ct_status one_pixel(const ct_package *p, ct_tileset *ts, const ct_camera 
     if (st == CT_OK) {
         st = ct_pose_rotate(pose, out->ray_cam_q30, out->dir_map_q39);
     }
+    return st;
+}
+
+/* ct_ray_from_map's ray from the pose centre along dir_map_q39 (|.| <=
+ * 2^39, a unit vector: never all 0). */
+static void pixel_ray(const ct_package *p, const geo_setup *s, const ct_geo *g, ct_ray *ray)
+{
+    int64_t d[3];
+    ct_grid_dir_from_map(p, g->dir_map_q39[0], g->dir_map_q39[1], g->dir_map_q39[2], d);
+    ray->x_q16 = s->ox;
+    ray->y_q16 = s->oy;
+    ray->z_q16 = s->oz;
+    ray->dx = d[0];
+    ray->dy = d[1];
+    ray->dz = d[2];
+}
+
+/* ts != NULL: trace over the tile set (p is its frame). */
+static ct_status one_pixel(const ct_package *p, ct_tileset *ts, const ct_camera *cam, const ct_pose *pose, ct_method m,
+                           const geo_setup *s, int64_t u, int64_t v, ct_geo *out)
+{
+    ct_ray ray;
+    ct_status st = pixel_dir(cam, pose, u, v, out);
     if (st == CT_OK && s->earth) {
         /* the map-frame direction without the pose's horizontal scale */
         int64_t dg[3];
         ct_pose_rotate_grid(pose, out->ray_cam_q30, dg);
         st = ct_trace_earth_set(p, ts, &s->es, dg, m, &out->hit);
     } else if (st == CT_OK) {
-        /* ct_ray_from_map's ray from the pose centre along dir_map_q39
-         * (|.| <= 2^39, a unit vector: never all 0) */
-        int64_t d[3];
-        ct_grid_dir_from_map(p, out->dir_map_q39[0], out->dir_map_q39[1], out->dir_map_q39[2], d);
-        ray.x_q16 = s->ox;
-        ray.y_q16 = s->oy;
-        ray.z_q16 = s->oz;
-        ray.dx = d[0];
-        ray.dy = d[1];
-        ray.dz = d[2];
+        pixel_ray(p, s, out, &ray);
         if (ts != NULL) {
             st = s->bend.coeff_q16 == 0 ? ct_tileset_trace(ts, &ray, m, &out->hit)
                                         : ct_trace_bent_set_ts(p, ts, &ray, &s->bent, m, &out->hit);
@@ -163,6 +176,55 @@ static ct_status one_pixel(const ct_package *p, ct_tileset *ts, const ct_camera 
     }
     out->status = st;
     return st;
+}
+
+/* A batch on one package with straight rays or the lowered model, in runs
+ * of up to CT_RUN_MAX consecutive pixels traced together (ct_trace_run):
+ * each record as one_pixel's but for hit.steps and hit.iters (the pixel's
+ * own walk).  A pixel whose ray does not take that walk (an unprojection
+ * or preparation error, a vertical ray of a bent trace) is done as
+ * one_pixel does it. */
+CT_NOINLINE static void run_pixels(const ct_package *p, const ct_camera *cam, const ct_pose *pose, ct_method m,
+                                   const geo_setup *s, const int64_t *uv_q16, size_t count, ct_geo *out)
+{
+    ct_prepared r[CT_RUN_MAX];
+    ct_hit *hp[CT_RUN_MAX];
+    ct_status st[CT_RUN_MAX];
+    size_t idx[CT_RUN_MAX];
+    const ct_lower *lw = s->bend.coeff_q16 != 0 ? &s->bent.lw : NULL;
+    size_t k = 0u;
+    uint32_t n, i;
+    /* bound: count pixels, at least one per pass */
+    while (k < count) {
+        /* bound: CT_RUN_MAX pixels per run */
+        for (n = 0u; k < count && n < CT_RUN_MAX; ++k) {
+            ct_geo *g = &out[k];
+            ct_ray ray;
+            ct_status sp = pixel_dir(cam, pose, uv_q16[2u * k], uv_q16[2u * k + 1u], g);
+            g->status = sp;
+            if (sp != CT_OK) {
+                continue;
+            }
+            pixel_ray(p, s, g, &ray);
+            if (lw != NULL && !ct_bent_takes_lowered(&ray, &s->bent)) {
+                g->status = ct_trace_bent_set(p, &ray, &s->bent, m, &g->hit);
+                continue;
+            }
+            sp = ct_prepare_lowered(p, &ray, 0, lw, &r[n]);
+            if (sp < 0) {
+                g->status = sp;
+                continue;
+            }
+            hp[n] = &g->hit;
+            idx[n] = k;
+            n++;
+        }
+        (void)ct_trace_run(p, r, n, lw, m, hp, st);
+        /* bound: n <= CT_RUN_MAX */
+        for (i = 0u; i < n; ++i) {
+            out[idx[i]].status = st[i];
+        }
+    }
 }
 
 /* ct_geolocate on one package (ts NULL) or over a tile set (pkg its frame). */
@@ -196,6 +258,12 @@ static ct_status geolocate_many(const ct_package *pkg, ct_tileset *ts, const ct_
     st = setup(pkg, cam, pose, method, effects, &s); /* NULL pkg: CT_ERR_ARG */
     if (st != CT_OK) {
         return st;
+    }
+    if (ts == NULL && !s.earth && (s.bend.coeff_q16 == 0 || s.bent.lowered) && method != CT_METHOD_INCREMENTAL) {
+        /* runs (the incremental method stays the plain cell-by-cell walk,
+         * the reference, in a batch too) */
+        run_pixels(pkg, cam, pose, method, &s, uv_q16, count, out);
+        return CT_OK;
     }
     /* bound: count pixels (caller's buffers) */
     for (k = 0u; k < count; ++k) {

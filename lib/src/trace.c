@@ -827,3 +827,277 @@ ct_status ct_trace_lowered(const ct_package *p, const ct_ray *ray, const ct_lowe
     }
     return trace_impl(p, &r, m, 1, lw, NULL, h);
 }
+
+/* ---- runs: rays from one observer traced together --------------------- */
+/* A run's common bounds (ct_trace_run).  The rays' primary axis a (0: x,
+ * 1: y) has sign s for every ray, |d_a| >= |d_other| and |d_a| >= 2^19.
+ * u = s * (the a coordinate), Q16; u-cell cu holds u in [cu, cu + 1)
+ * 2^16, i.e. the a-axis cell i = cu (s > 0) or -1 - cu (s < 0).  On u-face
+ * fa + m (m in [0, w]) every ray's other coordinate lies in [QL(m), QH(m)]
+ * and its height (Q16 LSB) at or above ZL(m):
+ *     QL(m) = ql + floor(m sql / 2^16),  QH(m) = qh + ceil(m sqh / 2^16),
+ *     ZL(m) = zl + floor(m szl / 2^16)
+ * (below run_bounds).  Ranges: |u|, |q| < 2^31 on the tile; |ZL| < 2^57. */
+#ifndef RUN_MIN_CELLS
+#define RUN_MIN_CELLS 16
+#endif
+typedef struct {
+    int a;
+    int32_t s;
+    int64_t fa, w;        /* first u-face, faces fa .. fa + w (the tile's end) */
+    int64_t ql, qh, zl;   /* at fa */
+    int64_t sql, sqh, szl; /* per u-cell, Q16 */
+} runb;
+
+/* The other coordinate and the height of prepared ray r on u-face U
+ * (Q16): *qlo, *qhi its floor and ceiling, *zlo a lower bound (Q16 LSB).
+ * e = U - u_origin, |e| < 2^32: e dq < 2^58, e dz < 2^58, quotients by
+ * du >= 2^19 below 2^39, times 2^zshift <= 2^16: < 2^55; |oz 2^zs| <=
+ * 2^46 (ct_prepared). */
+static void run_at(const ct_prepared *r, int a, int32_t s, int64_t U, int64_t *qlo, int64_t *qhi, int64_t *zlo)
+{
+    int64_t ou = s > 0 ? (a == 0 ? r->ox : r->oy) : -(a == 0 ? r->ox : r->oy);
+    int64_t du = ct_abs64(a == 0 ? r->dx : r->dy), dq = a == 0 ? r->dy : r->dx;
+    int64_t oq = a == 0 ? r->oy : r->ox, e = U - ou;
+    *qlo = oq + ct_floor_div(e * dq, du);
+    *qhi = oq - ct_floor_div(-(e * dq), du);
+    *zlo = r->oz * (INT64_C(1) << r->zshift) + ct_floor_div(e * (int64_t)r->dz, du) * (INT64_C(1) << r->zshift);
+}
+
+/* The run's bounds over rays use[] of r (1: in the run).  Returns 0 when
+ * they cannot be formed (fewer than two rays, primary axes differ, a ray
+ * too steep, or the heights' spread too large for the slopes' range).
+ * Each ray's coordinates are linear in u, so on every face between fa and
+ * fa + w they are at or above (below) the chord through the smallest
+ * (largest) values at the two ends; the slopes are rounded down (up) and
+ * m >= 0, so the bounds hold.  |QL_end - QL_start| < 2^33 (2^16 per u-cell
+ * plus the spread): times 2^16 < 2^49, m sql <= 2^49 * 2^16 / w... < 2^62. */
+static int run_bounds(const ct_package *p, const ct_prepared *r, const uint8_t *use, uint32_t n, runb *b)
+{
+    uint32_t k, cnt = 0u;
+    int64_t cu0 = 0, lo, hi, ql1 = 0, qh1 = 0, zl1 = 0;
+    int a = -1;
+    int32_t s = 0;
+    b->a = 0;
+    b->s = 1;
+    b->fa = b->w = b->ql = b->qh = b->zl = b->sql = b->sqh = b->szl = 0;
+    /* bound: n <= CT_RUN_MAX rays */
+    for (k = 0u; k < n; ++k) {
+        int64_t du, dq, ou, cu;
+        int ka;
+        if (!use[k]) {
+            continue;
+        }
+        ka = ct_abs64(r[k].dx) >= ct_abs64(r[k].dy) ? 0 : 1;
+        du = ct_abs64(ka == 0 ? r[k].dx : r[k].dy);
+        dq = ct_abs64(ka == 0 ? r[k].dy : r[k].dx);
+        if (a < 0) {
+            a = ka;
+            s = (ka == 0 ? r[k].dx : r[k].dy) > 0 ? 1 : -1;
+        }
+        if (ka != a || ((a == 0 ? r[k].dx : r[k].dy) > 0 ? 1 : -1) != s || du < (INT64_C(1) << 19) || dq > du) {
+            return 0;
+        }
+        /* a steep ray crosses the tile's relief within RUN_MIN_CELLS
+         * cells: its own walk is short, a run would not pay.  Across the
+         * relief it moves (hmax - hmin) du / (|dz| 2^zshift) cells:
+         * (hmax - hmin) du < 2^42, |dz| 2^zshift < 2^42 */
+        if ((int64_t)(p->hmax - p->hmin) * du < RUN_MIN_CELLS * ct_abs64(r[k].dz) * (INT64_C(1) << r[k].zshift)) {
+            return 0;
+        }
+        ou = s > 0 ? (a == 0 ? r[k].ox : r[k].oy) : -(a == 0 ? r[k].ox : r[k].oy);
+        cu = floor_shr(ou, 16u);
+        cu0 = cnt == 0u ? cu : ct_min64(cu0, cu);
+        cnt++;
+    }
+    if (cnt < 2u) {
+        return 0;
+    }
+    /* u-cells on the tile: [0, N) (s > 0) or [-N, 0) */
+    lo = s > 0 ? 0 : -(int64_t)(a == 0 ? p->cells_x : p->cells_y);
+    hi = lo + (int64_t)(a == 0 ? p->cells_x : p->cells_y);
+    b->a = a;
+    b->s = s;
+    b->fa = cu0 < lo ? lo : (cu0 >= hi ? hi - 1 : cu0);
+    b->w = hi - b->fa;
+    cnt = 0u;
+    /* bound: n <= CT_RUN_MAX rays */
+    for (k = 0u; k < n; ++k) {
+        int64_t q0, q1, z0, qa, qb, za;
+        if (!use[k]) {
+            continue;
+        }
+        run_at(&r[k], a, s, b->fa * ONE16, &q0, &q1, &z0);
+        run_at(&r[k], a, s, hi * ONE16, &qa, &qb, &za);
+        if (cnt == 0u) {
+            b->ql = q0;
+            b->qh = q1;
+            b->zl = z0;
+            ql1 = qa;
+            qh1 = qb;
+            zl1 = za;
+        } else {
+            b->ql = ct_min64(b->ql, q0);
+            b->qh = ct_max64(b->qh, q1);
+            b->zl = ct_min64(b->zl, z0);
+            ql1 = ct_min64(ql1, qa);
+            qh1 = ct_max64(qh1, qb);
+            zl1 = ct_min64(zl1, za);
+        }
+        cnt++;
+    }
+    if (ct_abs64(zl1 - b->zl) >= (INT64_C(1) << 45)) {
+        return 0; /* a steep run: its slope's range (and little to gain) */
+    }
+    b->sql = ct_floor_div((ql1 - b->ql) * ONE16, b->w);
+    b->sqh = -ct_floor_div(-((qh1 - b->qh) * ONE16), b->w);
+    b->szl = ct_floor_div((zl1 - b->zl) * ONE16, b->w);
+    return 1;
+}
+
+/* 1 when no ray of the run can meet the surface in u-cells [cu, cu + 2^l)
+ * (clamped to the tile's end), the level-l block of the max-mipmap (l = 0:
+ * the fine cells), between the run's bounds there: their lowest height is
+ * above the tallest post of every cell their other coordinate's range
+ * touches (a point on a cell's edge is bounded by that edge's posts, which
+ * the cell on either side holds), less (lw) the lowering at the block's
+ * near face -- every post of the block is at least as far from the
+ * observer, who is behind that face, and D grows with the range.  At most
+ * four blocks across; otherwise 0.  Outside the tile there is no surface. */
+static int run_clear(const ct_package *p, const ct_lower *lw, const runb *b, int64_t cu, uint32_t l)
+{
+    int64_t m0 = cu - b->fa, m1 = ct_min64(cu + ((int64_t)1 << l), b->fa + b->w) - b->fa;
+    int64_t qlo = ct_min64(b->ql + floor_shr(m0 * b->sql, 16u), b->ql + floor_shr(m1 * b->sql, 16u));
+    int64_t qhi = ct_max64(b->qh - floor_shr(-(m0 * b->sqh), 16u), b->qh - floor_shr(-(m1 * b->sqh), 16u));
+    int64_t z = ct_min64(b->zl + floor_shr(m0 * b->szl, 16u), b->zl + floor_shr(m1 * b->szl, 16u));
+    int32_t nq = (int32_t)(b->a == 0 ? p->cells_y : p->cells_x), i, j0, j1, bj;
+    int64_t hb = 0, D = 0;
+    if (qhi < 0 || qlo > (int64_t)nq * ONE16) {
+        return 1;
+    }
+    j0 = (int32_t)ct_max64(ct_min64(floor_shr(qlo, 16u), nq - 1), 0);
+    j1 = (int32_t)ct_max64(ct_min64(floor_shr(qhi, 16u), nq - 1), 0);
+    if ((j1 >> l) - (j0 >> l) > 3) {
+        return 0;
+    }
+    i = (int32_t)(b->s > 0 ? cu : -1 - cu);
+    /* bound: four blocks */
+    for (bj = j0 >> l; bj <= (j1 >> l); ++bj) {
+        int64_t v;
+        if (l == 0u) {
+            v = b->a == 0 ? cell_hmax(p, i, bj) : cell_hmax(p, bj, i);
+        } else {
+            v = b->a == 0 ? mip_at(p, l, i >> l, bj) : mip_at(p, l, bj, i >> l);
+        }
+        hb = ct_max64(hb, v);
+    }
+    if (lw != NULL) {
+        /* the near face, in the a coordinate: s * cu 2^16 */
+        int64_t f = b->s * cu * ONE16, o = b->a == 0 ? lw->obx : lw->oby;
+        if ((b->s > 0 && f > o) || (b->s < 0 && f < o)) {
+            D = b->a == 0 ? ct_lower_at(lw, f, lw->oby) : ct_lower_at(lw, lw->obx, f);
+        }
+    }
+    return z > hb * ONE16 - D;
+}
+
+/* The first u-cell the run's walk could not show free of the surface
+ * (fa + w: none).  The max-mipmap walk of the hierarchical method over
+ * the run's bounds: up one level after a block shown free (when aligned),
+ * down one after one not.  bound: every u-cell left at most once per
+ * advance, and a descent per advance plus the levels: 2 w + levels + 2. */
+static int64_t run_walk(const ct_package *p, const ct_lower *lw, const runb *b)
+{
+    int64_t cu = b->fa, end = b->fa + b->w;
+    uint32_t l = 0u, it, bound = 2u * (uint32_t)b->w + p->levels + 2u;
+    for (it = 0u; it < bound && cu < end; ++it) {
+        if (run_clear(p, lw, b, cu, l)) {
+            cu = ct_min64(cu + ((int64_t)1 << l), end);
+            if (l < p->levels && ((uint64_t)cu & ((UINT64_C(2) << l) - 1u)) == 0u) {
+                l++;
+            }
+        } else if (l > 0u) {
+            l--;
+        } else {
+            return cu;
+        }
+    }
+    return ct_min64(cu, end);
+}
+
+ct_status ct_trace_run(const ct_package *p, const ct_prepared *r, uint32_t n, const ct_lower *lw, ct_method m,
+                       ct_hit *const *h, ct_status *st)
+{
+    uint8_t use[CT_RUN_MAX] = {0u}, grp[CT_RUN_MAX] = {0u};
+    runb b[3];
+    int64_t cs[3] = {0, 0, 0};
+    uint32_t k, g;
+    if (p == NULL || r == NULL || h == NULL || st == NULL || n > CT_RUN_MAX) {
+        return CT_ERR_ARG;
+    }
+    /* bound: n <= CT_RUN_MAX rays */
+    for (k = 0u; k < n; ++k) {
+        use[k] = (uint8_t)(r[k].start == CT_OK && (r[k].dx != 0 || r[k].dy != 0));
+        grp[k] = 0u; /* 0: its own walk; 1: the run's; 2, 3: a half's */
+    }
+    if (run_bounds(p, r, use, n, &b[0])) {
+        cs[0] = run_walk(p, lw, &b[0]);
+        if (cs[0] > b[0].fa) {
+            /* bound: n rays */
+            for (k = 0u; k < n; ++k) {
+                grp[k] = use[k];
+            }
+        } else if (n >= 4u) {
+            /* a run too wide to show anything free: its halves apart */
+            /* bound: two halves */
+            for (g = 1u; g <= 2u; ++g) {
+                uint8_t half[CT_RUN_MAX];
+                /* bound: n rays */
+                for (k = 0u; k < n; ++k) {
+                    half[k] = (uint8_t)(use[k] && (k < n / 2u) == (g == 1u));
+                }
+                if (run_bounds(p, r, half, n, &b[g])) {
+                    cs[g] = run_walk(p, lw, &b[g]);
+                    /* bound: n rays */
+                    for (k = 0u; k < n; ++k) {
+                        grp[k] = half[k] != 0u ? (uint8_t)(g + 1u) : grp[k];
+                    }
+                }
+            }
+        }
+    }
+    /* bound: n <= CT_RUN_MAX rays */
+    for (k = 0u; k < n; ++k) {
+        wstart ws;
+        int64_t ou, c;
+        const runb *q;
+        rt tend;
+        if (grp[k] == 0u) {
+            st[k] = trace_impl(p, &r[k], m, 1, lw, NULL, h[k]);
+            continue;
+        }
+        q = &b[grp[k] - 1u];
+        c = cs[grp[k] - 1u];
+        ou = q->s > 0 ? (q->a == 0 ? r[k].ox : r[k].oy) : -(q->a == 0 ? r[k].ox : r[k].oy);
+        ws.t0.n = c * ONE16 - ou; /* < 2^32 */
+        ws.t0.d = ct_abs64(q->a == 0 ? r[k].dx : r[k].dy);
+        if (ws.t0.n <= 0) {
+            /* the ray starts in or after the first u-cell not shown free */
+            st[k] = trace_impl(p, &r[k], m, 1, lw, NULL, h[k]);
+            continue;
+        }
+        tend.n = r[k].tend_n;
+        tend.d = r[k].tend_d;
+        if (c == q->fa + q->w || !rt_lt(ws.t0, tend)) {
+            /* free until it leaves the tile's box: no hit, as its walk */
+            ct_hit_clear(h[k]);
+            st[k] = CT_MISS;
+            continue;
+        }
+        /* its walk from the face of u-cell c, as a tile set's seam */
+        ws.face = q->a == 0 ? 1 : 2;
+        ws.i = ws.j = (int32_t)(q->s > 0 ? c : -1 - c);
+        st[k] = trace_impl(p, &r[k], m, 1, lw, &ws, h[k]);
+    }
+    return CT_OK;
+}

@@ -153,8 +153,4 @@ static inline rt box_exit(const ct_package *p, const int64_t O[3], const int32_t
  * LSB times 2^32, exact (trace.c). */
 ct_i128 ct_surface_low_q48(const ct_package *p, const ct_lower *lw, int32_t i, int32_t j, int64_t x, int64_t y);
 
-/* Ray preparation (prepare.c) for a straight ray or segment (seg) or, with
- * lw, a bent ray's tangent against the lowered terrain. */
-ct_status ct_prepare_lowered(const ct_package *p, const ct_ray *ray, int seg, const ct_lower *lw, ct_prepared *out);
-
 #endif /* CT_TRACE_CORE_H */

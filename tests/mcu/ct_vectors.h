@@ -87,7 +87,9 @@ typedef struct {
 
 /* A camera over one of the packages: lens (or unprojection grid), pose,
  * effects, and its pixels; ct_geolocate_batch over all of them with
- * batch_method must equal the per-pixel results. */
+ * batch_method must give the host's batch records (batch; equal to the
+ * per-pixel results but for the runs' steps and iters, checked by the
+ * generator). */
 typedef struct {
     const char *name;
     uint32_t package;                     /* index into ct_vec_set.packages  */
@@ -102,6 +104,7 @@ typedef struct {
     uint32_t batch_method;
     const ct_vec_pixel *pixels;
     uint32_t npixels;
+    const ct_geo *batch;                  /* the host's batch, npixels      */
     int64_t tol_nm;                       /* ct_effects_for_tolerance with the
                                              effects' k and radius           */
     ct_status tol_status;

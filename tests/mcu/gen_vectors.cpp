@@ -735,6 +735,7 @@ struct Cam {
     ct_effects effects{};
     uint32_t batch_method = 0;
     std::vector<ct_vec_pixel> px;
+    std::vector<ct_geo> batch;  // the host's ct_geolocate_batch over px
     int64_t tol_nm = 0;
     ct_status tol_status = CT_ERR_ARG;
     ct_effects_choice tol{};
@@ -792,6 +793,15 @@ void run_camera(Rng &g, Cam &c, const ct_package &pkg)
         if (k < 8) {
             q.u_q16 = fixed_px[k][0];
             q.v_q16 = fixed_px[k][1];
+        } else if (k >= 24) {
+            // two runs of 8 neighbouring pixels of a row (the batch's runs)
+            if (k % 8 == 0) {
+                q.u_q16 = g.range(0, 600 * U);
+                q.v_q16 = g.range(0, 479 * U);
+            } else {
+                q.u_q16 = c.px.back().u_q16 + U;
+                q.v_q16 = c.px.back().v_q16;
+            }
         } else {
             q.u_q16 = g.range(-20 * U, 660 * U);
             q.v_q16 = g.range(-20 * U, 500 * U);
@@ -802,19 +812,42 @@ void run_camera(Rng &g, Cam &c, const ct_package &pkg)
             ct_geolocate(&pkg, &cam, &pose, (ct_method)m, &c.effects, q.u_q16, q.v_q16, &q.geo[m]);
         c.px.push_back(q);
     }
+    // the batch: every record as the single call's but for the runs' steps
+    {
+        std::vector<int64_t> uv;
+        for (const ct_vec_pixel &q : c.px) {
+            uv.push_back(q.u_q16);
+            uv.push_back(q.v_q16);
+        }
+        c.batch.assign(c.px.size(), ct_geo{});
+        if (ct_geolocate_batch(&pkg, &cam, &pose, (ct_method)c.batch_method, &c.effects, uv.data(), c.px.size(),
+                               c.batch.data(), c.batch.size()) != CT_OK)
+            die("camera " + c.name + ": batch failed on the host");
+        for (size_t k = 0; k < c.px.size(); ++k) {
+            const ct_geo &a = c.batch[k], &b = c.px[k].geo[c.batch_method];
+            ct_hit ha = a.hit, hb = b.hit;
+            ha.steps = hb.steps = ha.iters = hb.iters = 0;
+            if (a.status != b.status || a.unproject_iters != b.unproject_iters ||
+                std::memcmp(a.ray_cam_q30, b.ray_cam_q30, sizeof a.ray_cam_q30) != 0 ||
+                std::memcmp(a.dir_map_q39, b.dir_map_q39, sizeof a.dir_map_q39) != 0 ||
+                std::memcmp(&ha, &hb, sizeof ha) != 0)
+                die("camera " + c.name + ": a batch record differs from the single call's");
+        }
+    }
     // the effects a tolerance calls for (a different tolerance per camera)
     c.tol_nm = INT64_C(10000000) << (3 * (c.name.size() % 4));
     c.tol_status = ct_effects_for_tolerance(&pkg, &cam, &pose, c.effects.refraction_k_q16, c.effects.earth_radius_nm,
                                             c.tol_nm, &c.tol);
-    int hits = 0, miss = 0, errors = 0;
+    int hits = 0, miss = 0, errors = 0, shortened = 0;
+    for (size_t k = 0; k < c.px.size(); ++k) shortened += c.batch[k].hit.steps < c.px[k].geo[c.batch_method].hit.steps;
     for (const ct_vec_pixel &q : c.px) {
         const ct_status st = q.geo[0].status;
         hits += st == CT_HIT || st == CT_HIT_VOID;
         miss += st == CT_MISS;
         errors += st < 0;
     }
-    std::fprintf(stderr, "gen_vectors: camera %s: %zu pixels: %d hit, %d miss, %d errors\n", c.name.c_str(),
-                 c.px.size(), hits, miss, errors);
+    std::fprintf(stderr, "gen_vectors: camera %s: %zu pixels: %d hit, %d miss, %d errors; %d walks shortened by the batch's runs\n",
+                 c.name.c_str(), c.px.size(), hits, miss, errors, shortened);
 }
 
 std::vector<Cam> make_cameras(Rng &g, const std::vector<const ct_package *> &pk)
@@ -910,6 +943,9 @@ void emit_cameras(FILE *f, const std::vector<Cam> &cams)
             std::fprintf(f, "}},\n");
         }
         std::fprintf(f, "};\n\n");
+        std::fprintf(f, "static const ct_geo cam%zu_batch[%zu] = {\n", k, c.batch.size());
+        for (const ct_geo &o : c.batch) std::fprintf(f, "  %s,\n", geo_init(o).c_str());
+        std::fprintf(f, "};\n\n");
     }
     std::fprintf(f, "static const ct_vec_camera cameras[%zu] = {\n", cams.size());
     for (size_t k = 0; k < cams.size(); ++k) {
@@ -935,8 +971,8 @@ void emit_cameras(FILE *f, const std::vector<Cam> &cams)
         std::fprintf(f, "   .effects = {.flags = %uu, .refraction_k_q16 = %s, .earth_radius_nm = %s, .chord_nm = %s},\n",
                      c.effects.flags, i32(c.effects.refraction_k_q16).c_str(), i64(c.effects.earth_radius_nm).c_str(),
                      i64(c.effects.chord_nm).c_str());
-        std::fprintf(f, "   .batch_method = %uu, .pixels = cam%zu_pixels, .npixels = %zuu,\n", c.batch_method, k,
-                     c.px.size());
+        std::fprintf(f, "   .batch_method = %uu, .pixels = cam%zu_pixels, .npixels = %zuu, .batch = cam%zu_batch,\n",
+                     c.batch_method, k, c.px.size(), k);
         std::fprintf(f, "   .tol_nm = %s, .tol_status = %s, .tol_choice = {.flags = %uu, .chord_nm = %s, .bound_nm = {%s, %s, "
                         "%s, %s}, .range_nm = %s, .tan_min_q30 = %s, .samples = %uu}},\n",
                      i64(c.tol_nm).c_str(), i32(c.tol_status).c_str(), c.tol.flags, i64(c.tol.chord_nm).c_str(),
