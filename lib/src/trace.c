@@ -841,6 +841,9 @@ ct_status ct_trace_lowered(const ct_package *p, const ct_ray *ray, const ct_lowe
 #ifndef RUN_MIN_CELLS
 #define RUN_MIN_CELLS 16
 #endif
+#ifndef RUN_SPREAD
+#define RUN_SPREAD 8
+#endif
 typedef struct {
     int a;
     int32_t s;
@@ -864,9 +867,10 @@ static void run_at(const ct_prepared *r, int a, int32_t s, int64_t U, int64_t *q
     *zlo = r->oz * (INT64_C(1) << r->zshift) + ct_floor_div(e * (int64_t)r->dz, du) * (INT64_C(1) << r->zshift);
 }
 
-/* The run's bounds over rays use[] of r (1: in the run).  Returns 0 when
- * they cannot be formed (fewer than two rays, primary axes differ, a ray
- * too steep, or the heights' spread too large for the slopes' range).
+/* The run's bounds over rays use[] of r (1: in the run).  Returns 1, or 0
+ * when they cannot be formed (fewer than two rays, primary axes differ, a
+ * ray too steep, or the heights' spread too large for the slopes' range),
+ * or 2 when the rays part too fast for a shared walk to pay.
  * Each ray's coordinates are linear in u, so on every face between fa and
  * fa + w they are at or above (below) the chord through the smallest
  * (largest) values at the two ends; the slopes are rounded down (up) and
@@ -875,7 +879,7 @@ static void run_at(const ct_prepared *r, int a, int32_t s, int64_t U, int64_t *q
 static int run_bounds(const ct_package *p, const ct_prepared *r, const uint8_t *use, uint32_t n, runb *b)
 {
     uint32_t k, cnt = 0u;
-    int64_t cu0 = 0, lo, hi, ql1 = 0, qh1 = 0, zl1 = 0;
+    int64_t cu0 = 0, lo, hi, ql1 = 0, qh1 = 0, zl1 = 0, gq = 0, gu = 1;
     int a = -1;
     int32_t s = 0;
     b->a = 0;
@@ -904,6 +908,21 @@ static int run_bounds(const ct_package *p, const ct_prepared *r, const uint8_t *
          * (hmax - hmin) du < 2^42, |dz| 2^zshift < 2^42 */
         if ((int64_t)(p->hmax - p->hmin) * du < RUN_MIN_CELLS * ct_abs64(r[k].dz) * (INT64_C(1) << r[k].zshift)) {
             return 0;
+        }
+        /* rays that part by more than RUN_SPREAD cells from the first
+         * one's across the tile (pixels far apart) would stop the shared
+         * walk at once: 2, before any division.  Slopes dq / du to 8 bits
+         * less (a choice, not a bound): |q du0 - q0 du| < 2^37, times the
+         * tile's cells (< 2^15) < 2^52; RUN_SPREAD du du0 < 2^40 */
+        {
+            int64_t qs = (a == 0 ? r[k].dy : r[k].dx) / 256, us = du / 256;
+            if (cnt == 0u) {
+                gq = qs;
+                gu = us;
+            } else if (ct_abs64(qs * gu - gq * us) * (int64_t)(a == 0 ? p->cells_x : p->cells_y) >
+                       RUN_SPREAD * us * gu) {
+                return 2;
+            }
         }
         ou = s > 0 ? (a == 0 ? r[k].ox : r[k].oy) : -(a == 0 ? r[k].ox : r[k].oy);
         cu = floor_shr(ou, 16u);
@@ -1032,6 +1051,7 @@ ct_status ct_trace_run(const ct_package *p, const ct_prepared *r, uint32_t n, co
     runb b[3];
     int64_t cs[3] = {0, 0, 0};
     uint32_t k, g;
+    int wide;
     if (p == NULL || r == NULL || h == NULL || st == NULL || n > CT_RUN_MAX) {
         return CT_ERR_ARG;
     }
@@ -1040,28 +1060,30 @@ ct_status ct_trace_run(const ct_package *p, const ct_prepared *r, uint32_t n, co
         use[k] = (uint8_t)(r[k].start == CT_OK && (r[k].dx != 0 || r[k].dy != 0));
         grp[k] = 0u; /* 0: its own walk; 1: the run's; 2, 3: a half's */
     }
-    if (run_bounds(p, r, use, n, &b[0])) {
+    /* 1: bounds formed; 2: too wide, or the walk showed nothing free */
+    wide = run_bounds(p, r, use, n, &b[0]);
+    if (wide == 1) {
         cs[0] = run_walk(p, lw, &b[0]);
-        if (cs[0] > b[0].fa) {
+        wide = cs[0] > b[0].fa ? 1 : 2;
+    }
+    if (wide == 1) {
+        /* bound: n rays */
+        for (k = 0u; k < n; ++k) {
+            grp[k] = use[k];
+        }
+    } else if (wide == 2 && n >= 4u) {
+        /* the two halves apart (bound: two halves) */
+        for (g = 1u; g <= 2u; ++g) {
+            uint8_t half[CT_RUN_MAX];
             /* bound: n rays */
             for (k = 0u; k < n; ++k) {
-                grp[k] = use[k];
+                half[k] = (uint8_t)(use[k] && (k < n / 2u) == (g == 1u));
             }
-        } else if (n >= 4u) {
-            /* a run too wide to show anything free: its halves apart */
-            /* bound: two halves */
-            for (g = 1u; g <= 2u; ++g) {
-                uint8_t half[CT_RUN_MAX];
+            if (run_bounds(p, r, half, n, &b[g]) == 1) {
+                cs[g] = run_walk(p, lw, &b[g]);
                 /* bound: n rays */
                 for (k = 0u; k < n; ++k) {
-                    half[k] = (uint8_t)(use[k] && (k < n / 2u) == (g == 1u));
-                }
-                if (run_bounds(p, r, half, n, &b[g])) {
-                    cs[g] = run_walk(p, lw, &b[g]);
-                    /* bound: n rays */
-                    for (k = 0u; k < n; ++k) {
-                        grp[k] = half[k] != 0u ? (uint8_t)(g + 1u) : grp[k];
-                    }
+                    grp[k] = half[k] != 0u ? (uint8_t)(g + 1u) : grp[k];
                 }
             }
         }
