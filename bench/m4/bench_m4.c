@@ -233,7 +233,20 @@ static int geo_bench(const ct_package *p, uint32_t empty, uint64_t ipt_q16)
     for (k = 0u; k < n; ++k) {
         g_want[k] = m4_geo_grid_px[k];
     }
-    return pixel_row("straight, 8 px grid", p, &gcam, &pose, (const ct_effects *)0, uv, n, 0, empty, ipt_q16) && ok;
+    ok = pixel_row("straight, 8 px grid", p, &gcam, &pose, (const ct_effects *)0, uv, n, 0, empty, ipt_q16) && ok;
+    /* runs of 8 neighbouring pixels (the batch's runs), straight and on
+     * the sphere; no set-up column (the batch's gain is more than the
+     * set-up here).  bound: 2 effects x 64 pixels */
+    for (e = 0; e < 2; ++e) {
+        ct_effects fxs;
+        const ct_effects *fx = m4_geo_effects(e, &fxs, &map);
+        for (k = 0u; k < 64u; ++k) {
+            g_want[k] = m4_geo_rows_px[e][k];
+        }
+        ok = pixel_row(e == 0 ? "straight, rows of 8 px" : "sphere c+r, rows of 8 px", p, &cam, &pose, fx,
+                       m4_geo_rows_uv, 64u, 0, empty, ipt_q16) && ok;
+    }
+    return ok;
 }
 
 int main(void)

@@ -73,4 +73,9 @@ typedef struct {
     int64_t enh[3];
 } m4_grid_pixel;
 extern const m4_grid_pixel m4_geo_grid_px[];
+/* 64 pixels in 8 runs of 8 neighbours along a row (ct_geolocate_batch's
+ * runs), and the host's ct_geolocate of each with the lens: straight
+ * ([0]) and on the sphere ([1], m4_geo_effects(1)). */
+extern const int64_t m4_geo_rows_uv[128];
+extern const m4_grid_pixel m4_geo_rows_px[2][64];
 #endif

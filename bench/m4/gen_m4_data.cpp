@@ -148,6 +148,31 @@ bool geo_data(FILE *f, const ct_package &p)
                      hit ? (long long)x.hit.h_nm : 0LL);
     }
     std::fprintf(f, "};\n");
+    // 8 runs of 8 neighbouring pixels of a row (the batch's runs)
+    std::vector<int64_t> ruv;
+    for (int j = 0; j < 8; ++j)
+        for (int i = 0; i < 8; ++i) {
+            ruv.push_back(((int64_t)(64 + 116 * j + i) << 16) + 12345);
+            ruv.push_back(((int64_t)(48 + 96 * j) << 16) + 23456);
+        }
+    std::fprintf(f, "const int64_t m4_geo_rows_uv[128] = {");
+    for (size_t k = 0; k < ruv.size(); ++k) std::fprintf(f, "%sINT64_C(%lld),", k % 4 == 0 ? "\n  " : " ", (long long)ruv[k]);
+    std::fprintf(f, "\n};\nconst m4_grid_pixel m4_geo_rows_px[2][64] = {\n");
+    for (int e = 0; e < 2; ++e) {
+        ct_effects fx;
+        const ct_effects *pf = m4_geo_effects(e, &fx, &map);
+        std::fprintf(f, " {\n");
+        for (size_t k = 0; k < 64; ++k) {
+            ct_geo x;
+            ct_geolocate(&p, &cam, &pose, CT_METHOD_DIRECTIONAL, pf, ruv[2 * k], ruv[2 * k + 1], &x);
+            const bool hit = x.status == CT_HIT || x.status == CT_HIT_VOID;
+            std::fprintf(f, "  {%d, %uu, {INT64_C(%lld), INT64_C(%lld), INT64_C(%lld)}},\n", (int)x.status, x.hit.steps,
+                         hit ? (long long)x.hit.e_nm : 0LL, hit ? (long long)x.hit.n_nm : 0LL,
+                         hit ? (long long)x.hit.h_nm : 0LL);
+        }
+        std::fprintf(f, " },\n");
+    }
+    std::fprintf(f, "};\n");
     return true;
 }
 
