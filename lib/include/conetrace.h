@@ -1073,12 +1073,14 @@ ct_status ct_geolocate(const ct_package *pkg, const ct_camera *cam,
  * off, or c > 0 on a sphere; not the true Earth nor the polyline) and
  * every method but CT_METHOD_INCREMENTAL (the plain reference walk), the
  * pixels go in runs of up to 8 consecutive ones.  Where the run's rays
- * share a horizontal axis and direction and each crosses the tile's
- * relief over at least 16 cells, one max-mipmap walk over bounds holding
- * all their paths shows a first stretch free of the surface for all of
- * them (at most 2 w + levels + 2 iterations, w the tile's cells along that
- * axis; for a run too wide to show anything, once more for each half),
- * and each pixel's walk starts where that stretch ends.  Every status and
+ * share a horizontal axis and direction, each crosses the tile's relief
+ * over at least 16 cells and none parts from the first by more than 8
+ * cells across the tile, one max-mipmap walk over bounds holding all
+ * their paths shows a first stretch free of the surface for all of them
+ * (at most 2 w + levels + 2 iterations, w the tile's cells along that
+ * axis; when it shows nothing or the rays part too fast, the same for
+ * each half of the run), and each pixel's walk starts where that stretch
+ * ends.  Every status and
  * hit is as ct_geolocate's; hit.steps and hit.iters count the pixel's own
  * walk only.  Consecutive pixels of an image row (or column) make good
  * runs; in any order the results are the same.

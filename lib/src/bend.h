@@ -93,12 +93,15 @@ ct_status ct_prepare_lowered(const ct_package *p, const ct_ray *ray, int seg, co
  * straight), each one's status in st[k] and hit in *h[k], the same as
  * its own trace from t = 0 (ct_trace_prepared_own / _lowered) in every
  * field but steps and iters, which count only the ray's own walk.  Where
- * the rays' paths share a primary axis, one walk of the max-mipmap over
- * their common bounds shows a first stretch free of the surface for all
- * of them (at most 2 w + levels + 2 iterations, w the tile's cells along
- * that axis); each ray's walk then starts on the face where it ends, as
- * a tile set's walk starts on a seam.  CT_ERR_ARG for a NULL argument or
- * n > CT_RUN_MAX, else CT_OK.                                             */
+ * the rays' paths share a primary axis and direction (each crossing the
+ * relief over 16 cells or more, none parting from the first by more than
+ * 8 cells across the tile), one walk of the max-mipmap over their common
+ * bounds shows a first stretch free of the surface for all of them (at
+ * most 2 w + levels + 2 iterations, w the tile's cells along that axis;
+ * when it shows nothing, or the rays part too fast, the same for each
+ * half of a run of 4 or more); each ray's walk then starts on the face
+ * where that stretch ends, as a tile set's walk starts on a seam.
+ * CT_ERR_ARG for a NULL argument or n > CT_RUN_MAX, else CT_OK.          */
 #define CT_RUN_MAX 8u
 ct_status ct_trace_run(const ct_package *pkg, const ct_prepared *r, uint32_t n, const ct_lower *lw, ct_method method,
                        ct_hit *const *h, ct_status *st);

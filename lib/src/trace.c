@@ -874,8 +874,10 @@ static void run_at(const ct_prepared *r, int a, int32_t s, int64_t U, int64_t *q
  * Each ray's coordinates are linear in u, so on every face between fa and
  * fa + w they are at or above (below) the chord through the smallest
  * (largest) values at the two ends; the slopes are rounded down (up) and
- * m >= 0, so the bounds hold.  |QL_end - QL_start| < 2^33 (2^16 per u-cell
- * plus the spread): times 2^16 < 2^49, m sql <= 2^49 * 2^16 / w... < 2^62. */
+ * m >= 0, so the bounds hold.  Ranges: |QL_end - QL_start| < 2^34 (q on
+ * the faces within 2^31 + 2^32), times 2^16 < 2^50, and m sql <= (2^50 +
+ * w) m / w < 2^51 for m <= w; the heights' difference is held below 2^45
+ * (else 0), so m szl < 2^62. */
 static int run_bounds(const ct_package *p, const ct_prepared *r, const uint8_t *use, uint32_t n, runb *b)
 {
     uint32_t k, cnt = 0u;
@@ -905,7 +907,7 @@ static int run_bounds(const ct_package *p, const ct_prepared *r, const uint8_t *
         /* a steep ray crosses the tile's relief within RUN_MIN_CELLS
          * cells: its own walk is short, a run would not pay.  Across the
          * relief it moves (hmax - hmin) du / (|dz| 2^zshift) cells:
-         * (hmax - hmin) du < 2^42, |dz| 2^zshift < 2^42 */
+         * (hmax - hmin) du < 2^42, RUN_MIN_CELLS |dz| 2^zshift < 2^46 */
         if ((int64_t)(p->hmax - p->hmin) * du < RUN_MIN_CELLS * ct_abs64(r[k].dz) * (INT64_C(1) << r[k].zshift)) {
             return 0;
         }
