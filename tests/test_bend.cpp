@@ -806,10 +806,32 @@ void test_runs_vs_own_trace()
             }
             ct_prepared r[CT_RUN_MAX];
             uint32_t n = 0;
-            for (uint32_t k = 0; k < CT_RUN_MAX; ++k) {
-                const int64_t ex = tx + ct_rng_range(&rng, -sc / 64, sc / 64), ey = ty + ct_rng_range(&rng, -sc / 64, sc / 64);
-                const int64_t ez = top - drop + base + ct_rng_range(&rng, -sc / 10, sc / 10);
-                const ct_ray ray = {ox, oy, oz, ex - ox, ey - oy, ez - oz};
+            // every 7th trial in turn: a vertical ray in the run (its own
+            // walk); three rays at spikes far apart (too wide, no halves);
+            // level rays above every post (free to the tile's end); a fan
+            // 4 cells wide aimed at the tile's edge (rays that leave the
+            // tile sideways before the shared stretch ends)
+            const int kind = (int)(tr % 7);
+            const uint32_t nr = kind == 2 ? 3u : CT_RUN_MAX;
+            for (uint32_t k = 0; k < nr; ++k) {
+                int64_t ex = tx + ct_rng_range(&rng, -sc / 64, sc / 64), ey = ty + ct_rng_range(&rng, -sc / 64, sc / 64);
+                int64_t ez = top - drop + base + ct_rng_range(&rng, -sc / 10, sc / 10), rz = oz;
+                if (kind == 1 && k == 0) {
+                    ex = ox;
+                    ey = oy;
+                } else if (kind == 2) {
+                    const auto q = spikes[(size_t)ct_rng_range(&rng, 0, (int64_t)spikes.size() - 1)];
+                    ex = (int64_t)q.first * 65536;
+                    ey = (int64_t)q.second * 65536;
+                } else if (kind == 3) {
+                    rz = (int64_t)(p.hmax + 40) * 65536;
+                    ez = rz - ct_rng_range(&rng, 0, 65536);
+                    ex = ox + (tx - ox) * 4;
+                    ey = oy + (ty - oy) * 4;
+                } else if (kind == 5) {
+                    ey = (int64_t)(k * 65536) - 2 * 65536 + (ty % 65536);
+                }
+                const ct_ray ray = {ox, oy, rz, ex - ox, ey - oy, ez - rz};
                 if (ct_prepare_lowered(&p, &ray, 0, plw, &r[n]) == CT_OK) n++;
             }
             if (n == 0) continue;

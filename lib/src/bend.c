@@ -453,15 +453,6 @@ ct_status ct_trace_bent_set(const ct_package *p, const ct_ray *ray, const ct_ben
     return ct_trace_bent_set_ts(p, NULL, ray, bs, m, h);
 }
 
-int ct_bent_takes_lowered(const ct_ray *ray, const ct_bent_setup *bs)
-{
-    return bs->bend.coeff_q16 != 0 && (ray->dx != 0 || ray->dy != 0) && bs->lowered &&
-           ct_abs64(ray->x_q16) <= CT_MAX_ORIGIN_Q16 && ct_abs64(ray->y_q16) <= CT_MAX_ORIGIN_Q16 &&
-           ct_abs64(ray->z_q16) <= CT_MAX_ORIGIN_Q16 && ct_abs64(ray->dx) <= (INT64_C(1) << 62) &&
-           ct_abs64(ray->dy) <= (INT64_C(1) << 62) && ct_abs64(ray->dz) <= (INT64_C(1) << 62) &&
-           ray->x_q16 == bs->lw.obx && ray->y_q16 == bs->lw.oby;
-}
-
 ct_status ct_trace_bent_set_ts(const ct_package *p, ct_tileset *ts, const ct_ray *ray, const ct_bent_setup *bs,
                                ct_method m, ct_hit *h)
 {

@@ -106,10 +106,6 @@ ct_status ct_prepare_lowered(const ct_package *p, const ct_ray *ray, int seg, co
 ct_status ct_trace_run(const ct_package *pkg, const ct_prepared *r, uint32_t n, const ct_lower *lw, ct_method method,
                        ct_hit *const *h, ct_status *st);
 
-/* 1 when ct_trace_bent_set_ts traces ray with the lowered model (bs->lowered,
- * a ray from the observer that is not vertical and within its ranges).    */
-int ct_bent_takes_lowered(const ct_ray *ray, const ct_bent_setup *bs);
-
 /* A segment (origin to origin + direction) of a lowered ray: prepared as
  * ct_ray_prepare_segment, traced against the lowered terrain (lw = NULL:
  * the terrain itself).  A hit in the last cell beyond the segment's end

@@ -35,6 +35,14 @@
 #define CT_ALWAYS_INLINE
 #endif
 
+/* CT_ALWAYS_INLINE when optimising only: the coverage build (-O0) keeps
+ * such a helper one function, with one set of branches.                  */
+#if defined(__GNUC__) && defined(__OPTIMIZE__)
+#define CT_OPT_INLINE __attribute__((always_inline))
+#else
+#define CT_OPT_INLINE
+#endif
+
 /* A hint to start loading a cache line, on hosts with caches (GCC and clang
  * on x86-64 and AArch64); nothing on the flight MCUs, which have none (the
  * code around it is compiled out there: CT_HAVE_PREFETCH 0).               */
@@ -68,7 +76,7 @@ static inline int64_t ct_floor_div(int64_t a, int64_t b)
 /* floor(a / 2^n), n < 63, without relying on the implementation-defined
  * right shift of negative values (|a| < 2^63 - 2^n).  Inlined: the cone
  * walk's hot loop uses it (a call there costs Cortex-M4 5-10 % of a ray). */
-CT_ALWAYS_INLINE static inline int64_t ct_floor_shr(int64_t a, unsigned n)
+CT_OPT_INLINE static inline int64_t ct_floor_shr(int64_t a, unsigned n)
 {
     return a >= 0 ? a >> n : -(int64_t)(((uint64_t)(-a) + (((uint64_t)1 << n) - 1u)) >> n);
 }

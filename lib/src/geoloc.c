@@ -206,7 +206,11 @@ CT_NOINLINE static void run_pixels(const ct_package *p, const ct_camera *cam, co
                 continue;
             }
             pixel_ray(p, s, g, &ray);
-            if (lw != NULL && !ct_bent_takes_lowered(&ray, &s->bent)) {
+            if (lw != NULL && ray.dx == 0 && ray.dy == 0) {
+                /* a vertical ray of a bent trace is traced straight; every
+                 * other takes ct_trace_bent_set's lowered walk (its origin
+                 * the observer, within range: setup; |d| <= 2^62:
+                 * ct_grid_dir_from_map) */
                 g->status = ct_trace_bent_set(p, &ray, &s->bent, m, &g->hit);
                 continue;
             }

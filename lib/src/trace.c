@@ -869,15 +869,17 @@ static void run_at(const ct_prepared *r, int a, int32_t s, int64_t U, int64_t *q
 
 /* The run's bounds over rays use[] of r (1: in the run).  Returns 1, or 0
  * when they cannot be formed (fewer than two rays, primary axes differ, a
- * ray too steep, or the heights' spread too large for the slopes' range),
- * or 2 when the rays part too fast for a shared walk to pay.
+ * ray too steep), or 2 when the rays part too fast for a shared walk to
+ * pay.
  * Each ray's coordinates are linear in u, so on every face between fa and
  * fa + w they are at or above (below) the chord through the smallest
  * (largest) values at the two ends; the slopes are rounded down (up) and
  * m >= 0, so the bounds hold.  Ranges: |QL_end - QL_start| < 2^34 (q on
  * the faces within 2^31 + 2^32), times 2^16 < 2^50, and m sql <= (2^50 +
- * w) m / w < 2^51 for m <= w; the heights' difference is held below 2^45
- * (else 0), so m szl < 2^62. */
+ * w) m / w < 2^51 for m <= w.  Heights: each ray changes by at most
+ * (hmax - hmin) 2^16 / 16 Q16 LSB per u-cell (the relief test above), so
+ * over w < 2^15 cells by < 2^43 (and its floor by 2^16 more), and the
+ * lowest at either end differ by less than that: m szl < 2^59 + 2^15. */
 static int run_bounds(const ct_package *p, const ct_prepared *r, const uint8_t *use, uint32_t n, runb *b)
 {
     uint32_t k, cnt = 0u;
@@ -889,19 +891,18 @@ static int run_bounds(const ct_package *p, const ct_prepared *r, const uint8_t *
     b->fa = b->w = b->ql = b->qh = b->zl = b->sql = b->sqh = b->szl = 0;
     /* bound: n <= CT_RUN_MAX rays */
     for (k = 0u; k < n; ++k) {
-        int64_t du, dq, ou, cu;
+        int64_t du, ou, cu;
         int ka;
         if (!use[k]) {
             continue;
         }
         ka = ct_abs64(r[k].dx) >= ct_abs64(r[k].dy) ? 0 : 1;
         du = ct_abs64(ka == 0 ? r[k].dx : r[k].dy);
-        dq = ct_abs64(ka == 0 ? r[k].dy : r[k].dx);
         if (a < 0) {
             a = ka;
             s = (ka == 0 ? r[k].dx : r[k].dy) > 0 ? 1 : -1;
         }
-        if (ka != a || ((a == 0 ? r[k].dx : r[k].dy) > 0 ? 1 : -1) != s || du < (INT64_C(1) << 19) || dq > du) {
+        if (ka != a || ((a == 0 ? r[k].dx : r[k].dy) > 0 ? 1 : -1) != s || du < (INT64_C(1) << 19)) {
             return 0;
         }
         /* a steep ray crosses the tile's relief within RUN_MIN_CELLS
@@ -939,7 +940,7 @@ static int run_bounds(const ct_package *p, const ct_prepared *r, const uint8_t *
     hi = lo + (int64_t)(a == 0 ? p->cells_x : p->cells_y);
     b->a = a;
     b->s = s;
-    b->fa = cu0 < lo ? lo : (cu0 >= hi ? hi - 1 : cu0);
+    b->fa = ct_min64(cu0, hi - 1); /* cu0 >= lo: every origin is in the box */
     b->w = hi - b->fa;
     cnt = 0u;
     /* bound: n <= CT_RUN_MAX rays */
@@ -966,9 +967,6 @@ static int run_bounds(const ct_package *p, const ct_prepared *r, const uint8_t *
             zl1 = ct_min64(zl1, za);
         }
         cnt++;
-    }
-    if (ct_abs64(zl1 - b->zl) >= (INT64_C(1) << 45)) {
-        return 0; /* a steep run: its slope's range (and little to gain) */
     }
     b->sql = ct_floor_div((ql1 - b->ql) * ONE16, b->w);
     b->sqh = -ct_floor_div(-((qh1 - b->qh) * ONE16), b->w);

@@ -21,7 +21,7 @@ typedef struct {
 
 
 /* floor(a / 2^n) (fixed.h's ct_floor_shr, under the tracer's short name). */
-CT_ALWAYS_INLINE static inline int64_t floor_shr(int64_t a, unsigned n) { return ct_floor_shr(a, n); }
+CT_OPT_INLINE static inline int64_t floor_shr(int64_t a, unsigned n) { return ct_floor_shr(a, n); }
 
 /* a < b for rationals: n <= 2^34, d <= 2^26 -> products < 2^60 */
 static inline int rt_lt(rt a, rt b) { return a.n * b.d < b.n * a.d; }
