@@ -9,6 +9,7 @@
 // same sandwich, the four methods must agree bit for bit, and the bending
 // must matter (hits differ from the straight ray's).
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <vector>
 
@@ -809,8 +810,9 @@ void test_runs_vs_own_trace()
             // every 7th trial in turn: a vertical ray in the run (its own
             // walk); three rays at spikes far apart (too wide, no halves);
             // level rays above every post (free to the tile's end); a fan
-            // 4 cells wide aimed at the tile's edge (rays that leave the
-            // tile sideways before the shared stretch ends)
+            // 3.5 cells wide across the tile's edge (rays that leave the
+            // tile sideways before the shared stretch ends); rays with dx
+            // exactly 0
             const int kind = (int)(tr % 7);
             const uint32_t nr = kind == 2 ? 3u : CT_RUN_MAX;
             for (uint32_t k = 0; k < nr; ++k) {
@@ -829,7 +831,14 @@ void test_runs_vs_own_trace()
                     ex = ox + (tx - ox) * 4;
                     ey = oy + (ty - oy) * 4;
                 } else if (kind == 5) {
-                    ey = (int64_t)(k * 65536) - 2 * 65536 + (ty % 65536);
+                    // a fan half a cell apart across the tile's edge on the
+                    // side axis (the low edge and the high one in turn)
+                    const bool along_x = std::llabs(tx - ox) >= std::llabs(ty - oy);
+                    const int64_t edge = (tr / 7) % 2 ? (int64_t)(along_x ? h - 1 : w - 1) * 65536 : 0;
+                    const int64_t side = edge + (int64_t)k * 32768 - 7 * 16384;
+                    if (along_x) ey = side; else ex = side;
+                } else if (kind == 6) {
+                    ex = ox;  // dx = 0 exactly: the run's axis is y
                 }
                 const ct_ray ray = {ox, oy, rz, ex - ox, ey - oy, ez - rz};
                 if (ct_prepare_lowered(&p, &ray, 0, plw, &r[n]) == CT_OK) n++;

@@ -401,6 +401,47 @@ void test_occluded_by_wall()
     TEST_ASSERT_MSG(found >= 10, "only %d points hidden by the wall", found);
 }
 
+// The batch's runs around the exact nadir camera's principal point, whose
+// ray is exactly vertical: with a bent trace (the sphere) that pixel takes
+// ct_trace_bent_set's straight vertical trace, its neighbours the runs
+// (straight and bent, every method): every record as ct_geolocate's but
+// for the steps.
+void test_batch_vertical_pixel()
+{
+    World *wd = world();
+    TEST_ASSERT(wd != nullptr);
+    std::vector<Cam> cams = cameras(*wd);
+    const Cam &nadir = cams[0];
+    const int64_t cu = std::llround(nadir.in[2] * 65536), cv = std::llround(nadir.in[3] * 65536);
+    std::vector<int64_t> uv;
+    for (int k = -5; k <= 6; ++k) {
+        uv.push_back(cu + k * 65536);
+        uv.push_back(cv);
+    }
+    const size_t n = uv.size() / 2;
+    ct_effects sphere = {CT_EFFECT_CURVATURE | CT_EFFECT_REFRACTION, CT_REFRACTION_K_STD_Q16, CT_EARTH_RADIUS_NM, 0,
+                         nullptr};
+    for (const ct_effects *fx : {(const ct_effects *)nullptr, (const ct_effects *)&sphere}) {
+        for (int m = 0; m < CT_METHOD_COUNT; ++m) {
+            std::vector<ct_geo> batch(n);
+            TEST_ASSERT_EQUAL_INT(CT_OK, ct_geolocate_batch(&wd->p, &nadir.lib.cam, &nadir.lib.pose, (ct_method)m, fx,
+                                                            uv.data(), n, batch.data(), n));
+            TEST_ASSERT_MSG(batch[5].dir_map_q39[0] == 0 && batch[5].dir_map_q39[1] == 0,
+                            "the principal point's ray is not vertical (%lld, %lld)",
+                            (long long)batch[5].dir_map_q39[0], (long long)batch[5].dir_map_q39[1]);
+            for (size_t k = 0; k < n; ++k) {
+                ct_geo g;
+                ct_geolocate(&wd->p, &nadir.lib.cam, &nadir.lib.pose, (ct_method)m, fx, uv[2 * k], uv[2 * k + 1], &g);
+                ct_hit a = g.hit, b = batch[k].hit;
+                a.steps = b.steps = a.iters = b.iters = 0;
+                TEST_ASSERT_MSG(g.status == batch[k].status && std::memcmp(&a, &b, sizeof a) == 0 &&
+                                    std::memcmp(g.dir_map_q39, batch[k].dir_map_q39, sizeof g.dir_map_q39) == 0,
+                                "%s, method %d, pixel %zu: the batch's record differs", fx ? "sphere" : "straight", m, k);
+            }
+        }
+    }
+}
+
 void test_statuses_and_errors()
 {
     World *wd = world();
@@ -631,6 +672,7 @@ int main()
     RUN_TEST(test_geolocate_vs_mrcal);
     RUN_TEST(test_occluded_by_wall);
     RUN_TEST(test_statuses_and_errors);
+    RUN_TEST(test_batch_vertical_pixel);
     RUN_TEST(test_effects_choice);
     return TEST_END();
 }
