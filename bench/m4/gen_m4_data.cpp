@@ -23,6 +23,18 @@
 
 namespace {
 
+// One m4_grid_pixel initialiser: the host's ct_geolocate (directional) of
+// pixel (u, v) -- status, steps and the hit (0 without one).
+void put_grid_pixel(FILE *f, const ct_package &p, const ct_camera &cam, const ct_pose &pose, const ct_effects *fx,
+                    int64_t u, int64_t v)
+{
+    ct_geo x;
+    ct_geolocate(&p, &cam, &pose, CT_METHOD_DIRECTIONAL, fx, u, v, &x);
+    const bool hit = x.status == CT_HIT || x.status == CT_HIT_VOID;
+    std::fprintf(f, "  {%d, %uu, {INT64_C(%lld), INT64_C(%lld), INT64_C(%lld)}},\n", (int)x.status, x.hit.steps,
+                 hit ? (long long)x.hit.e_nm : 0LL, hit ? (long long)x.hit.n_nm : 0LL, hit ? (long long)x.hit.h_nm : 0LL);
+}
+
 // The geolocation scene (see the head comment); false on a library error.
 bool geo_data(FILE *f, const ct_package &p)
 {
@@ -140,12 +152,7 @@ bool geo_data(FILE *f, const ct_package &p)
                  nu, nv, (long long)u0, (long long)v0, (long long)step, nodes.size());
     std::fprintf(f, "const m4_grid_pixel m4_geo_grid_px[%zu] = {\n", n);
     for (size_t k = 0; k < n; ++k) {
-        ct_geo x;
-        ct_geolocate(&p, &gcam, &pose, CT_METHOD_DIRECTIONAL, nullptr, uv[2 * k], uv[2 * k + 1], &x);
-        const bool hit = x.status == CT_HIT || x.status == CT_HIT_VOID;
-        std::fprintf(f, "  {%d, %uu, {INT64_C(%lld), INT64_C(%lld), INT64_C(%lld)}},\n", (int)x.status, x.hit.steps,
-                     hit ? (long long)x.hit.e_nm : 0LL, hit ? (long long)x.hit.n_nm : 0LL,
-                     hit ? (long long)x.hit.h_nm : 0LL);
+        put_grid_pixel(f, p, gcam, pose, nullptr, uv[2 * k], uv[2 * k + 1]);
     }
     std::fprintf(f, "};\n");
     // 8 runs of 8 neighbouring pixels of a row (the batch's runs)
@@ -162,14 +169,7 @@ bool geo_data(FILE *f, const ct_package &p)
         ct_effects fx;
         const ct_effects *pf = m4_geo_effects(e, &fx, &map);
         std::fprintf(f, " {\n");
-        for (size_t k = 0; k < 64; ++k) {
-            ct_geo x;
-            ct_geolocate(&p, &cam, &pose, CT_METHOD_DIRECTIONAL, pf, ruv[2 * k], ruv[2 * k + 1], &x);
-            const bool hit = x.status == CT_HIT || x.status == CT_HIT_VOID;
-            std::fprintf(f, "  {%d, %uu, {INT64_C(%lld), INT64_C(%lld), INT64_C(%lld)}},\n", (int)x.status, x.hit.steps,
-                         hit ? (long long)x.hit.e_nm : 0LL, hit ? (long long)x.hit.n_nm : 0LL,
-                         hit ? (long long)x.hit.h_nm : 0LL);
-        }
+        for (size_t k = 0; k < 64; ++k) put_grid_pixel(f, p, cam, pose, pf, ruv[2 * k], ruv[2 * k + 1]);
         std::fprintf(f, " },\n");
     }
     std::fprintf(f, "};\n");
