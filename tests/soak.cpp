@@ -8,7 +8,8 @@
 // random size (9..160 posts a side) and height range (1..60,000 codes),
 // built with a random N in {1, 3, 8, 24} and r in {1, 2, 3}; 4,000 rays of
 // every family per terrain, and 4,000 pixels of a camera posed over it
-// (soak_pixels).
+// (soak_pixels), and rows of neighbouring pixels through ct_geolocate_batch
+// (its runs) against ct_geolocate.
 //
 // Usage: ct_soak [--rays N] [--seconds S] [--threads T] [--seed K]
 // (defaults: 10^7 rays, 1,800 s, all cores, seed 1).  Exit 1 when any
@@ -38,6 +39,9 @@ struct Counts {
     // pixels: geolocated with each method; their grid ray formed again from
     // the pose and ct_geo (ct_ray_from_map) and traced must give the same hit
     long pixels = 0, pixel_hits = 0, pixel_unprojected = 0, pixel_retrace_differ = 0;
+    // the batch's runs: rows of neighbouring pixels through ct_geolocate_batch
+    // against ct_geolocate, pixel by pixel
+    long batch_pixels = 0, batch_differ = 0, batch_shortened = 0;
     long tangent_by[dem_cases::FAMILY_COUNT] = {};
     long tangent_both_hit = 0; // both hit, positions apart by more than judge::POS_TOL_Q16
     double worst_xy = 0, worst_z = 0; // the largest such distances (Q16)
@@ -61,6 +65,9 @@ struct Counts {
         pixel_hits += o.pixel_hits;
         pixel_unprojected += o.pixel_unprojected;
         pixel_retrace_differ += o.pixel_retrace_differ;
+        batch_pixels += o.batch_pixels;
+        batch_differ += o.batch_differ;
+        batch_shortened += o.batch_shortened;
     }
 };
 
@@ -261,6 +268,34 @@ void soak_pixels(const Soaked &sk, uint64_t seed, long npx, Counts *c)
         }
         judge_one(cs, d, seed, "pixel", dem_cases::FAMILY_COUNT, ray, pr, s[0], g[0].hit, c);
     }
+    // the batch's runs: rows of 16 pixels 1/4 to 2 px apart, straight and on
+    // a small sphere (the lowered walk), every method
+    const ct_effects sphere = {CT_EFFECT_CURVATURE, 0, INT64_C(1) << 50, 0, nullptr};
+    std::vector<int64_t> uv;
+    for (long r = 0; r < std::max(1L, npx / 64); ++r) {
+        const int64_t u0 = ct_rng_range(&rng, 0, 600 << 16), v = ct_rng_range(&rng, 0, 479 << 16);
+        const int64_t du = ct_rng_range(&rng, 16384, 131072);
+        for (int k = 0; k < 16; ++k) {
+            uv.push_back(u0 + k * du);
+            uv.push_back(v);
+        }
+    }
+    const size_t nb = uv.size() / 2;
+    std::vector<ct_geo> batch(nb);
+    for (const ct_effects *fx : {(const ct_effects *)nullptr, &sphere})
+        for (int m = 0; m < 4; ++m) {
+            if (ct_geolocate_batch(&p, &cam, &pose, (ct_method)m, fx, uv.data(), nb, batch.data(), nb) != CT_OK) {
+                c->errors++;
+                continue;
+            }
+            for (size_t k = 0; k < nb; ++k) {
+                ct_geo g;
+                const ct_status st = ct_geolocate(&p, &cam, &pose, (ct_method)m, fx, uv[2 * k], uv[2 * k + 1], &g);
+                c->batch_pixels++;
+                c->batch_differ += !same(st, g.hit, batch[k].status, batch[k].hit);
+                c->batch_shortened += batch[k].hit.steps < g.hit.steps;
+            }
+        }
 }
 
 }  // namespace
@@ -319,6 +354,9 @@ int main(int argc, char **argv)
     std::printf("  pixels (one camera per terrain): %ld unprojected, %ld hit; the pixel's ray formed again from the "
                 "pose and ct_geo by ct_ray_from_map and traced: %ld differ from ct_geolocate's hit\n",
                 c.pixel_unprojected, c.pixel_hits, c.pixel_retrace_differ);
+    std::printf("  the batch's runs (rows of 16 neighbouring pixels, straight and on a 2^50 nm sphere, 4 methods): %ld "
+                "pixels, %ld differ from ct_geolocate's, %ld walks shortened\n",
+                c.batch_pixels, c.batch_differ, c.batch_shortened);
     std::printf("  disputes the judge settles as tangent (the reference's ray within 1e-6 LSB of the surface there): "
                 "%ld, of them %ld where both hit -- x and y at most %.1f Q16 apart (the stated bound: 2), z up to "
                 "%.1f (steep cells: 2 Q16 across a cliff is many codes up); by family:",
@@ -326,5 +364,5 @@ int main(int argc, char **argv)
     for (int f = 0; f < dem_cases::FAMILY_COUNT; ++f)
         std::printf(" %s %ld", dem_cases::family_name((dem_cases::Family)f), c.tangent_by[f]);
     std::printf("\n");
-    return (c.wrong || c.differ || c.bound || c.errors || c.pixel_retrace_differ) ? 1 : 0;
+    return (c.wrong || c.differ || c.bound || c.errors || c.pixel_retrace_differ || c.batch_differ) ? 1 : 0;
 }
