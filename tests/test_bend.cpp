@@ -840,6 +840,20 @@ void test_runs_vs_own_trace()
                 } else if (kind == 6) {
                     ex = ox;  // dx = 0 exactly: the run's axis is y
                 }
+                if (kind == 4 && tr % 14 == 4) {
+                    // from 1.5 cells inside the low y edge, +x, rays parting
+                    // by 0.7 cells each over 240 cells down to 80 m under
+                    // the ground there: those bound for y < 0 leave the tile
+                    // sideways before the others near the ground
+                    rz = (int64_t)(p.hmax + 160) * 65536;
+                    const int64_t bx = std::llabs(ox) % (30 * 65536) + 20 * 65536, by = 98304;
+                    ex = bx + 240 * 65536;
+                    ey = by + ((int64_t)k * 2 - 7) * 22938;
+                    ez = (int64_t)z[(size_t)w + (size_t)(ex >> 16)] * 65536 - 80 * 65536;
+                    const ct_ray ray = {bx, by, rz, ex - bx, ey - by, ez - rz};
+                    if (ct_prepare_lowered(&p, &ray, 0, plw, &r[n]) == CT_OK) n++;
+                    continue;
+                }
                 const ct_ray ray = {ox, oy, rz, ex - ox, ey - oy, ez - rz};
                 if (ct_prepare_lowered(&p, &ray, 0, plw, &r[n]) == CT_OK) n++;
             }

@@ -206,7 +206,7 @@ CT_NOINLINE static void run_pixels(const ct_package *p, const ct_camera *cam, co
                 continue;
             }
             pixel_ray(p, s, g, &ray);
-            if (lw != NULL && ray.dx == 0 && ray.dy == 0) {
+            if (lw != NULL && (ray.dx | ray.dy) == 0) {
                 /* a vertical ray of a bent trace is traced straight; every
                  * other takes ct_trace_bent_set's lowered walk (its origin
                  * the observer, within range: setup; |d| <= 2^62:
