@@ -837,7 +837,8 @@ ct_status ct_trace_lowered(const ct_package *p, const ct_ray *ray, const ct_lowe
  * and its height (Q16 LSB) at or above ZL(m):
  *     QL(m) = ql + floor(m sql / 2^16),  QH(m) = qh + ceil(m sqh / 2^16),
  *     ZL(m) = zl + floor(m szl / 2^16)
- * (below run_bounds).  Ranges: |u|, |q| < 2^31 on the tile; |ZL| < 2^57. */
+ * (below run_bounds).  Ranges: |u| < 2^31 on the tile, |q| < 2^33 on the
+ * faces (a ray's line runs on past the tile's sides), |ZL| < 2^57. */
 #ifndef RUN_MIN_CELLS
 #define RUN_MIN_CELLS 16
 #endif
@@ -877,7 +878,7 @@ static void run_at(const ct_prepared *r, int a, int32_t s, int64_t U, int64_t *q
  * m >= 0, so the bounds hold.  Ranges: |QL_end - QL_start| < 2^34 (q on
  * the faces within 2^31 + 2^32), times 2^16 < 2^50, and m sql <= (2^50 +
  * w) m / w < 2^51 for m <= w.  Heights: each ray changes by at most
- * (hmax - hmin) 2^16 / 16 Q16 LSB per u-cell (the relief test above), so
+ * (hmax - hmin) 2^16 / 16 Q16 LSB per u-cell (the relief test below), so
  * over w < 2^15 cells by < 2^43 (and its floor by 2^16 more), and the
  * lowest at either end differ by less than that: m szl < 2^59 + 2^15. */
 static int run_bounds(const ct_package *p, const ct_prepared *r, const uint8_t *use, uint32_t n, runb *b)
