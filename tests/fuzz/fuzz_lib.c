@@ -19,6 +19,9 @@
  *                     k, radius 0 = the true Earth on the UTM package,
  *                     chord) through ct_geolocate with every method: a
  *                     documented status, identical results, hits in the tile;
+ *                     and 8 pixels along a row from it through
+ *                     ct_geolocate_batch (its runs): each record as
+ *                     ct_geolocate's;
  *   mode 3 (geodesy, byte 0 = 3 mod 4): int64 lat, lon, e, n, yaw, pitch,
  *                     roll, h and a zone byte through ct_utm_forward,
  *                     ct_utm_inverse, ct_utm_factors, ct_quat_from_ypr and
@@ -615,6 +618,26 @@ static void geoloc_mode(const ct_vec_package *vp, const uint8_t *d, size_t n)
         for (m = 1; m < CT_METHOD_COUNT; ++m) { /* bound: 4 methods */
             s = ct_geolocate(&pkg, &cam, &pose, (ct_method)m, &fx, u, v, &g);
             CHECK(s == s0 && same_hit(s0, &g0.hit, s, &g.hit));
+        }
+        {
+            /* the batch's runs: 8 pixels along a row from (u, v), 1/64 to
+             * 4 px apart, with a method from the bytes: each record as
+             * ct_geolocate's (status and hit; the steps may differ) */
+            int64_t uv[16];
+            ct_geo gb[8];
+            const int64_t du = 1024 + (int64_t)((pix >> 20) & 0x3ffff);
+            const ct_method bm = (ct_method)((e >> 60) & 3);
+            uint32_t k;
+            for (k = 0u; k < 8u; ++k) { /* bound: 8 pixels */
+                uv[2u * k] = u + (int64_t)k * du;
+                uv[2u * k + 1u] = v;
+            }
+            s = ct_geolocate_batch(&pkg, &cam, &pose, bm, &fx, uv, 8u, gb, 8u);
+            CHECK(s == CT_OK || s == s0);
+            for (k = 0u; k < 8u && s == CT_OK; ++k) { /* bound: 8 pixels */
+                const ct_status s1 = ct_geolocate(&pkg, &cam, &pose, bm, &fx, uv[2u * k], uv[2u * k + 1u], &g);
+                CHECK(s1 == gb[k].status && same_hit(s1, &g.hit, gb[k].status, &gb[k].hit));
+            }
         }
     }
 }
