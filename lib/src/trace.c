@@ -853,6 +853,18 @@ typedef struct {
     int64_t sql, sqh, szl; /* per u-cell, Q16 */
 } runb;
 
+/* Ray r's direction on axis a (0: x, 1: y), and its origin's u there. */
+static int32_t run_d(const ct_prepared *r, int a)
+{
+    return a == 0 ? r->dx : r->dy;
+}
+
+static int64_t run_u(const ct_prepared *r, int a, int32_t s)
+{
+    int64_t o = a == 0 ? r->ox : r->oy;
+    return s > 0 ? o : -o;
+}
+
 /* The other coordinate and the height of prepared ray r on u-face U
  * (Q16): *qlo, *qhi its floor and ceiling, *zlo a lower bound (Q16 LSB).
  * e = U - u_origin, |e| < 2^32: e dq < 2^58, e dz < 2^58, quotients by
@@ -860,9 +872,8 @@ typedef struct {
  * 2^46 (ct_prepared). */
 static void run_at(const ct_prepared *r, int a, int32_t s, int64_t U, int64_t *qlo, int64_t *qhi, int64_t *zlo)
 {
-    int64_t ou = s > 0 ? (a == 0 ? r->ox : r->oy) : -(a == 0 ? r->ox : r->oy);
-    int64_t du = ct_abs64(a == 0 ? r->dx : r->dy), dq = a == 0 ? r->dy : r->dx;
-    int64_t oq = a == 0 ? r->oy : r->ox, e = U - ou;
+    int64_t du = ct_abs64(run_d(r, a)), dq = run_d(r, 1 - a);
+    int64_t oq = a == 0 ? r->oy : r->ox, e = U - run_u(r, a, s);
     *qlo = oq + ct_floor_div(e * dq, du);
     *qhi = oq - ct_floor_div(-(e * dq), du);
     *zlo = r->oz * (INT64_C(1) << r->zshift) + ct_floor_div(e * (int64_t)r->dz, du) * (INT64_C(1) << r->zshift);
@@ -884,7 +895,7 @@ static void run_at(const ct_prepared *r, int a, int32_t s, int64_t U, int64_t *q
 static int run_bounds(const ct_package *p, const ct_prepared *r, const uint8_t *use, uint32_t n, runb *b)
 {
     uint32_t k, cnt = 0u;
-    int64_t cu0 = 0, lo, hi, ql1 = 0, qh1 = 0, zl1 = 0, gq = 0, gu = 1;
+    int64_t cu0 = 0, lo, hi, ql1 = 0, qh1 = 0, zl1 = 0, gq = 0, gu = 1, ncell = 0;
     int a = -1;
     int32_t s = 0;
     b->a = 0;
@@ -892,18 +903,19 @@ static int run_bounds(const ct_package *p, const ct_prepared *r, const uint8_t *
     b->fa = b->w = b->ql = b->qh = b->zl = b->sql = b->sqh = b->szl = 0;
     /* bound: n <= CT_RUN_MAX rays */
     for (k = 0u; k < n; ++k) {
-        int64_t du, ou, cu;
+        int64_t du, cu;
         int ka;
         if (!use[k]) {
             continue;
         }
         ka = ct_abs64(r[k].dx) >= ct_abs64(r[k].dy) ? 0 : 1;
-        du = ct_abs64(ka == 0 ? r[k].dx : r[k].dy);
+        du = ct_abs64(run_d(&r[k], ka));
         if (a < 0) {
             a = ka;
-            s = (ka == 0 ? r[k].dx : r[k].dy) > 0 ? 1 : -1;
+            s = run_d(&r[k], ka) > 0 ? 1 : -1;
+            ncell = (int64_t)(a == 0 ? p->cells_x : p->cells_y);
         }
-        if (ka != a || ((a == 0 ? r[k].dx : r[k].dy) > 0 ? 1 : -1) != s || du < (INT64_C(1) << 19)) {
+        if (ka != a || (run_d(&r[k], a) > 0 ? 1 : -1) != s || du < (INT64_C(1) << 19)) {
             return 0;
         }
         /* a steep ray crosses the tile's relief within RUN_MIN_CELLS
@@ -919,17 +931,15 @@ static int run_bounds(const ct_package *p, const ct_prepared *r, const uint8_t *
          * less (a choice, not a bound): |q du0 - q0 du| < 2^37, times the
          * tile's cells (< 2^15) < 2^52; RUN_SPREAD du du0 < 2^40 */
         {
-            int64_t qs = (a == 0 ? r[k].dy : r[k].dx) / 256, us = du / 256;
+            int64_t qs = run_d(&r[k], 1 - a) / 256, us = du / 256;
             if (cnt == 0u) {
                 gq = qs;
                 gu = us;
-            } else if (ct_abs64(qs * gu - gq * us) * (int64_t)(a == 0 ? p->cells_x : p->cells_y) >
-                       RUN_SPREAD * us * gu) {
+            } else if (ct_abs64(qs * gu - gq * us) * ncell > RUN_SPREAD * us * gu) {
                 return 2;
             }
         }
-        ou = s > 0 ? (a == 0 ? r[k].ox : r[k].oy) : -(a == 0 ? r[k].ox : r[k].oy);
-        cu = floor_shr(ou, 16u);
+        cu = floor_shr(run_u(&r[k], a, s), 16u);
         cu0 = cnt == 0u ? cu : ct_min64(cu0, cu);
         cnt++;
     }
@@ -937,8 +947,8 @@ static int run_bounds(const ct_package *p, const ct_prepared *r, const uint8_t *
         return 0;
     }
     /* u-cells on the tile: [0, N) (s > 0) or [-N, 0) */
-    lo = s > 0 ? 0 : -(int64_t)(a == 0 ? p->cells_x : p->cells_y);
-    hi = lo + (int64_t)(a == 0 ? p->cells_x : p->cells_y);
+    lo = s > 0 ? 0 : -ncell;
+    hi = lo + ncell;
     b->a = a;
     b->s = s;
     b->fa = ct_min64(cu0, hi - 1); /* cu0 >= lo: every origin is in the box */
@@ -1048,6 +1058,7 @@ static int64_t run_walk(const ct_package *p, const ct_lower *lw, const runb *b)
 ct_status ct_trace_run(const ct_package *p, const ct_prepared *r, uint32_t n, const ct_lower *lw, ct_method m,
                        ct_hit *const *h, ct_status *st)
 {
+    /* grp: 0 its own walk; 1 the run's; 2, 3 a half's */
     uint8_t use[CT_RUN_MAX] = {0u}, grp[CT_RUN_MAX] = {0u};
     runb b[3];
     int64_t cs[3] = {0, 0, 0};
@@ -1059,7 +1070,6 @@ ct_status ct_trace_run(const ct_package *p, const ct_prepared *r, uint32_t n, co
     /* bound: n <= CT_RUN_MAX rays */
     for (k = 0u; k < n; ++k) {
         use[k] = (uint8_t)(r[k].start == CT_OK && (r[k].dx != 0 || r[k].dy != 0));
-        grp[k] = 0u; /* 0: its own walk; 1: the run's; 2, 3: a half's */
     }
     /* 1: bounds formed; 2: too wide, or the walk showed nothing free */
     wide = run_bounds(p, r, use, n, &b[0]);
@@ -1092,7 +1102,7 @@ ct_status ct_trace_run(const ct_package *p, const ct_prepared *r, uint32_t n, co
     /* bound: n <= CT_RUN_MAX rays */
     for (k = 0u; k < n; ++k) {
         wstart ws;
-        int64_t ou, c;
+        int64_t c;
         const runb *q;
         rt tend;
         if (grp[k] == 0u) {
@@ -1101,9 +1111,8 @@ ct_status ct_trace_run(const ct_package *p, const ct_prepared *r, uint32_t n, co
         }
         q = &b[grp[k] - 1u];
         c = cs[grp[k] - 1u];
-        ou = q->s > 0 ? (q->a == 0 ? r[k].ox : r[k].oy) : -(q->a == 0 ? r[k].ox : r[k].oy);
-        ws.t0.n = c * ONE16 - ou; /* < 2^32 */
-        ws.t0.d = ct_abs64(q->a == 0 ? r[k].dx : r[k].dy);
+        ws.t0.n = c * ONE16 - run_u(&r[k], q->a, q->s); /* < 2^32 */
+        ws.t0.d = ct_abs64(run_d(&r[k], q->a));
         if (ws.t0.n <= 0) {
             /* the ray starts in or after the first u-cell not shown free */
             st[k] = trace_impl(p, &r[k], m, 1, lw, NULL, h[k]);
