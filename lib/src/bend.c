@@ -102,13 +102,6 @@ static ct_status vertex(const bent *b, int64_t s, v3 *v)
     return CT_OK;
 }
 
-/* Max-mipmap value of block (bi, bj) at level l >= 1 (the hierarchical
- * walk's array). */
-static int64_t mip_max(const ct_package *p, uint32_t l, int64_t bi, int64_t bj)
-{
-    return (int64_t)ct_ld16(p->mip[l] + 2u * ((size_t)bj * p->mip_w[l] + (size_t)bi));
-}
-
 /* Culling.  1 when nothing at or below zmin (Q16) stands under the
  * horizontal box [x0, x1] x [y0, y1] (Q16): zmin is above the max-mipmap's
  * maximum over the fine cells the box touches.  *over_tile says whether the
@@ -140,7 +133,7 @@ static int box_above_terrain(const ct_package *p, int64_t x0, int64_t x1, int64_
         /* bound: at most 2 x 2 blocks */
         for (bj = j0 >> l; bj <= (j1 >> l); ++bj) {
             for (bi = i0 >> l; bi <= (i1 >> l); ++bi) {
-                top = ct_max64(top, mip_max(p, l, bi, bj));
+                top = ct_max64(top, (int64_t)ct_mip_at(p, l, (uint32_t)bi, (uint32_t)bj));
             }
         }
     }

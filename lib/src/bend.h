@@ -7,10 +7,19 @@
 #define CT_BEND_H
 
 #include "conetrace.h"
+#include "fixed.h"
 
 #ifdef __cplusplus
 extern "C" {
 #endif
+
+/* The max-mipmap's value (the tallest post under it) of block (bi, bj) at
+ * level l in [1, levels], the block inside that level's grid (the walks'
+ * and the culling's one read of it). */
+static inline uint32_t ct_mip_at(const ct_package *p, uint32_t l, uint32_t bi, uint32_t bj)
+{
+    return ct_ld16(p->mip[l] + 2u * ((size_t)bj * p->mip_w[l] + (size_t)bi));
+}
 
 /* The grid direction of a map direction (|.| <= 2^40, not all 0), as
  * ct_ray_from_map forms it (frames.c); geolocation uses it so that a pixel's

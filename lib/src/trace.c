@@ -184,11 +184,6 @@ static ct_status walk_incremental(const ctx *c, ct_hit *h)
     return st;
 }
 
-static uint32_t mip_at(const ct_package *p, uint32_t l, int32_t bi, int32_t bj)
-{
-    return ct_ld16(p->mip[l] + 2u * ((size_t)(uint32_t)bj * p->mip_w[l] + (uint32_t)bi));
-}
-
 static ct_status walk_hierarchical(const ctx *c, ct_hit *h)
 {
     const ct_package *p = c->p;
@@ -222,7 +217,7 @@ static ct_status walk_hierarchical(const ctx *c, ct_hit *h)
             lvl = p->levels > 0u ? 1u : 0u;
         } else {
             int32_t bi = i >> lvl, bj = j >> lvl, xf, yf;
-            int64_t bmax = (int64_t)mip_at(p, lvl, bi, bj);
+            int64_t bmax = (int64_t)ct_mip_at(p, lvl, (uint32_t)bi, (uint32_t)bj);
             rt tx;
             int face;
             /* the block's exit faces (cells), clamped to the tile */
@@ -1017,7 +1012,8 @@ static int run_clear(const ct_package *p, const ct_lower *lw, const runb *b, int
         if (l == 0u) {
             v = b->a == 0 ? cell_hmax(p, i, bj) : cell_hmax(p, bj, i);
         } else {
-            v = b->a == 0 ? mip_at(p, l, i >> l, bj) : mip_at(p, l, bj, i >> l);
+            uint32_t bu = (uint32_t)(i >> l), bq = (uint32_t)bj;
+            v = b->a == 0 ? ct_mip_at(p, l, bu, bq) : ct_mip_at(p, l, bq, bu);
         }
         hb = ct_max64(hb, v);
     }
