@@ -1052,6 +1052,106 @@ void test_geolocation()
 // Intervisibility over a set: ct_los_tiles = ct_los on the merged package
 // (straight, a sphere, the true Earth), and with a tile missing the merged
 // answer or CT_NO_DATA, never "visible" through or "blocked" on that tile.
+// The batch's runs over a set (ct_tileset_trace_run): whole image rows of
+// neighbouring pixels, every record (status, hit position, cell; a missing
+// tile's CT_NO_DATA point too) as the same pixel's ct_geolocate_tiles and,
+// where the set has every tile, as the merged package's; straight and on a
+// sphere, every method; every tile resident and a single slot (the run
+// never loads a tile the rays' own walks would not: the batch's loads are
+// at most the single calls'); cameras high, low and grazing, and one
+// outside the set.  The runs must take part: some walks shortened.
+void test_batch_runs()
+{
+    const ct_host::Terrain t = dem_cases::mirror_tiled(dem_cases::real_terrain(), 500, 500);
+    ct_host::BuildOptions o;
+    o.sectors = 24;
+    o.reduce = 3;
+    const TileSetBytes tb = ct_host::build_tileset(t, o, 129, 0);
+    const TileSetBytes holed = ct_host::build_tileset(t, o, 129, 0, [](int c, int r) { return c == 2 && r == 1; });
+    const std::vector<uint8_t> merged = ct_host::build_package(t, o);
+    ct_package mp;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_package_open(&mp, merged.data(), merged.size()));
+    ct_camera cam;
+    TEST_ASSERT_EQUAL_INT(CT_OK, pinhole(&cam, 640, 480, 500, 639, 479));
+    std::vector<int64_t> uv;
+    for (int row : {0, 100, 239, 380, 479})
+        for (int col = 0; col < 640; ++col) {
+            uv.push_back(((int64_t)col << 16) + (1 << 15));
+            uv.push_back(((int64_t)row << 16) + (1 << 15));
+        }
+    const size_t np = uv.size() / 2;
+    struct View {
+        const char *what;
+        int ci, cj;
+        double up_m, yaw, pitch;
+    };
+    const View views[] = {
+        {"2 km up, 20 deg down", 120, 380, 2000, 45, -20},
+        {"300 m over the top, 4 deg down", 60, 60, 300, 30, -4},
+        {"400 m up, 12 deg down, looking west", 470, 250, 400, 175, -12},
+        {"outside the set, 1 km up, 8 deg down", -40, 200, 1000, 5, -8},
+    };
+    ct_effects sphere = {CT_EFFECT_CURVATURE | CT_EFFECT_REFRACTION, CT_REFRACTION_K_STD_Q16,
+                         (int64_t)6371000 * 1000000000, 0, NULL};
+    const ct_effects *fxs[2] = {nullptr, &sphere};
+    long shortened = 0, compared = 0, nodata = 0;
+    for (const View &v : views) {
+        int32_t q[4];
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_quat_from_ypr(dem_cases::deg_q61(v.yaw), dem_cases::deg_q61(v.pitch), 0, q));
+        const int64_t e = mp.origin_e_nm + (int64_t)v.ci * mp.posting_e_nm;
+        const int64_t n = mp.origin_n_nm + (int64_t)v.cj * mp.posting_n_nm;
+        const int64_t h = mp.height_offset_nm + (int64_t)mp.hmax * mp.height_scale_nm + (int64_t)(v.up_m * 1e9);
+        ct_pose pose;
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_pose_from_map(&pose, e, n, h, q));
+        for (int f = 0; f < 2; ++f)
+            for (int m = 0; m < 4; ++m)
+                for (int which = 0; which < 2; ++which)
+                    for (int slots : {16, 1}) {
+                        const TileSetBytes &sb = which == 0 ? tb : holed;
+                        Set a, b;
+                        TEST_ASSERT_EQUAL_INT(CT_OK, a.open(sb, slots));
+                        TEST_ASSERT_EQUAL_INT(CT_OK, b.open(sb, slots));
+                        std::vector<ct_geo> gb(np), gm(np);
+                        TEST_ASSERT_EQUAL_INT(CT_OK, ct_geolocate_batch_tiles(&a.ts, &cam, &pose, (ct_method)m, fxs[f],
+                                                                              uv.data(), np, gb.data(), np));
+                        if (which == 0)
+                            TEST_ASSERT_EQUAL_INT(CT_OK, ct_geolocate_batch(&mp, &cam, &pose, (ct_method)m, fxs[f],
+                                                                            uv.data(), np, gm.data(), np));
+                        for (size_t k = 0; k < np; ++k) {
+                            ct_geo one;
+                            ct_geolocate_tiles(&b.ts, &cam, &pose, (ct_method)m, fxs[f], uv[2 * k], uv[2 * k + 1], &one);
+                            const ct_hit &x = gb[k].hit, &y = one.hit;
+                            const bool placed = one.status == CT_HIT || one.status == CT_HIT_VOID ||
+                                                one.status == CT_NO_DATA;
+                            const bool same = gb[k].status == one.status &&
+                                              (!placed || (x.x_q16 == y.x_q16 && x.y_q16 == y.y_q16 &&
+                                                           x.z_q16 == y.z_q16 && x.t_q26 == y.t_q26 &&
+                                                           x.cell_x == y.cell_x && x.cell_y == y.cell_y &&
+                                                           x.e_nm == y.e_nm && x.n_nm == y.n_nm && x.h_nm == y.h_nm));
+                            TEST_ASSERT_MSG(same, "%s, effects %d, method %d, %s set, %d slots, pixel %zu: batch %d "
+                                            "(cell %d,%d) vs single %d (cell %d,%d)", v.what, f, m,
+                                            which == 0 ? "whole" : "holed", slots, k, gb[k].status, x.cell_x, x.cell_y,
+                                            one.status, y.cell_x, y.cell_y);
+                            if (which == 0)
+                                TEST_ASSERT_MSG(same_hit(gm[k].status, gm[k].hit, gb[k].status, gb[k].hit),
+                                                "%s, effects %d, method %d, pixel %zu: set %d vs merged %d", v.what, f,
+                                                m, k, gb[k].status, gm[k].status);
+                            shortened += gb[k].hit.steps < one.hit.steps;
+                            nodata += gb[k].status == CT_NO_DATA;
+                            compared++;
+                            if (!same) break;
+                        }
+                        TEST_ASSERT_MSG(a.ts.loads <= b.ts.loads, "%s, effects %d, method %d, %d slots: the batch "
+                                        "loaded %u tiles, the single calls %u", v.what, f, m, slots,
+                                        (unsigned)a.ts.loads, (unsigned)b.ts.loads);
+                    }
+    }
+    std::printf("  batch runs over a set: %ld records as the single calls' (%ld CT_NO_DATA), %ld walks shortened\n",
+                compared, nodata, shortened);
+    TEST_ASSERT(nodata > 0);
+    TEST_ASSERT(shortened > compared / 10);
+}
+
 void test_los()
 {
     const ct_host::Terrain t = dem_cases::mirror_tiled(dem_cases::real_terrain(), 500, 500);
@@ -1390,6 +1490,7 @@ int main()
     RUN_TEST(test_manifest_checks);
     RUN_TEST(test_voids);
     RUN_TEST(test_geolocation);
+    RUN_TEST(test_batch_runs);
     RUN_TEST(test_los);
     RUN_TEST(test_bent_saturated);
     RUN_TEST(test_bent_start_below_after_entered);

@@ -115,6 +115,25 @@ ct_status ct_prepare_lowered(const ct_package *p, const ct_ray *ray, int seg, co
 ct_status ct_trace_run(const ct_package *pkg, const ct_prepared *r, uint32_t n, const ct_lower *lw, ct_method method,
                        ct_hit *const *h, ct_status *st);
 
+/* Where each ray of a run starts its own walk on pkg (ct_run_starts, the
+ * first half of ct_trace_run; a tile set's run on one tile, tiles.c):
+ * CT_RUN_OWN from its first point as alone; CT_RUN_FACE on the face of
+ * cell column (face 1) or row (face 2) `cell` of pkg's grid at t = t0_n /
+ * t0_d (t0_d = |dx| or |dy|), as a tile set's walk starts on a seam, the
+ * ray's way there holding no point of pkg's surface; CT_RUN_CLEAR: none
+ * on its whole way through pkg's box.                                     */
+enum { CT_RUN_OWN = 0, CT_RUN_FACE = 1, CT_RUN_CLEAR = 2 };
+typedef struct {
+    int64_t t0_n, t0_d;
+    int32_t cell;
+    uint8_t face, how;
+} ct_run_start;
+/* r[k] (k < n <= CT_RUN_MAX) prepared rays in pkg's grid (lw: the lowered
+ * terrain of all, or NULL), out[k] each one's start.  CT_ERR_ARG for a
+ * NULL argument or n > CT_RUN_MAX, else CT_OK.                            */
+ct_status ct_run_starts(const ct_package *pkg, const ct_prepared *const *r, uint32_t n, const ct_lower *lw,
+                        ct_run_start *out);
+
 /* A segment (origin to origin + direction) of a lowered ray: prepared as
  * ct_ray_prepare_segment, traced against the lowered terrain (lw = NULL:
  * the terrain itself).  A hit in the last cell beyond the segment's end

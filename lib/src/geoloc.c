@@ -178,16 +178,20 @@ static ct_status one_pixel(const ct_package *p, ct_tileset *ts, const ct_camera 
     return st;
 }
 
-/* A batch on one package with straight rays or the lowered model, in runs
- * of up to CT_RUN_MAX consecutive pixels traced together (ct_trace_run):
+/* A batch with straight rays or the lowered model on one package (ts
+ * NULL) or over a tile set (p its frame), in runs of up to CT_RUN_MAX
+ * consecutive pixels traced together (ct_trace_run, ct_tileset_trace_run):
  * each record as one_pixel's but for hit.steps and hit.iters (the pixel's
  * own walk).  A pixel whose ray does not take that walk (an unprojection
  * or preparation error, a vertical ray of a bent trace) is done as
  * one_pixel does it. */
-CT_NOINLINE static void run_pixels(const ct_package *p, const ct_camera *cam, const ct_pose *pose, ct_method m,
-                                   const geo_setup *s, const int64_t *uv_q16, size_t count, ct_geo *out)
+CT_NOINLINE static void run_pixels(const ct_package *p, ct_tileset *ts, const ct_camera *cam, const ct_pose *pose,
+                                   ct_method m, const geo_setup *s, const int64_t *uv_q16, size_t count, ct_geo *out)
 {
-    ct_prepared r[CT_RUN_MAX];
+    union {
+        ct_prepared r[CT_RUN_MAX]; /* one package: the prepared rays */
+        ct_ray ray[CT_RUN_MAX];    /* a tile set: the rays */
+    } u;
     ct_hit *hp[CT_RUN_MAX];
     ct_status st[CT_RUN_MAX];
     size_t idx[CT_RUN_MAX];
@@ -211,19 +215,27 @@ CT_NOINLINE static void run_pixels(const ct_package *p, const ct_camera *cam, co
                  * other takes ct_trace_bent_set's lowered walk (its origin
                  * the observer, within range: setup; |d| <= 2^62:
                  * ct_grid_dir_from_map) */
-                g->status = ct_trace_bent_set(p, &ray, &s->bent, m, &g->hit);
+                g->status = ct_trace_bent_set_ts(p, ts, &ray, &s->bent, m, &g->hit);
                 continue;
             }
-            sp = ct_prepare_lowered(p, &ray, 0, lw, &r[n]);
-            if (sp < 0) {
-                g->status = sp;
-                continue;
+            if (ts != NULL) {
+                u.ray[n] = ray;
+            } else {
+                sp = ct_prepare_lowered(p, &ray, 0, lw, &u.r[n]);
+                if (sp < 0) {
+                    g->status = sp;
+                    continue;
+                }
             }
             hp[n] = &g->hit;
             idx[n] = k;
             n++;
         }
-        (void)ct_trace_run(p, r, n, lw, m, hp, st);
+        if (ts != NULL) {
+            (void)ct_tileset_trace_run(ts, u.ray, n, lw, m, hp, st);
+        } else {
+            (void)ct_trace_run(p, u.r, n, lw, m, hp, st);
+        }
         /* bound: n <= CT_RUN_MAX */
         for (i = 0u; i < n; ++i) {
             out[idx[i]].status = st[i];
@@ -263,10 +275,10 @@ static ct_status geolocate_many(const ct_package *pkg, ct_tileset *ts, const ct_
     if (st != CT_OK) {
         return st;
     }
-    if (ts == NULL && !s.earth && (s.bend.coeff_q16 == 0 || s.bent.lowered) && method != CT_METHOD_INCREMENTAL) {
+    if (!s.earth && (s.bend.coeff_q16 == 0 || s.bent.lowered) && method != CT_METHOD_INCREMENTAL) {
         /* runs (the incremental method stays the plain cell-by-cell walk,
          * the reference, in a batch too) */
-        run_pixels(pkg, cam, pose, method, &s, uv_q16, count, out);
+        run_pixels(pkg, ts, cam, pose, method, &s, uv_q16, count, out);
         return CT_OK;
     }
     /* bound: count pixels (caller's buffers) */

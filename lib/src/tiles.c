@@ -366,95 +366,248 @@ static ct_status walk_tile(const ct_package *tp, ct_prepared *r, int64_t x0, int
     return st;
 }
 
+/* A ray's walk over the set: the prepared ray (frame's grid), the tile
+ * (a, bb) it is in and where its walk there starts -- t = tn / td, entry
+ * face(s) eface (0: the first point), cell (i, j) of the tile's grid --
+ * the tile when already fetched, and skip: a run showed the ray's way
+ * through that tile clear of its surface (no walk there). */
+typedef struct {
+    ct_prepared r;
+    const ct_package *tp;
+    int64_t tn, td;
+    int32_t i, j, ci, cj;
+    uint32_t a, bb;
+    int eface, skip;
+} set_walker;
+
+/* The ray prepared against the frame (no heights read) and the tile its
+ * first point is on: CT_OK, or the trace's status (an error, CT_MISS). */
+static ct_status set_geom(ct_tileset *ts, const ct_ray *ray, int seg, ct_method m, set_walker *w)
+{
+    const ct_package *F = &ts->frame;
+    ct_status st;
+    if ((unsigned)m >= (unsigned)CT_METHOD_COUNT) {
+        return CT_ERR_METHOD;
+    }
+    st = ct_tile_prep_geom(F, ray, seg, &w->r);
+    if (st != CT_OK) {
+        return st;
+    }
+    /* (i, j): the cell the walk starts in (in tile (a, bb)'s grid after
+     * set_begin); (ci, cj): the cell the first point is on */
+    ct_prepared_first_cell(F, &w->r, &w->i, &w->j);
+    w->ci = ct_clamp_cell(w->i, F->cells_x);
+    w->cj = ct_clamp_cell(w->j, F->cells_y);
+    w->a = tile_of(ts, w->ci, ts->tiles_x);
+    w->bb = tile_of(ts, w->cj, ts->tiles_y);
+    w->tp = NULL;
+    w->tn = 0;
+    w->td = 1;
+    w->eface = 0;
+    w->skip = 0;
+    return CT_OK;
+}
+
+/* The first point decided against its tile (set_start); seg, below_hit,
+ * tend: set_trace's.  1 when the walk goes on (*st CT_OK, or CT_HIT at the
+ * first point), else 0 with the trace's status in *st. */
+static int set_begin(ct_tileset *ts, const ct_ray *ray, int seg, const ct_lower *lw, int below_hit, ct_hit *h,
+                     int64_t tend[2], set_walker *w, ct_status *st)
+{
+    *st = set_start(ts, ray, seg, lw, w->a, w->bb, w->ci, w->cj, &w->r, &w->tp, &w->i, &w->j, tend, h);
+    if (*st == CT_NO_DATA) {
+        return 0;
+    }
+    if (*st == CT_BELOW && below_hit) {
+        w->r.start = CT_HIT; /* tend stays 0: the hit is at the first point */
+        *st = CT_HIT;
+    }
+    if (tend != NULL) {
+        tend[0] = w->r.tend_n;
+        tend[1] = w->r.tend_d;
+    }
+    return *st == CT_OK || *st == CT_HIT; /* else CT_BELOW */
+}
+
+/* The walk over the tiles the ray crosses, from w's. */
+static ct_status set_walk(ct_tileset *ts, set_walker *w, const ct_lower *lw, ct_method m, ct_hit *h)
+{
+    const ct_package *F = &ts->frame;
+    const ct_prepared *r = &w->r;
+    int32_t sx = r->dx > 0 ? 1 : (r->dx < 0 ? -1 : 0), sy = r->dy > 0 ? 1 : (r->dy < 0 ? -1 : 0);
+    uint32_t it;
+    ct_status st;
+    /* bound: a ray crosses at most tiles_x + tiles_y - 1 tiles */
+    for (it = 0u; it < ts->tiles_x + ts->tiles_y; ++it) {
+        const uint8_t *e = ts->entries + (size_t)(w->bb * ts->tiles_x + w->a) * CT_SET_ENTRY_SIZE;
+        int64_t en, ed;
+        const int face = tile_exit(ts, r, w->a, w->bb, &en, &ed);
+        if (!w->skip && tile_may_hit(e, r, w->tn, w->td, en, ed)) {
+            if (w->tp == NULL) {
+                w->tp = tile_get(ts, w->a, w->bb);
+                if (w->tp == NULL) {
+                    return no_data(ts, r, lw, w->a, w->bb, w->tn, w->td, h);
+                }
+            }
+            st = walk_tile(w->tp, &w->r, (int64_t)tile_first(ts, w->a), (int64_t)tile_first(ts, w->bb), w->tn, w->td,
+                           w->eface, w->i, w->j, lw, m, h);
+            if (st != CT_MISS) {
+                return st;
+            }
+        }
+        if (!t_lt(en, ed, r->tend_n, r->tend_d)) {
+            return CT_MISS;
+        }
+        /* onto the next tile (through a corner: the diagonal one), in the
+         * cell column (row) on its entry face */
+        if (face & 1) {
+            if ((sx < 0 && w->a == 0u) || (sx > 0 && w->a + 1u >= ts->tiles_x)) {
+                return CT_MISS;
+            }
+            w->a = sx > 0 ? w->a + 1u : w->a - 1u;
+            w->i = sx > 0 ? 0 : (int32_t)tile_posts_at(ts, w->a, F->width) - 2;
+        }
+        if (face & 2) {
+            if ((sy < 0 && w->bb == 0u) || (sy > 0 && w->bb + 1u >= ts->tiles_y)) {
+                return CT_MISS;
+            }
+            w->bb = sy > 0 ? w->bb + 1u : w->bb - 1u;
+            w->j = sy > 0 ? 0 : (int32_t)tile_posts_at(ts, w->bb, F->height) - 2;
+        }
+        w->eface = face;
+        w->skip = 0;
+        w->tp = NULL;
+        w->tn = en;
+        w->td = ed;
+    }
+    return CT_ERR_INTERNAL;
+}
+
 /* The trace over the set; lw: the lowered model in the frame's grid
  * (NULL: straight); seg, below_hit: ct_tileset_trace_segment's; *tend:
  * the prepared ray's end (NULL: not wanted). */
 static ct_status set_trace(ct_tileset *ts, const ct_ray *ray, int seg, const ct_lower *lw, int below_hit,
                            ct_method m, ct_hit *h, int64_t tend[2])
 {
-    const ct_package *F = &ts->frame;
-    const ct_package *tp = NULL; /* tile (a, bb) when already fetched */
-    ct_prepared r;
+    set_walker w;
     ct_status st;
-    int32_t i, j, ci, cj, sx, sy;
-    uint32_t a, bb, it;
-    int64_t tn = 0, td = 1;
-    int eface = 0; /* the walk's entry face(s) in tile (a, bb): 0 the first */
     ct_hit_clear(h);
-    if ((unsigned)m >= (unsigned)CT_METHOD_COUNT) {
-        return CT_ERR_METHOD;
-    }
-    st = ct_tile_prep_geom(F, ray, seg, &r);
-    if (st != CT_OK) {
+    st = set_geom(ts, ray, seg, m, &w);
+    if (st != CT_OK || !set_begin(ts, ray, seg, lw, below_hit, h, tend, &w, &st)) {
         return st;
     }
-    /* (i, j): the cell the walk starts in (in tile (a, bb)'s grid below);
-     * (ci, cj): the cell the first point is on */
-    ct_prepared_first_cell(F, &r, &i, &j);
-    ci = ct_clamp_cell(i, F->cells_x);
-    cj = ct_clamp_cell(j, F->cells_y);
-    a = tile_of(ts, ci, ts->tiles_x);
-    bb = tile_of(ts, cj, ts->tiles_y);
-    sx = r.dx > 0 ? 1 : (r.dx < 0 ? -1 : 0);
-    sy = r.dy > 0 ? 1 : (r.dy < 0 ? -1 : 0);
-    st = set_start(ts, ray, seg, lw, a, bb, ci, cj, &r, &tp, &i, &j, tend, h);
-    if (st == CT_NO_DATA) {
-        return st;
-    }
-    if (st == CT_BELOW && below_hit) {
-        r.start = CT_HIT; /* tend stays 0: the hit is at the first point */
-        st = CT_HIT;
-    }
-    if (tend != NULL) {
-        tend[0] = r.tend_n;
-        tend[1] = r.tend_d;
-    }
-    if (st != CT_OK && st != CT_HIT) {
-        return st; /* CT_BELOW */
-    }
-    /* bound: a ray crosses at most tiles_x + tiles_y - 1 tiles */
-    for (it = 0u; it < ts->tiles_x + ts->tiles_y; ++it) {
-        const uint8_t *e = ts->entries + (size_t)(bb * ts->tiles_x + a) * CT_SET_ENTRY_SIZE;
-        int64_t en, ed;
-        const int face = tile_exit(ts, &r, a, bb, &en, &ed);
-        if (tile_may_hit(e, &r, tn, td, en, ed)) {
-            if (tp == NULL) {
-                tp = tile_get(ts, a, bb);
-                if (tp == NULL) {
-                    return no_data(ts, &r, lw, a, bb, tn, td, h);
-                }
+    return set_walk(ts, &w, lw, m, h);
+}
+
+/* A run on tile (a, bb), where every ray of w[] with go[k] starts: when
+ * each one the run can take (start CT_OK, not vertical) may meet that
+ * tile's terrain (so that its own walk would fetch the tile) and the tile
+ * is at hand, the shared walk over it (ct_run_starts, the rays shifted
+ * into its grid in place and back) sets where each one's walk there
+ * starts, or that it has none there. */
+static void set_run(ct_tileset *ts, set_walker *w, const uint8_t *go, uint32_t n, const ct_lower *lw, uint32_t a,
+                    uint32_t bb)
+{
+    const uint8_t *e = ts->entries + (size_t)(bb * ts->tiles_x + a) * CT_SET_ENTRY_SIZE;
+    const int64_t x0 = (int64_t)tile_first(ts, a) * ONE16, y0 = (int64_t)tile_first(ts, bb) * ONE16;
+    const ct_prepared *rp[CT_RUN_MAX] = {NULL};
+    ct_run_start rs[CT_RUN_MAX];
+    uint32_t idx[CT_RUN_MAX];
+    const ct_package *tp;
+    ct_lower ll;
+    uint32_t k, cnt = 0u, used = 0u;
+    /* bound: n <= CT_RUN_MAX rays */
+    for (k = 0u; k < n; ++k) {
+        const ct_prepared *r = &w[k].r;
+        if (!go[k]) {
+            continue;
+        }
+        if (r->start == CT_OK && (r->dx != 0 || r->dy != 0)) {
+            int64_t en, ed;
+            (void)tile_exit(ts, r, a, bb, &en, &ed);
+            if (!tile_may_hit(e, r, 0, 1, en, ed)) {
+                return;
             }
-            st = walk_tile(tp, &r, (int64_t)tile_first(ts, a), (int64_t)tile_first(ts, bb), tn, td, eface, i, j, lw,
-                           m, h);
-            if (st != CT_MISS) {
-                return st;
+            used++;
+        }
+        rp[cnt] = r;
+        idx[cnt++] = k;
+    }
+    tp = used >= 2u ? tile_get(ts, a, bb) : NULL;
+    if (tp == NULL) {
+        return; /* each ray's own walk reports a tile it cannot have */
+    }
+    if (lw != NULL) {
+        lower_shifted(lw, x0, y0, &ll);
+    }
+    /* bound: cnt <= CT_RUN_MAX rays */
+    for (k = 0u; k < cnt; ++k) {
+        w[idx[k]].r.ox -= x0;
+        w[idx[k]].r.oy -= y0;
+    }
+    (void)ct_run_starts(tp, rp, cnt, lw != NULL ? &ll : NULL, rs);
+    /* bound: cnt <= CT_RUN_MAX rays */
+    for (k = 0u; k < cnt; ++k) {
+        set_walker *v = &w[idx[k]];
+        v->r.ox += x0;
+        v->r.oy += y0;
+        if (rs[k].how == CT_RUN_CLEAR) {
+            v->skip = 1;
+        } else if (rs[k].how == CT_RUN_FACE) {
+            v->tn = rs[k].t0_n;
+            v->td = rs[k].t0_d;
+            v->eface = (int)rs[k].face;
+            v->i = v->j = rs[k].cell;
+        }
+    }
+}
+
+ct_status ct_tileset_trace_run(ct_tileset *ts, const ct_ray *rays, uint32_t n, const ct_lower *lw, ct_method m,
+                               ct_hit *const *h, ct_status *st)
+{
+    set_walker w[CT_RUN_MAX];
+    uint8_t go[CT_RUN_MAX] = {0u};
+    uint32_t k, cnt = 0u, a = 0u, bb = 0u;
+    int one = 1; /* every ray starts on one tile */
+    if (ts == NULL || rays == NULL || h == NULL || st == NULL || n > CT_RUN_MAX || ts->ready != CT_SET_READY) {
+        return CT_ERR_ARG;
+    }
+    /* bound: n <= CT_RUN_MAX rays */
+    for (k = 0u; k < n; ++k) {
+        ct_hit_clear(h[k]);
+        st[k] = set_geom(ts, &rays[k], 0, m, &w[k]);
+        go[k] = (uint8_t)(st[k] == CT_OK);
+        if (go[k] && cnt++ == 0u) {
+            a = w[k].a;
+            bb = w[k].bb;
+        } else if (go[k] && (w[k].a != a || w[k].bb != bb)) {
+            one = 0;
+        }
+    }
+    if (cnt >= 2u && one) {
+        /* the first points decided on that tile (which only it may
+         * load), then one shared walk over it */
+        /* bound: n rays */
+        for (k = 0u; k < n; ++k) {
+            go[k] = (uint8_t)(go[k] && set_begin(ts, &rays[k], 0, lw, 0, h[k], NULL, &w[k], &st[k]));
+        }
+        set_run(ts, w, go, n, lw, a, bb);
+        /* bound: n rays */
+        for (k = 0u; k < n; ++k) {
+            if (go[k]) {
+                w[k].tp = NULL; /* another ray's walk may have moved it */
+                st[k] = set_walk(ts, &w[k], lw, m, h[k]);
             }
         }
-        if (!t_lt(en, ed, r.tend_n, r.tend_d)) {
-            return CT_MISS;
-        }
-        /* onto the next tile (through a corner: the diagonal one), in the
-         * cell column (row) on its entry face */
-        if (face & 1) {
-            if ((sx < 0 && a == 0u) || (sx > 0 && a + 1u >= ts->tiles_x)) {
-                return CT_MISS;
-            }
-            a = sx > 0 ? a + 1u : a - 1u;
-            i = sx > 0 ? 0 : (int32_t)tile_posts_at(ts, a, F->width) - 2;
-        }
-        if (face & 2) {
-            if ((sy < 0 && bb == 0u) || (sy > 0 && bb + 1u >= ts->tiles_y)) {
-                return CT_MISS;
-            }
-            bb = sy > 0 ? bb + 1u : bb - 1u;
-            j = sy > 0 ? 0 : (int32_t)tile_posts_at(ts, bb, F->height) - 2;
-        }
-        eface = face;
-        tp = NULL;
-        tn = en;
-        td = ed;
+        return CT_OK;
     }
-    return CT_ERR_INTERNAL;
+    /* bound: n rays */
+    for (k = 0u; k < n; ++k) {
+        if (go[k] && set_begin(ts, &rays[k], 0, lw, 0, h[k], NULL, &w[k], &st[k])) {
+            st[k] = set_walk(ts, &w[k], lw, m, h[k]);
+        }
+    }
+    return CT_OK;
 }
 
 ct_status ct_tileset_trace(ct_tileset *ts, const ct_ray *ray, ct_method m, ct_hit *h)

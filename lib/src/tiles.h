@@ -72,6 +72,16 @@ ct_status ct_tileset_trace_lowered(ct_tileset *ts, const ct_ray *ray, const ct_l
 ct_status ct_tileset_trace_segment(ct_tileset *ts, const ct_ray *ray, const ct_lower *lw, int below_hit,
                                    ct_method method, ct_hit *hit, int64_t *tend_n, int64_t *tend_d);
 
+/* ct_trace_run over a tile set (geoloc.c's batch): n <= CT_RUN_MAX rays
+ * from one observer (lw: the lowered model in the frame's grid, or NULL:
+ * straight), each one's status in st[k] and hit in *h[k] as
+ * ct_tileset_trace's (_lowered's) but for steps and iters (its own
+ * walks).  When every ray starts on one tile, that tile's walks start
+ * where the run's shared walk over it (ct_run_starts) leaves them; the
+ * later tiles are walked ray by ray.  CT_ERR_ARG for a NULL argument, a
+ * set not ready or n > CT_RUN_MAX, else CT_OK.                            */
+ct_status ct_tileset_trace_run(ct_tileset *ts, const ct_ray *rays, uint32_t n, const ct_lower *lw, ct_method method,
+                               ct_hit *const *h, ct_status *st);
 /* ct_trace_bent_set over a tile set (p: its frame; ts NULL: one package). */
 ct_status ct_trace_bent_set_ts(const ct_package *p, ct_tileset *ts, const ct_ray *ray, const ct_bent_setup *bs,
                                ct_method method, ct_hit *hit);

@@ -887,7 +887,7 @@ static void run_at(const ct_prepared *r, int a, int32_t s, int64_t U, int64_t *q
  * (hmax - hmin) 2^16 / 16 Q16 LSB per u-cell (the relief test below), so
  * over w < 2^15 cells by < 2^43 (and its floor by 2^16 more), and the
  * lowest at either end differ by less than that: m szl < 2^59 + 2^15. */
-static int run_bounds(const ct_package *p, const ct_prepared *r, const uint8_t *use, uint32_t n, runb *b)
+static int run_bounds(const ct_package *p, const ct_prepared *const *r, const uint8_t *use, uint32_t n, runb *b)
 {
     uint32_t k, cnt = 0u;
     int64_t cu0 = 0, lo, hi, ql1 = 0, qh1 = 0, zl1 = 0, gq = 0, gu = 1, ncell = 0;
@@ -903,21 +903,21 @@ static int run_bounds(const ct_package *p, const ct_prepared *r, const uint8_t *
         if (!use[k]) {
             continue;
         }
-        ka = ct_abs64(r[k].dx) >= ct_abs64(r[k].dy) ? 0 : 1;
-        du = ct_abs64(run_d(&r[k], ka));
+        ka = ct_abs64(r[k]->dx) >= ct_abs64(r[k]->dy) ? 0 : 1;
+        du = ct_abs64(run_d(r[k], ka));
         if (a < 0) {
             a = ka;
-            s = run_d(&r[k], ka) > 0 ? 1 : -1;
+            s = run_d(r[k], ka) > 0 ? 1 : -1;
             ncell = (int64_t)(a == 0 ? p->cells_x : p->cells_y);
         }
-        if (ka != a || (run_d(&r[k], a) > 0 ? 1 : -1) != s || du < (INT64_C(1) << 19)) {
+        if (ka != a || (run_d(r[k], a) > 0 ? 1 : -1) != s || du < (INT64_C(1) << 19)) {
             return 0;
         }
         /* a steep ray crosses the tile's relief within RUN_MIN_CELLS
          * cells: its own walk is short, a run would not pay.  Across the
          * relief it moves (hmax - hmin) du / (|dz| 2^zshift) cells:
          * (hmax - hmin) du < 2^42, RUN_MIN_CELLS |dz| 2^zshift < 2^46 */
-        if ((int64_t)(p->hmax - p->hmin) * du < RUN_MIN_CELLS * ct_abs64(r[k].dz) * (INT64_C(1) << r[k].zshift)) {
+        if ((int64_t)(p->hmax - p->hmin) * du < RUN_MIN_CELLS * ct_abs64(r[k]->dz) * (INT64_C(1) << r[k]->zshift)) {
             return 0;
         }
         /* rays that part by more than RUN_SPREAD cells from the first
@@ -926,7 +926,7 @@ static int run_bounds(const ct_package *p, const ct_prepared *r, const uint8_t *
          * less (a choice, not a bound): |q du0 - q0 du| < 2^37, times the
          * tile's cells (< 2^15) < 2^52; RUN_SPREAD du du0 < 2^40 */
         {
-            int64_t qs = run_d(&r[k], 1 - a) / 256, us = du / 256;
+            int64_t qs = run_d(r[k], 1 - a) / 256, us = du / 256;
             if (cnt == 0u) {
                 gq = qs;
                 gu = us;
@@ -934,7 +934,7 @@ static int run_bounds(const ct_package *p, const ct_prepared *r, const uint8_t *
                 return 2;
             }
         }
-        cu = floor_shr(run_u(&r[k], a, s), 16u);
+        cu = floor_shr(run_u(r[k], a, s), 16u);
         cu0 = cnt == 0u ? cu : ct_min64(cu0, cu);
         cnt++;
     }
@@ -955,8 +955,8 @@ static int run_bounds(const ct_package *p, const ct_prepared *r, const uint8_t *
         if (!use[k]) {
             continue;
         }
-        run_at(&r[k], a, s, b->fa * ONE16, &q0, &q1, &z0);
-        run_at(&r[k], a, s, hi * ONE16, &qa, &qb, &za);
+        run_at(r[k], a, s, b->fa * ONE16, &q0, &q1, &z0);
+        run_at(r[k], a, s, hi * ONE16, &qa, &qb, &za);
         if (cnt == 0u) {
             b->ql = q0;
             b->qh = q1;
@@ -1051,8 +1051,8 @@ static int64_t run_walk(const ct_package *p, const ct_lower *lw, const runb *b)
     return ct_min64(cu, end);
 }
 
-ct_status ct_trace_run(const ct_package *p, const ct_prepared *r, uint32_t n, const ct_lower *lw, ct_method m,
-                       ct_hit *const *h, ct_status *st)
+ct_status ct_run_starts(const ct_package *p, const ct_prepared *const *r, uint32_t n, const ct_lower *lw,
+                        ct_run_start *out)
 {
     /* grp: 0 its own walk; 1 the run's; 2, 3 a half's */
     uint8_t use[CT_RUN_MAX] = {0u}, grp[CT_RUN_MAX] = {0u};
@@ -1060,12 +1060,20 @@ ct_status ct_trace_run(const ct_package *p, const ct_prepared *r, uint32_t n, co
     int64_t cs[3] = {0, 0, 0};
     uint32_t k, g;
     int wide;
-    if (p == NULL || r == NULL || h == NULL || st == NULL || n > CT_RUN_MAX) {
+    if (p == NULL || r == NULL || out == NULL || n > CT_RUN_MAX) {
         return CT_ERR_ARG;
     }
     /* bound: n <= CT_RUN_MAX rays */
     for (k = 0u; k < n; ++k) {
-        use[k] = (uint8_t)(r[k].start == CT_OK && (r[k].dx != 0 || r[k].dy != 0));
+        if (r[k] == NULL) {
+            return CT_ERR_ARG;
+        }
+        use[k] = (uint8_t)(r[k]->start == CT_OK && (r[k]->dx != 0 || r[k]->dy != 0));
+        out[k].how = CT_RUN_OWN;
+        out[k].face = 0u;
+        out[k].cell = 0;
+        out[k].t0_n = 0;
+        out[k].t0_d = 1;
     }
     /* 1: bounds formed; 2: too wide, or the walk showed nothing free */
     wide = run_bounds(p, r, use, n, &b[0]);
@@ -1097,35 +1105,66 @@ ct_status ct_trace_run(const ct_package *p, const ct_prepared *r, uint32_t n, co
     }
     /* bound: n <= CT_RUN_MAX rays */
     for (k = 0u; k < n; ++k) {
-        wstart ws;
         int64_t c;
         const runb *q;
-        rt tend;
+        rt t0, tend;
         if (grp[k] == 0u) {
-            st[k] = trace_impl(p, &r[k], m, 1, lw, NULL, h[k]);
             continue;
         }
         q = &b[grp[k] - 1u];
         c = cs[grp[k] - 1u];
-        ws.t0.n = c * ONE16 - run_u(&r[k], q->a, q->s); /* < 2^32 */
-        ws.t0.d = ct_abs64(run_d(&r[k], q->a));
-        if (ws.t0.n <= 0) {
-            /* the ray starts in or after the first u-cell not shown free */
-            st[k] = trace_impl(p, &r[k], m, 1, lw, NULL, h[k]);
-            continue;
+        t0.n = c * ONE16 - run_u(r[k], q->a, q->s); /* < 2^32 */
+        t0.d = ct_abs64(run_d(r[k], q->a));
+        tend.n = r[k]->tend_n;
+        tend.d = r[k]->tend_d;
+        if (t0.n <= 0) {
+            continue; /* the ray starts in or after the first u-cell not shown free */
         }
-        tend.n = r[k].tend_n;
-        tend.d = r[k].tend_d;
-        if (c == q->fa + q->w || !rt_lt(ws.t0, tend)) {
-            /* free until it leaves the tile's box: no hit, as its walk */
-            ct_hit_clear(h[k]);
-            st[k] = CT_MISS;
+        if (c == q->fa + q->w || !rt_lt(t0, tend)) {
+            /* free until it leaves the tile's box */
+            out[k].how = CT_RUN_CLEAR;
             continue;
         }
         /* its walk from the face of u-cell c, as a tile set's seam */
-        ws.face = q->a == 0 ? 1 : 2;
-        ws.i = ws.j = (int32_t)(q->s > 0 ? c : -1 - c);
-        st[k] = trace_impl(p, &r[k], m, 1, lw, &ws, h[k]);
+        out[k].how = CT_RUN_FACE;
+        out[k].face = q->a == 0 ? 1u : 2u;
+        out[k].cell = (int32_t)(q->s > 0 ? c : -1 - c);
+        out[k].t0_n = t0.n;
+        out[k].t0_d = t0.d;
+    }
+    return CT_OK;
+}
+
+ct_status ct_trace_run(const ct_package *p, const ct_prepared *r, uint32_t n, const ct_lower *lw, ct_method m,
+                       ct_hit *const *h, ct_status *st)
+{
+    const ct_prepared *rp[CT_RUN_MAX] = {NULL};
+    ct_run_start rs[CT_RUN_MAX];
+    uint32_t k;
+    if (p == NULL || r == NULL || h == NULL || st == NULL || n > CT_RUN_MAX) {
+        return CT_ERR_ARG;
+    }
+    /* bound: n <= CT_RUN_MAX rays */
+    for (k = 0u; k < n; ++k) {
+        rp[k] = &r[k];
+    }
+    (void)ct_run_starts(p, rp, n, lw, rs);
+    /* bound: n <= CT_RUN_MAX rays */
+    for (k = 0u; k < n; ++k) {
+        if (rs[k].how == CT_RUN_CLEAR) {
+            /* no hit, as its walk */
+            ct_hit_clear(h[k]);
+            st[k] = CT_MISS;
+        } else if (rs[k].how == CT_RUN_FACE) {
+            wstart ws;
+            ws.t0.n = rs[k].t0_n;
+            ws.t0.d = rs[k].t0_d;
+            ws.face = (int)rs[k].face;
+            ws.i = ws.j = rs[k].cell;
+            st[k] = trace_impl(p, &r[k], m, 1, lw, &ws, h[k]);
+        } else {
+            st[k] = trace_impl(p, &r[k], m, 1, lw, NULL, h[k]);
+        }
     }
     return CT_OK;
 }
