@@ -840,6 +840,12 @@ ct_status ct_trace_lowered(const ct_package *p, const ct_ray *ray, const ct_lowe
 #ifndef RUN_SPREAD
 #define RUN_SPREAD 8
 #endif
+#ifndef RUN_SPAN
+#define RUN_SPAN 512
+#endif
+#ifndef RUN_WIDTH
+#define RUN_WIDTH 4
+#endif
 typedef struct {
     int a;
     int32_t s;
@@ -890,7 +896,7 @@ static void run_at(const ct_prepared *r, int a, int32_t s, int64_t U, int64_t *q
 static int run_bounds(const ct_package *p, const ct_prepared *const *r, const uint8_t *use, uint32_t n, runb *b)
 {
     uint32_t k, cnt = 0u;
-    int64_t cu0 = 0, lo, hi, ql1 = 0, qh1 = 0, zl1 = 0, gq = 0, gu = 1, ncell = 0;
+    int64_t cu0 = 0, lo, hi, ql1 = 0, qh1 = 0, zl1 = 0, gq = 0, gu = 1, gc = 0, gw = 0, ncell = 0;
     int a = -1;
     int32_t s = 0;
     b->a = 0;
@@ -920,21 +926,30 @@ static int run_bounds(const ct_package *p, const ct_prepared *const *r, const ui
         if ((int64_t)(p->hmax - p->hmin) * du < RUN_MIN_CELLS * ct_abs64(r[k]->dz) * (INT64_C(1) << r[k]->zshift)) {
             return 0;
         }
-        /* rays that part by more than RUN_SPREAD cells from the first
-         * one's across the tile (pixels far apart) would stop the shared
-         * walk at once: 2, before any division.  Slopes dq / du to 8 bits
-         * less (a choice, not a bound): |q du0 - q0 du| < 2^37, times the
-         * tile's cells (< 2^15) < 2^52; RUN_SPREAD du du0 < 2^40 */
+        /* Pixels far apart would stop the shared walk at once: 2, before
+         * any division, for rays that part from the first one by more than
+         * RUN_SPREAD cells over RUN_SPAN cells (or the tile's width if
+         * less), or lie more than RUN_WIDTH cells from it across the first
+         * one's origin cell (the walk starts with single cells, at most four
+         * across).  Slopes dq / du to 8 bits less and positions in whole
+         * cells (a choice, not a bound): |q du0 - q0 du| < 2^37, times
+         * <= 2^9 cells; the other coordinates' difference (< 2^16 cells)
+         * times us gu < 2^36, and the u distance (< 2^16) times qs gu <
+         * 2^36: < 2^53; RUN_SPREAD (RUN_WIDTH) us gu < 2^40. */
+        cu = floor_shr(run_u(r[k], a, s), 16u);
         {
             int64_t qs = run_d(r[k], 1 - a) / 256, us = du / 256;
+            int64_t oq = floor_shr(a == 0 ? r[k]->oy : r[k]->ox, 16u);
             if (cnt == 0u) {
                 gq = qs;
                 gu = us;
-            } else if (ct_abs64(qs * gu - gq * us) * ncell > RUN_SPREAD * us * gu) {
+                gc = cu;
+                gw = oq;
+            } else if (ct_abs64(qs * gu - gq * us) * ct_min64(ncell, RUN_SPAN) > RUN_SPREAD * us * gu ||
+                       ct_abs64((oq - gw) * us * gu + (gc - cu) * qs * gu) > RUN_WIDTH * us * gu) {
                 return 2;
             }
         }
-        cu = floor_shr(run_u(r[k], a, s), 16u);
         cu0 = cnt == 0u ? cu : ct_min64(cu0, cu);
         cnt++;
     }
