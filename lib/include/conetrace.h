@@ -1069,18 +1069,21 @@ ct_status ct_geolocate(const ct_package *pkg, const ct_camera *cam,
  * hit.steps and hit.iters where runs apply (below); the per-call set-up
  * (argument checks, the camera centre in the grid frame, the bend's or the
  * true Earth's set-up) is done once.
- * Runs: on one package with straight rays or the lowered model (effects
- * off, or c > 0 on a sphere; not the true Earth nor the polyline) and
- * every method but CT_METHOD_INCREMENTAL (the plain reference walk), the
- * pixels go in runs of up to 8 consecutive ones.  Where the run's rays
- * share a horizontal axis and direction, each crosses the tile's relief
- * over at least 16 cells and none parts from the first by more than 8
- * cells across the tile, one max-mipmap walk over bounds holding all
- * their paths shows a first stretch free of the surface for all of them
- * (at most 2 w + levels + 2 iterations, w the tile's cells along that
- * axis; when it shows nothing or the rays part too fast, the same for
- * each half of the run), and each pixel's walk starts where that stretch
- * ends.  Every status and
+ * Runs: with straight rays or the lowered model (effects off, or c > 0
+ * on a sphere; not the true Earth nor the polyline) and every method but
+ * CT_METHOD_INCREMENTAL (the plain reference walk), the pixels go in runs
+ * of up to 8 consecutive ones.  Where the run's rays share a horizontal
+ * axis and direction, each crosses the tile's relief over at least 16
+ * cells, none parts from the first by more than 8 cells over 512 (or the
+ * tile's width) nor lies more than 4 cells from it across its origin's
+ * cell, one max-mipmap walk over bounds holding all their paths shows a
+ * first stretch free of the surface for all of them (at most 2 w + levels
+ * + 2 iterations, w the tile's cells along that axis; when it shows
+ * nothing or the rays part too fast, the same for each half of the run),
+ * and each pixel's walk starts where that stretch ends.  Over a tile set
+ * (ct_geolocate_batch_tiles) the same on the tile every ray of the run
+ * starts on, when each would fetch it anyway (a ray shown clear through
+ * it skips it); later tiles ray by ray.  Every status and
  * hit is as ct_geolocate's; hit.steps and hit.iters count the pixel's own
  * walk only.  Consecutive pixels of an image row (or column) make good
  * runs; in any order the results are the same.

@@ -104,7 +104,8 @@ ct_status ct_prepare_lowered(const ct_package *p, const ct_ray *ray, int seg, co
  * field but steps and iters, which count only the ray's own walk.  Where
  * the rays' paths share a primary axis and direction (each crossing the
  * relief over 16 cells or more, none parting from the first by more than
- * 8 cells across the tile), one walk of the max-mipmap over their common
+ * 8 cells over 512 cells or the tile's width, nor more than 4 cells from
+ * it across its origin's cell), one walk of the max-mipmap over their common
  * bounds shows a first stretch free of the surface for all of them (at
  * most 2 w + levels + 2 iterations, w the tile's cells along that axis;
  * when it shows nothing, or the rays part too fast, the same for each
