@@ -9,7 +9,9 @@
 // built with a random N in {1, 3, 8, 24} and r in {1, 2, 3}; 4,000 rays of
 // every family per terrain, and 4,000 pixels of a camera posed over it
 // (soak_pixels), and rows of neighbouring pixels through ct_geolocate_batch
-// (its runs) against ct_geolocate.
+// (its runs) against ct_geolocate, and through ct_geolocate_batch_tiles on
+// the terrain cut into a tile set (random tile size, cache slots, a tile
+// left out now and then) against ct_geolocate_tiles.
 //
 // Usage: ct_soak [--rays N] [--seconds S] [--threads T] [--seed K]
 // (defaults: 10^7 rays, 1,800 s, all cores, seed 1).  Exit 1 when any
@@ -30,6 +32,7 @@
 #include "dem_cases.hpp"
 #include "judge.hpp"
 #include "reference.hpp"
+#include "tileset.hpp"
 
 namespace {
 
@@ -42,6 +45,8 @@ struct Counts {
     // the batch's runs: rows of neighbouring pixels through ct_geolocate_batch
     // against ct_geolocate, pixel by pixel
     long batch_pixels = 0, batch_differ = 0, batch_shortened = 0;
+    // ... and over a tile set against ct_geolocate_tiles
+    long set_pixels = 0, set_differ = 0, set_shortened = 0, set_nodata = 0;
     long tangent_by[dem_cases::FAMILY_COUNT] = {};
     long tangent_both_hit = 0; // both hit, positions apart by more than judge::POS_TOL_Q16
     double worst_xy = 0, worst_z = 0; // the largest such distances (Q16)
@@ -68,6 +73,10 @@ struct Counts {
         batch_pixels += o.batch_pixels;
         batch_differ += o.batch_differ;
         batch_shortened += o.batch_shortened;
+        set_pixels += o.set_pixels;
+        set_differ += o.set_differ;
+        set_shortened += o.set_shortened;
+        set_nodata += o.set_nodata;
     }
 };
 
@@ -296,6 +305,59 @@ void soak_pixels(const Soaked &sk, uint64_t seed, long npx, Counts *c)
                 c->batch_shortened += batch[k].hit.steps < g.hit.steps;
             }
         }
+    // the same rows over the terrain cut into a tile set: tiles of 3 posts
+    // up to the whole, 1 to 4 slots or one per tile, a tile left out in a
+    // quarter of the sets (CT_NO_DATA where a line of sight reaches it,
+    // the same point from the batch and the single call)
+    const int side = std::max(cs.t.width, cs.t.height);  // at most 64 tiles a side
+    const int P = (int)ct_rng_range(&rng, std::max(3, (side - 2) / 64 + 2), side);
+    const bool hole = ct_rng_range(&rng, 0, 3) == 0;
+    const int64_t hc = ct_rng_range(&rng, 0, 63), hr = ct_rng_range(&rng, 0, 63);
+    const ct_host::TileSetBytes tb = ct_host::build_tileset(cs.t, cs.opt, P, 1, [&](int col, int row) {
+        return hole && col == hc % ((cs.t.width - 2) / (P - 1) + 1) && row == hr % ((cs.t.height - 2) / (P - 1) + 1);
+    });
+    const int ntiles = (int)tb.tiles.size();
+    const int nslots = ct_rng_range(&rng, 0, 1) ? ntiles : (int)ct_rng_range(&rng, 1, 4);
+    struct Loader {
+        static ct_status load(void *user, uint32_t col, uint32_t row, uint8_t *, size_t, const uint8_t **bytes,
+                              size_t *len)
+        {
+            const ct_host::TileSetBytes *b = static_cast<const ct_host::TileSetBytes *>(user);
+            const std::vector<uint8_t> &v = b->tiles[(size_t)row * b->grid.tiles_x + col];
+            if (v.empty()) return CT_ERR_ARG;
+            *bytes = v.data();
+            *len = v.size();
+            return CT_OK;
+        }
+    };
+    for (const ct_effects *fx : {(const ct_effects *)nullptr, &sphere})
+        for (int m = 0; m < 4; ++m) {
+            std::vector<ct_tile_slot> sa((size_t)std::min(nslots, (int)CT_SET_MAX_SLOTS)), sb(sa.size());
+            ct_tileset ta, tsb;
+            if (ct_tileset_open(&ta, tb.manifest.data(), tb.manifest.size(), sa.data(), (uint32_t)sa.size(),
+                                Loader::load, (void *)&tb) != CT_OK ||
+                ct_tileset_open(&tsb, tb.manifest.data(), tb.manifest.size(), sb.data(), (uint32_t)sb.size(),
+                                Loader::load, (void *)&tb) != CT_OK ||
+                ct_geolocate_batch_tiles(&ta, &cam, &pose, (ct_method)m, fx, uv.data(), nb, batch.data(), nb) !=
+                    CT_OK) {
+                c->errors++;
+                continue;
+            }
+            for (size_t k = 0; k < nb; ++k) {
+                ct_geo g;
+                const ct_status st = ct_geolocate_tiles(&tsb, &cam, &pose, (ct_method)m, fx, uv[2 * k], uv[2 * k + 1], &g);
+                const ct_hit &x = batch[k].hit, &y = g.hit;
+                const bool placed = st == CT_HIT || st == CT_HIT_VOID || st == CT_NO_DATA;
+                c->set_pixels++;
+                c->set_differ += batch[k].status != st ||
+                                 (placed && (x.x_q16 != y.x_q16 || x.y_q16 != y.y_q16 || x.z_q16 != y.z_q16 ||
+                                             x.t_q26 != y.t_q26 || x.cell_x != y.cell_x || x.cell_y != y.cell_y ||
+                                             x.e_nm != y.e_nm || x.n_nm != y.n_nm || x.h_nm != y.h_nm));
+                c->set_shortened += x.steps < y.steps;
+                c->set_nodata += st == CT_NO_DATA;
+            }
+            c->set_differ += ta.loads > tsb.loads;  // the runs never load a tile the single walks would not
+        }
 }
 
 }  // namespace
@@ -357,6 +419,10 @@ int main(int argc, char **argv)
     std::printf("  the batch's runs (rows of 16 neighbouring pixels, straight and on a 2^50 nm sphere, 4 methods): %ld "
                 "pixels, %ld differ from ct_geolocate's, %ld walks shortened\n",
                 c.batch_pixels, c.batch_differ, c.batch_shortened);
+    std::printf("  the same rows over the terrain cut into a tile set (random tiles and slots, a tile missing in a "
+                "quarter of the sets): %ld pixels, %ld differ from ct_geolocate_tiles' (or loaded more), %ld CT_NO_DATA, "
+                "%ld walks shortened\n",
+                c.set_pixels, c.set_differ, c.set_nodata, c.set_shortened);
     std::printf("  disputes the judge settles as tangent (the reference's ray within 1e-6 LSB of the surface there): "
                 "%ld, of them %ld where both hit -- x and y at most %.1f Q16 apart (the stated bound: 2), z up to "
                 "%.1f (steep cells: 2 Q16 across a cliff is many codes up); by family:",
@@ -364,5 +430,6 @@ int main(int argc, char **argv)
     for (int f = 0; f < dem_cases::FAMILY_COUNT; ++f)
         std::printf(" %s %ld", dem_cases::family_name((dem_cases::Family)f), c.tangent_by[f]);
     std::printf("\n");
-    return (c.wrong || c.differ || c.bound || c.errors || c.pixel_retrace_differ || c.batch_differ) ? 1 : 0;
+    return (c.wrong || c.differ || c.bound || c.errors || c.pixel_retrace_differ || c.batch_differ ||
+            c.set_differ) ? 1 : 0;
 }
