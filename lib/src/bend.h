@@ -129,9 +129,9 @@ typedef struct {
     int32_t cell;
     uint8_t face, how;
 } ct_run_start;
-/* r[k] (k < n <= CT_RUN_MAX) prepared rays in pkg's grid (lw: the lowered
- * terrain of all, or NULL), out[k] each one's start.  CT_ERR_ARG for a
- * NULL argument or n > CT_RUN_MAX, else CT_OK.                            */
+/* *r[k] (k < n <= CT_RUN_MAX, none NULL) prepared rays in pkg's grid (lw:
+ * the lowered terrain of all, or NULL), out[k] each one's start.
+ * CT_ERR_ARG for a NULL argument or n > CT_RUN_MAX, else CT_OK.           */
 ct_status ct_run_starts(const ct_package *pkg, const ct_prepared *const *r, uint32_t n, const ct_lower *lw,
                         ct_run_start *out);
 

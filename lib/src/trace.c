@@ -1080,9 +1080,6 @@ ct_status ct_run_starts(const ct_package *p, const ct_prepared *const *r, uint32
     }
     /* bound: n <= CT_RUN_MAX rays */
     for (k = 0u; k < n; ++k) {
-        if (r[k] == NULL) {
-            return CT_ERR_ARG;
-        }
         use[k] = (uint8_t)(r[k]->start == CT_OK && (r[k]->dx != 0 || r[k]->dy != 0));
         out[k].how = CT_RUN_OWN;
         out[k].face = 0u;
