@@ -1146,6 +1146,51 @@ void test_batch_runs()
                                         (unsigned)a.ts.loads, (unsigned)b.ts.loads);
                     }
     }
+    // rays the runs leave to their own walks: a nadir camera's (an exact
+    // rotation) principal point and the pixels around it (vertical rays, rays
+    // in a vertical grid plane), and a camera exactly on a post (every ray a
+    // hit at its first point)
+    {
+        const int32_t nadir[9] = {1 << 30, 0, 0, 0, -(1 << 30), 0, 0, 0, -(1 << 30)};
+        const int pi = 200, pj = 260;
+        const int64_t pe = mp.origin_e_nm + (int64_t)pi * mp.posting_e_nm, pn = mp.origin_n_nm + (int64_t)pj * mp.posting_n_nm;
+        ct_pose down, on_post;
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_pose_init(&down, nadir, pe, pn, mp.height_offset_nm +
+                                                      ((int64_t)mp.hmax + 30000) * mp.height_scale_nm));
+        ct_geo below;  // the surface under the post: the vertical ray's hit
+        TEST_ASSERT_EQUAL_INT(CT_HIT, ct_geolocate(&mp, &cam, &down, CT_METHOD_INCREMENTAL, nullptr,
+                                                   ((int64_t)319 << 16) + (1 << 15), ((int64_t)239 << 16) + (1 << 15),
+                                                   &below));
+        const int64_t post_h = below.hit.h_nm;
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_pose_init(&on_post, nadir, pe, pn, post_h));
+        std::vector<int64_t> px;
+        for (int dv = -1; dv <= 1; ++dv)
+            for (int du = -1; du <= 1; ++du) {
+                px.push_back(((int64_t)(319 + du) << 16) + (1 << 15));
+                px.push_back(((int64_t)(239 + dv) << 16) + (1 << 15));
+            }
+        const size_t n9 = px.size() / 2;
+        long vertical = 0, at_camera = 0;
+        for (const ct_pose *ps : {&down, &on_post})
+            for (int m = 0; m < 4; ++m) {
+                Set a, b;
+                TEST_ASSERT_EQUAL_INT(CT_OK, a.open(tb, 4));
+                TEST_ASSERT_EQUAL_INT(CT_OK, b.open(tb, 4));
+                std::vector<ct_geo> gb(n9);
+                TEST_ASSERT_EQUAL_INT(CT_OK, ct_geolocate_batch_tiles(&a.ts, &cam, ps, (ct_method)m, nullptr, px.data(),
+                                                                      n9, gb.data(), n9));
+                for (size_t k = 0; k < n9; ++k) {
+                    ct_geo one;
+                    ct_geolocate_tiles(&b.ts, &cam, ps, (ct_method)m, nullptr, px[2 * k], px[2 * k + 1], &one);
+                    TEST_ASSERT_MSG(same_hit(one.status, one.hit, gb[k].status, gb[k].hit),
+                                    "%s, method %d, pixel %zu: batch %d vs single %d",
+                                    ps == &down ? "nadir" : "on a post", m, k, gb[k].status, one.status);
+                    vertical += ps == &down && gb[k].dir_map_q39[0] == 0 && gb[k].dir_map_q39[1] == 0;
+                    at_camera += ps == &on_post && gb[k].status == CT_HIT && gb[k].hit.h_nm == post_h;
+                }
+            }
+        TEST_ASSERT(vertical > 0 && at_camera > 0);
+    }
     std::printf("  batch runs over a set: %ld records as the single calls' (%ld CT_NO_DATA), %ld walks shortened\n",
                 compared, nodata, shortened);
     TEST_ASSERT(nodata > 0);
