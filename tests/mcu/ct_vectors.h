@@ -175,7 +175,10 @@ typedef struct {
  * const arrays; the target loads them into nslots RAM slots of
  * CT_VEC_TILE_CAP bytes (tile `missing` refused; ntiles: none) and traces
  * the cases' rays with every method in order: the statuses, hits and the
- * final load count are the host's (prep fields unused). */
+ * final load count are the host's (prep fields unused).  Then, with the
+ * same set, camera `camera`'s pixels through ct_geolocate_batch_tiles
+ * (its lens or grid, pose, effects and batch method): every record and
+ * the load count after it (batch_loads) the host's. */
 #define CT_VEC_TILE_CAP 4096u
 typedef struct {
     const uint8_t *bytes;
@@ -192,6 +195,9 @@ typedef struct {
     const ct_vec_case *cases;
     uint32_t ncases;
     uint32_t loads;                       /* ct_tileset.loads after the cases */
+    uint32_t camera;                      /* index into ct_vec_set.cameras   */
+    const ct_geo *batch;                  /* the camera's npixels records    */
+    uint32_t batch_loads;                 /* ct_tileset.loads after them     */
 } ct_vec_tileset;
 
 typedef struct {

@@ -995,6 +995,9 @@ struct TSet {
     uint32_t nslots = 2, missing = 0;  // missing == tiles: none
     std::vector<ct_vec_case> cases;
     uint32_t loads = 0;
+    uint32_t camera = 0;        // the camera whose pixels go through the set's batch
+    std::vector<ct_geo> batch;  // ct_geolocate_batch_tiles over them, after the cases
+    uint32_t batch_loads = 0;
 };
 
 struct TLoad {
@@ -1014,7 +1017,7 @@ ct_status tset_loader(void *user, uint32_t col, uint32_t row, uint8_t *buf, size
     return CT_OK;
 }
 
-void run_tileset(Rng &g, TSet &s, const ct_package &merged, int nrays)
+void run_tileset(Rng &g, TSet &s, const ct_package &merged, int nrays, const std::vector<Cam> &cams)
 {
     std::vector<ct_tile_slot> slots(s.nslots);
     std::vector<std::vector<uint8_t>> bufs(s.nslots, std::vector<uint8_t>(CT_VEC_TILE_CAP));
@@ -1046,8 +1049,41 @@ void run_tileset(Rng &g, TSet &s, const ct_package &merged, int nrays)
         s.cases.push_back(c);
     }
     s.loads = ts.loads;
-    std::fprintf(stderr, "gen_vectors: tile set %s: %zu tiles, %u slots, %d rays x 4 methods, %u loads, %d no_data\n",
-                 s.name.c_str(), s.b.tiles.size(), s.nslots, nrays, s.loads, nodata);
+    // a camera over the merged package: its pixels through the set's batch
+    // (the runs over the tile its rays start on), each record as the merged
+    // batch's where the set has every tile
+    const Cam &c = cams[s.camera];
+    if (c.package != 0) die("the tile sets' camera must be over the first package");
+    ct_camera cam;
+    ct_pose pose;
+    std::memset(&cam, 0, sizeof cam);
+    std::memset(&pose, 0, sizeof pose);
+    if ((c.grid.nu ? ct_camera_init_grid(&cam, &c.grid) : ct_camera_init(&cam, &c.lens)) != CT_OK ||
+        ct_pose_init(&pose, c.R, c.e_nm, c.n_nm, c.h_nm) != CT_OK)
+        die("tile set " + s.name + ": camera set-up failed on the host");
+    std::vector<int64_t> uv;
+    for (const ct_vec_pixel &q : c.px) {
+        uv.push_back(q.u_q16);
+        uv.push_back(q.v_q16);
+    }
+    s.batch.assign(c.px.size(), ct_geo{});
+    if (ct_geolocate_batch_tiles(&ts, &cam, &pose, (ct_method)c.batch_method, &c.effects, uv.data(), c.px.size(),
+                                 s.batch.data(), s.batch.size()) != CT_OK)
+        die("tile set " + s.name + ": batch failed on the host");
+    int differ = 0, set_nodata = 0;
+    for (size_t k = 0; k < c.px.size(); ++k) {
+        const ct_geo &a = s.batch[k], &b = c.batch[k];
+        set_nodata += a.status == CT_NO_DATA;
+        if (s.missing >= s.b.tiles.size())
+            differ += a.status != b.status || a.hit.t_q26 != b.hit.t_q26 || a.hit.x_q16 != b.hit.x_q16 ||
+                      a.hit.y_q16 != b.hit.y_q16 || a.hit.z_q16 != b.hit.z_q16;
+    }
+    if (differ) die("tile set " + s.name + ": the batch differs from the merged package's");
+    s.batch_loads = ts.loads;
+    std::fprintf(stderr, "gen_vectors: tile set %s: %zu tiles, %u slots, %d rays x 4 methods, %u loads, %d no_data; "
+                 "camera %s's %zu pixels through its batch: %d no_data, %u loads in all\n",
+                 s.name.c_str(), s.b.tiles.size(), s.nslots, nrays, s.loads, nodata, c.name.c_str(), c.px.size(),
+                 set_nodata, s.batch_loads);
 }
 
 void emit_tilesets(FILE *f, const std::vector<TSet> &sets)
@@ -1071,6 +1107,8 @@ void emit_tilesets(FILE *f, const std::vector<TSet> &sets)
             std::fprintf(f, "  {tset%zu_tile%zu.b, %zuu},\n", k, t, s.b.tiles[t].size());
         std::fprintf(f, "};\n\nstatic const ct_vec_case tset%zu_cases[%zu] = {\n", k, s.cases.size());
         for (const ct_vec_case &c : s.cases) emit_case(f, c);
+        std::fprintf(f, "};\n\nstatic const ct_geo tset%zu_batch[%zu] = {\n", k, s.batch.size());
+        for (const ct_geo &o : s.batch) std::fprintf(f, "  %s,\n", geo_init(o).c_str());
         std::fprintf(f, "};\n\n");
     }
     std::fprintf(f, "static const ct_vec_tileset tilesets[%zu] = {\n", sets.size());
@@ -1078,9 +1116,10 @@ void emit_tilesets(FILE *f, const std::vector<TSet> &sets)
         const TSet &s = sets[k];
         std::fprintf(f,
                      "  {.name = \"%s\", .manifest = tset%zu_manifest.b, .manifest_size = %zuu, .tiles = tset%zu_tiles,\n"
-                     "   .ntiles = %zuu, .nslots = %uu, .missing = %uu, .cases = tset%zu_cases, .ncases = %zuu, .loads = %uu},\n",
+                     "   .ntiles = %zuu, .nslots = %uu, .missing = %uu, .cases = tset%zu_cases, .ncases = %zuu, .loads = %uu,\n"
+                     "   .camera = %uu, .batch = tset%zu_batch, .batch_loads = %uu},\n",
                      s.name.c_str(), k, s.b.manifest.size(), k, s.b.tiles.size(), s.nslots, s.missing, k,
-                     s.cases.size(), s.loads);
+                     s.cases.size(), s.loads, s.camera, k, s.batch_loads);
     }
     std::fprintf(f, "};\n\n");
 }
@@ -1168,7 +1207,7 @@ std::vector<Pkg> make_packages(const Dem &dem, int nrays, std::string *generator
 
 // Tile sets: the DEM in 3 x 3 tiles (N = 8, r = 2, the first package's
 // builder), all tiles in 2 slots, and tile (1, 1) refused with 1 slot.
-std::vector<TSet> make_tilesets(const Dem &dem, const Pkg &first)
+std::vector<TSet> make_tilesets(const Dem &dem, const Pkg &first, const std::vector<Cam> &cams)
 {
     std::vector<TSet> tsets;
     {
@@ -1187,7 +1226,10 @@ std::vector<TSet> make_tilesets(const Dem &dem, const Pkg &first)
             s.b = b;
             s.nslots = v == 0 ? 2u : 1u;
             s.missing = v == 0 ? (uint32_t)b.tiles.size() : 4u;
-            run_tileset(gt, s, first.p, 120);
+            // the grazing camera over a small earth (the lowered walk): runs
+            for (size_t k = 0; k < cams.size(); ++k)
+                if (cams[k].name == "opencv4_grazing_small_earth") s.camera = (uint32_t)k;
+            run_tileset(gt, s, first.p, 120, cams);
             tsets.push_back(std::move(s));
         }
     }
@@ -1558,7 +1600,6 @@ int main(int argc, char **argv)
     std::string generator = "degenerate";
 #endif
     const std::vector<Pkg> pkgs = make_packages(dem, nrays, &generator);
-    const std::vector<TSet> tsets = make_tilesets(dem, pkgs[0]);
     std::vector<ct_vec_fixed> fx;
     std::vector<ct_vec_dir> dirs;
     make_fixed(&fx, &dirs);
@@ -1566,6 +1607,7 @@ int main(int argc, char **argv)
     for (const Pkg &P : pkgs) pk.push_back(&P.p);
     Rng gc(20251125u);
     const std::vector<Cam> cams = make_cameras(gc, pk);
+    const std::vector<TSet> tsets = make_tilesets(dem, pkgs[0], cams);
 
     FILE *f = std::fopen(argv[1], "w");
     if (!f) die(std::string("cannot write ") + argv[1]);

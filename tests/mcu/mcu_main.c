@@ -178,11 +178,13 @@ enum {
     ST_GEOLOCATE,
     ST_BATCH,
     ST_TILESET,
+    ST_BATCH_TILES,
     ST_COUNT
 };
 static const char *const st_names[ST_COUNT] = {"ct_package_open",     "ct_ray_prepare",      "ct_trace",
                                                "ct_trace_prepared",   "ct_camera_unproject", "ct_camera_project",
-                                               "ct_geolocate",        "ct_geolocate_batch",  "ct_tileset_trace"};
+                                               "ct_geolocate",        "ct_geolocate_batch",  "ct_tileset_trace",
+                                               "ct_geolocate_batch_tiles"};
 static unsigned st_max[ST_COUNT];
 
 static void st_note(int k)
@@ -727,7 +729,7 @@ static ct_status vec_loader(void *user, uint32_t col, uint32_t row, uint8_t *buf
     return CT_OK;
 }
 
-static uint32_t check_tileset(const ct_vec_tileset *vt, uint32_t *hits)
+static uint32_t check_tileset(const ct_vec_set *vs, const ct_vec_tileset *vt, uint32_t *hits)
 {
     uint32_t k, m, s, ok = 0u;
     ct_status st;
@@ -768,6 +770,37 @@ static uint32_t check_tileset(const ct_vec_tileset *vt, uint32_t *hits)
         }
     }
     eq_u64("tileset loads", vt->loads, g_ts.loads);
+    /* the camera's pixels through the set's batch (its runs), then */
+    if (vt->camera >= vs->ncameras || vs->cameras[vt->camera].npixels > CAM_MAX_PIXELS) {
+        eq_i64("tileset camera", 0, 1);
+        return ok;
+    }
+    {
+        const ct_vec_camera *vc = &vs->cameras[vt->camera];
+        zero_bytes(&g_cam, sizeof g_cam);
+        zero_bytes(&g_pose, sizeof g_pose);
+        st = vc->grid.nu > 0u ? ct_camera_init_grid(&g_cam, &vc->grid) : ct_camera_init(&g_cam, &vc->lens);
+        eq_i64("tileset camera init", CT_OK, st);
+        eq_i64("tileset pose init", CT_OK, ct_pose_init(&g_pose, vc->R_q30, vc->e_nm, vc->n_nm, vc->h_nm));
+        /* bound: the camera's pixels */
+        for (k = 0u; k < vc->npixels; ++k) {
+            g_uv[2u * k] = vc->pixels[k].u_q16;
+            g_uv[2u * k + 1u] = vc->pixels[k].v_q16;
+        }
+        g_method = vc->batch_method;
+        zero_bytes(g_batch, sizeof g_batch);
+        ct_plat_stack_paint();
+        st = ct_geolocate_batch_tiles(&g_ts, &g_cam, &g_pose, (ct_method)vc->batch_method, &vc->effects, g_uv,
+                                      vc->npixels, g_batch, CAM_MAX_PIXELS);
+        st_note(ST_BATCH_TILES);
+        eq_i64("tileset batch status", CT_OK, st);
+        /* bound: the camera's pixels */
+        for (k = 0u; k < vc->npixels; ++k) {
+            g_idx = k;
+            eq_geo(&vt->batch[k], &g_batch[k]);
+        }
+        eq_u64("tileset loads after the batch", vt->batch_loads, g_ts.loads);
+    }
     return ok;
 }
 
@@ -861,7 +894,7 @@ static void report_tilesets(const ct_vec_set *vs, uint32_t *traces, uint32_t *to
     for (p = 0u; p < vs->ntilesets; ++p) { /* bound: the vectors' tile sets */
         const ct_vec_tileset *vt = &vs->tilesets[p];
         uint32_t h = 0u, before = g_fail;
-        const uint32_t ok = check_tileset(vt, &h);
+        const uint32_t ok = check_tileset(vs, vt, &h);
         *total += vt->ncases * (uint32_t)CT_METHOD_COUNT;
         *traces += ok;
         put_rays_line("  tile set ", vt->name, vt->ncases, ok, h);
