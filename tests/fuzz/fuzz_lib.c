@@ -46,6 +46,10 @@
  *                     (CT_NO_DATA included), the bound, hits in the box,
  *                     and with no tile accepted edited, each result is the
  *                     merged package's, or CT_NO_DATA no later than it;
+ *                     then (24 more bytes) 8 pixels of a row through
+ *                     ct_geolocate_batch_tiles (straight or on a small
+ *                     sphere), each record as ct_geolocate_tiles' and,
+ *                     with no tile accepted edited, the merged package's;
  *   mode 5 (lens, byte 0 = 5 mod 16, taken from mode 1, whose corpus
  *                     inputs have byte 0 = 1; its byte 1 the flags): a
  *                     ct_lens of every model (or a raw model number) with
@@ -356,6 +360,56 @@ static void tileset_mode(const uint8_t *d, size_t n)
                     CHECK(sm == CT_MISS || sm == CT_BELOW || ((sm == CT_HIT || sm == CT_HIT_VOID) && hs.t_q26 <= hm.t_q26));
                 } else {
                     CHECK(same_hit(sm, &hm, ss, &hs));
+                }
+            }
+        }
+    }
+    if (pos + 24u <= n) {
+        /* a row of 8 pixels through the set's batch (its runs over the tile
+         * the rays start on), straight or on a small sphere (the lowered
+         * walk): each record as ct_geolocate_tiles', and with every accepted
+         * tile intact as the merged package's (or no data no later) */
+        const int64_t a = rd64(d, n, &pos), b = rd64(d, n, &pos), c = rd64(d, n, &pos);
+        const int64_t deg = INT64_C(40244552544872904); /* one degree, Q61 */
+        ct_lens lens;
+        ct_camera cam;
+        ct_pose pose;
+        ct_effects fx;
+        ct_geo gb[8], g, gm;
+        int64_t uv[16];
+        int32_t q[4];
+        memset(&lens, 0, sizeof lens);
+        lens.model = CT_LENS_PINHOLE;
+        lens.width = lens.height = 1000u;
+        lens.fx_q32 = lens.fy_q32 = (int64_t)(200 + (c & 1023)) << 32;
+        lens.cx_q32 = lens.cy_q32 = (int64_t)500 << 32;
+        CHECK(ct_camera_init(&cam, &lens) == CT_OK);
+        memset(&fx, 0, sizeof fx);
+        fx.flags = (c >> 10) & 1 ? CT_EFFECT_CURVATURE : 0u;
+        fx.earth_radius_nm = INT64_C(1) << (44 + ((c >> 11) & 3));
+        /* over the merged box or beside it, looking down 1 .. 64 deg */
+        if (ct_quat_from_ypr((int64_t)(int16_t)(c >> 16) * (deg / 180), -(int64_t)(1 + ((c >> 32) & 63)) * deg, 0, q) ==
+                CT_OK &&
+            ct_pose_from_map(&pose, merged.origin_e_nm + (a % ((int64_t)merged.width * 2)) * merged.posting_e_nm,
+                             merged.origin_n_nm + ((a >> 32) % ((int64_t)merged.height * 2)) * merged.posting_n_nm,
+                             merged.height_offset_nm + ((int64_t)merged.hmax + (b & 0xffff)) * merged.height_scale_nm,
+                             q) == CT_OK) {
+            const ct_method bm = (ct_method)((c >> 40) & 3);
+            uint32_t k;
+            for (k = 0u; k < 8u; ++k) { /* bound: 8 pixels */
+                uv[2u * k] = ((b >> 16) & 0x3ffffff) + (int64_t)k * (1 + ((b >> 42) & 0x1ffff));
+                uv[2u * k + 1u] = (b >> 20) & 0x3ffffff;
+            }
+            CHECK(ct_geolocate_batch_tiles(&ts, &cam, &pose, bm, &fx, uv, 8u, gb, 8u) == CT_OK);
+            for (k = 0u; k < 8u; ++k) { /* bound: 8 pixels */
+                const ct_status s1 = ct_geolocate_tiles(&ts, &cam, &pose, bm, &fx, uv[2u * k], uv[2u * k + 1u], &g);
+                CHECK(s1 == gb[k].status);
+                CHECK(s1 != CT_NO_DATA || (g.hit.cell_x == gb[k].hit.cell_x && g.hit.cell_y == gb[k].hit.cell_y &&
+                                           g.hit.t_q26 == gb[k].hit.t_q26));
+                CHECK(same_hit(s1, &g.hit, gb[k].status, &gb[k].hit));
+                if (edited == 9u || (d[0] & 2u) == 0u) {
+                    const ct_status s2 = ct_geolocate(&merged, &cam, &pose, bm, &fx, uv[2u * k], uv[2u * k + 1u], &gm);
+                    CHECK(s1 == CT_NO_DATA ? edited != 9u : same_hit(s2, &gm.hit, s1, &g.hit));
                 }
             }
         }
