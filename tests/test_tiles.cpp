@@ -1056,9 +1056,11 @@ void test_geolocation()
 // neighbouring pixels, every record (status, hit position, cell; a missing
 // tile's CT_NO_DATA point too) as the same pixel's ct_geolocate_tiles and,
 // where the set has every tile, as the merged package's; straight and on a
-// sphere, every method; every tile resident and a single slot (the run
-// never loads a tile the rays' own walks would not: the batch's loads are
-// at most the single calls'); cameras high, low and grazing, and one
+// sphere, every method; a slot per tile and a single slot (the run fetches
+// only the tile its rays' walks would, and a ray it shows clear through it
+// skips it: with these caches the batch's loads are at most the single
+// calls'; with a few LRU slots the skipped visits may change which tile a
+// slot drops, ct_soak counts it); cameras high, low and grazing, and one
 // outside the set.  The runs must take part: some walks shortened.
 void test_batch_runs()
 {
