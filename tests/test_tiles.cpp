@@ -1052,6 +1052,26 @@ void test_geolocation()
 // Intervisibility over a set: ct_los_tiles = ct_los on the merged package
 // (straight, a sphere, the true Earth), and with a tile missing the merged
 // answer or CT_NO_DATA, never "visible" through or "blocked" on that tile.
+// The fixture mirror-tiled to 500 x 500 posts (N sectors, r = 3) cut into
+// 4 x 4 tiles of 129 posts, the same set with tile (hc, hr) left out, and
+// the package built from the merged DEM (opened in mp).
+struct Mirror500 {
+    ct_host::Terrain t;
+    ct_host::BuildOptions o;
+    TileSetBytes tb, holed;
+    std::vector<uint8_t> merged;
+    ct_package mp{};
+    Mirror500(int sectors, int hc, int hr) : t(dem_cases::mirror_tiled(dem_cases::real_terrain(), 500, 500))
+    {
+        o.sectors = sectors;
+        o.reduce = 3;
+        tb = ct_host::build_tileset(t, o, 129, 0);
+        holed = ct_host::build_tileset(t, o, 129, 0, [&](int c, int r) { return c == hc && r == hr; });
+        merged = ct_host::build_package(t, o);
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_package_open(&mp, merged.data(), merged.size()));
+    }
+};
+
 // The batch's runs over a set (ct_tileset_trace_run): whole image rows of
 // neighbouring pixels, every record (status, hit position, cell; a missing
 // tile's CT_NO_DATA point too) as the same pixel's ct_geolocate_tiles and,
@@ -1064,15 +1084,10 @@ void test_geolocation()
 // outside the set.  The runs must take part: some walks shortened.
 void test_batch_runs()
 {
-    const ct_host::Terrain t = dem_cases::mirror_tiled(dem_cases::real_terrain(), 500, 500);
-    ct_host::BuildOptions o;
-    o.sectors = 24;
-    o.reduce = 3;
-    const TileSetBytes tb = ct_host::build_tileset(t, o, 129, 0);
-    const TileSetBytes holed = ct_host::build_tileset(t, o, 129, 0, [](int c, int r) { return c == 2 && r == 1; });
-    const std::vector<uint8_t> merged = ct_host::build_package(t, o);
-    ct_package mp;
-    TEST_ASSERT_EQUAL_INT(CT_OK, ct_package_open(&mp, merged.data(), merged.size()));
+    const Mirror500 w(24, 2, 1);
+    const ct_host::Terrain &t = w.t;
+    const TileSetBytes &tb = w.tb, &holed = w.holed;
+    const ct_package &mp = w.mp;
     ct_camera cam;
     TEST_ASSERT_EQUAL_INT(CT_OK, pinhole(&cam, 640, 480, 500, 639, 479));
     std::vector<int64_t> uv;
@@ -1201,15 +1216,10 @@ void test_batch_runs()
 
 void test_los()
 {
-    const ct_host::Terrain t = dem_cases::mirror_tiled(dem_cases::real_terrain(), 500, 500);
-    ct_host::BuildOptions o;
-    o.sectors = 16;
-    o.reduce = 3;
-    const TileSetBytes tb = ct_host::build_tileset(t, o, 129, 0);
-    const TileSetBytes holed = ct_host::build_tileset(t, o, 129, 0, [](int c, int r) { return c == 1 && r == 2; });
-    const std::vector<uint8_t> merged = ct_host::build_package(t, o);
-    ct_package mp;
-    TEST_ASSERT_EQUAL_INT(CT_OK, ct_package_open(&mp, merged.data(), merged.size()));
+    const Mirror500 w(16, 1, 2);
+    const ct_host::Terrain &t = w.t;
+    const TileSetBytes &tb = w.tb, &holed = w.holed;
+    const ct_package &mp = w.mp;
     Set set, hs;
     TEST_ASSERT_EQUAL_INT(CT_OK, set.open(tb, 3));
     TEST_ASSERT_EQUAL_INT(CT_OK, hs.open(holed, 3));
