@@ -505,8 +505,8 @@ static ct_status set_trace(ct_tileset *ts, const ct_ray *ray, int seg, const ct_
  * is at hand, the shared walk over it (ct_run_starts, the rays shifted
  * into its grid in place and back) sets where each one's walk there
  * starts, or that it has none there. */
-CT_NOINLINE static void set_run(ct_tileset *ts, set_walker *w, const uint8_t *go, uint32_t n, const ct_lower *lw, uint32_t a,
-                    uint32_t bb)
+CT_NOINLINE static void set_run(ct_tileset *ts, set_walker *w, const uint8_t *go, uint32_t n, const ct_lower *lw,
+                                uint32_t a, uint32_t bb)
 {
     const uint8_t *e = ts->entries + (size_t)(bb * ts->tiles_x + a) * CT_SET_ENTRY_SIZE;
     const int64_t x0 = (int64_t)tile_first(ts, a) * ONE16, y0 = (int64_t)tile_first(ts, bb) * ONE16;
