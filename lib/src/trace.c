@@ -1130,7 +1130,8 @@ ct_status ct_run_starts(const ct_package *p, const ct_prepared *const *r, uint32
         tend.n = r[k]->tend_n;
         tend.d = r[k]->tend_d;
         if (t0.n <= 0) {
-            continue; /* the ray starts in or after the first u-cell not shown free */
+            /* the ray starts in or after the first u-cell not shown free */
+            continue;
         }
         if (c == q->fa + q->w || !rt_lt(t0, tend)) {
             /* free until it leaves the tile's box */

@@ -771,18 +771,36 @@ void look(double az_deg, double pitch_deg, int32_t R[9])
     }
 }
 
+// Camera c's lens (or grid) and pose set up on the host: *init and
+// *pose_st their statuses.
+void camera_setup(const Cam &c, ct_camera *cam, ct_pose *pose, ct_status *init, ct_status *pose_st)
+{
+    std::memset(cam, 0, sizeof *cam);
+    std::memset(pose, 0, sizeof *pose);
+    *init = c.grid.nu ? ct_camera_init_grid(cam, &c.grid) : ct_camera_init(cam, &c.lens);
+    *pose_st = ct_pose_init(pose, c.R, c.e_nm, c.n_nm, c.h_nm);
+}
+
+// Camera c's pixels as the batch takes them (u, v pairs, Q16).
+std::vector<int64_t> camera_uv(const Cam &c)
+{
+    std::vector<int64_t> uv;
+    for (const ct_vec_pixel &q : c.px) {
+        uv.push_back(q.u_q16);
+        uv.push_back(q.v_q16);
+    }
+    return uv;
+}
+
 // Unprojection, projection back and geolocation (every method) of a
 // camera's pixels on the host.  The batch is compared with these on the
 // targets (and test_geoloc checks it on the host).
 void run_camera(Rng &g, Cam &c, const ct_package &pkg)
 {
     ct_camera cam;
-    std::memset(&cam, 0, sizeof cam);
-    c.init_status = c.grid.nu ? ct_camera_init_grid(&cam, &c.grid) : ct_camera_init(&cam, &c.lens);
-    c.r2_max_q32 = cam.r2_max_q32;
     ct_pose pose;
-    std::memset(&pose, 0, sizeof pose);
-    c.pose_status = ct_pose_init(&pose, c.R, c.e_nm, c.n_nm, c.h_nm);
+    camera_setup(c, &cam, &pose, &c.init_status, &c.pose_status);
+    c.r2_max_q32 = cam.r2_max_q32;
     if (c.init_status != CT_OK || c.pose_status != CT_OK) die("camera " + c.name + ": init failed on the host");
     const int64_t U = INT64_C(1) << 16;
     const int64_t fixed_px[][2] = {{0, 0}, {639 * U, 0}, {0, 479 * U}, {639 * U, 479 * U}, {319 * U + U / 2, 239 * U + U / 2},
@@ -814,11 +832,7 @@ void run_camera(Rng &g, Cam &c, const ct_package &pkg)
     }
     // the batch: every record as the single call's but for the runs' steps
     {
-        std::vector<int64_t> uv;
-        for (const ct_vec_pixel &q : c.px) {
-            uv.push_back(q.u_q16);
-            uv.push_back(q.v_q16);
-        }
+        const std::vector<int64_t> uv = camera_uv(c);
         c.batch.assign(c.px.size(), ct_geo{});
         if (ct_geolocate_batch(&pkg, &cam, &pose, (ct_method)c.batch_method, &c.effects, uv.data(), c.px.size(),
                                c.batch.data(), c.batch.size()) != CT_OK)
@@ -1056,16 +1070,10 @@ void run_tileset(Rng &g, TSet &s, const ct_package &merged, int nrays, const std
     if (c.package != 0) die("the tile sets' camera must be over the first package");
     ct_camera cam;
     ct_pose pose;
-    std::memset(&cam, 0, sizeof cam);
-    std::memset(&pose, 0, sizeof pose);
-    if ((c.grid.nu ? ct_camera_init_grid(&cam, &c.grid) : ct_camera_init(&cam, &c.lens)) != CT_OK ||
-        ct_pose_init(&pose, c.R, c.e_nm, c.n_nm, c.h_nm) != CT_OK)
-        die("tile set " + s.name + ": camera set-up failed on the host");
-    std::vector<int64_t> uv;
-    for (const ct_vec_pixel &q : c.px) {
-        uv.push_back(q.u_q16);
-        uv.push_back(q.v_q16);
-    }
+    ct_status init, pst;
+    camera_setup(c, &cam, &pose, &init, &pst);
+    if (init != CT_OK || pst != CT_OK) die("tile set " + s.name + ": camera set-up failed on the host");
+    const std::vector<int64_t> uv = camera_uv(c);
     s.batch.assign(c.px.size(), ct_geo{});
     if (ct_geolocate_batch_tiles(&ts, &cam, &pose, (ct_method)c.batch_method, &c.effects, uv.data(), c.px.size(),
                                  s.batch.data(), s.batch.size()) != CT_OK)
