@@ -74,6 +74,7 @@ def number(cell):
 
 
 def second_number(cell):
+    """The second number of a table cell ('400 / 253' -> 253); None for none."""
     nums = re.findall(r"-?\d+(?:\.\d+)?", cell.replace(",", ""))
     return float(nums[1]) if len(nums) > 1 else None
 
