@@ -67,16 +67,11 @@ def parse_bench(text):
     return rays, packages
 
 
-def number(cell):
-    """The first number of a table cell ('328 / 5.9' -> 328, '3.5x' -> 3.5); None for none."""
-    m = re.search(r"-?\d+(?:\.\d+)?", cell.replace(",", ""))
-    return float(m.group(0)) if m else None
-
-
-def second_number(cell):
-    """The second number of a table cell ('400 / 253' -> 253); None for none."""
+def number(cell, k=0):
+    """The k-th number of a table cell ('328 / 5.9' -> 328 for k = 0, 5.9 for k = 1; '3.5x' -> 3.5); None
+    for none."""
     nums = re.findall(r"-?\d+(?:\.\d+)?", cell.replace(",", ""))
-    return float(nums[1]) if len(nums) > 1 else None
+    return float(nums[k]) if len(nums) > k else None
 
 
 def parse_geoloc(text):
@@ -177,7 +172,7 @@ def summary(rays, packages, geo, which="every pixel"):
         for scene, limit in (("nadir", 300), ("oblique30", 600)):
             row = geo.get(scene)
             cell = column(row, "whole image") if row else None
-            v = second_number(cell) if cell else None
+            v = number(cell, 1) if cell else None
             if v is not None:
                 rep.check(scene, v, v <= limit, "{:.0f} ns")
     out = ["", "Issue 14's targets in this run ({} of {} met; ratios within this one run):".format(rep.met, rep.total)]
