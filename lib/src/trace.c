@@ -297,8 +297,18 @@ static rt footprint_exit(const ctx *c, uint32_t ci, uint32_t cj)
     return c->r->dz > 0 && rt_lt(c->tend, tx) ? c->tend : tx;
 }
 
-static ct_status walk_cones(const ctx *c, uint32_t plane, ct_hit *h)
+/* The cone walk.  fine, a constant: 1 for a package at r = 1, whose coarse
+ * cells are its fine cells (no multiplier for the coarse cell, no step from
+ * a footprint's exit) -- an instance of its own on hosts (walk_cones
+ * below); the MCUs compile one instance, fine = 0, for code size. */
+#if CT_HAVE_PREFETCH
+CT_OPT_INLINE static inline ct_status walk_cones_r(const ctx *c, uint32_t plane, ct_hit *h, const int fine)
 {
+#else
+static ct_status walk_cones_r(const ctx *c, uint32_t plane, ct_hit *h)
+{
+    const int fine = 0;
+#endif
     const ct_package *p = c->p;
     const ct_prepared *r = c->r;
     const uint8_t *ang = p->angles + (size_t)plane * p->coarse_x * p->coarse_y;
@@ -310,7 +320,7 @@ static ct_status walk_cones(const ctx *c, uint32_t plane, ct_hit *h)
     /* Cone steps from the coarse footprint's exit (below) at r > 1; at
      * r = 1 the footprint is the fine cell, and the exit's division costs
      * more than the one cell it adds to a step. */
-    const int from_exit = p->reduce > 1u;
+    const int from_exit = !fine && p->reduce > 1u;
     rt t = c->t0;   /* current point */
     rt tin = c->t0; /* canonical entry of the current cell */
     int tin_ok = 1;
@@ -331,8 +341,8 @@ static ct_status walk_cones(const ctx *c, uint32_t plane, ct_hit *h)
             break;
         }
         steps++;
-        ci = ct_coarse_of(p, i);
-        cj = ct_coarse_of(p, j);
+        ci = fine ? (uint32_t)i : ct_coarse_of(p, i);
+        cj = fine ? (uint32_t)j : ct_coarse_of(p, j);
         k = (size_t)cj * p->coarse_x + ci;
         lb = -1;
         /* Below the apex of coarse cell k at an earlier fine cell of it (the
@@ -445,7 +455,8 @@ static ct_status walk_cones(const ctx *c, uint32_t plane, ct_hit *h)
                             int64_t px = floor_shr(ox + floor_shr(T2 * (int64_t)dx, CT_T_FRAC_BITS), 16u);
                             int64_t py = floor_shr(oy + floor_shr(T2 * (int64_t)dy, CT_T_FRAC_BITS), 16u);
                             if (px >= 0 && py >= 0 && px < c->cx && py < c->cy) {
-                                size_t k2 = ct_coarse_index(p, (int32_t)px, (int32_t)py);
+                                size_t k2 = fine ? (size_t)py * p->coarse_x + (size_t)px
+                                                 : ct_coarse_index(p, (int32_t)px, (int32_t)py);
                                 CT_PREFETCH(ang + k2);
                                 CT_PREFETCH(p->apex + 2u * k2);
                             }
@@ -490,6 +501,32 @@ static ct_status walk_cones(const ctx *c, uint32_t plane, ct_hit *h)
     h->steps = steps;
     h->iters = it; /* == bound with CT_ERR_INTERNAL */
     return st;
+}
+
+#if CT_HAVE_PREFETCH
+/* hosts: the two instances, each a function of its own (one function
+ * holding both cost the r > 1 walk 2-3 %) */
+CT_NOINLINE static ct_status walk_cones_fine(const ctx *c, uint32_t plane, ct_hit *h)
+{
+    return walk_cones_r(c, plane, h, 1);
+}
+
+CT_NOINLINE static ct_status walk_cones_coarse(const ctx *c, uint32_t plane, ct_hit *h)
+{
+    return walk_cones_r(c, plane, h, 0);
+}
+#endif
+
+static ct_status walk_cones(const ctx *c, uint32_t plane, ct_hit *h)
+{
+#if CT_HAVE_PREFETCH
+    /* hosts: packages at r = 1 take their own instance (their planes are
+     * large, and a step's chain from one angle code's load to the next is
+     * what limits it); the MCUs keep one instance (code size) */
+    return c->p->reduce == 1u ? walk_cones_fine(c, plane, h) : walk_cones_coarse(c, plane, h);
+#else
+    return walk_cones_r(c, plane, h);
+#endif
 }
 
 /* A seam start's cheap proof of f(t0) > 0, as the cone walk's first test
