@@ -320,7 +320,7 @@ static ct_status walk_cones_r(const ctx *c, uint32_t plane, ct_hit *h)
     /* Cone steps from the coarse footprint's exit (below) at r > 1; at
      * r = 1 the footprint is the fine cell, and the exit's division costs
      * more than the one cell it adds to a step. */
-    const int from_exit = !fine && p->reduce > 1u;
+    const int from_exit = fine ? 0 : p->reduce > 1u;
     rt t = c->t0;   /* current point */
     rt tin = c->t0; /* canonical entry of the current cell */
     int tin_ok = 1;
