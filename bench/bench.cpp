@@ -37,7 +37,23 @@ struct Result {
     long hits = 0;
 };
 
-Result run(const ct_package &p, const std::vector<ct_ray> &rays, ct_method m, std::vector<ct_hit> *out)
+// ns per ray of one pass of m over the rays
+double time_pass(const ct_package &p, const std::vector<ct_ray> &rays, ct_method m)
+{
+    ct_hit h;
+    uint64_t sink = 0;
+    auto t0 = clk::now();
+    for (const ct_ray &ray : rays) {
+        ct_trace(&p, &ray, m, &h);
+        sink += (uint64_t)h.x_q16;
+    }
+    double ns = std::chrono::duration<double, std::nano>(clk::now() - t0).count() / std::max<size_t>(1, rays.size());
+    if (sink == 42) std::printf(" ");
+    return ns;
+}
+
+// steps and hits of m over the rays (untimed); ns left to the caller
+Result count(const ct_package &p, const std::vector<ct_ray> &rays, ct_method m, std::vector<ct_hit> *out)
 {
     Result res;
     std::vector<uint32_t> steps(rays.size());
@@ -53,43 +69,38 @@ Result run(const ct_package &p, const std::vector<ct_ray> &rays, ct_method m, st
     std::vector<uint32_t> sorted = steps;
     std::sort(sorted.begin(), sorted.end());
     res.median_steps = sorted.empty() ? 0 : sorted[sorted.size() / 2];
-    // time: best of 3 passes
-    double best = 1e30;
-    for (int rep = 0; rep < 3; ++rep) {
-        ct_hit h;
-        uint64_t sink = 0;
-        auto t0 = clk::now();
-        for (const ct_ray &ray : rays) {
-            ct_trace(&p, &ray, m, &h);
-            sink += (uint64_t)h.x_q16;
-        }
-        double ns = std::chrono::duration<double, std::nano>(clk::now() - t0).count() / std::max<size_t>(1, rays.size());
-        if (sink == 42) std::printf(" ");
-        best = std::min(best, ns);
-    }
-    res.ns = best;
+    return res;
+}
+
+// one method alone (--method): its steps and its best of 3 passes
+Result run(const ct_package &p, const std::vector<ct_ray> &rays, ct_method m, std::vector<ct_hit> *out)
+{
+    Result res = count(p, rays, m, out);
+    res.ns = 1e30;
+    for (int rep = 0; rep < 3; ++rep) res.ns = std::min(res.ns, time_pass(p, rays, m));
     return res;
 }
 
 #ifdef CT_HAVE_EMBREE
-double run_embree(const EmbreeTerrain &e, const std::vector<ct_ray> &rays, long *hits)
+// Embree's rays (its unit directions) and one timed pass over them (ns per ray)
+std::vector<std::array<double, 6>> embree_rays(const std::vector<ct_ray> &rays)
 {
     std::vector<std::array<double, 6>> rr;
     for (const ct_ray &r : rays) {
         double m = std::max(std::fabs((double)r.dx), std::max(std::fabs((double)r.dy), std::fabs((double)r.dz)));
         rr.push_back({r.x_q16 / 65536.0, r.y_q16 / 65536.0, r.z_q16 / 65536.0, r.dx / m, r.dy / m, r.dz / m});
     }
-    double best = 1e30;
-    for (int rep = 0; rep < 3; ++rep) {
-        long h = 0;
-        double t;
-        auto t0 = clk::now();
-        for (const auto &q : rr) h += e.intersect(q.data(), q.data() + 3, 1e7, &t);
-        double ns = std::chrono::duration<double, std::nano>(clk::now() - t0).count() / std::max<size_t>(1, rr.size());
-        best = std::min(best, ns);
-        *hits = h;
-    }
-    return best;
+    return rr;
+}
+
+double embree_pass(const EmbreeTerrain &e, const std::vector<std::array<double, 6>> &rr, long *hits)
+{
+    long h = 0;
+    double t;
+    auto t0 = clk::now();
+    for (const auto &q : rr) h += e.intersect(q.data(), q.data() + 3, 1e7, &t);
+    *hits = h;
+    return std::chrono::duration<double, std::nano>(clk::now() - t0).count() / std::max<size_t>(1, rr.size());
 }
 #endif
 
@@ -153,7 +164,31 @@ void bench_dem(const char *title, const ct_host::Terrain &t, int n, const std::v
             Result base;
             std::vector<ct_hit> hs[4];
             Result res[4];
-            for (int m = 0; m < 4; ++m) res[m] = run(p, f.rays, (ct_method)m, &hs[m]);
+            for (int m = 0; m < 4; ++m) res[m] = count(p, f.rays, (ct_method)m, &hs[m]);
+            // Timed in alternating rounds, every method (and Embree) once a
+            // round, the order reversed every other round, so that all of
+            // them see the same machine (its speed drifts by tens of percent
+            // within seconds); each side's best of 3 rounds.
+            int sides = 4;
+#ifdef CT_HAVE_EMBREE
+            double ens = 1e30;
+            long eh = 0;
+            std::vector<std::array<double, 6>> rr = embree_rays(f.rays);
+            sides = 5;
+#endif
+            for (int m = 0; m < 4; ++m) res[m].ns = 1e30;
+            for (int round = 0; round < 3; ++round)
+                for (int q = 0; q < sides; ++q) {
+                    int s = round % 2 ? sides - 1 - q : q;
+                    if (s < 4) {
+                        res[s].ns = std::min(res[s].ns, time_pass(p, f.rays, (ct_method)s));
+                    }
+#ifdef CT_HAVE_EMBREE
+                    else {
+                        ens = std::min(ens, embree_pass(emb, rr, &eh));
+                    }
+#endif
+                }
             base = res[0];
             const char *mn[4] = {"incremental", "hierarchical", "cone", "directional"};
             for (int m = 0; m < 4; ++m) {
@@ -164,8 +199,6 @@ void bench_dem(const char *title, const ct_host::Terrain &t, int n, const std::v
             std::printf("%-11s %6s   directional vs cone: %.2fx fewer steps\n", "", "",
                         res[2].mean_steps / std::max(1e-9, res[3].mean_steps));
 #ifdef CT_HAVE_EMBREE
-            long eh = 0;
-            double ens = run_embree(emb, f.rays, &eh);
             std::printf("%-11s %6s   embree %.0f ns/ray (%ld hits vs our %ld): directional/embree time = %.2f\n", "", "", ens,
                         eh, res[3].hits, res[3].ns / ens);
 #endif
