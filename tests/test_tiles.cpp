@@ -1049,9 +1049,6 @@ void test_geolocation()
     }
 }
 
-// Intervisibility over a set: ct_los_tiles = ct_los on the merged package
-// (straight, a sphere, the true Earth), and with a tile missing the merged
-// answer or CT_NO_DATA, never "visible" through or "blocked" on that tile.
 // The fixture mirror-tiled to 500 x 500 posts (N sectors, r = 3) cut into
 // 4 x 4 tiles of 129 posts, the same set with tile (hc, hr) left out, and
 // the package built from the merged DEM (opened in mp).
@@ -1060,7 +1057,9 @@ struct Mirror500 {
     ct_host::BuildOptions o;
     TileSetBytes tb, holed;
     std::vector<uint8_t> merged;
-    ct_package mp{};
+    ct_package mp{}; // opened over merged: not to be copied
+    Mirror500(const Mirror500 &) = delete;
+    Mirror500 &operator=(const Mirror500 &) = delete;
     Mirror500(int sectors, int hc, int hr) : t(dem_cases::mirror_tiled(dem_cases::real_terrain(), 500, 500))
     {
         o.sectors = sectors;
@@ -1214,6 +1213,9 @@ void test_batch_runs()
     TEST_ASSERT(shortened > compared / 10);
 }
 
+// Intervisibility over a set: ct_los_tiles = ct_los on the merged package
+// (straight, a sphere, the true Earth), and with a tile missing the merged
+// answer or CT_NO_DATA, never "visible" through or "blocked" on that tile.
 void test_los()
 {
     const Mirror500 w(16, 1, 2);

@@ -408,12 +408,22 @@ static ct_pose g_pose;
 static int64_t g_uv[2u * CAM_MAX_PIXELS];
 static ct_geo g_batch[CAM_MAX_PIXELS];
 
+/* Camera vc's lens (or grid) and pose into g_cam and g_pose: the two
+ * statuses in *init and *pose. */
+static void camera_setup(const ct_vec_camera *vc, ct_status *init, ct_status *pose)
+{
+    zero_bytes(&g_cam, sizeof g_cam);
+    zero_bytes(&g_pose, sizeof g_pose);
+    *init = vc->grid.nu > 0u ? ct_camera_init_grid(&g_cam, &vc->grid) : ct_camera_init(&g_cam, &vc->lens);
+    *pose = ct_pose_init(&g_pose, vc->R_q30, vc->e_nm, vc->n_nm, vc->h_nm);
+}
+
 /* Cameras: lens (or grid) and pose set-up, unprojection, projection back,
  * geolocation with every method and the batch, each bit-identical to the
  * host's.  Returns the number of geolocations that matched in full. */
 static uint32_t check_camera(const ct_vec_set *vs, const ct_vec_camera *vc, uint32_t *total)
 {
-    ct_status st;
+    ct_status st, pst;
     uint32_t k, m, ok = 0u, before;
     g_where = vc->name;
     g_idx = 0u;
@@ -429,12 +439,10 @@ static uint32_t check_camera(const ct_vec_set *vs, const ct_vec_camera *vc, uint
     if (st != CT_OK) {
         return 0u;
     }
-    zero_bytes(&g_cam, sizeof g_cam);
-    st = vc->grid.nu > 0u ? ct_camera_init_grid(&g_cam, &vc->grid) : ct_camera_init(&g_cam, &vc->lens);
+    camera_setup(vc, &st, &pst);
     eq_i64("camera init", vc->init_status, st);
     eq_i64("r2_max_q32", vc->r2_max_q32, g_cam.r2_max_q32);
-    zero_bytes(&g_pose, sizeof g_pose);
-    eq_i64("pose init", vc->pose_status, ct_pose_init(&g_pose, vc->R_q30, vc->e_nm, vc->n_nm, vc->h_nm));
+    eq_i64("pose init", vc->pose_status, pst);
     if (vc->init_status != CT_OK || vc->pose_status != CT_OK) {
         return 0u;
     }
@@ -777,11 +785,10 @@ static uint32_t check_tileset(const ct_vec_set *vs, const ct_vec_tileset *vt, ui
     }
     {
         const ct_vec_camera *vc = &vs->cameras[vt->camera];
-        zero_bytes(&g_cam, sizeof g_cam);
-        zero_bytes(&g_pose, sizeof g_pose);
-        st = vc->grid.nu > 0u ? ct_camera_init_grid(&g_cam, &vc->grid) : ct_camera_init(&g_cam, &vc->lens);
+        ct_status pst;
+        camera_setup(vc, &st, &pst);
         eq_i64("tileset camera init", CT_OK, st);
-        eq_i64("tileset pose init", CT_OK, ct_pose_init(&g_pose, vc->R_q30, vc->e_nm, vc->n_nm, vc->h_nm));
+        eq_i64("tileset pose init", CT_OK, pst);
         /* bound: the camera's pixels */
         for (k = 0u; k < vc->npixels; ++k) {
             g_uv[2u * k] = vc->pixels[k].u_q16;
