@@ -1070,10 +1070,13 @@ static int run_clear(const ct_package *p, const ct_lower *lw, const runb *b, int
         hb = ct_max64(hb, v);
     }
     if (lw != NULL) {
-        /* the near face, in the a coordinate: s * cu 2^16 */
-        int64_t f = b->s * cu * ONE16, o = b->a == 0 ? lw->obx : lw->oby;
+        /* the near face, in the a coordinate: s * cu 2^16; across it the
+         * posts of cells j0 .. j1, whose nearest to the observer is at its
+         * q clamped to [j0, j1 + 1] cells (D grows with the range) */
+        int64_t f = b->s * cu * ONE16, o = b->a == 0 ? lw->obx : lw->oby, oq = b->a == 0 ? lw->oby : lw->obx;
         if ((b->s > 0 && f > o) || (b->s < 0 && f < o)) {
-            D = b->a == 0 ? ct_lower_at(lw, f, lw->oby) : ct_lower_at(lw, lw->obx, f);
+            int64_t q = ct_max64(ct_min64(oq, ((int64_t)j1 + 1) * ONE16), (int64_t)j0 * ONE16);
+            D = b->a == 0 ? ct_lower_at(lw, f, q) : ct_lower_at(lw, q, f);
         }
     }
     return z > hb * ONE16 - D;
