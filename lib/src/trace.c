@@ -1037,9 +1037,12 @@ static int run_bounds(const ct_package *p, const ct_prepared *const *r, const ui
  * the fine cells), between the run's bounds there: their lowest height is
  * above the tallest post of every cell their other coordinate's range
  * touches (a point on a cell's edge is bounded by that edge's posts, which
- * the cell on either side holds), less (lw) the lowering at the block's
- * near face -- every post of the block is at least as far from the
- * observer, who is behind that face, and D grows with the range.  At most
+ * the cell on either side holds), less (lw) the lowering at the nearest
+ * of those cells' posts to the observer: on the block's near face (the
+ * observer is behind it), across the axis at the observer's coordinate
+ * clamped to the posts' range -- every post of those cells is at least as
+ * far from the observer, and D grows with the range (a bilinear cell of
+ * lowered posts is no higher than its tallest lowered post).  At most
  * four blocks across; otherwise 0.  Outside the tile there is no surface. */
 static int run_clear(const ct_package *p, const ct_lower *lw, const runb *b, int64_t cu, uint32_t l)
 {
@@ -1070,9 +1073,9 @@ static int run_clear(const ct_package *p, const ct_lower *lw, const runb *b, int
         hb = ct_max64(hb, v);
     }
     if (lw != NULL) {
-        /* the near face, in the a coordinate: s * cu 2^16; across it the
-         * posts of cells j0 .. j1, whose nearest to the observer is at its
-         * q clamped to [j0, j1 + 1] cells (D grows with the range) */
+        /* the near face, in the a coordinate: s * cu 2^16; across the
+         * axis the posts of cells j0 .. j1, q in [j0, j1 + 1] cells (in
+         * the tile, as ct_lower_at asks) */
         int64_t f = b->s * cu * ONE16, o = b->a == 0 ? lw->obx : lw->oby, oq = b->a == 0 ? lw->oby : lw->obx;
         if ((b->s > 0 && f > o) || (b->s < 0 && f < o)) {
             int64_t q = ct_max64(ct_min64(oq, ((int64_t)j1 + 1) * ONE16), (int64_t)j0 * ONE16);
