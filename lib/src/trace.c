@@ -1072,6 +1072,9 @@ static int run_clear(const ct_package *p, const ct_lower *lw, const runb *b, int
         }
         hb = ct_max64(hb, v);
     }
+    if (z > hb * ONE16) {
+        return 1; /* clear whatever the lowering (D >= 0) */
+    }
     if (lw != NULL) {
         /* the near face, in the a coordinate: s * cu 2^16; across the
          * axis the posts of cells j0 .. j1, q in [j0, j1 + 1] cells (in
