@@ -1072,13 +1072,15 @@ static int run_clear(const ct_package *p, const ct_lower *lw, const runb *b, int
         }
         hb = ct_max64(hb, v);
     }
-    if (z > hb * ONE16) {
-        return 1; /* clear whatever the lowering (D >= 0) */
+    if (lw == NULL || z > hb * ONE16) {
+        /* straight, or above the tallest post: clear whatever the
+         * lowering (D >= 0) */
+        return z > hb * ONE16;
     }
-    if (lw != NULL) {
-        /* the near face, in the a coordinate: s * cu 2^16; across the
-         * axis the posts of cells j0 .. j1, q in [j0, j1 + 1] cells (in
-         * the tile, as ct_lower_at asks) */
+    {
+        /* lowered: the near face, in the a coordinate: s * cu 2^16;
+         * across the axis the posts of cells j0 .. j1, q in [j0, j1 + 1]
+         * cells (in the tile, as ct_lower_at asks) */
         int64_t f = b->s * cu * ONE16, o = b->a == 0 ? lw->obx : lw->oby, oq = b->a == 0 ? lw->oby : lw->obx;
         if ((b->s > 0 && f > o) || (b->s < 0 && f < o)) {
             int64_t q = ct_max64(ct_min64(oq, ((int64_t)j1 + 1) * ONE16), (int64_t)j0 * ONE16);
