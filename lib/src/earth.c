@@ -476,21 +476,31 @@ static const int8_t cheb_pow[CT_EARTH_MAP_DEG + 1][CT_EARTH_MAP_DEG + 1] = {
     {1, 0, 0, 0, 0, 0, 0},  {0, 1, 0, 0, 0, 0, 0},   {-1, 0, 2, 0, 0, 0, 0},   {0, -3, 0, 4, 0, 0, 0},
     {1, 0, -8, 0, 8, 0, 0}, {0, 5, 0, -20, 0, 16, 0}, {-1, 0, 18, 0, -48, 0, 32}};
 
-/* The fit's Taylor terms of degrees 1..3 at the cube's centre (s = 0):
- * for each such term s^alpha (term_abc 1..19), the sum over the fit's
- * terms of cf 2^sh C_a C_b C_c, C the power coefficients of its Chebyshev
- * factors (exact integers: |cf 2^sh| < 2^56, |C C C| <= 48^3 < 2^17, <= 56
- * terms: < 2^80 in 128 bits), kept in cf[TAY0 + t - 1] (a fit of degree
- * <= 5 uses cf[0 .. 55] only: no stack for them).  0 for degree 6, or when
- * one reaches 2^58 (taylor_nodes' range). */
+/* The fit's Taylor terms of degrees 1..3 at the cube's centre (s = 0), and
+ * of degree 4 for a fit of degree 4 (whose path is then its Taylor terms
+ * alone): for each such term s^alpha (term_abc 1..19, 20..34), the sum over
+ * the fit's terms of cf 2^sh C_a C_b C_c, C the power coefficients of its
+ * Chebyshev factors (exact integers: |cf 2^sh| < 2^56, |C C C| <= 48^3 <
+ * 2^17, <= 56 terms: < 2^80 in 128 bits), kept in cf[tay_row(t)]: rows
+ * TAY0 .. for degrees 1..3 (a fit of degree <= 5 uses cf[0 .. 55] only: no
+ * stack for them), TAY4 .. for degree 4 (a degree-4 fit uses cf[0 .. 34]).
+ * 0 for degree 6, or when one reaches 2^58 (taylor_nodes' range). */
 #define TAY0 56
+#define TAY4 35 /* a degree-4 fit's terms of degree 4 (term_abc 20..34) */
+static int tay_row(int t)
+{
+    return t < 20 ? TAY0 + t - 1 : TAY4 + t - 20;
+}
+
 static int map_taylor(ct_earth_map *mp)
 {
     int t, u, o, nt = deg_start[mp->deg + 1];
     if (mp->deg > 5) {
         return 0;
     }
-    for (t = 1; t < 20; ++t) { /* bound: 19 terms */
+    /* bound: 19 terms, 34 for a degree-4 fit (its degree-4 terms then in
+     * cf[TAY4 ..], which it leaves unused: nt = 35) */
+    for (t = 1; t < (mp->deg == 4 ? 35 : 20); ++t) {
         const uint8_t *e = term_abc[t];
         for (o = 0; o < 3; ++o) { /* bound: 3 coordinates */
             ct_i128 acc = ct_i128_from64(0);
@@ -506,7 +516,7 @@ static int map_taylor(ct_earth_map *mp)
             if (ct_i128_cmp(ct_i128_abs(acc), ct_i128_from64(INT64_C(1) << 58)) >= 0) {
                 return 0;
             }
-            mp->cf[TAY0 + t - 1][o] = ct_i128_to64(acc);
+            mp->cf[tay_row(t)][o] = ct_i128_to64(acc);
         }
     }
     return 1;
@@ -726,6 +736,91 @@ static const uint8_t tay_axis[20] = {0, 0, 0, 0, 2, 1, 1, 0, 0, 0, 2, 1, 1, 1, 0
 static const uint8_t binom5[6][6] = {{1, 0, 0, 0, 0, 0},  {1, 1, 0, 0, 0, 0},  {1, 2, 1, 0, 0, 0},
                                      {1, 3, 3, 1, 0, 0},  {1, 4, 6, 4, 1, 0},  {1, 5, 10, 10, 5, 1}};
 
+/* The index in term_abc of the monomial s_x^e0 s_y^e1 s_z^e2 (total degree
+ * k <= CT_EARTH_MAP_DEG): by degree, then e0, then e1. */
+static int term_index(int e0, int e1, int e2)
+{
+    int k = e0 + e1 + e2, x, idx = deg_start[k];
+    for (x = 0; x < e0; ++x) { /* bound: CT_EARTH_MAP_DEG */
+        idx += k - x + 1;
+    }
+    return idx + e1;
+}
+
+/* The quartic and quintic Taylor terms of a degree-4 fit along x(tau) =
+ * tau a - tau^2 b (taylor_nodes, which gives a, b with |b| <= 2^53 per
+ * axis, and am, the monomials a^alpha of degrees 1..3, Q62): p4 = G_4(a) -
+ * E_31 + G_2(b) and p5 = -E_41 + E_32 into p[4], p[5] (Q30), each
+ * coordinate's sum Q(fb + 60) below 2^(fb + 83), else 0.  Out of line: its
+ * monomials are not on the stack while the images are found. */
+CT_NOINLINE static int taylor_alone(const ct_earth_map *mp, const int64_t a[3], const int64_t b[3],
+                                    const int64_t am3[20], int64_t p[6][3])
+{
+    /* a^alpha of degrees 1..4 (|.| <= 2^62); per monomial of degree 3 and
+     * 4 E_k1's factor sum e_i b_i a^(alpha - e_i) (|d1| <= 4 2^53), of
+     * degree 3 E_32's (|d2| <= 6 2^44), of degree 2 b^alpha (<= 2^44) */
+    int64_t am[35], d1[35], d2[20], bm[10];
+    int t, i, j, o;
+    for (t = 1; t < 20; ++t) { /* bound: 19 terms */
+        am[t] = am3[t];
+    }
+    for (t = 20; t < 35; ++t) { /* bound: 15 terms */
+        const uint8_t *e = term_abc[t];
+        int ax = e[0] > 0 ? 0 : (e[1] > 0 ? 1 : 2);
+        am[t] = ct_mul_shr(am[term_index(e[0] - (ax == 0), e[1] - (ax == 1), e[2] - (ax == 2))], a[ax], 62u);
+    }
+    for (t = 10; t < 35; ++t) { /* bound: 25 terms of degrees 3 and 4 */
+        const uint8_t *e = term_abc[t];
+        d1[t] = 0;
+        for (i = 0; i < 3; ++i) { /* bound: 3 axes */
+            if (e[i] > 0) {
+                int r = term_index(e[0] - (i == 0), e[1] - (i == 1), e[2] - (i == 2));
+                d1[t] += (int64_t)e[i] * ct_mul_shr(b[i], am[r], 62u);
+            }
+        }
+    }
+    for (t = 10; t < 20; ++t) { /* bound: 10 terms of degree 3 */
+        const uint8_t *e = term_abc[t];
+        d2[t] = 0;
+        for (i = 0; i < 3; ++i) {     /* bound: 3 axes */
+            for (j = i; j < 3; ++j) { /* bound: 3 axes */
+                int f0 = e[0] - (i == 0) - (j == 0), f1 = e[1] - (i == 1) - (j == 1), f2 = e[2] - (i == 2) - (j == 2);
+                /* binom(e_i, 2) for i = j, e_i e_j otherwise */
+                int64_t m = i == j ? (int64_t)(e[i] * (e[i] - 1) / 2) : (int64_t)(e[i] * e[j]);
+                if (m != 0 && f0 >= 0 && f1 >= 0 && f2 >= 0) {
+                    d2[t] += m * ct_mul_shr(ct_mul_shr(b[i], b[j], 62u), am[term_index(f0, f1, f2)], 62u);
+                }
+            }
+        }
+    }
+    for (t = 4; t < 10; ++t) { /* bound: 6 terms of degree 2: b_i b_j */
+        const uint8_t *e = term_abc[t];
+        int ax = e[0] > 0 ? 0 : (e[1] > 0 ? 1 : 2);               /* the first axis of e */
+        int ox = e[ax] == 2 ? ax : (ax == 0 && e[1] > 0 ? 1 : 2); /* the other */
+        bm[t] = ct_mul_shr(b[ax], b[ox], 62u);
+    }
+    for (o = 0; o < 3; ++o) { /* bound: 3 coordinates */
+        ct_i128 s4 = ct_i128_from64(0), s5 = ct_i128_from64(0);
+        for (t = 4; t < 10; ++t) { /* bound: 6 terms: G_2(b) */
+            s4 = ct_i128_add(s4, ct_i128_mul(mp->cf[TAY0 + t - 1][o], bm[t]));
+        }
+        for (t = 10; t < 20; ++t) { /* bound: 10 terms: - E_31; E_32 */
+            s4 = ct_i128_sub(s4, ct_i128_mul(mp->cf[TAY0 + t - 1][o], d1[t]));
+            s5 = ct_i128_add(s5, ct_i128_mul(mp->cf[TAY0 + t - 1][o], d2[t]));
+        }
+        for (t = 20; t < 35; ++t) { /* bound: 15 terms: G_4(a); - E_41 */
+            s4 = ct_i128_add(s4, ct_i128_mul(mp->cf[TAY4 + t - 20][o], am[t]));
+            s5 = ct_i128_sub(s5, ct_i128_mul(mp->cf[TAY4 + t - 20][o], d1[t]));
+        }
+        if (ct_i128_bits(ct_i128_abs(s4)) > mp->fb[o] + 83u || ct_i128_bits(ct_i128_abs(s5)) > mp->fb[o] + 83u) {
+            return 0;
+        }
+        p[4][o] = ct_i128_round_shr(s4, mp->fb[o] + 30u);
+        p[5][o] = ct_i128_round_shr(s5, mp->fb[o] + 30u);
+    }
+    return 1;
+}
+
 /* Taylor-Lobatto nodes (a fit per call, es->tay_ok: tmax < 70 km):
  * the path's polynomial in tau = t / tmax through the camera's image with
  * the fit's own first three derivatives there, and the fit's images at
@@ -733,16 +828,28 @@ static const uint8_t binom5[6][6] = {{1, 0, 0, 0, 0, 0},  {1, 1, 0, 0, 0, 0},  {
  * or two images a line of sight instead of the Lobatto nodes' three or
  * four.  Along the line x(tau) = tau a - tau^2 b (x = (P - c) / 2^q, a =
  * tmax d / 2^q, b = bend(tmax) w / 2^q: refraction's bend is k t^2 / 2R
- * exactly, vertex_exact's within a nanometre) the fit G has the Taylor
- * terms p1 = G_1 a, p2 = G_2(a) - G_1 b, p3 = G_3(a) - G_2'(a) b (G_k its
- * terms of degree k, b^2 in the quartic term and beyond): exact for the
- * fit along a straight line up to the degree, and otherwise off by its
- * terms of degree 5 (6) times at most max |tau^4 (tau - 1)| = 0.082 (max
- * |tau^4 (tau - 3/4) (tau - 1)| = 0.0099): within 0.0054 mm of the fit's
- * images (test_earth test_taylor_path; the Lobatto nodes' 0.0125 mm).  Units: a, b and their products Q62, the
- * terms' sums Q(fb + 60) in 128 bits (|tay| < 2^58: 20 products < 2^125),
- * rounded to Q30 (below 2^54, else none); the images X in Q24 less the
- * camera's, |X| < 2^46.
+ * exactly, vertex_exact's within a nanometre) the fit G = sum G_k (G_k its
+ * terms of degree k) has the Taylor terms p_m = sum over k + l = m of
+ * (-1)^l E_kl, E_kl the coefficient of eps^l in G_k(a + eps b): p1 = G_1 a,
+ * p2 = G_2(a) - G_1 b, p3 = G_3(a) - G_2'(a) b: exact for the fit along a
+ * straight line up to the degree, and otherwise off by its terms of
+ * degree 5 (6) times at most max |tau^4 (tau - 1)| = 0.082 (max |tau^4
+ * (tau - 3/4) (tau - 1)| = 0.0099): within 0.0054 mm of the fit's images
+ * (test_earth test_taylor_path; the Lobatto nodes' 0.0125 mm).
+ * A fit of degree 4 (cubes of 2^44 nm) takes its Taylor terms alone, no
+ * image: also p4 = E_40 - E_31 + E_22 and p5 = -E_41 + E_32 (E_k1 = sum
+ * over i of alpha_i b_i a^(alpha - e_i) per monomial a^alpha, E_k2 its
+ * second-order analogue, E_22 = G_2(b)), which along a straight line (b =
+ * 0) is the fit exactly (degree 4 in tau); the terms left out, E_42, E_33,
+ * E_43 and E_44, carry b^2 or more: with |b| <= 2^-9 per axis (else the
+ * images, as above) at most 2^-18 of 11 |G_4| and 2^-27 of |G_3|, below a
+ * nanometre at 2^44 nm, where the quartic and cubic terms are about
+ * rho^4 / R^3 = 0.4 mm and rho^3 / R^2 = 0.13 m (refraction's bend is 2.6
+ * m at 16 km with k = 0.13: |b| about 2^-13; 2^-9 is k = 2 at 13 km).
+ * Units: a, b and their products Q62, the terms' sums Q(fb + 60) in 128
+ * bits (|tay| < 2^58: <= 31 products < 2^121 each, < 2^126), rounded to Q30
+ * (below 2^54, else none); the images X in Q24 less the camera's, |X| <
+ * 2^46.
  * Returns 0 (the Lobatto nodes then) when an image is missing or too far,
  * or a coefficient reaches 2^49. */
 static int taylor_nodes(path *pa, int64_t tmax)
@@ -750,20 +857,26 @@ static int taylor_nodes(path *pa, int64_t tmax)
     const ct_earth *es = pa->es;
     const ct_earth_map *mp = es->map;
     int64_t a[3], b[3], am[20], db[6], p[6][3], X[2][3];
-    int deg = tmax <= NODES_4_NM ? 4 : 5, nf = deg - 3, i, j, k, t, o;
+    int deg = tmax <= NODES_4_NM ? 4 : 5, nf, alone = 0, i, j, k, t, o;
     unsigned q = mp->qrho;
     int64_t bmax = pa->refract ? es->tay_bend_nm : 0;
-    for (j = 0; j < nf; ++j) { /* bound: 2 far nodes: tau = 3/4 (3 tmax < 2^50) and 1 */
-        if (!node_image(pa, j == nf - 1 ? tmax : (3 * tmax) >> 2, X[j])) {
-            return 0;
-        }
-    }
     /* a: tmax |d| < 2^48 2^40 over 2^(q - 23) (q >= 44): |a| <= 2^62 as
      * tmax < 2^q; b: |bend| < 2^47 (the cube holds it), |w| <= 2^30 + 2,
      * over 2^(q - 32): |b| < 2^62 */
     for (i = 0; i < 3; ++i) { /* bound: 3 axes */
         a[i] = ct_i128_round_shr(ct_i128_mul(tmax, pa->d[i]), q - 23u);
         b[i] = ct_i128_round_shr(ct_i128_mul(bmax, pa->w[i]), q - 32u);
+    }
+    if (mp->deg == 4 && ct_abs64(b[0]) <= (INT64_C(1) << 53) && ct_abs64(b[1]) <= (INT64_C(1) << 53) &&
+        ct_abs64(b[2]) <= (INT64_C(1) << 53)) {
+        alone = 1;
+        deg = 5;
+    }
+    nf = alone ? 0 : deg - 3;
+    for (j = 0; j < nf; ++j) { /* bound: 2 far nodes: tau = 3/4 (3 tmax < 2^50) and 1 */
+        if (!node_image(pa, j == nf - 1 ? tmax : (3 * tmax) >> 2, X[j])) {
+            return 0;
+        }
     }
     /* a^alpha for the terms of degrees 1..3 (Q62): a term's monomial is
      * its parent's (tay_parent) times a along tay_axis; and each quadratic
@@ -801,6 +914,9 @@ static int taylor_nodes(path *pa, int64_t tmax)
         p[1][o] = ct_i128_round_shr(s1, mp->fb[o] + 30u);
         p[2][o] = ct_i128_round_shr(s2, mp->fb[o] + 30u);
         p[3][o] = ct_i128_round_shr(s3, mp->fb[o] + 30u);
+        if (alone) {
+            continue; /* p4, p5: taylor_alone, below */
+        }
         if (deg == 4) {
             p[4][o] = X[0][o] * 64 - p[1][o] - p[2][o] - p[3][o];
         } else {
@@ -814,6 +930,9 @@ static int taylor_nodes(path *pa, int64_t tmax)
             p[5][o] = 4 * (r1s - vq);
             p[4][o] = r1s - p[5][o];
         }
+    }
+    if (alone && !taylor_alone(mp, a, b, am, p)) {
+        return 0;
     }
     pa->nodes = deg + 1;
     /* in powers of sigma = 2 tau - 1: c_j = sum_k p_k binom(k, j) / 2^k
