@@ -487,6 +487,7 @@ static const int8_t cheb_pow[CT_EARTH_MAP_DEG + 1][CT_EARTH_MAP_DEG + 1] = {
  * 0 for degree 6, or when one reaches 2^58 (taylor_nodes' range). */
 #define TAY0 56
 #define TAY4 35 /* a degree-4 fit's terms of degree 4 (term_abc 20..34) */
+#define TAY_S 50 /* and the sums of their and lower terms' magnitudes */
 static int tay_row(int t)
 {
     return t < 20 ? TAY0 + t - 1 : TAY4 + t - 20;
@@ -517,6 +518,26 @@ static int map_taylor(ct_earth_map *mp)
                 return 0;
             }
             mp->cf[tay_row(t)][o] = ct_i128_to64(acc);
+        }
+    }
+    if (mp->deg == 4) {
+        /* taylor_alone's bound: per coordinate S4 = sum |G_4's terms| in
+         * cf[TAY_S][o] (< 15 2^58), ceil((S2 + 4 S3) / 2) in cf[TAY_S +
+         * 1][o] (S2 < 6 2^58, S3 < 10 2^58: the sum < 2^63.4, half < 2^63) */
+        for (o = 0; o < 3; ++o) { /* bound: 3 coordinates */
+            uint64_t s2 = 0u, s3 = 0u, s4 = 0u;
+            for (t = 4; t < 35; ++t) { /* bound: 31 terms of degrees 2..4 */
+                uint64_t v = (uint64_t)ct_abs64(mp->cf[tay_row(t)][o]);
+                if (t < 10) {
+                    s2 += v;
+                } else if (t < 20) {
+                    s3 += v;
+                } else {
+                    s4 += v;
+                }
+            }
+            mp->cf[TAY_S][o] = (int64_t)s4;
+            mp->cf[TAY_S + 1][o] = (int64_t)((s2 + 4u * s3 + 1u) >> 1);
         }
     }
     return 1;
@@ -736,87 +757,73 @@ static const uint8_t tay_axis[20] = {0, 0, 0, 0, 2, 1, 1, 0, 0, 0, 2, 1, 1, 1, 0
 static const uint8_t binom5[6][6] = {{1, 0, 0, 0, 0, 0},  {1, 1, 0, 0, 0, 0},  {1, 2, 1, 0, 0, 0},
                                      {1, 3, 3, 1, 0, 0},  {1, 4, 6, 4, 1, 0},  {1, 5, 10, 10, 5, 1}};
 
-/* The index in term_abc of the monomial s_x^e0 s_y^e1 s_z^e2 (total degree
- * k <= CT_EARTH_MAP_DEG): by degree, then e0, then e1. */
-static int term_index(int e0, int e1, int e2)
-{
-    int k = e0 + e1 + e2, x, idx = deg_start[k];
-    for (x = 0; x < e0; ++x) { /* bound: CT_EARTH_MAP_DEG */
-        idx += k - x + 1;
-    }
-    return idx + e1;
-}
+/* For the terms 20..34 of term_abc (degree 4): the degree-3 term whose
+ * monomial times s along quart_axis is this one's; for the terms 10..19
+ * (degree 3): per axis i the degree-2 term alpha - e_i (0: alpha_i = 0). */
+static const uint8_t quart_parent[15] = {10, 10, 11, 12, 13, 10, 11, 12, 13, 14, 15, 16, 17, 18, 19};
+static const uint8_t quart_axis[15] = {2, 1, 1, 1, 1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0};
+static const uint8_t cub_less[10][3] = {{0, 0, 4}, {0, 4, 5}, {0, 5, 6}, {0, 6, 0}, {4, 0, 7},
+                                        {5, 7, 8}, {6, 8, 0}, {7, 0, 9}, {8, 9, 0}, {9, 0, 0}};
 
-/* The quartic and quintic Taylor terms of a degree-4 fit along x(tau) =
- * tau a - tau^2 b (taylor_nodes, which gives a, b with |b| <= 2^53 per
- * axis, and am, the monomials a^alpha of degrees 1..3, Q62): p4 = G_4(a) -
- * E_31 + G_2(b) and p5 = -E_41 + E_32 into p[4], p[5] (Q30), each
- * coordinate's sum Q(fb + 60) below 2^(fb + 83), else 0.  Out of line: its
- * monomials are not on the stack while the images are found. */
-CT_NOINLINE static int taylor_alone(const ct_earth_map *mp, const int64_t a[3], const int64_t b[3],
-                                    const int64_t am3[20], int64_t p[6][3])
+/* The quartic Taylor term of a degree-4 fit along x(tau) = tau a - tau^2 b
+ * (taylor_nodes, which gives a, b with |b| <= 2^53 per axis and am, the
+ * monomials a^alpha of degrees 1..3, Q62): p4 = G_4(a) - E_31 into p[4]
+ * (Q30; the sums Q(fb + 60)).  What it leaves out, E_22 = G_2(b) in tau^4
+ * and the terms of degree 5 and more in tau (E_4l, l >= 1, and E_3l, l >=
+ * 2), is with every |a^alpha| <= 1 at most |b|^2 S2 + |b| (4 + 6 |b| + 4
+ * |b|^2 + |b|^3) S4 + |b|^2 (3 + |b|) S3 <= |b|^2 (S2 + 4 S3) + 5 |b| S4
+ * (|b| <= 2^-9), S_k the sum of |G_k|'s coefficients; 0 (the images then)
+ * when that could reach 2 um (2^11 nm) for a coordinate -- the path with an
+ * image is within 5.4 um of the fit's images (taylor_nodes) -- or a sum
+ * 2^(fb + 83).  Out of line: its monomials are not on the stack while the
+ * images are found. */
+CT_NOINLINE static int taylor_alone(const ct_package *pk, const ct_earth_map *mp, const int64_t a[3], const int64_t b[3],
+                        const int64_t am[20], int64_t p[6][3])
 {
-    /* a^alpha of degrees 1..4 (|.| <= 2^62); per monomial of degree 3 and
-     * 4 E_k1's factor sum e_i b_i a^(alpha - e_i) (|d1| <= 4 2^53), of
-     * degree 3 E_32's (|d2| <= 6 2^44), of degree 2 b^alpha (<= 2^44) */
-    int64_t am[35], d1[35], d2[20], bm[10];
-    int t, i, j, o;
-    for (t = 1; t < 20; ++t) { /* bound: 19 terms */
-        am[t] = am3[t];
+    int64_t a4[15], d1[10];
+    int t, i, o, bent = b[0] != 0 || b[1] != 0 || b[2] != 0;
+    int64_t bx = ct_max64(ct_abs64(b[0]), ct_max64(ct_abs64(b[1]), ct_abs64(b[2]))), bx2 = ct_mul_shr(bx, bx, 62u);
+    for (t = 0; t < 15; ++t) { /* bound: 15 terms of degree 4; |.| <= 2^62 */
+        a4[t] = ct_mul_shr(am[quart_parent[t]], a[quart_axis[t]], 62u);
     }
-    for (t = 20; t < 35; ++t) { /* bound: 15 terms */
-        const uint8_t *e = term_abc[t];
-        int ax = e[0] > 0 ? 0 : (e[1] > 0 ? 1 : 2);
-        am[t] = ct_mul_shr(am[term_index(e[0] - (ax == 0), e[1] - (ax == 1), e[2] - (ax == 2))], a[ax], 62u);
-    }
-    for (t = 10; t < 35; ++t) { /* bound: 25 terms of degrees 3 and 4 */
-        const uint8_t *e = term_abc[t];
-        d1[t] = 0;
-        for (i = 0; i < 3; ++i) { /* bound: 3 axes */
-            if (e[i] > 0) {
-                int r = term_index(e[0] - (i == 0), e[1] - (i == 1), e[2] - (i == 2));
-                d1[t] += (int64_t)e[i] * ct_mul_shr(b[i], am[r], 62u);
-            }
-        }
-    }
-    for (t = 10; t < 20; ++t) { /* bound: 10 terms of degree 3 */
-        const uint8_t *e = term_abc[t];
-        d2[t] = 0;
-        for (i = 0; i < 3; ++i) {     /* bound: 3 axes */
-            for (j = i; j < 3; ++j) { /* bound: 3 axes */
-                int f0 = e[0] - (i == 0) - (j == 0), f1 = e[1] - (i == 1) - (j == 1), f2 = e[2] - (i == 2) - (j == 2);
-                /* binom(e_i, 2) for i = j, e_i e_j otherwise */
-                int64_t m = i == j ? (int64_t)(e[i] * (e[i] - 1) / 2) : (int64_t)(e[i] * e[j]);
-                if (m != 0 && f0 >= 0 && f1 >= 0 && f2 >= 0) {
-                    d2[t] += m * ct_mul_shr(ct_mul_shr(b[i], b[j], 62u), am[term_index(f0, f1, f2)], 62u);
+    if (bent) {
+        /* E_31's factor per cubic monomial, sum e_i b_i a^(alpha - e_i)
+         * (|.| <= 3 2^53) */
+        for (t = 0; t < 10; ++t) { /* bound: 10 terms of degree 3 */
+            const uint8_t *e = term_abc[10 + t];
+            d1[t] = 0;
+            for (i = 0; i < 3; ++i) { /* bound: 3 axes */
+                if (e[i] > 0) {
+                    d1[t] += (int64_t)e[i] * ct_mul_shr(b[i], am[cub_less[t][i]], 62u);
                 }
             }
         }
     }
-    for (t = 4; t < 10; ++t) { /* bound: 6 terms of degree 2: b_i b_j */
-        const uint8_t *e = term_abc[t];
-        int ax = e[0] > 0 ? 0 : (e[1] > 0 ? 1 : 2);               /* the first axis of e */
-        int ox = e[ax] == 2 ? ax : (ax == 0 && e[1] > 0 ? 1 : 2); /* the other */
-        bm[t] = ct_mul_shr(b[ax], b[ox], 62u);
-    }
     for (o = 0; o < 3; ++o) { /* bound: 3 coordinates */
-        ct_i128 s4 = ct_i128_from64(0), s5 = ct_i128_from64(0);
-        for (t = 4; t < 10; ++t) { /* bound: 6 terms: G_2(b) */
-            s4 = ct_i128_add(s4, ct_i128_mul(mp->cf[TAY0 + t - 1][o], bm[t]));
+        ct_i128 s4 = ct_i128_from64(0);
+        for (t = 0; t < 15; ++t) { /* bound: 15 terms: G_4(a) */
+            s4 = ct_i128_add(s4, ct_i128_mul(mp->cf[TAY4 + t][o], a4[t]));
         }
-        for (t = 10; t < 20; ++t) { /* bound: 10 terms: - E_31; E_32 */
-            s4 = ct_i128_sub(s4, ct_i128_mul(mp->cf[TAY0 + t - 1][o], d1[t]));
-            s5 = ct_i128_add(s5, ct_i128_mul(mp->cf[TAY0 + t - 1][o], d2[t]));
+        if (bent) {
+            /* 5 |b| S4 + |b|^2 (S2 + 4 S3) (map_taylor's sums: S4 < 2^62,
+             * half the other < 2^63; |b| <= 2^53, |b|^2 <= 2^44: the bound
+             * < 2^119).  In nm: lim / 2^(fb + 36) Q24 units of the axis'
+             * unit (a posting, or a height LSB: < 2^50 nm), below 2^11 nm */
+            int64_t unit = o == 0 ? pk->posting_e_nm : (o == 1 ? pk->posting_n_nm : pk->height_scale_nm);
+            ct_i128 lim = ct_i128_mul(mp->cf[TAY_S][o], bx);
+            lim = ct_i128_add(ct_i128_add(lim, ct_i128_shl(lim, 2u)),
+                              ct_i128_shl(ct_i128_mul(mp->cf[TAY_S + 1][o], bx2), 1u));
+            if (ct_i128_bits(lim) + ct_bitlen64((uint64_t)ct_abs64(unit)) > mp->fb[o] + 36u + 24u + 11u) {
+                return 0;
+            }
+            for (t = 0; t < 10; ++t) { /* bound: 10 terms: - E_31 */
+                s4 = ct_i128_sub(s4, ct_i128_mul(mp->cf[TAY0 + 9 + t][o], d1[t]));
+            }
         }
-        for (t = 20; t < 35; ++t) { /* bound: 15 terms: G_4(a); - E_41 */
-            s4 = ct_i128_add(s4, ct_i128_mul(mp->cf[TAY4 + t - 20][o], am[t]));
-            s5 = ct_i128_sub(s5, ct_i128_mul(mp->cf[TAY4 + t - 20][o], d1[t]));
-        }
-        if (ct_i128_bits(ct_i128_abs(s4)) > mp->fb[o] + 83u || ct_i128_bits(ct_i128_abs(s5)) > mp->fb[o] + 83u) {
+        if (ct_i128_bits(ct_i128_abs(s4)) > mp->fb[o] + 83u) {
             return 0;
         }
         p[4][o] = ct_i128_round_shr(s4, mp->fb[o] + 30u);
-        p[5][o] = ct_i128_round_shr(s5, mp->fb[o] + 30u);
     }
     return 1;
 }
@@ -837,15 +844,12 @@ CT_NOINLINE static int taylor_alone(const ct_earth_map *mp, const int64_t a[3], 
  * (tau - 3/4) (tau - 1)| = 0.0099): within 0.0054 mm of the fit's images
  * (test_earth test_taylor_path; the Lobatto nodes' 0.0125 mm).
  * A fit of degree 4 (cubes of 2^44 nm) takes its Taylor terms alone, no
- * image: also p4 = E_40 - E_31 + E_22 and p5 = -E_41 + E_32 (E_k1 = sum
- * over i of alpha_i b_i a^(alpha - e_i) per monomial a^alpha, E_k2 its
- * second-order analogue, E_22 = G_2(b)), which along a straight line (b =
- * 0) is the fit exactly (degree 4 in tau); the terms left out, E_42, E_33,
- * E_43 and E_44, carry b^2 or more: with |b| <= 2^-9 per axis (else the
- * images, as above) at most 2^-18 of 11 |G_4| and 2^-27 of |G_3|, below a
- * nanometre at 2^44 nm, where the quartic and cubic terms are about
- * rho^4 / R^3 = 0.4 mm and rho^3 / R^2 = 0.13 m (refraction's bend is 2.6
- * m at 16 km with k = 0.13: |b| about 2^-13; 2^-9 is k = 2 at 13 km).
+ * image: also p4 = E_40 - E_31 (E_31 = sum over i of alpha_i b_i a^(alpha
+ * - e_i) per cubic monomial a^alpha), which along a straight line (b = 0)
+ * is the fit exactly (degree 4 in tau); with refraction what it leaves
+ * out (G_2(b) and the terms of degree 5 and more in tau) is bounded by
+ * taylor_alone, which takes the image instead when that could reach 2 um
+ * (with k = 0.13 the bound is about 1 um at 10 km).
  * Units: a, b and their products Q62, the terms' sums Q(fb + 60) in 128
  * bits (|tay| < 2^58: <= 31 products < 2^121 each, < 2^126), rounded to Q30
  * (below 2^54, else none); the images X in Q24 less the camera's, |X| <
@@ -867,20 +871,10 @@ static int taylor_nodes(path *pa, int64_t tmax)
         a[i] = ct_i128_round_shr(ct_i128_mul(tmax, pa->d[i]), q - 23u);
         b[i] = ct_i128_round_shr(ct_i128_mul(bmax, pa->w[i]), q - 32u);
     }
-    if (mp->deg == 4 && ct_abs64(b[0]) <= (INT64_C(1) << 53) && ct_abs64(b[1]) <= (INT64_C(1) << 53) &&
-        ct_abs64(b[2]) <= (INT64_C(1) << 53)) {
-        alone = 1;
-        deg = 5;
-    }
-    nf = alone ? 0 : deg - 3;
-    for (j = 0; j < nf; ++j) { /* bound: 2 far nodes: tau = 3/4 (3 tmax < 2^50) and 1 */
-        if (!node_image(pa, j == nf - 1 ? tmax : (3 * tmax) >> 2, X[j])) {
-            return 0;
-        }
-    }
     /* a^alpha for the terms of degrees 1..3 (Q62): a term's monomial is
      * its parent's (tay_parent) times a along tay_axis; and each quadratic
      * one's derivative along b, e_i b_i a^(alpha - e_i) (|.| < 2^63) */
+    am[0] = T_ONE_Q62;
     am[1] = a[2];
     am[2] = a[1];
     am[3] = a[0];
@@ -890,6 +884,19 @@ static int taylor_nodes(path *pa, int64_t tmax)
     for (t = 4; t < 10; ++t) { /* bound: 6 terms: alpha = e_i + e_j, parent e_j */
         int ax = tay_axis[t], ox = 3 - (int)tay_parent[t]; /* term 3 - i is e_i's */
         db[t - 4] = ct_mul_shr(b[ax], a[ox], 62u) + ct_mul_shr(b[ox], a[ax], 62u);
+    }
+    /* a degree-4 fit: its Taylor terms alone when taylor_alone bounds what
+     * they leave out (|b| <= 2^53: its products' range) */
+    if (mp->deg == 4 && ct_abs64(b[0]) <= (INT64_C(1) << 53) && ct_abs64(b[1]) <= (INT64_C(1) << 53) &&
+        ct_abs64(b[2]) <= (INT64_C(1) << 53) && taylor_alone(pa->p, mp, a, b, am, p)) {
+        alone = 1;
+        deg = 4;
+    }
+    nf = alone ? 0 : deg - 3;
+    for (j = 0; j < nf; ++j) { /* bound: 2 far nodes: tau = 3/4 (3 tmax < 2^50) and 1 */
+        if (!node_image(pa, j == nf - 1 ? tmax : (3 * tmax) >> 2, X[j])) {
+            return 0;
+        }
     }
     for (o = 0; o < 3; ++o) { /* bound: 3 coordinates */
         ct_i128 s1 = ct_i128_from64(0), s2 = ct_i128_from64(0), s3 = ct_i128_from64(0);
@@ -915,7 +922,7 @@ static int taylor_nodes(path *pa, int64_t tmax)
         p[2][o] = ct_i128_round_shr(s2, mp->fb[o] + 30u);
         p[3][o] = ct_i128_round_shr(s3, mp->fb[o] + 30u);
         if (alone) {
-            continue; /* p4, p5: taylor_alone, below */
+            continue; /* p4: taylor_alone's */
         }
         if (deg == 4) {
             p[4][o] = X[0][o] * 64 - p[1][o] - p[2][o] - p[3][o];
@@ -930,9 +937,6 @@ static int taylor_nodes(path *pa, int64_t tmax)
             p[5][o] = 4 * (r1s - vq);
             p[4][o] = r1s - p[5][o];
         }
-    }
-    if (alone && !taylor_alone(mp, a, b, am, p)) {
-        return 0;
     }
     pa->nodes = deg + 1;
     /* in powers of sigma = 2 tau - 1: c_j = sum_k p_k binom(k, j) / 2^k
