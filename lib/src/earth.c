@@ -499,9 +499,7 @@ static int map_taylor(ct_earth_map *mp)
     if (mp->deg > 5) {
         return 0;
     }
-    /* bound: 19 terms, 34 for a degree-4 fit (its degree-4 terms then in
-     * cf[TAY4 ..], which it leaves unused: nt = 35) */
-    for (t = 1; t < (mp->deg == 4 ? 35 : 20); ++t) {
+    for (t = 1; t < 20; ++t) { /* bound: 19 terms */
         const uint8_t *e = term_abc[t];
         for (o = 0; o < 3; ++o) { /* bound: 3 coordinates */
             ct_i128 acc = ct_i128_from64(0);
@@ -521,6 +519,22 @@ static int map_taylor(ct_earth_map *mp)
         }
     }
     if (mp->deg == 4) {
+        /* its terms of degree 4 (in cf[TAY4 ..], which it leaves unused: nt
+         * = 35): only its own Chebyshev term of degree 4 has a monomial of
+         * that degree, so each is cf 2^sh times the leading power
+         * coefficients 2^(n - 1) of its factors T_n (n >= 1): |cf 2^sh| <
+         * 2^56, times at most 2^3 */
+        for (t = 20; t < 35; ++t) {   /* bound: 15 terms */
+            const uint8_t *e = term_abc[t];
+            for (o = 0; o < 3; ++o) { /* bound: 3 coordinates */
+                int64_t cc = (int64_t)cheb_pow[e[0]][e[0]] * cheb_pow[e[1]][e[1]] * cheb_pow[e[2]][e[2]];
+                int64_t v = mp->cf[t][o] * (cc * (INT64_C(1) << mp->sh[4][o]));
+                if (ct_abs64(v) >= (INT64_C(1) << 58)) {
+                    return 0;
+                }
+                mp->cf[tay_row(t)][o] = v;
+            }
+        }
         /* taylor_alone's bound: per coordinate S4 = sum |G_4's terms| in
          * cf[TAY_S][o] (< 15 2^58), ceil((S2 + 4 S3) / 2) in cf[TAY_S +
          * 1][o] (S2 < 6 2^58, S3 < 10 2^58: the sum < 2^63.4, half < 2^63) */
@@ -538,6 +552,32 @@ static int map_taylor(ct_earth_map *mp)
             }
             mp->cf[TAY_S][o] = (int64_t)s4;
             mp->cf[TAY_S + 1][o] = (int64_t)((s2 + 4u * s3 + 1u) >> 1);
+        }
+        /* taylor_alone's 64-bit sums: the quartic terms in place as cf'
+         * = round(cf / 2^sh4) with |cf'| <= 2^27, sh4 in cf[TAY_S + 2][o];
+         * the cubic ones' shift sh3 for |cf| / 2^sh3 <= 2^35 in cf[TAY_S +
+         * 3][o] (|cf| < 2^58: sh4 <= 31, sh3 <= 23) */
+        for (o = 0; o < 3; ++o) { /* bound: 3 coordinates */
+            int64_t m4 = 0, m3 = 0;
+            unsigned sh4 = 0u, sh3 = 0u;
+            for (t = 10; t < 35; ++t) { /* bound: 25 terms of degrees 3 and 4 */
+                if (t < 20) {
+                    m3 = ct_max64(m3, ct_abs64(mp->cf[tay_row(t)][o]));
+                } else {
+                    m4 = ct_max64(m4, ct_abs64(mp->cf[tay_row(t)][o]));
+                }
+            }
+            while ((m4 >> sh4) >= (INT64_C(1) << 27)) { /* bound: 31 shifts */
+                sh4++;
+            }
+            while ((m3 >> sh3) >= (INT64_C(1) << 35)) { /* bound: 23 shifts */
+                sh3++;
+            }
+            for (t = 20; t < 35; ++t) { /* bound: 15 terms */
+                mp->cf[tay_row(t)][o] = sh4 > 0u ? rshr64(mp->cf[tay_row(t)][o], sh4) : mp->cf[tay_row(t)][o];
+            }
+            mp->cf[TAY_S + 2][o] = (int64_t)sh4;
+            mp->cf[TAY_S + 3][o] = (int64_t)sh3;
         }
     }
     return 1;
@@ -778,52 +818,69 @@ static const uint8_t cub_less[10][3] = {{0, 0, 4}, {0, 4, 5}, {0, 5, 6}, {0, 6, 
  * 2^(fb + 83).  Out of line: its monomials are not on the stack while the
  * images are found. */
 CT_NOINLINE static int taylor_alone(const ct_package *pk, const ct_earth_map *mp, const int64_t a[3], const int64_t b[3],
-                        const int64_t am[20], int64_t p[6][3])
+                                    const int64_t am[20], int64_t p[6][3])
 {
-    int64_t a4[15], d1[10];
+    /* In 64 bits, as fit_eval's terms of degree >= 3: the monomials in Q30
+     * (|.| <= 2^30 + 2), E_31's factors in Q30 (|b| / 2^32 <= 2^21: |.| <=
+     * 3 2^21 + 3), the quartic coefficients scaled to <= 2^27 and the cubic
+     * ones to <= 2^35 (map_taylor): each coordinate's sums below 2^61 (15
+     * terms < 2^57.1, 10 terms < 2^57.6), then into 128 bits times 2^sh (sh
+     * <= 31: < 2^93), which is the Q(fb + 60) sum over 2^32.  Their
+     * roundings are 2^-27 of the quartic terms and 2^-30 of the cubic ones
+     * in E_31: nanometres. */
+    int64_t aq[3], bq[3], a4[15], d1[10];
     int t, i, o, bent = b[0] != 0 || b[1] != 0 || b[2] != 0;
     int64_t bx = ct_max64(ct_abs64(b[0]), ct_max64(ct_abs64(b[1]), ct_abs64(b[2]))), bx2 = ct_mul_shr(bx, bx, 62u);
-    for (t = 0; t < 15; ++t) { /* bound: 15 terms of degree 4; |.| <= 2^62 */
-        a4[t] = ct_mul_shr(am[quart_parent[t]], a[quart_axis[t]], 62u);
+    for (i = 0; i < 3; ++i) { /* bound: 3 axes */
+        aq[i] = rshr64(a[i], 32u);
+        bq[i] = rshr64(b[i], 32u);
+    }
+    for (t = 0; t < 15; ++t) { /* bound: 15 terms of degree 4 */
+        a4[t] = rshr64(rshr64(am[quart_parent[t]], 32u) * aq[quart_axis[t]], 30u);
     }
     if (bent) {
-        /* E_31's factor per cubic monomial, sum e_i b_i a^(alpha - e_i)
-         * (|.| <= 3 2^53) */
+        /* E_31's factor per cubic monomial, sum e_i b_i a^(alpha - e_i) */
         for (t = 0; t < 10; ++t) { /* bound: 10 terms of degree 3 */
             const uint8_t *e = term_abc[10 + t];
             d1[t] = 0;
             for (i = 0; i < 3; ++i) { /* bound: 3 axes */
                 if (e[i] > 0) {
-                    d1[t] += (int64_t)e[i] * ct_mul_shr(b[i], am[cub_less[t][i]], 62u);
+                    d1[t] += (int64_t)e[i] * rshr64(bq[i] * rshr64(am[cub_less[t][i]], 32u), 30u);
                 }
             }
         }
     }
     for (o = 0; o < 3; ++o) { /* bound: 3 coordinates */
-        ct_i128 s4 = ct_i128_from64(0);
+        int64_t u = 0;
+        unsigned sh4 = (unsigned)mp->cf[TAY_S + 2][o], sh3 = (unsigned)mp->cf[TAY_S + 3][o];
+        ct_i128 s4;
         for (t = 0; t < 15; ++t) { /* bound: 15 terms: G_4(a) */
-            s4 = ct_i128_add(s4, ct_i128_mul(mp->cf[TAY4 + t][o], a4[t]));
+            u += mp->cf[TAY4 + t][o] * a4[t];
         }
+        s4 = ct_i128_mul(u, INT64_C(1) << sh4);
         if (bent) {
             /* 5 |b| S4 + |b|^2 (S2 + 4 S3) (map_taylor's sums: S4 < 2^62,
-             * half the other < 2^63; |b| <= 2^53, |b|^2 <= 2^44: the bound
-             * < 2^119).  In nm: lim / 2^(fb + 36) Q24 units of the axis'
-             * unit (a posting, or a height LSB: < 2^50 nm), below 2^11 nm */
+             * half the other < 2^63; 5 |b| <= 5 2^53, 2 |b|^2 <= 2^45: the
+             * bound < 2^119).  In nm: lim / 2^(fb + 36) Q24 units of the
+             * axis' unit (a posting, or a height LSB: < 2^50 nm), below 2^11
+             * nm */
             int64_t unit = o == 0 ? pk->posting_e_nm : (o == 1 ? pk->posting_n_nm : pk->height_scale_nm);
-            ct_i128 lim = ct_i128_mul(mp->cf[TAY_S][o], bx);
-            lim = ct_i128_add(ct_i128_add(lim, ct_i128_shl(lim, 2u)),
-                              ct_i128_shl(ct_i128_mul(mp->cf[TAY_S + 1][o], bx2), 1u));
+            ct_i128 lim = ct_i128_add(ct_i128_mul(mp->cf[TAY_S][o], 5 * bx), ct_i128_mul(mp->cf[TAY_S + 1][o], 2 * bx2));
             if (ct_i128_bits(lim) + ct_bitlen64((uint64_t)ct_abs64(unit)) > mp->fb[o] + 36u + 24u + 11u) {
                 return 0;
             }
+            u = 0;
             for (t = 0; t < 10; ++t) { /* bound: 10 terms: - E_31 */
-                s4 = ct_i128_sub(s4, ct_i128_mul(mp->cf[TAY0 + 9 + t][o], d1[t]));
+                u += (sh3 > 0u ? rshr64(mp->cf[TAY0 + 9 + t][o], sh3) : mp->cf[TAY0 + 9 + t][o]) * d1[t];
             }
+            s4 = ct_i128_sub(s4, ct_i128_mul(u, INT64_C(1) << sh3));
         }
-        if (ct_i128_bits(ct_i128_abs(s4)) > mp->fb[o] + 83u) {
+        /* |s4| 2^32 below 2^(fb + 83), as taylor_nodes' sums (fb >= 2:
+         * the rounding shift is positive) */
+        if (ct_i128_bits(ct_i128_sign(s4) < 0 ? ct_i128_neg(s4) : s4) > mp->fb[o] + 51u) {
             return 0;
         }
-        p[4][o] = ct_i128_round_shr(s4, mp->fb[o] + 30u);
+        p[4][o] = ct_i128_round_shr(s4, mp->fb[o] - 2u);
     }
     return 1;
 }
