@@ -1250,7 +1250,7 @@ void test_taylor_path()
             std::printf("  camera %3.0Lf km east, k = %+.2f: range %.1f km, fit of degree %d, %d coefficients (%s): "
                         "path vs the fit's images max %.4f mm\n",
                         back_km, k / 65536.0, es.tmax_nm * 1e-12, (int)es.fit.deg, (int)nodes,
-                        alone ? "Taylor terms alone" : (taylor ? "Taylor terms" : "Lobatto nodes"), err * 1e3);
+                        alone ? "Taylor terms, alone where their bound allows" : (taylor ? "Taylor terms" : "Lobatto nodes"), err * 1e3);
             if (back_km > 100 && k == 0) {
                 // a line 40 deg down over 130 km: its image passes 2^46 Q24
                 // units (100 km horizontally at 30 m posts), beyond the
