@@ -477,8 +477,7 @@ static const int8_t cheb_pow[CT_EARTH_MAP_DEG + 1][CT_EARTH_MAP_DEG + 1] = {
     {1, 0, -8, 0, 8, 0, 0}, {0, 5, 0, -20, 0, 16, 0}, {-1, 0, 18, 0, -48, 0, 32}};
 
 /* The fit's Taylor terms of degrees 1..3 at the cube's centre (s = 0), and
- * of degree 4 for a fit of degree 4 (whose path is then its Taylor terms
- * alone): for each such term s^alpha (term_abc 1..19, 20..34), the sum over
+ * of degree 4 for a fit of degree 4 (taylor_alone): for each such term s^alpha (term_abc 1..19, 20..34), the sum over
  * the fit's terms of cf 2^sh C_a C_b C_c, C the power coefficients of its
  * Chebyshev factors (exact integers: |cf 2^sh| < 2^56, |C C C| <= 48^3 <
  * 2^17, <= 56 terms: < 2^80 in 128 bits), kept in cf[tay_row(t)]: rows
@@ -487,7 +486,7 @@ static const int8_t cheb_pow[CT_EARTH_MAP_DEG + 1][CT_EARTH_MAP_DEG + 1] = {
  * 0 for degree 6, or when one reaches 2^58 (taylor_nodes' range). */
 #define TAY0 56
 #define TAY4 35 /* a degree-4 fit's terms of degree 4 (term_abc 20..34) */
-#define TAY_S 50 /* and the sums of their and lower terms' magnitudes */
+#define TAY_S 50 /* then taylor_alone's magnitudes and shifts (4 rows) */
 static int tay_row(int t)
 {
     return t < 20 ? TAY0 + t - 1 : TAY4 + t - 20;
