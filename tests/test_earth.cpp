@@ -1203,17 +1203,17 @@ void test_path_interpolation()
 // of the Lobatto nodes' three or four, when the fit's degree is 5 or less
 // (its unused coefficients hold the terms); a fit of degree 4 (cubes of
 // 2^44 nm) from its Taylor terms alone, up to the fourth power of the
-// range, no image, where the bound of what that leaves out allows.  The same cameras as above
-// (ranges 10-135 km), a fit per call each, with and without refraction,
-// lines of sight in every direction the cameras see, against the fit's own
-// images every 1/1000 of the range (ct_earth_path_image24 with interp = 0:
-// the fit evaluated at the exact point C + t d - bend w): within 0.02 mm
-// (the Lobatto nodes, which the degree-6 fits of the farthest cameras
-// take, within 0.04 mm), and each regime taken (the Taylor terms alone and
-// with one image: 5 coefficients up to 35 km; 6 beyond; the Lobatto
-// nodes); a line whose image passes the polynomial's range has
-// none (exact vertices).  Breaking a Taylor term (a cubic monomial's axis
-// in taylor_nodes, or a quartic one's) fails it.
+// range, no image, where the bound of what that leaves out allows.  The
+// same cameras as above (ranges 10-135 km), a fit per call each, with and
+// without refraction, lines of sight in every direction the cameras see,
+// against the fit's own images every 1/1000 of the range
+// (ct_earth_path_image24 with interp = 0: the fit evaluated at the exact
+// point C + t d - bend w): within 0.02 mm (the Lobatto nodes, which the
+// degree-6 fits of the farthest cameras take, within 0.04 mm), and each
+// regime taken (the Taylor terms alone and with one image: 5 coefficients
+// up to 35 km; 6 beyond; the Lobatto nodes); a line whose image passes the
+// polynomial's range has none (exact vertices).  Breaking a Taylor term (a
+// cubic monomial's axis in taylor_nodes, or a quartic one's) fails it.
 void test_taylor_path()
 {
     World *w = jacksboro();
@@ -1250,7 +1250,9 @@ void test_taylor_path()
             std::printf("  camera %3.0Lf km east, k = %+.2f: range %.1f km, fit of degree %d, %d coefficients (%s): "
                         "path vs the fit's images max %.4f mm\n",
                         back_km, k / 65536.0, es.tmax_nm * 1e-12, (int)es.fit.deg, (int)nodes,
-                        alone ? "Taylor terms, alone where their bound allows" : (taylor ? "Taylor terms" : "Lobatto nodes"), err * 1e3);
+                        alone ? "Taylor terms, alone where their bound allows"
+                              : (taylor ? "Taylor terms" : "Lobatto nodes"),
+                        err * 1e3);
             if (back_km > 100 && k == 0) {
                 // a line 40 deg down over 130 km: its image passes 2^46 Q24
                 // units (100 km horizontally at 30 m posts), beyond the
