@@ -1869,22 +1869,25 @@ void test_tiny_posting()
     // (and with the map fitted per call from 20 km: a cube of 35 km, whose
     // fit has the Taylor terms, but the lines' images pass the path
     // polynomial's range, 2^46 Q24 units, at 1 mm posts -- neither the
-    // Taylor terms nor the Lobatto nodes, every vertex by the fit)
-    for (int fit = 0; fit < 2; ++fit)
+    // Taylor terms nor the Lobatto nodes, every vertex by the fit; and from
+    // 10 km: a cube of 17.6 km, whose degree-4 fit's quartic and cubic
+    // terms are, at 1 mm posts, within a factor 2 of taylor_alone's 64-bit
+    // range)
+    for (int fit = 0; fit < 3; ++fit)
         for (int side = 0; side < 2; ++side) {
             const int mode = side;  // west: curvature; south: with refraction
             const ct_effects fx = {CT_EFFECT_CURVATURE | (mode ? CT_EFFECT_REFRACTION : 0u) |
                                        (fit ? CT_EFFECT_EARTH_FIT : 0u),
                                    CT_REFRACTION_K_STD_Q16, 0, 0, nullptr};
-            const ld d = fit ? 20000 : 60000;
+            const ld d = fit == 2 ? 10000 : (fit ? 20000 : 60000);
             const Pose p = aim_at(pj, z, fx, Ec, Nc, 400, side ? 0 : d, side ? d : 0, d + 400, side ? 0 : 90, -45);
             for (int iv = -1; iv <= 1; ++iv)
                 for (int iu = -1; iu <= 1; ++iu) judge_domain(w, pj, -81, cam, p, fx, u0 + iu * 40, v0 + iv * 40, T, 0);
         }
-    std::printf("  1 mm posts, cameras 60 km away (exact map) and 20 km (fitted): %ld pixels, %ld hits as the "
+    std::printf("  1 mm posts, cameras 60 km away (exact map), 20 km and 10 km (fitted): %ld pixels, %ld hits as the "
                 "reference's (within %.5f m), %ld misses as its; %ld wrong\n",
                 T.n, T.hits, T.worst, T.misses, T.bad);
-    TEST_ASSERT(T.bad == 0 && T.domain_miss == 0 && T.hits >= 24 && T.n == 36);
+    TEST_ASSERT(T.bad == 0 && T.domain_miss == 0 && T.hits >= 36 && T.n == 54);
     static World *wavy = nullptr;
     if (!wavy)
         wavy = synthetic(32617, 201045, 4065840, 0.001, 201, 201,

@@ -486,7 +486,7 @@ static const int8_t cheb_pow[CT_EARTH_MAP_DEG + 1][CT_EARTH_MAP_DEG + 1] = {
  * 0 for degree 6, or when one reaches 2^58 (taylor_nodes' range). */
 #define TAY0 56
 #define TAY4 35 /* a degree-4 fit's terms of degree 4 (term_abc 20..34) */
-#define TAY_S 50 /* then taylor_alone's magnitudes and shifts (4 rows) */
+#define TAY_S 50 /* then taylor_alone's magnitudes and range (3 rows) */
 static int tay_row(int t)
 {
     return t < 20 ? TAY0 + t - 1 : TAY4 + t - 20;
@@ -552,31 +552,17 @@ static int map_taylor(ct_earth_map *mp)
             mp->cf[TAY_S][o] = (int64_t)s4;
             mp->cf[TAY_S + 1][o] = (int64_t)((s2 + 4u * s3 + 1u) >> 1);
         }
-        /* taylor_alone's 64-bit sums: the quartic terms in place as cf'
-         * = round(cf / 2^sh4) with |cf'| <= 2^27, sh4 in cf[TAY_S + 2][o];
-         * the cubic ones' shift sh3 for |cf| / 2^sh3 <= 2^35 in cf[TAY_S +
-         * 3][o] (|cf| < 2^58: sh4 <= 31, sh3 <= 23) */
+        /* taylor_alone's 64-bit sums take quartic terms below 2^27 and
+         * cubic ones below 2^35: 1 in cf[TAY_S + 2][o] when a coordinate's
+         * exceed that (the image then), 0 otherwise.  The quartic terms are
+         * about (rho / R)^3 of the image's extent, which fit_map keeps below
+         * 2^55 in these units, so it takes postings below about 0.5 mm */
         for (o = 0; o < 3; ++o) { /* bound: 3 coordinates */
-            int64_t m4 = 0, m3 = 0;
-            unsigned sh4 = 0u, sh3 = 0u;
+            int big = 0;
             for (t = 10; t < 35; ++t) { /* bound: 25 terms of degrees 3 and 4 */
-                if (t < 20) {
-                    m3 = ct_max64(m3, ct_abs64(mp->cf[tay_row(t)][o]));
-                } else {
-                    m4 = ct_max64(m4, ct_abs64(mp->cf[tay_row(t)][o]));
-                }
+                big |= ct_abs64(mp->cf[tay_row(t)][o]) >= (INT64_C(1) << (t < 20 ? 35 : 27));
             }
-            while ((m4 >> sh4) >= (INT64_C(1) << 27)) { /* bound: 31 shifts */
-                sh4++;
-            }
-            while ((m3 >> sh3) >= (INT64_C(1) << 35)) { /* bound: 23 shifts */
-                sh3++;
-            }
-            for (t = 20; t < 35; ++t) { /* bound: 15 terms */
-                mp->cf[tay_row(t)][o] = sh4 > 0u ? rshr64(mp->cf[tay_row(t)][o], sh4) : mp->cf[tay_row(t)][o];
-            }
-            mp->cf[TAY_S + 2][o] = (int64_t)sh4;
-            mp->cf[TAY_S + 3][o] = (int64_t)sh3;
+            mp->cf[TAY_S + 2][o] = big;
         }
     }
     return 1;
@@ -813,20 +799,18 @@ static const uint8_t cub_less[10][3] = {{0, 0, 4}, {0, 4, 5}, {0, 5, 6}, {0, 6, 
  * |b|^2 + |b|^3) S4 + |b|^2 (3 + |b|) S3 <= |b|^2 (S2 + 4 S3) + 5 |b| S4
  * (|b| <= 2^-9), S_k the sum of |G_k|'s coefficients; 0 (the images then)
  * when that could reach 2 um (2^11 nm) for a coordinate -- the path with an
- * image is within 5.4 um of the fit's images (taylor_nodes) -- or a sum
- * 2^(fb + 83).  Out of line: its monomials are not on the stack while the
- * images are found. */
+ * image is within 5.4 um of the fit's images (taylor_nodes) -- or when the
+ * terms exceed its 64-bit sums' range (map_taylor).  Out of line: its
+ * monomials are not on the stack while the images are found. */
 CT_NOINLINE static int taylor_alone(const ct_package *pk, const ct_earth_map *mp, const int64_t a[3], const int64_t b[3],
                                     const int64_t am[20], int64_t p[6][3])
 {
     /* In 64 bits, as fit_eval's terms of degree >= 3: the monomials in Q30
      * (|.| <= 2^30 + 2), E_31's factors in Q30 (|b| / 2^32 <= 2^21: |.| <=
-     * 3 2^21 + 3), the quartic coefficients scaled to <= 2^27 and the cubic
-     * ones to <= 2^35 (map_taylor): each coordinate's sums below 2^61 (15
-     * terms < 2^57.1, 10 terms < 2^57.6), then into 128 bits times 2^sh (sh
-     * <= 31: < 2^93), which is the Q(fb + 60) sum over 2^32.  Their
-     * roundings are 2^-27 of the quartic terms and 2^-30 of the cubic ones
-     * in E_31: nanometres. */
+     * 3 2^21 + 3), the quartic coefficients below 2^27 and the cubic ones
+     * below 2^35 (map_taylor): each coordinate's sums below 2^61 (15 terms <
+     * 2^57.1, 10 terms < 2^57.6), which is the Q(fb + 60) sum over 2^32.
+     * The monomials' rounding is 2^-30 of the terms: nanometres. */
     int64_t aq[3], bq[3], a4[15], d1[10];
     int t, i, o, bent = b[0] != 0 || b[1] != 0 || b[2] != 0;
     int64_t bx = ct_max64(ct_abs64(b[0]), ct_max64(ct_abs64(b[1]), ct_abs64(b[2]))), bx2 = ct_mul_shr(bx, bx, 62u);
@@ -851,12 +835,14 @@ CT_NOINLINE static int taylor_alone(const ct_package *pk, const ct_earth_map *mp
     }
     for (o = 0; o < 3; ++o) { /* bound: 3 coordinates */
         int64_t u = 0;
-        unsigned sh4 = (unsigned)mp->cf[TAY_S + 2][o], sh3 = (unsigned)mp->cf[TAY_S + 3][o];
         ct_i128 s4;
+        if (mp->cf[TAY_S + 2][o] != 0) {
+            return 0;
+        }
         for (t = 0; t < 15; ++t) { /* bound: 15 terms: G_4(a) */
             u += mp->cf[TAY4 + t][o] * a4[t];
         }
-        s4 = ct_i128_mul(u, INT64_C(1) << sh4);
+        s4 = ct_i128_from64(u);
         if (bent) {
             /* 5 |b| S4 + |b|^2 (S2 + 4 S3) (map_taylor's sums: S4 < 2^62,
              * half the other < 2^63; 5 |b| <= 5 2^53, 2 |b|^2 <= 2^45: the
@@ -870,15 +856,11 @@ CT_NOINLINE static int taylor_alone(const ct_package *pk, const ct_earth_map *mp
             }
             u = 0;
             for (t = 0; t < 10; ++t) { /* bound: 10 terms: - E_31 */
-                u += (sh3 > 0u ? rshr64(mp->cf[TAY0 + 9 + t][o], sh3) : mp->cf[TAY0 + 9 + t][o]) * d1[t];
+                u += mp->cf[TAY0 + 9 + t][o] * d1[t];
             }
-            s4 = ct_i128_sub(s4, ct_i128_mul(u, INT64_C(1) << sh3));
+            s4 = ct_i128_sub(s4, ct_i128_from64(u));
         }
-        /* |s4| 2^32 below 2^(fb + 83), as taylor_nodes' sums (fb >= 2:
-         * the rounding shift is positive) */
-        if (ct_i128_bits(ct_i128_sign(s4) < 0 ? ct_i128_neg(s4) : s4) > mp->fb[o] + 51u) {
-            return 0;
-        }
+        /* |s4| < 2^62: Q30 by a shift of fb - 2 >= 24 (fb >= 26, fit_map) */
         p[4][o] = ct_i128_round_shr(s4, mp->fb[o] - 2u);
     }
     return 1;
