@@ -791,8 +791,8 @@ static const uint8_t cub_less[10][3] = {{0, 0, 4}, {0, 4, 5}, {0, 5, 6}, {0, 6, 
                                         {5, 7, 8}, {6, 8, 0}, {7, 0, 9}, {8, 9, 0}, {9, 0, 0}};
 
 /* The quartic Taylor term of a degree-4 fit along x(tau) = tau a - tau^2 b
- * (taylor_nodes, which gives a, b with |b| <= 2^53 per axis and am, the
- * monomials a^alpha of degrees 1..3, Q62): p4 = G_4(a) - E_31 into p[4]
+ * (taylor_nodes, which gives a, b and am, the monomials a^alpha of degrees
+ * 1..3, Q62; |b| <= 2^53 per axis, else 0): p4 = G_4(a) - E_31 into p[4]
  * (Q30; the sums Q(fb + 60)).  What it leaves out, E_22 = G_2(b) in tau^4
  * and the terms of degree 5 and more in tau (E_4l, l >= 1, and E_3l, l >=
  * 2), is with every |a^alpha| <= 1 at most |b|^2 S2 + |b| (4 + 6 |b| + 4
@@ -812,8 +812,12 @@ CT_NOINLINE static int taylor_alone(const ct_package *pk, const ct_earth_map *mp
      * 2^57.1, 10 terms < 2^57.6), which is the Q(fb + 60) sum over 2^32.
      * The monomials' rounding is 2^-30 of the terms: nanometres. */
     int64_t aq[3], bq[3], a4[15], d1[10];
-    int t, i, o, bent = b[0] != 0 || b[1] != 0 || b[2] != 0;
-    int64_t bx = ct_max64(ct_abs64(b[0]), ct_max64(ct_abs64(b[1]), ct_abs64(b[2]))), bx2 = ct_mul_shr(bx, bx, 62u);
+    int64_t bx = ct_max64(ct_abs64(b[0]), ct_max64(ct_abs64(b[1]), ct_abs64(b[2]))), bx2;
+    int t, i, o, bent = bx != 0;
+    if (bx > (INT64_C(1) << 53)) {
+        return 0; /* |b| <= 2^-9: its products' range, and the bound's */
+    }
+    bx2 = ct_mul_shr(bx, bx, 62u);
     for (i = 0; i < 3; ++i) { /* bound: 3 axes */
         aq[i] = rshr64(a[i], 32u);
         bq[i] = rshr64(b[i], 32u);
@@ -924,9 +928,8 @@ static int taylor_nodes(path *pa, int64_t tmax)
         db[t - 4] = ct_mul_shr(b[ax], a[ox], 62u) + ct_mul_shr(b[ox], a[ax], 62u);
     }
     /* a degree-4 fit: its Taylor terms alone when taylor_alone bounds what
-     * they leave out (|b| <= 2^53: its products' range) */
-    if (mp->deg == 4 && ct_abs64(b[0]) <= (INT64_C(1) << 53) && ct_abs64(b[1]) <= (INT64_C(1) << 53) &&
-        ct_abs64(b[2]) <= (INT64_C(1) << 53) && taylor_alone(pa->p, mp, a, b, am, p)) {
+     * they leave out */
+    if (mp->deg == 4 && taylor_alone(pa->p, mp, a, b, am, p)) {
         alone = 1;
         deg = 4;
     }
