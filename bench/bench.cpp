@@ -82,7 +82,7 @@ Result run(const ct_package &p, const std::vector<ct_ray> &rays, ct_method m, st
 }
 
 #ifdef CT_HAVE_EMBREE
-// Embree's rays (its unit directions) and one timed pass over them (ns per ray)
+// Embree's rays: the origins and unit directions of ours
 std::vector<std::array<double, 6>> embree_rays(const std::vector<ct_ray> &rays)
 {
     std::vector<std::array<double, 6>> rr;

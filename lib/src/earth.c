@@ -486,7 +486,7 @@ static const int8_t cheb_pow[CT_EARTH_MAP_DEG + 1][CT_EARTH_MAP_DEG + 1] = {
  * 0 for degree 6, or when one reaches 2^58 (taylor_nodes' range). */
 #define TAY0 56
 #define TAY4 35 /* a degree-4 fit's terms of degree 4 (term_abc 20..34) */
-#define TAY_S 50 /* then taylor_alone's magnitudes and range (3 rows) */
+#define TAY_S 50 /* then taylor_alone's magnitudes and range flag (3 rows) */
 static int tay_row(int t)
 {
     return t < 20 ? TAY0 + t - 1 : TAY4 + t - 20;
@@ -523,10 +523,11 @@ static int map_taylor(ct_earth_map *mp)
          * that degree, so each is cf 2^sh times the leading power
          * coefficients 2^(n - 1) of its factors T_n (n >= 1): |cf 2^sh| <
          * 2^56, times at most 2^3 */
-        for (t = 20; t < 35; ++t) {   /* bound: 15 terms */
+        int big = 0;
+        for (t = 20; t < 35; ++t) { /* bound: 15 terms */
             const uint8_t *e = term_abc[t];
+            int64_t cc = (int64_t)cheb_pow[e[0]][e[0]] * cheb_pow[e[1]][e[1]] * cheb_pow[e[2]][e[2]];
             for (o = 0; o < 3; ++o) { /* bound: 3 coordinates */
-                int64_t cc = (int64_t)cheb_pow[e[0]][e[0]] * cheb_pow[e[1]][e[1]] * cheb_pow[e[2]][e[2]];
                 int64_t v = mp->cf[t][o] * (cc * (INT64_C(1) << mp->sh[4][o]));
                 if (ct_abs64(v) >= (INT64_C(1) << 58)) {
                     return 0;
@@ -536,7 +537,12 @@ static int map_taylor(ct_earth_map *mp)
         }
         /* taylor_alone's bound: per coordinate S4 = sum |G_4's terms| in
          * cf[TAY_S][o] (< 15 2^58), ceil((S2 + 4 S3) / 2) in cf[TAY_S +
-         * 1][o] (S2 < 6 2^58, S3 < 10 2^58: the sum < 2^63.4, half < 2^63) */
+         * 1][o] (S2 < 6 2^58, S3 < 10 2^58: the sum < 2^63.4, half < 2^63).
+         * Its 64-bit sums take quartic terms below 2^27 and cubic ones below
+         * 2^35: cf[TAY_S + 2][0] is 1 when a term exceeds that (the image
+         * then), else 0.  The quartic terms are about (rho / R)^3 of the
+         * image's extent, which fit_map keeps below 2^55 in these units, so
+         * that takes postings below about 0.5 mm */
         for (o = 0; o < 3; ++o) { /* bound: 3 coordinates */
             uint64_t s2 = 0u, s3 = 0u, s4 = 0u;
             for (t = 4; t < 35; ++t) { /* bound: 31 terms of degrees 2..4 */
@@ -545,25 +551,16 @@ static int map_taylor(ct_earth_map *mp)
                     s2 += v;
                 } else if (t < 20) {
                     s3 += v;
+                    big |= v >= (UINT64_C(1) << 35);
                 } else {
                     s4 += v;
+                    big |= v >= (UINT64_C(1) << 27);
                 }
             }
             mp->cf[TAY_S][o] = (int64_t)s4;
             mp->cf[TAY_S + 1][o] = (int64_t)((s2 + 4u * s3 + 1u) >> 1);
         }
-        /* taylor_alone's 64-bit sums take quartic terms below 2^27 and
-         * cubic ones below 2^35: 1 in cf[TAY_S + 2][o] when a coordinate's
-         * exceed that (the image then), 0 otherwise.  The quartic terms are
-         * about (rho / R)^3 of the image's extent, which fit_map keeps below
-         * 2^55 in these units, so it takes postings below about 0.5 mm */
-        for (o = 0; o < 3; ++o) { /* bound: 3 coordinates */
-            int big = 0;
-            for (t = 10; t < 35; ++t) { /* bound: 25 terms of degrees 3 and 4 */
-                big |= ct_abs64(mp->cf[tay_row(t)][o]) >= (INT64_C(1) << (t < 20 ? 35 : 27));
-            }
-            mp->cf[TAY_S + 2][o] = big;
-        }
+        mp->cf[TAY_S + 2][0] = big;
     }
     return 1;
 }
@@ -813,11 +810,26 @@ CT_NOINLINE static int taylor_alone(const ct_package *pk, const ct_earth_map *mp
      * The monomials' rounding is 2^-30 of the terms: nanometres. */
     int64_t aq[3], bq[3], a4[15], d1[10];
     int64_t bx = ct_max64(ct_abs64(b[0]), ct_max64(ct_abs64(b[1]), ct_abs64(b[2]))), bx2;
-    int t, i, o, bent = bx != 0;
+    int t, i, o, bent = bx != 0; /* a straight line (b = 0) leaves nothing out */
+    if (mp->cf[TAY_S + 2][0] != 0) {
+        return 0; /* terms beyond the 64-bit sums' range */
+    }
     if (bx > (INT64_C(1) << 53)) {
         return 0; /* |b| <= 2^-9: its products' range, and the bound's */
     }
     bx2 = ct_mul_shr(bx, bx, 62u);
+    /* what is left out, per coordinate: 5 |b| S4 + |b|^2 (S2 + 4 S3)
+     * (map_taylor's sums: S4 < 2^62, half the other < 2^63; 5 |b| <= 5
+     * 2^53, 2 |b|^2 <= 2^45: the bound < 2^119).  In nm: lim / 2^(fb + 36)
+     * Q24 units of the axis' unit (a posting, or a height LSB: < 2^50 nm),
+     * below 2^11 nm */
+    for (o = 0; bent && o < 3; ++o) { /* bound: 3 coordinates */
+        int64_t unit = o == 0 ? pk->posting_e_nm : (o == 1 ? pk->posting_n_nm : pk->height_scale_nm);
+        ct_i128 lim = ct_i128_add(ct_i128_mul(mp->cf[TAY_S][o], 5 * bx), ct_i128_mul(mp->cf[TAY_S + 1][o], 2 * bx2));
+        if (ct_i128_bits(lim) + ct_bitlen64((uint64_t)ct_abs64(unit)) > mp->fb[o] + 36u + 24u + 11u) {
+            return 0;
+        }
+    }
     for (i = 0; i < 3; ++i) { /* bound: 3 axes */
         aq[i] = rshr64(a[i], 32u);
         bq[i] = rshr64(b[i], 32u);
@@ -825,47 +837,26 @@ CT_NOINLINE static int taylor_alone(const ct_package *pk, const ct_earth_map *mp
     for (t = 0; t < 15; ++t) { /* bound: 15 terms of degree 4 */
         a4[t] = rshr64(rshr64(am[quart_parent[t]], 32u) * aq[quart_axis[t]], 30u);
     }
-    if (bent) {
-        /* E_31's factor per cubic monomial, sum e_i b_i a^(alpha - e_i) */
-        for (t = 0; t < 10; ++t) { /* bound: 10 terms of degree 3 */
-            const uint8_t *e = term_abc[10 + t];
-            d1[t] = 0;
-            for (i = 0; i < 3; ++i) { /* bound: 3 axes */
-                if (e[i] > 0) {
-                    d1[t] += (int64_t)e[i] * rshr64(bq[i] * rshr64(am[cub_less[t][i]], 32u), 30u);
-                }
+    /* E_31's factor per cubic monomial, sum e_i b_i a^(alpha - e_i) */
+    for (t = 0; bent && t < 10; ++t) { /* bound: 10 terms of degree 3 */
+        const uint8_t *e = term_abc[10 + t];
+        d1[t] = 0;
+        for (i = 0; i < 3; ++i) { /* bound: 3 axes */
+            if (e[i] > 0) {
+                d1[t] += (int64_t)e[i] * rshr64(bq[i] * rshr64(am[cub_less[t][i]], 32u), 30u);
             }
         }
     }
     for (o = 0; o < 3; ++o) { /* bound: 3 coordinates */
         int64_t u = 0;
-        ct_i128 s4;
-        if (mp->cf[TAY_S + 2][o] != 0) {
-            return 0;
-        }
         for (t = 0; t < 15; ++t) { /* bound: 15 terms: G_4(a) */
-            u += mp->cf[TAY4 + t][o] * a4[t];
+            u += mp->cf[tay_row(20 + t)][o] * a4[t];
         }
-        s4 = ct_i128_from64(u);
-        if (bent) {
-            /* 5 |b| S4 + |b|^2 (S2 + 4 S3) (map_taylor's sums: S4 < 2^62,
-             * half the other < 2^63; 5 |b| <= 5 2^53, 2 |b|^2 <= 2^45: the
-             * bound < 2^119).  In nm: lim / 2^(fb + 36) Q24 units of the
-             * axis' unit (a posting, or a height LSB: < 2^50 nm), below 2^11
-             * nm */
-            int64_t unit = o == 0 ? pk->posting_e_nm : (o == 1 ? pk->posting_n_nm : pk->height_scale_nm);
-            ct_i128 lim = ct_i128_add(ct_i128_mul(mp->cf[TAY_S][o], 5 * bx), ct_i128_mul(mp->cf[TAY_S + 1][o], 2 * bx2));
-            if (ct_i128_bits(lim) + ct_bitlen64((uint64_t)ct_abs64(unit)) > mp->fb[o] + 36u + 24u + 11u) {
-                return 0;
-            }
-            u = 0;
-            for (t = 0; t < 10; ++t) { /* bound: 10 terms: - E_31 */
-                u += mp->cf[TAY0 + 9 + t][o] * d1[t];
-            }
-            s4 = ct_i128_sub(s4, ct_i128_from64(u));
+        for (t = 0; bent && t < 10; ++t) { /* bound: 10 terms: - E_31 */
+            u -= mp->cf[tay_row(10 + t)][o] * d1[t];
         }
-        /* |s4| < 2^62: Q30 by a shift of fb - 2 >= 24 (fb >= 26, fit_map) */
-        p[4][o] = ct_i128_round_shr(s4, mp->fb[o] - 2u);
+        /* |u| < 2^62: Q30 by a shift of fb - 2 >= 24 (fb >= 26, fit_map) */
+        p[4][o] = ct_i128_round_shr(ct_i128_from64(u), mp->fb[o] - 2u);
     }
     return 1;
 }
@@ -930,8 +921,7 @@ static int taylor_nodes(path *pa, int64_t tmax)
     /* a degree-4 fit: its Taylor terms alone when taylor_alone bounds what
      * they leave out */
     if (mp->deg == 4 && taylor_alone(pa->p, mp, a, b, am, p)) {
-        alone = 1;
-        deg = 4;
+        alone = 1; /* deg is 4: tmax < 2^44 nm, below NODES_4_NM */
     }
     nf = alone ? 0 : deg - 3;
     for (j = 0; j < nf; ++j) { /* bound: 2 far nodes: tau = 3/4 (3 tmax < 2^50) and 1 */
