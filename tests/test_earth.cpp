@@ -1224,10 +1224,14 @@ void test_taylor_path()
     for (ld back_km : {0.0L, 24.0L, 40.0L, 111.0L, 116.0L}) {
         Pose p;
         TEST_ASSERT(make_pose(w->sf, {"far", 201045 + back_km * 1000, 4065840, 3000, 270, -10}, &p));
-        for (int32_t k : {0, CT_REFRACTION_K_STD_Q16, -2 * CT_REFRACTION_K_STD_Q16, 16 * CT_REFRACTION_K_STD_Q16}) {
-            // k = 2.08 on the nearest camera only: the Taylor terms alone
-            // bound what they leave out too loosely there and take the image
-            if (k == 16 * CT_REFRACTION_K_STD_Q16 && back_km > 0) continue;
+        for (int32_t k : {0, CT_REFRACTION_K_STD_Q16, -2 * CT_REFRACTION_K_STD_Q16, 16 * CT_REFRACTION_K_STD_Q16,
+                          64 * CT_REFRACTION_K_STD_Q16}) {
+            // k = 2.08 and 8.32 on the nearest camera only: the Taylor terms
+            // alone take the image there, at 2.08 as their bound of what
+            // they leave out could reach 2 um, at 8.32 as refraction bends
+            // the line more than 2^-9 of the cube's half-width
+            const bool strong = k >= 16 * CT_REFRACTION_K_STD_Q16;
+            if (strong && back_km > 0) continue;
             ct_earth es;
             TEST_ASSERT_EQUAL_INT(CT_OK, ct_earth_setup(&pk, &p.pose, k, CT_EARTH_RADIUS_NM, CT_EFFECTS_CHORD_NM, 0u,
                                                         1, nullptr, &es));
@@ -1236,22 +1240,22 @@ void test_taylor_path()
             double err = 0;
             path_vs_images(pk, es, 0, 315, 45, &nodes, &err);
             // the Taylor terms (a fit of degree <= 5, to 130 km): 5 or 6
-            // coefficients; else the Lobatto nodes: 4, 5 or 6
+            // coefficients, alone (+8: a fit of degree 4) where their bound
+            // allows; else the Lobatto nodes: 4, 5 or 6
             const int64_t km = 1000000000000;
             const bool near = es.tmax_nm <= 35 * km, mid = es.tmax_nm <= 130 * km;
-            const bool taylor = es.tay_ok != 0 && mid, alone = taylor && es.fit.deg == 4;
-            const int want = taylor ? (near ? 5 : 6) : (near ? 4 : (mid ? 5 : 6));
+            const bool taylor = es.tay_ok != 0 && mid, alone = taylor && es.fit.deg == 4 && !strong;
+            const int want = (taylor ? (near ? 5 : 6) : (near ? 4 : (mid ? 5 : 6))) + (alone ? 8 : 0);
             TEST_ASSERT_MSG(es.tay_ok == (es.fit.deg <= 5), "range %.1f km: Taylor terms %d, the fit's degree %d",
                             es.tmax_nm * 1e-12, (int)es.tay_ok, (int)es.fit.deg);
-            TEST_ASSERT_MSG(nodes == want, "range %.1f km: %d coefficients, not %d", es.tmax_nm * 1e-12, (int)nodes,
-                            want);
+            TEST_ASSERT_MSG(nodes == want, "range %.1f km, k = %.2f: %d coefficients (+8: alone), not %d",
+                            es.tmax_nm * 1e-12, k / 65536.0, (int)nodes, want);
             const int regime = alone ? 4 : (taylor ? want : 7);
             counts |= 1u << regime;
             std::printf("  camera %3.0Lf km east, k = %+.2f: range %.1f km, fit of degree %d, %d coefficients (%s): "
                         "path vs the fit's images max %.4f mm\n",
-                        back_km, k / 65536.0, es.tmax_nm * 1e-12, (int)es.fit.deg, (int)nodes,
-                        alone ? "Taylor terms, alone where their bound allows"
-                              : (taylor ? "Taylor terms" : "Lobatto nodes"),
+                        back_km, k / 65536.0, es.tmax_nm * 1e-12, (int)es.fit.deg, (int)nodes % 8,
+                        alone ? "Taylor terms alone" : (taylor ? "Taylor terms and images" : "Lobatto nodes"),
                         err * 1e3);
             if (back_km > 100 && k == 0) {
                 // a line 40 deg down over 130 km: its image passes 2^46 Q24

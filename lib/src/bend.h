@@ -257,7 +257,8 @@ int ct_segment_above_terrain(const ct_package *p, int64_t ax, int64_t ay, int64_
  * between its nodes (interp != 0; CT_ERR_RANGE when they could not be
  * set) or found as a node is (the map, or the exact conversions); *nodes
  * the number of the path polynomial's coefficients (0: none): the Lobatto
- * nodes' count, or with a fit per call 5 or 6 (earth.c taylor_nodes).
+ * nodes' count, or with a fit per call 5 or 6 (earth.c taylor_nodes), plus
+ * 8 when they are the fit's Taylor terms alone (no image).
  * For tests of the interpolation.                                        */
 ct_status ct_earth_path_image24(const ct_package *pkg, const ct_earth *es, const int64_t dg[3], int64_t t, int interp,
                                 int64_t g[3], int32_t *nodes);

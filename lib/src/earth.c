@@ -134,6 +134,7 @@ typedef struct {
     int64_t w[3];  /* refraction's bending direction, Q30 (0: none) */
     int refract;
     int interp;    /* 1: the nodes below are set */
+    int alone;     /* 1: the fit's Taylor terms alone, no image (taylor_nodes) */
     int nodes;     /* coefficients: 4, 5 or 6 (Lobatto: the nodes) */
     int64_t tmax;
     int64_t tinv;  /* floor(2^(60 + tsh) / tmax), in (2^60, 2^61]    */
@@ -970,6 +971,7 @@ static int taylor_nodes(path *pa, int64_t tmax)
         }
     }
     pa->nodes = deg + 1;
+    pa->alone = alone;
     /* in powers of sigma = 2 tau - 1: c_j = sum_k p_k binom(k, j) / 2^k
      * (Q30 -> Q24: / 2^(deg + 6)) */
     for (j = 0; j <= deg; ++j) { /* bound: NODES */
@@ -995,6 +997,7 @@ CT_NOINLINE static void set_nodes(path *pa, int64_t tmax)
     int j, k;
     int64_t X[NODES][3];
     pa->interp = 0;
+    pa->alone = 0;
     pa->tmax = tmax;
     /* tmax >= 1 km (set-up): tsh in [40, 49], 60 + tsh < 128 */
     pa->tsh = ct_bitlen64((uint64_t)tmax);
@@ -1963,7 +1966,7 @@ ct_status ct_earth_path_image24(const ct_package *p, const ct_earth *es, const i
         return CT_ERR_ARG;
     }
     path_init(&pa, p, es, dg);
-    *nodes = pa.nodes * pa.interp;
+    *nodes = pa.nodes * pa.interp + 8 * pa.alone;
     if (interp && !pa.interp) {
         return CT_ERR_RANGE;
     }
