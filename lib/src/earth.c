@@ -344,12 +344,17 @@ CT_NOINLINE static void fit_eval(const ct_earth_map *mp, const int64_t D[3], int
     }
     for (k = 3; k <= deg; ++k) { /* bound: CT_EARTH_MAP_DEG - 2 */
         int64_t s0 = 0, s1 = 0, s2 = 0;
-        for (t = deg_start[k]; t < deg_start[k + 1]; ++t) { /* bound: 28 terms of degree k */
-            const uint8_t *e = term_abc[t];
-            int64_t ttt = rshr64(V[e[0]][e[1]] * U[2][e[2]], 30u);
-            s0 += mp->cf[t][0] * ttt;
-            s1 += mp->cf[t][1] * ttt;
-            s2 += mp->cf[t][2] * ttt;
+        const int64_t(*cf)[3] = &mp->cf[deg_start[k]];
+        int ea, eb;
+        /* term_abc's order within a degree: a, then b (c = k - a - b) */
+        for (ea = 0; ea <= k; ++ea) {          /* bound: CT_EARTH_MAP_DEG + 1 */
+            for (eb = 0; ea + eb <= k; ++eb) { /* bound: CT_EARTH_MAP_DEG + 1 */
+                int64_t ttt = rshr64(V[ea][eb] * U[2][k - ea - eb], 30u);
+                s0 += cf[0][0] * ttt;
+                s1 += cf[0][1] * ttt;
+                s2 += cf[0][2] * ttt;
+                cf++;
+            }
         }
         acc[0] = ct_i128_add(acc[0], ct_i128_shl(ct_i128_from64(s0), 32u + mp->sh[k][0]));
         acc[1] = ct_i128_add(acc[1], ct_i128_shl(ct_i128_from64(s1), 32u + mp->sh[k][1]));
