@@ -1218,20 +1218,22 @@ void test_taylor_path()
 {
     World *w = jacksboro();
     const ct_package &pk = w->p;
-    const double kInterpM = 2e-5, kLobattoM = 4e-5, kAloneM = 4.5e-6;
-    double worst = 0, worst_lobatto = 0, worst_alone = 0;
+    const double kInterpM = 2e-5, kLobattoM = 4e-5, kAloneM = 4.5e-6, kFarM = 6.3e-6;
+    double worst = 0, worst_lobatto = 0, worst_alone = 0, worst_far = 0;
     uint32_t counts = 0;
     for (ld back_km : {0.0L, 24.0L, 40.0L, 111.0L, 116.0L}) {
         Pose p;
         TEST_ASSERT(make_pose(w->sf, {"far", 201045 + back_km * 1000, 4065840, 3000, 270, -10}, &p));
         for (int32_t k : {0, CT_REFRACTION_K_STD_Q16, -2 * CT_REFRACTION_K_STD_Q16, 16 * CT_REFRACTION_K_STD_Q16,
                           64 * CT_REFRACTION_K_STD_Q16}) {
-            // k = 2.08 and 8.32 on the nearest camera only: the Taylor terms
+            // k = 2.08 and 8.32 on the nearest camera: the Taylor terms
             // alone take the image there, at 2.08 as their bound of what
             // they leave out could reach 2 um, at 8.32 as refraction bends
-            // the line more than 2^-9 of the cube's half-width
+            // the line more than 2^-9 of the cube's half-width; at 8.32 on
+            // the camera 40 km east too, where the quartic term is then
+            // not formed (two images)
             const bool strong = k >= 16 * CT_REFRACTION_K_STD_Q16;
-            if (strong && back_km > 0) continue;
+            if (strong && back_km > 0 && !(back_km == 40 && k == 64 * CT_REFRACTION_K_STD_Q16)) continue;
             ct_earth es;
             TEST_ASSERT_EQUAL_INT(CT_OK, ct_earth_setup(&pk, &p.pose, k, CT_EARTH_RADIUS_NM, CT_EFFECTS_CHORD_NM, 0u,
                                                         1, nullptr, &es));
@@ -1271,6 +1273,8 @@ void test_taylor_path()
             }
             if (alone)
                 worst_alone = std::max(worst_alone, err);
+            else if (taylor && !near && !strong)
+                worst_far = std::max(worst_far, err);
             else if (taylor)
                 worst = std::max(worst, err);
             else
@@ -1280,6 +1284,13 @@ void test_taylor_path()
     TEST_ASSERT_MSG(counts == (1u << 4) + (1u << 5) + (1u << 6) + (1u << 7), "the cameras did not take every regime (%x)",
                     counts);
     TEST_ASSERT_MSG(worst <= kInterpM, "path off the fit's images by %.3g m (> %.3g m)", worst, kInterpM);
+    // beyond 35 km (a fit of degree 5) the Taylor terms to the quartic and
+    // one image: the fit along a straight line exactly (degree 5), with
+    // refraction within nanometres, so at the images' rounding (3 Q24
+    // units, 0.0054 mm); leaving out refraction's E_22 (0.0089 mm) or
+    // E_31, or a quartic monomial's wrong axis or leading coefficient, fails
+    TEST_ASSERT_MSG(worst_far <= kFarM, "path (Taylor terms to the quartic, one image) off the fit's images by %.3g m "
+                    "(> %.3g m)", worst_far, kFarM);
     // the Taylor terms alone (a degree-4 fit) are the fit's restriction to
     // the path but for the rounding of the images compared (2 Q24 units,
     // 0.0036 mm) and what they leave out (nanometres at these k): leaving

@@ -867,6 +867,77 @@ CT_NOINLINE static int taylor_alone(const ct_package *pk, const ct_earth_map *mp
     return 1;
 }
 
+/* For the quartic terms 20..34 of term_abc: the product of the leading
+ * power coefficients 2^(n - 1) of their Chebyshev factors T_n (n >= 1),
+ * as a power of 2: the degree less the nonzero exponents. */
+static const uint8_t quart_lead[15] = {3, 2, 2, 2, 3, 2, 1, 1, 2, 2, 1, 2, 2, 2, 3};
+
+/* The quartic Taylor term of a fit of degree 5 along x(tau) = tau a - tau^2
+ * b (taylor_nodes: a, b, am and db in Q62; |a_i| <= 1, |b_i| <= 2^-9 else
+ * 0): p4 = E_40 - E_31 + E_22 (Q30), for a path of degree 5 through one
+ * image, at its far end.  Its quartic power coefficients need no rows: only
+ * the fit's own Chebyshev terms of degree 4 have quartic monomials (T_n has
+ * n's parity), so each is cf' 2^(sh[4] + quart_lead).
+ * Ranges, in Q30 (rshr64 of 64-bit products, as fit_eval's terms of degree
+ * >= 3: the roundings, 2^-31 of a term each, are nanometres): the
+ * monomials (<= 2^30), b (<= 2^21), E_31's factors (<= 3 2^21: sums of two
+ * products < 2^53), b^beta (<= 2^12).  G_2's and G_3's coefficients (<
+ * 2^58) times those in 128 bits: 16 products, < 2^85 (Q(fb + 28)).  The
+ * quartic terms in 64 bits: cf' (<= 2^27) times the monomial times
+ * 2^quart_lead in Q26, whose sum over the 15 terms is at most 66 2^26 for
+ * |a_i| <= 1: < 2^59.1, then times 2^(sh + 4) (sh <= 29): < 2^93.
+ * 0 (two images then) when |b| > 2^-9 or p4 reaches 2^53. */
+CT_NOINLINE static int taylor_quartic(const ct_earth_map *mp, const int64_t a[3], const int64_t b[3],
+                                      const int64_t am[20], const int64_t db[6], int64_t p4[3])
+{
+    int64_t aq[3], bq[3], s4[3] = {0, 0, 0};
+    ct_i128 u4[3];
+    int64_t bx = ct_max64(ct_abs64(b[0]), ct_max64(ct_abs64(b[1]), ct_abs64(b[2])));
+    int t, i, o, bent = bx != 0; /* a straight line: no E_31, E_22 */
+    if (bx > (INT64_C(1) << 53)) {
+        return 0;
+    }
+    for (i = 0; i < 3; ++i) { /* bound: 3 axes */
+        aq[i] = rshr64(a[i], 32u);
+        bq[i] = rshr64(b[i], 32u);
+        u4[i] = ct_i128_from64(0);
+    }
+    /* + E_22 = G_2(b) */
+    for (t = 4; bent && t < 10; ++t) { /* bound: 6 terms of degree 2 */
+        int64_t bb = rshr64(bq[3 - tay_parent[t]] * bq[tay_axis[t]], 30u);
+        for (o = 0; o < 3; ++o) { /* bound: 3 coordinates */
+            u4[o] = ct_i128_add(u4[o], ct_i128_mul(mp->cf[TAY0 + t - 1][o], bb));
+        }
+    }
+    /* - E_31: a cubic alpha = beta + e_i has the eps term a^beta b_i +
+     * db_beta a_i */
+    for (t = 10; bent && t < 20; ++t) { /* bound: 10 terms of degree 3 */
+        int pt = tay_parent[t];
+        int64_t d1;
+        i = tay_axis[t];
+        d1 = rshr64(rshr64(am[pt], 32u) * bq[i] + rshr64(db[pt - 4], 32u) * aq[i], 30u);
+        for (o = 0; o < 3; ++o) { /* bound: 3 coordinates */
+            u4[o] = ct_i128_sub(u4[o], ct_i128_mul(mp->cf[TAY0 + t - 1][o], d1));
+        }
+    }
+    /* + E_40 = G_4(a) */
+    for (t = 0; t < 15; ++t) { /* bound: 15 terms of degree 4 */
+        int64_t m = rshr64(rshr64(am[quart_parent[t]], 32u) * aq[quart_axis[t]], 30u);
+        int64_t mq = rshr64(m * (INT64_C(1) << quart_lead[t]), 4u);
+        for (o = 0; o < 3; ++o) { /* bound: 3 coordinates */
+            s4[o] += mp->cf[20 + t][o] * mq;
+        }
+    }
+    for (o = 0; o < 3; ++o) { /* bound: 3 coordinates */
+        ct_i128 v = ct_i128_add(u4[o], ct_i128_shl(ct_i128_from64(s4[o]), mp->sh[4][o] + 4u));
+        if (ct_i128_bits(ct_i128_abs(v)) > mp->fb[o] + 51u) {
+            return 0;
+        }
+        p4[o] = ct_i128_round_shr(v, mp->fb[o] - 2u);
+    }
+    return 1;
+}
+
 /* Taylor-Lobatto nodes (a fit per call, es->tay_ok: tmax < 70 km):
  * the path's polynomial in tau = t / tmax through the camera's image with
  * the fit's own first three derivatives there, and the fit's images at
@@ -900,7 +971,7 @@ static int taylor_nodes(path *pa, int64_t tmax)
     const ct_earth *es = pa->es;
     const ct_earth_map *mp = es->map;
     int64_t a[3], b[3], am[20], db[6], p[6][3], X[2][3];
-    int deg = tmax <= NODES_4_NM ? 4 : 5, nf, alone = 0, i, j, k, t, o;
+    int deg = tmax <= NODES_4_NM ? 4 : 5, nf, alone = 0, quart = 0, i, j, k, t, o;
     unsigned q = mp->qrho;
     int64_t bmax = pa->refract ? es->tay_bend_nm : 0;
     /* a: tmax |d| < 2^48 2^40 over 2^(q - 23) (q >= 44): |a| <= 2^62 as
@@ -928,8 +999,12 @@ static int taylor_nodes(path *pa, int64_t tmax)
      * they leave out */
     if (mp->deg == 4 && taylor_alone(pa->p, mp, a, b, am, p)) {
         alone = 1; /* deg is 4: tmax < 2^44 nm, below NODES_4_NM */
+    } else if (deg == 5 && taylor_quartic(mp, a, b, am, db, p[4])) {
+        /* beyond 35 km (the fit's degree is 5: its cube holds over 35 km):
+         * the quartic term too, and one image */
+        quart = 1;
     }
-    nf = alone ? 0 : deg - 3;
+    nf = alone ? 0 : (quart ? 1 : deg - 3);
     for (j = 0; j < nf; ++j) { /* bound: 2 far nodes: tau = 3/4 (3 tmax < 2^50) and 1 */
         if (!node_image(pa, j == nf - 1 ? tmax : (3 * tmax) >> 2, X[j])) {
             return 0;
@@ -963,6 +1038,9 @@ static int taylor_nodes(path *pa, int64_t tmax)
         }
         if (deg == 4) {
             p[4][o] = X[0][o] * 64 - p[1][o] - p[2][o] - p[3][o];
+        } else if (quart) {
+            /* through the image at tau = 1: |p4| < 2^53, |64 X| < 2^52 */
+            p[5][o] = X[0][o] * 64 - p[1][o] - p[2][o] - p[3][o] - p[4][o];
         } else {
             /* r0 + r1 tau through tau = 3/4 and 1 of (X - p1 tau - p2 tau^2
              * - p3 tau^3) / tau^4: R1 at 1 (< 2^56); at 3/4 its 64-fold M
