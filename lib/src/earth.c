@@ -929,8 +929,14 @@ CT_NOINLINE static int taylor_quartic(const ct_earth_map *mp, const int64_t a[3]
         }
     }
     for (o = 0; o < 3; ++o) { /* bound: 3 coordinates */
-        ct_i128 v = ct_i128_add(u4[o], ct_i128_shl(ct_i128_from64(s4[o]), mp->sh[4][o] + 4u));
-        if (ct_i128_bits(ct_i128_abs(v)) > mp->fb[o] + 51u) {
+        /* (no 128-bit shift or abs here: one more use of either makes GCC
+         * -Os call them out of line throughout this file, which costs every
+         * true-Earth pixel on Cortex-M4) */
+        ct_i128 v = ct_i128_add(u4[o], ct_i128_mul(s4[o], INT64_C(1) << (mp->sh[4][o] + 4u)));
+        /* v / 2^(fb + 51) by two shifts of at most 63 (fb >= 26); |v| <
+         * 2^93, so its low word holds it */
+        int64_t h = ct_i128_to64(ct_i128_sar(ct_i128_sar(v, 63u), mp->fb[o] - 12u));
+        if (h != 0 && h != -1) {
             return 0;
         }
         p4[o] = ct_i128_round_shr(v, mp->fb[o] - 2u);
