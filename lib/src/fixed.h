@@ -193,7 +193,7 @@ static inline ct_i128 ct_i128_neg(ct_i128 a)
 
 static inline ct_i128 ct_i128_sub(ct_i128 a, ct_i128 b) { return ct_i128_add(a, ct_i128_neg(b)); }
 
-static inline ct_i128 ct_i128_shl(ct_i128 a, unsigned n)
+CT_OPT_INLINE static inline ct_i128 ct_i128_shl(ct_i128 a, unsigned n)
 {
     ct_i128 r;
     if (n == 0u) {
@@ -279,7 +279,7 @@ static inline ct_i128 ct_i128_mul128_64(ct_i128 a, int64_t b)
 
 
 /* |a| for a > -2^127.                                                       */
-static inline ct_i128 ct_i128_abs(ct_i128 a) { return ct_i128_sign(a) < 0 ? ct_i128_neg(a) : a; }
+CT_OPT_INLINE static inline ct_i128 ct_i128_abs(ct_i128 a) { return ct_i128_sign(a) < 0 ? ct_i128_neg(a) : a; }
 
 /* Number of significant bits of a non-negative 128-bit value (0 for 0).    */
 static inline unsigned ct_i128_bits(ct_i128 a)
