@@ -929,9 +929,6 @@ CT_NOINLINE static int taylor_quartic(const ct_earth_map *mp, const int64_t a[3]
         }
     }
     for (o = 0; o < 3; ++o) { /* bound: 3 coordinates */
-        /* (no 128-bit shift or abs here: one more use of either makes GCC
-         * -Os call them out of line throughout this file, which costs every
-         * true-Earth pixel on Cortex-M4) */
         ct_i128 v = ct_i128_add(u4[o], ct_i128_mul(s4[o], INT64_C(1) << (mp->sh[4][o] + 4u)));
         /* v / 2^(fb + 51) by two shifts of at most 63 (fb >= 26); |v| <
          * 2^93, so its low word holds it */

@@ -304,7 +304,7 @@ static inline ct_i128 ct_i128_sar(ct_i128 a, unsigned n)
  * arithmetic shift of the two words.  Caller: v + 2^(n-1) does not wrap
  * (|v| <= 2^126 ensures it) and the result fits in int64 (only its low 64
  * bits are returned).                                                            */
-static inline int64_t ct_i128_round_shr(ct_i128 v, unsigned n)
+CT_OPT_INLINE static inline int64_t ct_i128_round_shr(ct_i128 v, unsigned n)
 {
     ct_i128 h = ct_i128_from64(1);
     ct_i128 r;
@@ -322,7 +322,7 @@ static inline int64_t ct_i128_round_shr(ct_i128 v, unsigned n)
 /* round(a * b / 2^q), 1 <= q <= 63, through the 64 x 64 -> 128-bit
  * product (|a * b| <= 2^126 for any int64 operands, so the sum cannot
  * wrap); the result must fit in int64 (caller's bound at each use).        */
-static inline int64_t ct_mul_shr(int64_t a, int64_t b, unsigned q)
+CT_OPT_INLINE static inline int64_t ct_mul_shr(int64_t a, int64_t b, unsigned q)
 {
     return ct_i128_round_shr(ct_i128_mul(a, b), q);
 }
