@@ -43,6 +43,15 @@
 #define CT_OPT_INLINE
 #endif
 
+/* CT_OPT_INLINE for the 64 x 64 -> 128-bit product's four 32 x 32 -> 64-bit
+ * ones, except on ARMv6-M (Cortex-M0), which has no such multiply: there
+ * each is a library call and an inlined copy only adds flash.             */
+#if defined(__ARM_ARCH_6M__)
+#define CT_MUL_INLINE
+#else
+#define CT_MUL_INLINE CT_OPT_INLINE
+#endif
+
 /* A hint to start loading a cache line, on hosts with caches (GCC and clang
  * on x86-64 and AArch64); nothing on the flight MCUs, which have none (the
  * code around it is compiled out there: CT_HAVE_PREFETCH 0).               */
@@ -223,7 +232,7 @@ static inline int ct_i128_cmp(ct_i128 a, ct_i128 b)
 }
 
 /* Unsigned 64 x 64 -> 128 from 32-bit halves. */
-static inline ct_i128 ct_umul64(uint64_t a, uint64_t b)
+CT_MUL_INLINE static inline ct_i128 ct_umul64(uint64_t a, uint64_t b)
 {
     ct_i128 r;
 #ifdef CT_NATIVE_INT128
