@@ -132,24 +132,39 @@ static void qsincos(int64_t x, int64_t *s, int64_t *c)
     }
 }
 
+/* The series' coefficients in Q59, as integer divisions of ONE (constant
+ * tables: -Os would otherwise divide them out, 14 64-bit divisions a call):
+ * atan (-1)^k / (2k + 1), atanh 1 / (2k + 1), asinh (-1)^k t_k / (2k + 1)
+ * with t_0 = ONE, t_(k+1) = floor(t_k / (2k + 2)) (2k + 1). */
+static const int64_t atan_c[14] = {
+    INT64_C(576460752303423488), -INT64_C(192153584101141162), INT64_C(115292150460684697),
+    -INT64_C(82351536043346212), INT64_C(64051194700380387),   -INT64_C(52405522936674862),
+    INT64_C(44343134792571037),  -INT64_C(38430716820228232),  INT64_C(33909456017848440),
+    -INT64_C(30340039594917025), INT64_C(27450512014448737),   -INT64_C(25063510969714064),
+    INT64_C(23058430092136939),  -INT64_C(21350398233460129)};
+static const int64_t atanh_c[12] = {
+    INT64_C(576460752303423488), INT64_C(192153584101141162), INT64_C(115292150460684697),
+    INT64_C(82351536043346212),  INT64_C(64051194700380387),  INT64_C(52405522936674862),
+    INT64_C(44343134792571037),  INT64_C(38430716820228232),  INT64_C(33909456017848440),
+    INT64_C(30340039594917025),  INT64_C(27450512014448737),  INT64_C(25063510969714064)};
+static const int64_t asinh_c[14] = {
+    INT64_C(576460752303423488), -INT64_C(96076792050570581), INT64_C(43234556422756761),
+    -INT64_C(25734855013545691), INT64_C(17513998550885262),  -INT64_C(12896671660197329),
+    INT64_C(10003187633871005),  -INT64_C(8050184333924761),  INT64_C(6659159835048056),
+    -INT64_C(5627184772891486),  INT64_C(4836699292890063),   -INT64_C(4215384166333039),
+    INT64_C(3716563706650296),   -INT64_C(3308906433983525)};
+
 /* atan(x) for |x| <= 1 (Q59): two halvings x / (1 + sqrt(1 + x^2)) bring
  * it to <= tan(pi/16) < 0.2, then 14 terms of the series (0.04^14 <
  * 2^-64), times 4. */
 static int64_t atan_unit(int64_t x)
 {
-    int64_t c[14], s;
     int k;
     /* bound: 2 halvings */
     for (k = 0; k < 2; ++k) {
         x = qdiv(x, ONE + qhypot(ONE, x));
     }
-    /* bound: 14 coefficients */
-    for (k = 0; k < 14; ++k) {
-        int64_t v = ONE / (2 * k + 1);
-        c[k] = (k & 1) ? -v : v;
-    }
-    s = odd_series(x, c, 14);
-    return 4 * s;
+    return 4 * odd_series(x, atan_c, 14);
 }
 
 /* atan2(y, x) in (-pi, pi], |x|, |y| < 16, not both 0 */
@@ -170,25 +185,13 @@ static int64_t qatan2(int64_t y, int64_t x)
 /* atanh(x) for |x| <= 0.1: 12 terms of x + x^3/3 + ... (0.01^12) */
 static int64_t atanh_small(int64_t x)
 {
-    int64_t c[12];
-    int k;
-    for (k = 0; k < 12; ++k) { /* bound: 12 */
-        c[k] = ONE / (2 * k + 1);
-    }
-    return odd_series(x, c, 12);
+    return odd_series(x, atanh_c, 12);
 }
 
 /* asinh(x) for |x| <= 0.17: 14 terms (0.029^14 < 2^-70) */
 static int64_t asinh_small(int64_t x)
 {
-    int64_t c[14], t = ONE; /* t = (2k)! / (4^k k!^2) */
-    int k;
-    for (k = 0; k < 14; ++k) { /* bound: 14 */
-        int64_t v = t / (2 * k + 1);
-        c[k] = (k & 1) ? -v : v;
-        t = t / (2 * k + 2) * (2 * k + 1); /* t_{k+1} = t_k (2k+1) / (2k+2) */
-    }
-    return odd_series(x, c, 14);
+    return odd_series(x, asinh_c, 14); /* t_k ~ (2k)! / (4^k k!^2) */
 }
 
 /* sinh and cosh of |x| <= 0.2: 12 terms each */
