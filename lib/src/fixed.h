@@ -252,10 +252,11 @@ CT_MUL_INLINE static inline ct_i128 ct_umul64(uint64_t a, uint64_t b)
 
 static inline uint64_t ct_uabs64(int64_t a) { return a < 0 ? (uint64_t)0 - (uint64_t)a : (uint64_t)a; }
 
-/* a b, 64 x 64 -> 128 bits.  ct_i128_mul_inl is always inlined on Cortex-M3/M4
- * (for the few hot loops that call it most: geodesy's Q59 product);
- * ct_i128_mul, everywhere else, is left to the compiler (inlined at all of
- * its call sites it would add 16 KB of flash on Cortex-M4).               */
+/* a b, 64 x 64 -> 128 bits.  ct_i128_mul_inl is always inlined when
+ * optimising, except on Cortex-M0 (CT_MUL_INLINE), for the hot loop that
+ * calls it most: geodesy's Q59 product; ct_i128_mul, everywhere else, is
+ * left to the compiler (inlined at all of its call sites it would add 16 KB
+ * of flash on Cortex-M4).                                                  */
 CT_MUL_INLINE static inline ct_i128 ct_i128_mul_inl(int64_t a, int64_t b)
 {
 #ifdef CT_NATIVE_INT128
