@@ -97,6 +97,66 @@ static void test_i128_random(void)
     }
 }
 
+/* The 128-by-64-bit division's digit paths (fixed.c udiv128: on targets
+ * without a 128-bit type, Knuth's algorithm D in base 2^32, each digit
+ * estimated from the top digits and corrected at most twice): divisors,
+ * quotients and remainders built from the digits where the estimates need
+ * correcting -- top divisor digits just above 2^31 and at 2^32 - 1 after
+ * normalisation, second digits 0, 1 and all ones, quotient digits 0, 1,
+ * 2^31 and all ones, remainders 0, 1 and d - 1 -- each n = q d + r (and
+ * -n) against the native quotient; plus random ones whose remainders run
+ * high (partial remainders with a top digit equal to the divisor's). */
+static void test_div_digits(void)
+{
+    static const uint64_t top[] = {0x80000000u, 0x80000001u, 0xC0000000u, 0xFFFFFFFEu, 0xFFFFFFFFu};
+    static const uint64_t low[] = {0u, 1u, 0x7FFFFFFFu, 0x80000000u, 0xFFFFFFFEu, 0xFFFFFFFFu};
+    static const uint64_t qd[] = {0u, 1u, 0x7FFFFFFFu, 0x80000000u, 0xFFFFFFFFu};
+    long n_cases = 0;
+    unsigned a, b, c, e, f, sh;
+    for (sh = 1u; sh <= 33u; sh += 4u) {                          /* the normalisation shift */
+        for (a = 0u; a < sizeof top / sizeof top[0]; ++a) {
+            for (b = 0u; b < sizeof low / sizeof low[0]; ++b) {
+                uint64_t d = ((top[a] << 32) | low[b]) >> sh; /* < 2^63 */
+                if (d == 0u) continue;
+                for (c = 0u; c < sizeof qd / sizeof qd[0]; ++c) {
+                    for (e = 0u; e < sizeof qd / sizeof qd[0]; ++e) {
+                        uint64_t q = ((qd[c] << 32) | qd[e]) >> 2; /* < 2^62 */
+                        for (f = 0u; f < 3u; ++f) {
+                            uint64_t r = f == 0u ? 0u : (f == 1u ? 1u % d : d - 1u);
+                            i128 n = (i128)q * (i128)d + (i128)r;
+                            ct_i128 nn = ct_i128_from64(0);
+                            nn.hi = (uint64_t)(n >> 64);
+                            nn.lo = (uint64_t)n;
+                            TEST_ASSERT_MSG(ct_i128_floor_div(nn, (int64_t)d) == (int64_t)q,
+                                            "floor_div(q %llx d %llx r %llx)", (unsigned long long)q,
+                                            (unsigned long long)d, (unsigned long long)r);
+                            TEST_ASSERT(ct_i128_floor_div(ct_i128_neg(nn), (int64_t)d) ==
+                                        -(int64_t)q - (r != 0u ? 1 : 0));
+                            n_cases++;
+                        }
+                    }
+                }
+            }
+        }
+    }
+    /* random: q's digits and d's digits random, r = d - 1 - small, so the
+     * partial remainders run high */
+    ct_rng_seed(&rng, ct_test_seed() * 31 + 7);
+    for (a = 0u; a < 200000u; ++a) {
+        uint64_t d = (ct_rng_u64(&rng) >> (unsigned)ct_rng_range(&rng, 1, 31)) | ((uint64_t)1 << 32);
+        uint64_t q = ct_rng_u64(&rng) >> 2;
+        uint64_t r = d - 1u - (uint64_t)ct_rng_range(&rng, 0, 3) % d;
+        i128 n = (i128)q * (i128)d + (i128)r;
+        ct_i128 nn = ct_i128_from64(0);
+        nn.hi = (uint64_t)(n >> 64);
+        nn.lo = (uint64_t)n;
+        TEST_ASSERT_MSG(ct_i128_floor_div(nn, (int64_t)d) == (int64_t)q, "floor_div(q %llx d %llx r %llx)",
+                        (unsigned long long)q, (unsigned long long)d, (unsigned long long)r);
+        n_cases++;
+    }
+    printf("  %ld divisions\n", n_cases);
+}
+
 /* ct_bitlen64 against counting bits one at a time: every power of two and
  * its neighbours, and random values of every length. */
 static unsigned bitlen_ref(uint64_t v)
@@ -305,6 +365,7 @@ int main(void)
     RUN_TEST(test_i128_hard_values);
     RUN_TEST(test_i128_random);
     RUN_TEST(test_bitlen);
+    RUN_TEST(test_div_digits);
     RUN_TEST(test_isqrt);
     RUN_TEST(test_cot_table);
     RUN_TEST(test_sector_boundaries);
