@@ -482,10 +482,17 @@ static const int8_t cheb_pow[CT_EARTH_MAP_DEG + 1][CT_EARTH_MAP_DEG + 1] = {
     {1, 0, 0, 0, 0, 0, 0},  {0, 1, 0, 0, 0, 0, 0},   {-1, 0, 2, 0, 0, 0, 0},   {0, -3, 0, 4, 0, 0, 0},
     {1, 0, -8, 0, 8, 0, 0}, {0, 5, 0, -20, 0, 16, 0}, {-1, 0, 18, 0, -48, 0, 32}};
 
+/* For the quartic terms 20..34 of term_abc: the product of the leading
+ * power coefficients 2^(n - 1) of their Chebyshev factors T_n (n >= 1,
+ * cheb_pow[n][n]), as a power of 2: the degree less the nonzero exponents.
+ * Only a fit's own terms of degree 4 have quartic monomials, so its quartic
+ * power coefficients are these times cf 2^sh (map_taylor, taylor_quartic). */
+static const uint8_t quart_lead[15] = {3, 2, 2, 2, 3, 2, 1, 1, 2, 2, 1, 2, 2, 2, 3};
+
 /* The fit's Taylor terms of degrees 1..3 at the cube's centre (s = 0), and
- * of degree 4 for a fit of degree 4 (taylor_alone): for each such term s^alpha (term_abc 1..19, 20..34), the sum over
- * the fit's terms of cf 2^sh C_a C_b C_c, C the power coefficients of its
- * Chebyshev factors (exact integers: |cf 2^sh| < 2^56, |C C C| <= 48^3 <
+ * of degree 4 for a fit of degree 4 (taylor_alone): for each such term
+ * s^alpha (term_abc 1..19, 20..34), the sum over the fit's terms of cf 2^sh
+ * C_a C_b C_c, C the power coefficients of its Chebyshev factors (exact integers: |cf 2^sh| < 2^56, |C C C| <= 48^3 <
  * 2^17, <= 56 terms: < 2^80 in 128 bits), kept in cf[tay_row(t)]: rows
  * TAY0 .. for degrees 1..3 (a fit of degree <= 5 uses cf[0 .. 55] only: no
  * stack for them), TAY4 .. for degree 4 (a degree-4 fit uses cf[0 .. 34]).
@@ -531,10 +538,8 @@ static int map_taylor(ct_earth_map *mp)
          * 2^56, times at most 2^3 */
         int big = 0;
         for (t = 20; t < 35; ++t) { /* bound: 15 terms */
-            const uint8_t *e = term_abc[t];
-            int64_t cc = (int64_t)cheb_pow[e[0]][e[0]] * cheb_pow[e[1]][e[1]] * cheb_pow[e[2]][e[2]];
             for (o = 0; o < 3; ++o) { /* bound: 3 coordinates */
-                int64_t v = mp->cf[t][o] * (cc * (INT64_C(1) << mp->sh[4][o]));
+                int64_t v = mp->cf[t][o] * (INT64_C(1) << (quart_lead[t - 20] + mp->sh[4][o]));
                 if (ct_abs64(v) >= (INT64_C(1) << 58)) {
                     return 0;
                 }
@@ -793,6 +798,13 @@ static const uint8_t quart_axis[15] = {2, 1, 1, 1, 1, 0, 0, 0, 0, 0, 0, 0, 0, 0,
 static const uint8_t cub_less[10][3] = {{0, 0, 4}, {0, 4, 5}, {0, 5, 6}, {0, 6, 0}, {4, 0, 7},
                                         {5, 7, 8}, {6, 8, 0}, {7, 0, 9}, {8, 9, 0}, {9, 0, 0}};
 
+/* The quartic monomial a^alpha of term 20 + t (Q30) from its cubic parent
+ * in am (Q62) and a in Q30 (aq): |.| <= 2^30 + 2. */
+CT_OPT_INLINE static inline int64_t quart_mono(const int64_t am[20], const int64_t aq[3], int t)
+{
+    return rshr64(rshr64(am[quart_parent[t]], 32u) * aq[quart_axis[t]], 30u);
+}
+
 /* The quartic Taylor term of a degree-4 fit along x(tau) = tau a - tau^2 b
  * (taylor_nodes, which gives a, b and am, the monomials a^alpha of degrees
  * 1..3, Q62; |b| <= 2^53 per axis, else 0): p4 = G_4(a) - E_31 into p[4]
@@ -841,7 +853,7 @@ CT_NOINLINE static int taylor_alone(const ct_package *pk, const ct_earth_map *mp
         bq[i] = rshr64(b[i], 32u);
     }
     for (t = 0; t < 15; ++t) { /* bound: 15 terms of degree 4 */
-        a4[t] = rshr64(rshr64(am[quart_parent[t]], 32u) * aq[quart_axis[t]], 30u);
+        a4[t] = quart_mono(am, aq, t);
     }
     /* E_31's factor per cubic monomial, sum e_i b_i a^(alpha - e_i) */
     for (t = 0; bent && t < 10; ++t) { /* bound: 10 terms of degree 3 */
@@ -866,11 +878,6 @@ CT_NOINLINE static int taylor_alone(const ct_package *pk, const ct_earth_map *mp
     }
     return 1;
 }
-
-/* For the quartic terms 20..34 of term_abc: the product of the leading
- * power coefficients 2^(n - 1) of their Chebyshev factors T_n (n >= 1),
- * as a power of 2: the degree less the nonzero exponents. */
-static const uint8_t quart_lead[15] = {3, 2, 2, 2, 3, 2, 1, 1, 2, 2, 1, 2, 2, 2, 3};
 
 /* The quartic Taylor term of a fit of degree 5 along x(tau) = tau a - tau^2
  * b (taylor_nodes: a, b, am and db in Q62; |a_i| <= 1, |b_i| <= 2^-9 else
@@ -922,8 +929,7 @@ CT_NOINLINE static int taylor_quartic(const ct_earth_map *mp, const int64_t a[3]
     }
     /* + E_40 = G_4(a) */
     for (t = 0; t < 15; ++t) { /* bound: 15 terms of degree 4 */
-        int64_t m = rshr64(rshr64(am[quart_parent[t]], 32u) * aq[quart_axis[t]], 30u);
-        int64_t mq = rshr64(m * (INT64_C(1) << quart_lead[t]), 4u);
+        int64_t mq = rshr64(quart_mono(am, aq, t) * (INT64_C(1) << quart_lead[t]), 4u);
         for (o = 0; o < 3; ++o) { /* bound: 3 coordinates */
             s4[o] += mp->cf[20 + t][o] * mq;
         }
