@@ -259,45 +259,55 @@ static ct_i128 udiv128_small(ct_i128 n, uint64_t d)
     return q;
 }
 
-/* *bd's ranges, and (c != 0) whether the polyline's segment would be at
- * least 1024 Q16 units (1/64 cell) -- ct_bend_segment's checks without its
- * square root: floor(isqrt(q) 2^16 / posting) >= 1024 iff isqrt(q) >=
- * ceil(posting / 64) iff q >= ceil(posting / 64)^2 (q as in
- * ct_bend_segment; ceil(posting / 64) < 2^57, its square 128-bit). */
-static ct_status bend_check(const ct_package *p, const ct_bend *bd)
+/* *bd's ranges (CT_ERR_ARG when one is out), and for c != 0 the square of
+ * the polyline's segment length, q = 8 eps R / |c| in nm^2 (eps the chord,
+ * R the radius, c = coeff_q16 / 2^16; *q = 0 for c = 0): eps R 2^19 <
+ * 2^123 over |coeff_q16| >= 1, divided as a 128-bit value (udiv128_small;
+ * the quotient must not be saturated to 64 bits: 8 eps R alone is ~2^75
+ * nm^2 for 1 mm and 6371 km). */
+static ct_status bend_q(const ct_bend *bd, ct_i128 *q)
 {
     if (bd->coeff_q16 < -(4 * 65536) || bd->coeff_q16 > 4 * 65536 || bd->radius_nm < (INT64_C(1) << 40) ||
         bd->radius_nm > (INT64_C(1) << 54) || bd->chord_nm < (INT64_C(1) << 10) ||
         bd->chord_nm > (INT64_C(1) << 50) || (bd->flags & ~CT_BEND_NO_CULL) != 0u) {
         return CT_ERR_ARG;
     }
+    *q = ct_i128_from64(0);
     if (bd->coeff_q16 != 0) {
         ct_i128 num = ct_i128_shl(ct_umul64((uint64_t)bd->chord_nm, (uint64_t)bd->radius_nm), 19);
-        ct_i128 q = udiv128_small(num, (uint64_t)ct_abs64((int64_t)bd->coeff_q16));
+        *q = udiv128_small(num, (uint64_t)ct_abs64((int64_t)bd->coeff_q16));
+    }
+    return CT_OK;
+}
+
+/* *bd's ranges, and (c != 0) whether the polyline's segment would be at
+ * least 1024 Q16 units (1/64 cell) -- ct_bend_segment's checks without its
+ * square root: floor(isqrt(q) 2^16 / posting) >= 1024 iff isqrt(q) >=
+ * ceil(posting / 64) iff q >= ceil(posting / 64)^2 (ceil(posting / 64) <
+ * 2^57, its square 128-bit). */
+static ct_status bend_check(const ct_package *p, const ct_bend *bd)
+{
+    ct_i128 q;
+    ct_status st = bend_q(bd, &q);
+    if (st == CT_OK && bd->coeff_q16 != 0) {
         uint64_t m = ((uint64_t)ct_abs64(p->posting_e_nm) + 63u) / 64u;
         if (ct_i128_cmp(q, ct_umul64(m, m)) < 0) {
             return CT_ERR_ARG;
         }
     }
-    return CT_OK;
+    return st;
 }
 
 ct_status ct_bend_segment(const ct_package *p, const ct_bend *bd, int64_t *delta)
 {
-    if (bd->coeff_q16 < -(4 * 65536) || bd->coeff_q16 > 4 * 65536 || bd->radius_nm < (INT64_C(1) << 40) ||
-        bd->radius_nm > (INT64_C(1) << 54) || bd->chord_nm < (INT64_C(1) << 10) ||
-        bd->chord_nm > (INT64_C(1) << 50) || (bd->flags & ~CT_BEND_NO_CULL) != 0u) {
+    ct_i128 q;
+    if (bend_q(bd, &q) != CT_OK) {
         return CT_ERR_ARG;
     }
     *delta = 0;
     if (bd->coeff_q16 != 0) {
-        /* Delta in nm: sqrt(8 eps R 2^16 / |c|): eps R < 2^104, * 2^19 <
-         * 2^123, and so is the quotient (|c| >= 1 in Q16): divided as a
-         * 128-bit value (udiv128_small; the quotient must not be saturated
-         * to 64 bits: 8 eps R alone is ~2^75 nm^2 for 1 mm and 6371 km).
-         * Then Q16 cells: Delta_nm < 2^62, * 2^16 / posting (saturated). */
-        ct_i128 num = ct_i128_shl(ct_umul64((uint64_t)bd->chord_nm, (uint64_t)bd->radius_nm), 19);
-        ct_i128 q = udiv128_small(num, (uint64_t)ct_abs64((int64_t)bd->coeff_q16));
+        /* Delta in nm: sqrt(q); then Q16 cells: Delta_nm < 2^62, * 2^16 /
+         * posting (saturated). */
         uint64_t dn = ct_i128_isqrt(q);
         /* at most SEG_MAX_NM: a segment shorter than the tolerance allows
          * is as good, and the polyline's last vertex, a segment past the
