@@ -220,9 +220,72 @@ static void test_isqrt(void)
         TEST_ASSERT_MSG((unsigned __int128)r * r <= n && (unsigned __int128)(r + 1) * (r + 1) > n,
                         "isqrt64(%llu) = %llu", (unsigned long long)n, (unsigned long long)r);
     }
+    /* each start-table segment's ends (its top eight bits k = 64..255),
+     * where the table's start is farthest from the root, at every scale,
+     * and the 128-bit values with those top bits (N_hi's root) */
+    for (k = 64; k < 256; ++k) {
+        unsigned e;
+        for (e = 0; e < 32; ++e) {
+            uint64_t lo = ((uint64_t)k << 56) >> (2u * e), hi = (((uint64_t)(k + 1) << 56) - 1u) >> (2u * e);
+            uint64_t r0 = ct_isqrt64(lo), r1 = ct_isqrt64(hi);
+            ct_i128 v;
+            uint64_t r;
+            unsigned __int128 n;
+            TEST_ASSERT_MSG((unsigned __int128)r0 * r0 <= lo && (unsigned __int128)(r0 + 1) * (r0 + 1) > lo,
+                            "isqrt64 segment %d start", (int)k);
+            TEST_ASSERT_MSG((unsigned __int128)r1 * r1 <= hi && (unsigned __int128)(r1 + 1) * (r1 + 1) > hi,
+                            "isqrt64 segment %d end", (int)k);
+            /* 2^126 .. 2^127 - 1 and below: positive 128-bit values */
+            n = ((unsigned __int128)(k < 128 ? hi : hi >> 1) << 64 | ~(uint64_t)0) >> (2u * e);
+            v.hi = (uint64_t)(n >> 64);
+            v.lo = (uint64_t)n;
+            r = ct_i128_isqrt(v);
+            TEST_ASSERT_MSG((unsigned __int128)r * r <= n && ((unsigned __int128)r + 1) * ((unsigned __int128)r + 1) > n,
+                            "isqrt128 segment %d scale %d", (int)k, (int)e);
+        }
+    }
+    {
+        /* the largest 128-bit value and squares at the top of the range */
+        const uint64_t roots[] = {((uint64_t)1 << 63) - 1, (uint64_t)3037000499u * 4294967296u, (uint64_t)1 << 62,
+                                  ((uint64_t)1 << 62) + 1, ((uint64_t)1 << 32) + 1, 0xb504f333f9de6484ull};
+        unsigned __int128 n = ((unsigned __int128)1 << 127) - 1;
+        ct_i128 v;
+        uint64_t r;
+        v.hi = (uint64_t)(n >> 64);
+        v.lo = (uint64_t)n;
+        r = ct_i128_isqrt(v);
+        TEST_ASSERT_MSG(r == 0xb504f333f9de6484ull, "isqrt128(2^127 - 1) = %llu", (unsigned long long)r);
+        /* all ones of an even length: the root 2^j - 1, where the Newton
+         * step from below reaches 2^j (caps at 2^32 and 2^64) */
+        for (k = 1; k <= 63; ++k) {
+            n = ((unsigned __int128)1 << (2u * k)) - 1u;
+            v.hi = (uint64_t)(n >> 64);
+            v.lo = (uint64_t)n;
+            r = ct_i128_isqrt(v);
+            TEST_ASSERT_MSG(r == ((uint64_t)1 << k) - 1u, "isqrt128(2^%d - 1) = %llu", (int)(2u * k), (unsigned long long)r);
+            if (k <= 32) {
+                r = ct_isqrt64(v.lo);
+                TEST_ASSERT_MSG(r == ((uint64_t)1 << k) - 1u, "isqrt64(2^%d - 1)", (int)(2u * k));
+            }
+        }
+        for (k = 0; k < sizeof roots / sizeof roots[0]; ++k) {
+            int d;
+            for (d = -1; d <= 1; ++d) {
+                n = (unsigned __int128)roots[k] * roots[k] + (unsigned __int128)(__int128)d;
+                if (n >> 127) {
+                    continue;
+                }
+                v.hi = (uint64_t)(n >> 64);
+                v.lo = (uint64_t)n;
+                r = ct_i128_isqrt(v);
+                TEST_ASSERT_MSG(r == roots[k] - (d < 0 ? 1u : 0u), "isqrt128 of %llu^2 %+d", (unsigned long long)roots[k],
+                                d);
+            }
+        }
+    }
     for (k = 0; k < 100000; ++k) {
-        /* 128-bit: n < 2^126, including perfect squares and their neighbours */
-        unsigned bits = (unsigned)ct_rng_range(&rng, 1, 125);
+        /* 128-bit: n < 2^127, including perfect squares and their neighbours */
+        unsigned bits = (unsigned)ct_rng_range(&rng, 1, 127);
         unsigned __int128 n = ((unsigned __int128)ct_rng_u64(&rng) << 64) | ct_rng_u64(&rng);
         uint64_t r;
         ct_i128 v;
@@ -230,7 +293,7 @@ static void test_isqrt(void)
         if (k % 3 == 0) {
             uint64_t s = (uint64_t)(n >> (bits / 2 + 1)) & (((uint64_t)1 << 62) - 1);
             n = (unsigned __int128)s * s + (unsigned __int128)(int)ct_rng_range(&rng, -1, 1);
-            if (n >> 126) continue;
+            if (n >> 127) continue;
         }
         v.hi = (uint64_t)(n >> 64);
         v.lo = (uint64_t)n;

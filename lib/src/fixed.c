@@ -102,101 +102,94 @@ int64_t ct_i128_floor_div_sat(ct_i128 n, int64_t d)
     return ct_i128_floor_div(n, d);
 }
 
-/* floor(sqrt(n)).  Newton from above, x <- (x + n/x) / 2, which decreases
- * monotonically to floor(sqrt(n)) from any start x0 >= floor(sqrt(n)) and
- * never passes below it; so the first x with x^2 <= n is the answer (a
- * product instead of the confirming division).  The start comes from n's
- * top eight bits: with n = m / 4^e, m in [2^62, 2^64), x0 = ceil(T / 2^e)
- * where T >= floor(sqrt(m)) (ct_isqrt_top8, capped at 2^32 - 1, so x0^2 <
- * 2^64), within 0.8 % of sqrt(n): the relative error after one step is
- * below 2^-14, after two below 2^-30 (under two units for x < 2^32), so at
- * most three divisions (20 million random n, every bit length: 0-3, mostly
- * 1-2).  bound: 8 steps (the error at least squares per step).            */
-uint64_t ct_isqrt64(uint64_t n)
+/* Integer square roots without a 64-bit division (a library call of 100-200
+ * instructions on Cortex-M0/M4): floor(sqrt(a)) of a 32-bit a by Newton's
+ * iteration with 32-bit divisions, then each doubling of the width by one
+ * Newton step from below, whose error is at most one unit.
+ *
+ * isqrt32_norm: floor(sqrt(a)) for a in [2^30, 2^32).  The start is the
+ * table's T (ct_isqrt_top8, by a's top eight bits: T >= floor(sqrt(m)) for
+ * every 64-bit m with those top bits, so ceil(T / 2^16) >= floor(sqrt(a)),
+ * and within 0.8 % of it, <= 2^16).  Newton from above, x <- (x + a / x) /
+ * 2 floored, decreases monotonically to floor(sqrt(a)) and never passes
+ * below it, so the first x with x^2 <= a is the answer: from 0.8 % the
+ * error is below 2^-14 after one step and 2^-28 after two (under a unit),
+ * plus the floors: at most three steps (every a of each table segment's
+ * ends and random ones: test_fixed).  bound: 8 steps. */
+static uint32_t isqrt32_norm(uint32_t a)
 {
-    uint64_t x;
-    unsigned e, k;
-    if (n < 2u) {
-        return n;
-    }
-    e = (64u - ct_bitlen64(n)) / 2u; /* m = n << 2e in [2^62, 2^64) */
-    x = (uint64_t)ct_isqrt_top8[((n << (2u * e)) >> 56) - 64u];
-    x = (x + (((uint64_t)1 << e) - 1u)) >> e;
-    for (k = 0u; k < 8u; ++k) {
-        if (x * x <= n) {
-            break;
-        }
-        x = (x + n / x) >> 1;
+    uint32_t t = ct_isqrt_top8[(a >> 24) - 64u];
+    uint32_t x = (t >> 16) + ((t & 0xffffu) != 0u ? 1u : 0u); /* <= 2^16 */
+    unsigned k;
+    for (k = 0u; k < 8u && (uint64_t)x * x > a; ++k) { /* bound: 8 steps (at most 2 taken) */
+        x = (x + a / x) >> 1; /* x >= 2^15: a / x < 2^17 */
     }
     return x;
 }
 
+/* floor(sqrt(m)) for m in [2^62, 2^64).  s1 = floor(sqrt(m_hi)) (m_hi = m /
+ * 2^32 floored, in [2^30, 2^32)) puts the root in [x0, x0 + 2^16), x0 = s1
+ * 2^16 >= 2^31.  One Newton step from below, x1 = x0 + r / (2 x0) with r =
+ * m - x0^2 (< (2 s1 + 1) 2^32 < 2^49), lands in [sqrt(m), sqrt(m) + 1]
+ * (its error (sqrt(m) - x0)^2 / (2 x0) < 2^32 / 2^32), so floor(x1) =
+ * x0 + floor(floor(r / 2^17) / s1) (a 32-bit division: r / 2^17 < 2^32) is
+ * the root or one more; capped at 2^32 - 1 (the root is below 2^32) and
+ * checked by its square. */
+static uint64_t isqrt64_norm(uint64_t m)
+{
+    uint32_t s1 = isqrt32_norm((uint32_t)(m >> 32));
+    uint64_t r = m - (((uint64_t)s1 * s1) << 32);
+    uint64_t y = ((uint64_t)s1 << 16) + (uint32_t)(r >> 17) / s1; /* <= 2^32 */
+    if (y > 0xffffffffu) {
+        y = 0xffffffffu;
+    }
+    return y * y > m ? y - 1u : y;
+}
+
+/* floor(sqrt(n)): n scaled by 4^e into [2^62, 2^64) (n >= 2), whose root
+ * floored and divided by 2^e (floored) is n's. */
+uint64_t ct_isqrt64(uint64_t n)
+{
+    unsigned e;
+    if (n < 2u) {
+        return n;
+    }
+    e = (64u - ct_bitlen64(n)) / 2u;
+    return isqrt64_norm(n << (2u * e)) >> e;
+}
+
+/* floor(sqrt(n)) of a 128-bit n (0 for n <= 0): n >= 2^64 scaled by 4^e
+ * into N in [2^126, 2^128) (2e <= 62), S1 = floor(sqrt(N_hi)) in [2^31,
+ * 2^32) puts N's root in [X0, X0 + 2^32), X0 = S1 2^64 / 2^32 >= 2^63, and
+ * one Newton step from below, X0 + floor(R / (2 X0)) with R = N - X0^2 <
+ * (2 S1 + 1) 2^64 < 2^97, is the root or one more (as isqrt64_norm's):
+ * floor(floor(R / 2^33) / S1), R / 2^33 < 2^64, one 64-bit division;
+ * capped at 2^64 - 1, checked by its 128-bit square, then divided by 2^e. */
 uint64_t ct_i128_isqrt(ct_i128 n)
 {
-    uint64_t x, q, rem;
-    int k;
+    unsigned e;
+    uint64_t s1, dh, q, hi, y;
+    ct_i128 N, sq;
     if (ct_i128_sign(n) <= 0) {
         return 0u;
     }
     if (n.hi == 0u) {
         return ct_isqrt64(n.lo);
     }
-    /* Newton from above, started from the square root of the top bits:
-     * with n' = n >> 2s < 2^62, x0 = (isqrt(n') + 1) << s > sqrt(n), and
-     * x <- (x + n/x)/2 decreases monotonically to floor(sqrt(n)) (two or
-     * three steps from this start).  bound: 70 iterations.               */
-    {
-        unsigned bits = 64u + ct_bitlen64(n.hi), s;
-        uint64_t top;
-        s = (bits - 61u) / 2u + 1u; /* 2s >= bits - 62, 2s < 64 + ... */
-        if (2u * s >= 64u) {
-            top = n.hi >> (2u * s - 64u);
-        } else {
-            top = (n.lo >> (2u * s)) | (n.hi << (64u - 2u * s));
-        }
-        x = (ct_isqrt64(top) + 1u) << s;
+    /* n < 2^127: bitlen(hi) in [1, 63], e in [0, 31] */
+    e = (64u - ct_bitlen64(n.hi)) / 2u;
+    N = e > 0u ? ct_i128_shl(n, 2u * e) : n;
+    s1 = isqrt64_norm(N.hi);
+    /* N_hi - S1^2 <= 2 S1 < 2^33: R / 2^33 = (N_hi - S1^2) 2^31 + N_lo / 2^33 */
+    dh = N.hi - s1 * s1;
+    q = ((dh << 31) | (N.lo >> 33)) / s1; /* <= 2^32 + 1 */
+    hi = s1 << 32;
+    y = q > ~hi ? ~(uint64_t)0 : hi + q;
+    sq = ct_umul64(y, y);
+    if (sq.hi > N.hi || (sq.hi == N.hi && sq.lo > N.lo)) {
+        y--;
     }
-    /* One Newton step from x0 lands within a few units of the root: x0 is
-     * within 2^s of it (relative 2^-29), so the step's error is at most
-     * 2^2s / 2^(30+s) = 2^(s-30) <= 8 (s <= 33), plus 2 for the floors and
-     * the +1.  The result is then fixed by exact squares (128-bit products:
-     * y < 2^63).  bound: 16 + 16 fix-ups; if they do not suffice (they
-     * always do by the argument above), the Newton loop below finishes. */
-    if (n.hi < x) {
-        uint64_t y = (x >> 1) + (udiv128(n.hi, n.lo, x, &rem) >> 1) + 1u;
-        int ok = 0;
-        for (k = 0; k < 16; ++k) {
-            ct_i128 sq = ct_umul64(y, y);
-            if (ct_i128_cmp(sq, n) <= 0) {
-                ok = 1;
-                break;
-            }
-            y--;
-        }
-        if (ok) {
-            for (k = 0; k < 16; ++k) {
-                ct_i128 sq = ct_umul64(y + 1u, y + 1u);
-                if (ct_i128_cmp(sq, n) > 0) {
-                    return y;
-                }
-                y++;
-            }
-        }
-    }
-    for (k = 0; k < 70; ++k) {
-        uint64_t y;
-        if (n.hi >= x) {
-            /* n / x does not fit: x far too small, cannot happen from above */
-            break;
-        }
-        q = udiv128(n.hi, n.lo, x, &rem);
-        y = (x >> 1) + (q >> 1) + ((x & q) & 1u);
-        if (y >= x) {
-            break;
-        }
-        x = y;
-    }
-    return x;
+    return y >> e;
 }
 
 /* ------------------------------------------------------------------------ */

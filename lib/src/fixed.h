@@ -374,9 +374,9 @@ static inline int ct_i128_round_div_lim(ct_i128 n, int64_t d, int64_t lim, int64
     *q = ct_i128_round_div(n, d);
     return 1;
 }
-/* floor(sqrt(n)) for 0 <= n < 2^126.                                         */
+/* floor(sqrt(n)) for n < 2^127 (0 for n <= 0); no 64-bit division.          */
 uint64_t ct_i128_isqrt(ct_i128 n);
-/* floor(sqrt(n)) for 64-bit n.                                               */
+/* floor(sqrt(n)) for 64-bit n; only 32-bit divisions.                       */
 uint64_t ct_isqrt64(uint64_t n);
 
 /* Integer cos/sin of 2*pi*k/n in units of 2^30 (|error| < 2^-28 of full
