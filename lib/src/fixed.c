@@ -102,8 +102,8 @@ int64_t ct_i128_floor_div_sat(ct_i128 n, int64_t d)
     return ct_i128_floor_div(n, d);
 }
 
-/* Integer square roots without a 64-bit division (a library call of 100-200
- * instructions on Cortex-M0/M4): floor(sqrt(a)) of a 32-bit a by Newton's
+/* Integer square roots without a 64-bit division (a library call on
+ * Cortex-M0/M4, about 50 instructions on M4): floor(sqrt(a)) of a 32-bit a by Newton's
  * iteration with 32-bit divisions, then each doubling of the width by one
  * Newton step from below, whose error is at most one unit.
  *
@@ -114,8 +114,9 @@ int64_t ct_i128_floor_div_sat(ct_i128 n, int64_t d)
  * 2 floored, decreases monotonically to floor(sqrt(a)) and never passes
  * below it, so the first x with x^2 <= a is the answer: from 0.8 % the
  * error is below 2^-14 after one step and 2^-28 after two (under a unit),
- * plus the floors: at most three steps (every a of each table segment's
- * ends and random ones: test_fixed).  bound: 8 steps. */
+ * plus the floors: at most two steps for every a in [2^30, 2^32) (a
+ * throwaway exhaustive run; test_fixed checks each table segment's ends at
+ * every scale).  bound: 8 steps. */
 static uint32_t isqrt32_norm(uint32_t a)
 {
     uint32_t t = ct_isqrt_top8[(a >> 24) - 64u];
@@ -160,7 +161,7 @@ uint64_t ct_isqrt64(uint64_t n)
 
 /* floor(sqrt(n)) of a 128-bit n (0 for n <= 0): n >= 2^64 scaled by 4^e
  * into N in [2^126, 2^128) (2e <= 62), S1 = floor(sqrt(N_hi)) in [2^31,
- * 2^32) puts N's root in [X0, X0 + 2^32), X0 = S1 2^64 / 2^32 >= 2^63, and
+ * 2^32) puts N's root in [X0, X0 + 2^32), X0 = S1 2^32 >= 2^63, and
  * one Newton step from below, X0 + floor(R / (2 X0)) with R = N - X0^2 <
  * (2 S1 + 1) 2^64 < 2^97, is the root or one more (as isqrt64_norm's):
  * floor(floor(R / 2^33) / S1), R / 2^33 < 2^64, one 64-bit division;
@@ -182,7 +183,7 @@ uint64_t ct_i128_isqrt(ct_i128 n)
     s1 = isqrt64_norm(N.hi);
     /* N_hi - S1^2 <= 2 S1 < 2^33: R / 2^33 = (N_hi - S1^2) 2^31 + N_lo / 2^33 */
     dh = N.hi - s1 * s1;
-    q = ((dh << 31) | (N.lo >> 33)) / s1; /* <= 2^32 + 1 */
+    q = ((dh << 31) | (N.lo >> 33)) / s1; /* <= 2^32 */
     hi = s1 << 32;
     y = q > ~hi ? ~(uint64_t)0 : hi + q;
     sq = ct_umul64(y, y);
