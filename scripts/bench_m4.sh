@@ -13,12 +13,10 @@
 # Environment: CT_M4_OPT (default -Os, as the flight builds of make cross).
 set -u
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
+. "$ROOT/scripts/m4_common.sh"
 BUILD=${1:-$ROOT/build}
 N=${2:-100}
-PREFIX=${CT_ARM_PREFIX:-arm-none-eabi-}
-QEMU=${CT_QEMU:-qemu-system-arm}
-OPT=${CT_M4_OPT:--Os}
-if ! command -v "${PREFIX}gcc" >/dev/null 2>&1 || ! command -v "$QEMU" >/dev/null 2>&1; then
+if ! m4_tools; then
     echo "bench_m4: ${PREFIX}gcc or $QEMU not found (scripts/deps.sh installs them); skipped"
     exit 0
 fi
@@ -27,12 +25,7 @@ GEN="$BUILD/bench/ct_gen_m4_data"
 OUT="$BUILD/bench/m4"
 mkdir -p "$OUT"
 "$GEN" "$OUT/bench_m4_data.c" "$N" || { echo "bench_m4: ct_gen_m4_data failed" >&2; exit 1; }
-M="$ROOT/tests/mcu"
-FLAGS="-mcpu=cortex-m4 -mthumb -mfloat-abi=soft -std=c99 -ffreestanding $OPT -Wall -Wextra -Werror -fno-builtin -fno-tree-loop-distribute-patterns"
-"${PREFIX}gcc" $FLAGS -I"$ROOT/lib/include" -I"$ROOT/lib/src" -I"$M" -I"$ROOT/bench/m4" \
-    -nostdlib -nostartfiles -T"$M/mps2.ld" -Wl,--gc-sections \
-    "$M/startup.c" "$ROOT/bench/m4/bench_m4.c" "$OUT/bench_m4_data.c" "$ROOT"/lib/src/*.c -lgcc \
-    -o "$OUT/bench_m4.elf" || { echo "bench_m4: Cortex-M4 build failed" >&2; exit 1; }
+m4_link "$OUT/bench_m4.elf" "$ROOT/bench/m4/bench_m4.c" "$OUT/bench_m4_data.c" ||
+    { echo "bench_m4: Cortex-M4 build failed" >&2; exit 1; }
 printf "bench_m4: %s build, %s rays per family\n" "$OPT" "$N"
-timeout 600 "$QEMU" -M mps2-an386 -icount shift=0 -nographic -monitor none -serial null \
-    -semihosting-config enable=on,target=native -kernel "$OUT/bench_m4.elf"
+m4_run 600 "$OUT/bench_m4.elf"

@@ -1,7 +1,8 @@
 #!/bin/sh
 # profile_m4.sh -- Cortex-M4 instructions per function of ct_geolocate
 # (bench/m4/profile_m4.c under qemu mps2-an386, single-stepped with the exec
-# log, -Os as the flight builds): the baked scene of bench_m4.sh, the
+# log, -Os as the flight builds, or CT_M4_OPT; toolchain and flags from
+# scripts/m4_common.sh, as bench_m4.sh): the baked scene of bench_m4.sh, the
 # effects FX (0 straight, 1 sphere, 2 the true Earth exact, 3 fitted per
 # call, 4 a kept map), N pixels one by one or in one batch (B = 1).  Prints
 # the functions with the most executed instructions between the two calls
@@ -11,14 +12,13 @@
 #   scripts/profile_m4.sh <build-dir> [FX] [N] [B] [top]
 set -u
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
+. "$ROOT/scripts/m4_common.sh"
 BUILD=${1:-$ROOT/build}
 FX=${2:-2}
 N=${3:-4}
 B=${4:-0}
 TOP=${5:-30}
-PREFIX=${CT_ARM_PREFIX:-arm-none-eabi-}
-QEMU=${CT_QEMU:-qemu-system-arm}
-if ! command -v "${PREFIX}gcc" >/dev/null 2>&1 || ! command -v "$QEMU" >/dev/null 2>&1; then
+if ! m4_tools; then
     echo "profile_m4: ${PREFIX}gcc or $QEMU not found (scripts/deps.sh installs them)" >&2
     exit 1
 fi
@@ -27,15 +27,9 @@ GEN="$BUILD/bench/ct_gen_m4_data"
 OUT=$(mktemp -d)
 trap 'rm -rf "$OUT"' EXIT
 "$GEN" "$OUT/data.c" 100 >/dev/null || { echo "profile_m4: ct_gen_m4_data failed" >&2; exit 1; }
-M="$ROOT/tests/mcu"
-FLAGS="-mcpu=cortex-m4 -mthumb -mfloat-abi=soft -std=c99 -ffreestanding -Os -Wall -Wextra -Werror -fno-builtin -fno-tree-loop-distribute-patterns"
-"${PREFIX}gcc" $FLAGS -DPROFILE_FX="$FX" -DPROFILE_PIXELS="$N" -DPROFILE_BATCH="$B" -I"$ROOT/lib/include" \
-    -I"$ROOT/lib/src" -I"$M" -I"$ROOT/bench/m4" -nostdlib -nostartfiles -T"$M/mps2.ld" -Wl,--gc-sections \
-    "$M/startup.c" "$ROOT/bench/m4/profile_m4.c" "$OUT/data.c" "$ROOT"/lib/src/*.c -lgcc -o "$OUT/p.elf" ||
-    { echo "profile_m4: build failed" >&2; exit 1; }
-timeout 1200 "$QEMU" -M mps2-an386 -icount shift=0 -nographic -monitor none -serial null \
-    -semihosting-config enable=on,target=native -kernel "$OUT/p.elf" -singlestep -d exec,nochain -D "$OUT/log" \
-    >/dev/null 2>&1
+m4_link "$OUT/p.elf" "$ROOT/bench/m4/profile_m4.c" "$OUT/data.c" -DPROFILE_FX="$FX" -DPROFILE_PIXELS="$N" \
+    -DPROFILE_BATCH="$B" || { echo "profile_m4: build failed" >&2; exit 1; }
+m4_run 1200 "$OUT/p.elf" -singlestep -d exec,nochain -D "$OUT/log" >/dev/null 2>&1
 # count each function's executed instructions between the first and the
 # second entry into profile_begin (each exec-log line: one instruction)
 awk -v top="$TOP" '
