@@ -179,7 +179,7 @@ uint64_t ct_i128_isqrt(ct_i128 n)
     }
     /* n < 2^127: bitlen(hi) in [1, 63], e in [0, 31] */
     e = (64u - ct_bitlen64(n.hi)) / 2u;
-    N = e > 0u ? ct_i128_shl(n, 2u * e) : n;
+    N = ct_i128_shl(n, 2u * e); /* 2e <= 62 (0: n itself) */
     s1 = isqrt64_norm(N.hi);
     /* N_hi - S1^2 <= 2 S1 < 2^33: R / 2^33 = (N_hi - S1^2) 2^31 + N_lo / 2^33 */
     dh = N.hi - s1 * s1;

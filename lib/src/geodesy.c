@@ -87,23 +87,21 @@ static int64_t even_series(int64_t x, const int64_t *c, int n)
 /* Series coefficients (Q59, rounded): 1/(2k+1)! with alternating sign
  * (sin), 1/(2k)! (cos), the same without signs (sinh, cosh), 1/(2k+1)
  * (atanh; alternating: atan), asinh's (-1)^k (2k)! / (4^k k!^2 (2k+1)). */
-#define NS 12
-static const int64_t c_sin[NS] = {
-    INT64_C(576460752303423488), -INT64_C(96076792050570581), INT64_C(4803839602528529),
-    -INT64_C(114377133393536),   INT64_C(1588571297132),      -INT64_C(14441557247),
-    INT64_C(92574085),           -INT64_C(440829),            INT64_C(1621),
-    -INT64_C(5),                 INT64_C(0),                  INT64_C(0)};
-static const int64_t c_cos[NS] = {
-    INT64_C(576460752303423488), -INT64_C(288230376151711744), INT64_C(24019198012642645),
-    -INT64_C(800639933754755),   INT64_C(14297141674192),      -INT64_C(158857129713),
-    INT64_C(1203463104),         -INT64_C(6612437),            INT64_C(27552),
-    -INT64_C(90),                INT64_C(0),                   INT64_C(0)};
+#define NS 10
+static const int64_t c_sin[NS] = {INT64_C(576460752303423488), -INT64_C(96076792050570581), INT64_C(4803839602528529),
+                                  -INT64_C(114377133393536),   INT64_C(1588571297132),      -INT64_C(14441557247),
+                                  INT64_C(92574085),           -INT64_C(440829),            INT64_C(1621),
+                                  -INT64_C(5)};
+static const int64_t c_cos[NS] = {INT64_C(576460752303423488), -INT64_C(288230376151711744), INT64_C(24019198012642645),
+                                  -INT64_C(800639933754755),   INT64_C(14297141674192),      -INT64_C(158857129713),
+                                  INT64_C(1203463104),         -INT64_C(6612437),            INT64_C(27552),
+                                  -INT64_C(90)};
 
-/* sin and cos of |r| <= pi/4 (Q59): Taylor to r^21 / r^20, error < 2^-60 */
+/* sin and cos of |r| <= pi/4 (Q59): Taylor to r^19 / r^18, error < 2^-60 */
 static void sincos_small(int64_t r, int64_t *s, int64_t *c)
 {
-    *s = odd_series(r, c_sin, 10);
-    *c = even_series(r, c_cos, 10);
+    *s = odd_series(r, c_sin, NS);
+    *c = even_series(r, c_cos, NS);
 }
 
 /* sin, cos of |x| <= pi (Q59): quadrant reduction by pi/2 */
@@ -194,7 +192,9 @@ static int64_t asinh_small(int64_t x)
     return odd_series(x, asinh_c, 14); /* t_k ~ (2k)! / (4^k k!^2) */
 }
 
-/* sinh and cosh of |x| <= 0.2: 12 terms each */
+/* sinh and cosh of |x| <= 0.2: 10 terms each, sin's and cos's without
+ * their signs (atanh_c is atan_c's magnitudes the same way, kept as its own
+ * table: a sign per term in the series' loop costs more than these) */
 static void sinhcosh_small(int64_t x, int64_t *sh, int64_t *ch)
 {
     int64_t cs[NS], cc[NS];
@@ -203,8 +203,8 @@ static void sinhcosh_small(int64_t x, int64_t *sh, int64_t *ch)
         cs[k] = ct_abs64(c_sin[k]);
         cc[k] = ct_abs64(c_cos[k]);
     }
-    *sh = odd_series(x, cs, 10);
-    *ch = even_series(x, cc, 10);
+    *sh = odd_series(x, cs, NS);
+    *ch = even_series(x, cc, NS);
 }
 
 /* tau' from tau = sin / cos of the latitude (Karney's taupf):
