@@ -853,6 +853,97 @@ void test_grid_evil()
     TEST_ASSERT_EQUAL_INT(CT_ERR_LENS, ct_camera_init(&cam, &l));
 }
 
+// A grid of nu x nv nodes whose rays turn by step_deg per node along u and
+// along v (about two axes), plus a zig-zag of zig_deg by the parity of i + j.
+static std::vector<int32_t> turning_grid(uint32_t nu, uint32_t nv, double step_deg, double zig_deg)
+{
+    std::vector<int32_t> t(3 * (size_t)nu * nv);
+    const double d2r = 3.14159265358979323846 / 180;
+    for (uint32_t j = 0; j < nv; ++j)
+        for (uint32_t i = 0; i < nu; ++i) {
+            const double a = ((double)i - nu / 2.0) * step_deg * d2r + ((i + j) % 2 ? zig_deg : -zig_deg) * d2r / 2;
+            const double b = ((double)j - nv / 2.0) * step_deg * d2r;
+            const double r[3] = {std::sin(a) * std::cos(b), std::sin(b), std::cos(a) * std::cos(b)};
+            for (int k = 0; k < 3; ++k) t[3 * ((size_t)j * nu + i) + k] = (int32_t)std::llround(r[k] * 1073741824.0);
+        }
+    return t;
+}
+
+// A smooth grid (every node a ray, neighbours within 5 deg: grid_smooth)
+// skips the per-pixel checks, which it cannot fail: on grids turning by
+// nearly 5 deg per node, and zig-zagging, every pixel's ray equals the one
+// the checks pass (the same camera with grid_smooth cleared) and lies
+// within 60 deg of its 16 nodes; just beyond 5 deg, or with a node
+// without a ray, the grid is not smooth.
+void test_grid_smooth()
+{
+    struct G {
+        double step, zig;
+        int smooth;
+    };
+    const G gs[] = {{4.99, 0.0, 1}, {0.0, 4.99, 1}, {2.4, 2.4, 1}, {0.5, 0.0, 1},
+                    {5.02, 0.0, 0}, {0.0, 5.02, 0}, {20.0, 0.0, 0}, {0.0, 40.0, 0}};
+    ct_rng rng;
+    ct_rng_seed(&rng, ct_test_seed() * 41 + 3);
+    for (const G &gd : gs) {
+        const uint32_t nu = 12, nv = 9;
+        std::vector<int32_t> t = turning_grid(nu, nv, gd.step, gd.zig);
+        ct_unproject_grid g;
+        g.nu = nu;
+        g.nv = nv;
+        g.u0_q16 = -(INT64_C(16) << 16);
+        g.v0_q16 = INT64_C(5) << 16;
+        g.step_q16 = INT64_C(16) << 16;
+        g.rays_q30 = t.data();
+        g.rays_len = t.size();
+        ct_camera cam, checked;
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_camera_init_grid(&cam, &g));
+        TEST_ASSERT_MSG((int)cam.grid_smooth == gd.smooth, "turning %.2f, zig-zag %.2f deg: grid_smooth %u", gd.step,
+                        gd.zig, cam.grid_smooth);
+        checked = cam;
+        checked.grid_smooth = 0u;
+        long ok = 0;
+        for (int k = 0; k < 4000; ++k) {
+            // pixels over the grid's whole support and a little beyond
+            const int64_t u = g.u0_q16 + (int64_t)((ct_rng_unit(&rng) * (nu + 1) - 1) * g.step_q16);
+            const int64_t v = g.v0_q16 + (int64_t)((ct_rng_unit(&rng) * (nv + 1) - 1) * g.step_q16);
+            int32_t r1[3], r2[3];
+            const ct_status s1 = ct_camera_unproject(&cam, u, v, r1, nullptr);
+            const ct_status s2 = ct_camera_unproject(&checked, u, v, r2, nullptr);
+            TEST_ASSERT_MSG(s1 == s2 && (s1 != CT_OK || (r1[0] == r2[0] && r1[1] == r2[1] && r1[2] == r2[2])),
+                            "pixel (%lld, %lld): %d (%d %d %d) against the checked %d (%d %d %d)", (long long)u,
+                            (long long)v, (int)s1, r1[0], r1[1], r1[2], (int)s2, r2[0], r2[1], r2[2]);
+            if (s1 != CT_OK) continue;
+            ++ok;
+            // within 60 deg of the 16 nodes around it (by the double-precision dot)
+            const int64_t i = (u - g.u0_q16) / g.step_q16, j = (v - g.v0_q16) / g.step_q16;
+            double worst = 1;
+            for (int64_t b = j - 1; b <= j + 2; ++b)
+                for (int64_t a = i - 1; a <= i + 2; ++a) {
+                    const int32_t *n = &t[3 * (size_t)(b * nu + a)];
+                    double dot = 0;
+                    for (int c = 0; c < 3; ++c) dot += (double)n[c] * r1[c] / 1073741824.0 / 1073741824.0;
+                    worst = std::min(worst, dot);
+                }
+            TEST_ASSERT_MSG(worst > 0.5, "pixel (%lld, %lld): %.1f deg from a node", (long long)u, (long long)v,
+                            std::acos(worst) * 180 / 3.14159265358979323846);
+        }
+        // the support (cells 1 .. n - 3) is 9/13 x 6/10 of the pixels drawn
+        TEST_ASSERT_MSG(ok > 1400, "turning %.2f deg: only %ld of 4000 pixels unprojected", gd.step, ok);
+    }
+    // the baked lenses are smooth; a node without a ray makes a grid not
+    ct_host::BakedGrid b = ct_host::bake_grid(splined_model(), 32);
+    ct_camera cam;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_camera_init_grid(&cam, &b.grid));
+    TEST_ASSERT_EQUAL_INT(1, (int)cam.grid_smooth);
+    std::vector<int32_t> t = *b.rays;
+    ct_unproject_grid g = b.grid;
+    g.rays_q30 = t.data();
+    t[3 * 40] = t[3 * 40 + 1] = t[3 * 40 + 2] = 0;
+    TEST_ASSERT_EQUAL_INT(CT_OK, ct_camera_init_grid(&cam, &g));
+    TEST_ASSERT_EQUAL_INT(0, (int)cam.grid_smooth);
+}
+
 // ---- pose ---------------------------------------------------------------
 
 void mat_mrcal(const ld r[3], double R[9])
@@ -1071,6 +1162,7 @@ int main()
     RUN_TEST(test_unproject_max_iters);
     RUN_TEST(test_grid_accuracy_vs_step);
     RUN_TEST(test_grid_evil);
+    RUN_TEST(test_grid_smooth);
     RUN_TEST(test_rodrigues_vs_mrcal);
     RUN_TEST(test_rotations_from_axes);
     RUN_TEST(test_pose_vs_mrcal);

@@ -730,6 +730,8 @@ typedef struct {
     int64_t r2_max_q32;        /* valid field: x^2 + y^2 <= r2_max (Q32)     */
     ct_unproject_grid grid;    /* CT_LENS_GRID only                         */
     uint32_t ready;            /* set by ct_camera_init                      */
+    uint32_t grid_smooth;      /* set by ct_camera_init_grid: every node a
+                                  ray, neighbours within 5 deg              */
 } ct_camera;
 
 /* Camera pose: centre in the map frame and R_map_cam.                      */

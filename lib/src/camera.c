@@ -436,6 +436,48 @@ ct_status ct_camera_project(const ct_camera *cam, const int32_t ray[3], int64_t 
 #define GRID_T_BITS 20u
 #define GRID_STEP_MAX (INT64_C(4096) << 16)
 
+/* cos 5 deg in Q60, rounded up */
+#define GRID_COS5_Q60 INT64_C(1148534290205298930)
+
+/* 1 when every node is a ray and each lies within 5 deg of its right and
+ * lower neighbours (Q60 dot products of nodes of length 1 +- 2^-20, each
+ * < 2^60.0001: |dot| < 2^61.1 in 64 bits; such a dot >= cos 5 deg means
+ * an angle below 5.001 deg).  Then grid_unproject's per-pixel checks
+ * cannot fail, and it skips them: the 4 x 4 nodes around a pixel are
+ * within 4 hops, so within alpha = 20.004 deg of its node (i, j), c.  The
+ * Catmull-Rom weights of one axis sum to 1 with negative ones of at most
+ * t (1 - t) / 2 <= 1/8 in all; the 16 products w_a w_b sum to 1 with
+ * S = sum |w| <= (1 + 1/4)^2 = 1.5625, so their positive part P <= 1.2813
+ * and negative part N <= 0.2813.  V = sum w r has V.c >= P cos alpha - N
+ * >= 0.9225 (a unit r has r.c in [cos alpha, 1]) and a part across c of at
+ * most S sin alpha <= 0.5346, so V is within atan(0.5346 / 0.9225) = 30.1
+ * deg of c and 50.1 deg of each node: the 60 deg check holds with 9 deg to
+ * spare (the rounding of weights, rows and the result is below 2^-28 rad),
+ * and |V| > 0.92, far from the half unit the length check asks.
+ * bound: nu nv nodes. */
+static uint32_t grid_is_smooth(const ct_unproject_grid *g)
+{
+    uint32_t i, j;
+    for (j = 0u; j < g->nv; ++j) {
+        for (i = 0u; i < g->nu; ++i) {
+            const int32_t *r = g->rays_q30 + 3u * (j * g->nu + i);
+            const int32_t *e = r + 3u, *s = r + 3u * g->nu;
+            if (r[0] == 0 && r[1] == 0 && r[2] == 0) {
+                return 0u;
+            }
+            if (i + 1u < g->nu &&
+                (int64_t)r[0] * e[0] + (int64_t)r[1] * e[1] + (int64_t)r[2] * e[2] < GRID_COS5_Q60) {
+                return 0u;
+            }
+            if (j + 1u < g->nv &&
+                (int64_t)r[0] * s[0] + (int64_t)r[1] * s[1] + (int64_t)r[2] * s[2] < GRID_COS5_Q60) {
+                return 0u;
+            }
+        }
+    }
+    return 1u;
+}
+
 ct_status ct_camera_init_grid(ct_camera *cam, const ct_unproject_grid *g)
 {
     uint32_t k, n;
@@ -470,6 +512,7 @@ ct_status ct_camera_init_grid(ct_camera *cam, const ct_unproject_grid *g)
             return CT_ERR_LENS;
         }
     }
+    cam->grid_smooth = grid_is_smooth(g);
     cam->lens.model = CT_LENS_GRID;
     cam->lens.width = cam->lens.height = 0u;
     cam->lens.fx_q32 = cam->lens.fy_q32 = cam->lens.cx_q32 = cam->lens.cy_q32 = 0;
@@ -541,7 +584,7 @@ static ct_status grid_unproject(const ct_camera *c, int64_t u, int64_t v, int32_
         int64_t acc[3] = {0, 0, 0};
         for (a = 0u; a < 4u; ++a) {
             const int32_t *r = rowp + 3u * a;
-            if (r[0] == 0 && r[1] == 0 && r[2] == 0) {
+            if (!c->grid_smooth && r[0] == 0 && r[1] == 0 && r[2] == 0) {
                 return CT_ERR_UNPROJECT; /* a node without a ray */
             }
             acc[0] += wu[a] * r[0];
@@ -581,9 +624,9 @@ static ct_status grid_unproject(const ct_camera *c, int64_t u, int64_t v, int32_
         out[k] = V[k] < 0 ? -m : m;
     }
     /* the result must lie within 60 deg of each of its 16 nodes (cos >=
-     * 1/2: dot >= 2^59 in Q60; products < 2^61, sums < 2^63).
-     * bound: 4 x 4 nodes */
-    for (b = 0u; b < 4u; ++b) {
+     * 1/2: dot >= 2^59 in Q60; products < 2^61, sums < 2^63); on a smooth
+     * grid it does (grid_is_smooth).  bound: 4 x 4 nodes */
+    for (b = 0u; b < 4u && !c->grid_smooth; ++b) {
         for (a = 0u; a < 4u; ++a) {
             const int32_t *r = g->rays_q30 + 3u * ((j + b - 1u) * g->nu + (i - 1u + a));
             int64_t dot = (int64_t)r[0] * out[0] + (int64_t)r[1] * out[1] + (int64_t)r[2] * out[2];
