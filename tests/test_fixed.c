@@ -1,7 +1,8 @@
 /*
  * test_fixed.c -- fixed-point helpers against independent references:
  * 128-bit arithmetic against the compiler's __int128 (the library is built
- * twice, native and CT_PORTABLE_INT128, and this test links each), integer
+ * twice, native and CT_PORTABLE_INT128, and this test is compiled and
+ * linked with each: fixed.h's inline operations too), integer
  * square roots against long double, the cot table against long double cot,
  * sector boundary vectors against cos/sin (exact on axes and diagonals),
  * CRC-32 against the standard check value, sector selection against the
@@ -34,7 +35,8 @@ static int64_t rand_bits(int bits)
 static void test_i128_hard_values(void)
 {
     const int64_t hard[] = {0, 1, -1, 2, -2, INT64_MAX, INT64_MIN + 1, (int64_t)1 << 62, -((int64_t)1 << 62),
-                            ((int64_t)1 << 32) - 1, (int64_t)1 << 32, -((int64_t)1 << 32), 0x7fffffffll, -0x80000000ll};
+                            ((int64_t)1 << 32) - 1, (int64_t)1 << 32, -((int64_t)1 << 32), 0x7fffffffll, -0x80000000ll,
+                            INT64_MIN, -((int64_t)1 << 32) + 1, ((int64_t)1 << 32) + 1, -0x1ffffffffll, (int64_t)0xffffffff00000001ll};
     size_t n = sizeof hard / sizeof hard[0], a, b;
     for (a = 0; a < n; ++a) {
         for (b = 0; b < n; ++b) {

@@ -1262,6 +1262,15 @@ void make_fixed(std::vector<ct_vec_fixed> *out_fx, std::vector<ct_vec_dir> *out_
             if (k == 1) { v.a = INT64_MAX; v.b = -INT64_MAX; }
             if (k == 2) { v.a = 0; v.b = -5; }
             if (k == 3) { v.a = -1; v.b = 1; }
+            // the two's complement corrections of the product's high word
+            // (fixed.h: every sign, the most negative word, carries through
+            // all four partial products)
+            if (k == 5) { v.a = INT64_MIN; v.b = INT64_MIN; }
+            if (k == 6) { v.a = INT64_MIN; v.b = -1; }
+            if (k == 7) { v.a = INT64_MIN; v.b = INT64_MAX; }
+            if (k == 8) { v.a = -1; v.b = -1; }
+            if (k == 10) { v.a = -(INT64_C(1) << 32) + 1; v.b = (INT64_C(1) << 32) - 1; }
+            if (k == 11) { v.a = -(INT64_C(0xffffffff)); v.b = -(INT64_C(0x100000001)); }
             ct_i128 p = ct_i128_mul(v.a, v.b);
             v.mul_hi = p.hi;
             v.mul_lo = p.lo;
