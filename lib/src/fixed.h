@@ -276,12 +276,13 @@ CT_MUL_INLINE static inline ct_i128 ct_umul64(uint64_t a, uint64_t b)
 
 static inline uint64_t ct_uabs64(int64_t a) { return a < 0 ? (uint64_t)0 - (uint64_t)a : (uint64_t)a; }
 
-/* a b, 64 x 64 -> 128 bits.  ct_i128_mul_inl is always inlined when
- * optimising, except on Cortex-M0 (CT_MUL_INLINE), for the hot loop that
- * calls it most: geodesy's Q59 product; ct_i128_mul, everywhere else, is
- * left to the compiler (inlined at all of its call sites it would add 16 KB
- * of flash on Cortex-M4).                                                  */
-CT_MUL_INLINE static inline ct_i128 ct_i128_mul_inl(int64_t a, int64_t b)
+/* a b, 64 x 64 -> 128 bits, always inlined when optimising, except on
+ * Cortex-M0 (CT_MUL_INLINE), where each 32 x 32-bit product is a library
+ * call.  On Cortex-M4 the UMAAL product (ct_umul64) and the sign
+ * corrections are ~16 instructions in line against a call that returns
+ * the 16-byte result through memory: 5-6 % fewer instructions per pixel
+ * and ray for 6.7 KB more flash (bench_m4; docs/benchmarks.md).          */
+CT_MUL_INLINE static inline ct_i128 ct_i128_mul(int64_t a, int64_t b)
 {
 #ifdef CT_NATIVE_INT128
     return ct_from_n((ct_n128)a * (ct_n128)b);
@@ -294,7 +295,6 @@ CT_MUL_INLINE static inline ct_i128 ct_i128_mul_inl(int64_t a, int64_t b)
 #endif
 }
 
-static inline ct_i128 ct_i128_mul(int64_t a, int64_t b) { return ct_i128_mul_inl(a, b); }
 
 static inline ct_i128 ct_i128_mul128_64(ct_i128 a, int64_t b)
 {

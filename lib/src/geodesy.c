@@ -34,7 +34,7 @@
 /* a * b in Q59, rounded: |a b| < 2^63 * 2^59 */
 static int64_t qmul(int64_t a, int64_t b)
 {
-    return ct_i128_round_shr(ct_i128_mul_inl(a, b), QB);
+    return ct_i128_round_shr(ct_i128_mul(a, b), QB);
 }
 
 /* a / b in Q59 (b != 0, |a / b| < 16), floored: a 2^59 < 2^126 */
