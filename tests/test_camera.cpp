@@ -854,15 +854,16 @@ void test_grid_evil()
 }
 
 // A grid of nu x nv nodes whose rays turn by step_deg per node along u and
-// along v (about two axes), plus a zig-zag of zig_deg by the parity of i + j.
-static std::vector<int32_t> turning_grid(uint32_t nu, uint32_t nv, double step_deg, double zig_deg)
+// step_v_deg along v (about two axes), plus a zig-zag of zig_deg by the
+// parity of i + j.
+static std::vector<int32_t> turning_grid(uint32_t nu, uint32_t nv, double step_deg, double step_v_deg, double zig_deg)
 {
     std::vector<int32_t> t(3 * (size_t)nu * nv);
     const double d2r = 3.14159265358979323846 / 180;
     for (uint32_t j = 0; j < nv; ++j)
         for (uint32_t i = 0; i < nu; ++i) {
             const double a = ((double)i - nu / 2.0) * step_deg * d2r + ((i + j) % 2 ? zig_deg : -zig_deg) * d2r / 2;
-            const double b = ((double)j - nv / 2.0) * step_deg * d2r;
+            const double b = ((double)j - nv / 2.0) * step_v_deg * d2r;
             const double r[3] = {std::sin(a) * std::cos(b), std::sin(b), std::cos(a) * std::cos(b)};
             for (int k = 0; k < 3; ++k) t[3 * ((size_t)j * nu + i) + k] = (int32_t)std::llround(r[k] * 1073741824.0);
         }
@@ -878,16 +879,17 @@ static std::vector<int32_t> turning_grid(uint32_t nu, uint32_t nv, double step_d
 void test_grid_smooth()
 {
     struct G {
-        double step, zig;
+        double step, step_v, zig;
         int smooth;
     };
-    const G gs[] = {{4.99, 0.0, 1}, {0.0, 4.99, 1}, {2.4, 2.4, 1}, {0.5, 0.0, 1},
-                    {5.02, 0.0, 0}, {0.0, 5.02, 0}, {20.0, 0.0, 0}, {0.0, 40.0, 0}};
+    const G gs[] = {{4.99, 4.99, 0.0, 1}, {0.0, 0.0, 4.99, 1}, {2.4, 2.4, 2.4, 1}, {0.5, 0.5, 0.0, 1},
+                    {5.02, 5.02, 0.0, 0}, {0.0, 0.0, 5.02, 0}, {1.0, 5.02, 0.0, 0}, {20.0, 20.0, 0.0, 0},
+                    {0.0, 0.0, 40.0, 0}};
     ct_rng rng;
     ct_rng_seed(&rng, ct_test_seed() * 41 + 3);
     for (const G &gd : gs) {
         const uint32_t nu = 12, nv = 9;
-        std::vector<int32_t> t = turning_grid(nu, nv, gd.step, gd.zig);
+        std::vector<int32_t> t = turning_grid(nu, nv, gd.step, gd.step_v, gd.zig);
         ct_unproject_grid g;
         g.nu = nu;
         g.nv = nv;

@@ -192,24 +192,16 @@ ct_status ct_in_wedge(const int32_t *bound_x, const int32_t *bound_y,
     return CT_OK;
 }
 
-/* half(v): 0 for angles in [0, 180), 1 for [180, 360). */
+/* half(v): 0 for angles in [0, 180), 1 for [180, 360).  angle(b) <=
+ * angle(d), an exact total order on [0, 360), is half(b) < half(d), or the
+ * same half and b x d >= 0. */
 static int half_of(int64_t x, int64_t y) { return (y < 0 || (y == 0 && x < 0)) ? 1 : 0; }
-
-/* angle(b) <= angle(d), exact total order on [0, 360). */
-static int angle_le(int64_t bx, int64_t by, int64_t dx, int64_t dy)
-{
-    int hb = half_of(bx, by), hd = half_of(dx, dy);
-    if (hb != hd) {
-        return hb < hd;
-    }
-    return (bx * dy - by * dx) >= 0;
-}
 
 ct_status ct_sector_of(const ct_package *pkg, int64_t dx, int64_t dy,
                        uint32_t *out_sector)
 {
-    uint32_t lo, hi, n, inside = 0u;
-    ct_status st;
+    uint32_t lo, hi, n;
+    int hd;
     CT_ASSERT(pkg != NULL && out_sector != NULL);
     if (pkg == NULL || out_sector == NULL) {
         return CT_ERR_ARG;
@@ -223,28 +215,27 @@ ct_status ct_sector_of(const ct_package *pkg, int64_t dx, int64_t dy,
         *out_sector = 0u;
         return CT_OK;
     }
-    /* Largest k in [0, n) with angle(b_k) <= angle(d): b_0 is +x (angle 0),
-     * so k exists.  bound: log2(64) + 1 halvings.                          */
+    /* Largest k in [0, n) with angle(b_k) <= angle(d) (d's half formed
+     * once): b_0 is +x (angle 0), so k exists.  The boundaries are
+     * ct_sector_boundary's (ct_package_open), in increasing angle, so the
+     * search ends with angle(b_lo) <= angle(d) < angle(b_lo+1): d lies in
+     * the closed wedge lo, ct_in_wedge's test, which the builder uses
+     * (test_fixed's test_sector_of checks both for every N); on b_lo
+     * exactly it is in wedge lo - 1 as well, and either is valid.
+     * bound: log2(64) + 1 halvings.                                        */
+    hd = half_of(dx, dy);
     lo = 0u;
     hi = n; /* invariant: angle(b_lo) <= angle(d), and b_hi > d or hi == n */
     while (hi - lo > 1u) {
         uint32_t mid = (lo + hi) / 2u;
-        if (angle_le(pkg->bound_x[mid], pkg->bound_y[mid], dx, dy)) {
+        int64_t bx = pkg->bound_x[mid], by = pkg->bound_y[mid];
+        int hb = half_of(bx, by);
+        /* |b|, |d| <= 2^30: each product < 2^60 */
+        if (hb != hd ? hb < hd : bx * dy - by * dx >= 0) {
             lo = mid;
         } else {
             hi = mid;
         }
-    }
-    /* The closed wedge holds d by construction; prefer the lower index when
-     * d lies exactly on b_lo (it is then in sector lo - 1 as well).  Either
-     * wedge is valid; the exact test decides, and the same test is used by
-     * the builder.                                                        */
-    st = ct_in_wedge(pkg->bound_x, pkg->bound_y, n, lo, dx, dy, &inside);
-    if (st != CT_OK) {
-        return st;
-    }
-    if (!inside) {
-        return CT_ERR_INTERNAL;
     }
     *out_sector = lo;
     return CT_OK;
