@@ -731,7 +731,8 @@ typedef struct {
     ct_unproject_grid grid;    /* CT_LENS_GRID only                         */
     uint32_t ready;            /* set by ct_camera_init                      */
     uint32_t grid_smooth;      /* set by ct_camera_init_grid: every node a
-                                  ray, neighbours within 5 deg              */
+                                  ray, neighbours within 5 deg (0 for a
+                                  closed-form lens)                         */
 } ct_camera;
 
 /* Camera pose: centre in the map frame and R_map_cam.                      */

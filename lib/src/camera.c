@@ -318,6 +318,7 @@ ct_status ct_camera_init(ct_camera *cam, const ct_lens *lens)
         return CT_ERR_ARG;
     }
     cam->ready = 0u;
+    cam->grid_smooth = 0u; /* no grid */
     st = lens_check(lens);
     if (st != CT_OK) {
         return st;
@@ -460,18 +461,23 @@ static uint32_t grid_is_smooth(const ct_unproject_grid *g)
     uint32_t i, j;
     for (j = 0u; j < g->nv; ++j) {
         for (i = 0u; i < g->nu; ++i) {
+            /* node k = j nu + i < nu nv <= 2^28, its neighbours' indices
+             * formed only where they exist */
             const int32_t *r = g->rays_q30 + 3u * (j * g->nu + i);
-            const int32_t *e = r + 3u, *s = r + 3u * g->nu;
             if (r[0] == 0 && r[1] == 0 && r[2] == 0) {
                 return 0u;
             }
-            if (i + 1u < g->nu &&
-                (int64_t)r[0] * e[0] + (int64_t)r[1] * e[1] + (int64_t)r[2] * e[2] < GRID_COS5_Q60) {
-                return 0u;
+            if (i + 1u < g->nu) {
+                const int32_t *e = g->rays_q30 + 3u * (j * g->nu + i + 1u);
+                if ((int64_t)r[0] * e[0] + (int64_t)r[1] * e[1] + (int64_t)r[2] * e[2] < GRID_COS5_Q60) {
+                    return 0u;
+                }
             }
-            if (j + 1u < g->nv &&
-                (int64_t)r[0] * s[0] + (int64_t)r[1] * s[1] + (int64_t)r[2] * s[2] < GRID_COS5_Q60) {
-                return 0u;
+            if (j + 1u < g->nv) {
+                const int32_t *s = g->rays_q30 + 3u * ((j + 1u) * g->nu + i);
+                if ((int64_t)r[0] * s[0] + (int64_t)r[1] * s[1] + (int64_t)r[2] * s[2] < GRID_COS5_Q60) {
+                    return 0u;
+                }
             }
         }
     }

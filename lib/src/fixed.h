@@ -295,7 +295,6 @@ CT_MUL_INLINE static inline ct_i128 ct_i128_mul(int64_t a, int64_t b)
 #endif
 }
 
-
 static inline ct_i128 ct_i128_mul128_64(ct_i128 a, int64_t b)
 {
 #ifdef CT_NATIVE_INT128
