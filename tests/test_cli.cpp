@@ -1230,7 +1230,7 @@ static void test_big_dem(void)
     TEST_ASSERT_MSG(listing(d) == (std::set<std::string>{"big.tif", "mosaic"}), "left beside: {%s}", join(listing(d)).c_str());
     TEST_ASSERT_MSG(listing(d + "/mosaic") == (std::set<std::string>{"set_0_0", "set_0_1", "set_1_0", "set_1_1"}),
                     "mosaic: {%s}", join(listing(d + "/mosaic")).c_str());
-    // each set's manifest: its grid and merged size (7 tiles of 4,096 cells, then 3 for the last 11,327)
+    // each set's manifest: its grid and merged size (7 tiles of 4,096 cells, then 2 for the last 4,327)
     const int tiles[2] = {7, 2}, posts[2] = {7 * 4096 + 1, kBigW - 7 * 4096};
     for (int by = 0; by < 2; ++by)
         for (int bx = 0; bx < 2; ++bx) {

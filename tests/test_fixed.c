@@ -36,7 +36,7 @@ static void test_i128_hard_values(void)
 {
     const int64_t hard[] = {0, 1, -1, 2, -2, INT64_MAX, INT64_MIN + 1, (int64_t)1 << 62, -((int64_t)1 << 62),
                             ((int64_t)1 << 32) - 1, (int64_t)1 << 32, -((int64_t)1 << 32), 0x7fffffffll, -0x80000000ll,
-                            INT64_MIN, -((int64_t)1 << 32) + 1, ((int64_t)1 << 32) + 1, -0x1ffffffffll, (int64_t)0xffffffff00000001ll};
+                            INT64_MIN, -((int64_t)1 << 32) + 1, ((int64_t)1 << 32) + 1, -0x1ffffffffll, INT64_MIN + 0xffffffffll};
     size_t n = sizeof hard / sizeof hard[0], a, b;
     for (a = 0; a < n; ++a) {
         for (b = 0; b < n; ++b) {
