@@ -590,9 +590,6 @@ static ct_status grid_unproject(const ct_camera *c, int64_t u, int64_t v, int32_
         int64_t acc[3] = {0, 0, 0};
         for (a = 0u; a < 4u; ++a) {
             const int32_t *r = rowp + 3u * a;
-            if (!c->grid_smooth && r[0] == 0 && r[1] == 0 && r[2] == 0) {
-                return CT_ERR_UNPROJECT; /* a node without a ray */
-            }
             acc[0] += wu[a] * r[0];
             acc[1] += wu[a] * r[1];
             acc[2] += wu[a] * r[2];
@@ -630,14 +627,17 @@ static ct_status grid_unproject(const ct_camera *c, int64_t u, int64_t v, int32_
         out[k] = V[k] < 0 ? -m : m;
     }
     /* the result must lie within 60 deg of each of its 16 nodes (cos >=
-     * 1/2: dot >= 2^59 in Q60; products < 2^61, sums < 2^63); on a smooth
-     * grid it does (grid_is_smooth).  bound: 4 x 4 nodes */
-    for (b = 0u; b < 4u && !c->grid_smooth; ++b) {
-        for (a = 0u; a < 4u; ++a) {
-            const int32_t *r = g->rays_q30 + 3u * ((j + b - 1u) * g->nu + (i - 1u + a));
-            int64_t dot = (int64_t)r[0] * out[0] + (int64_t)r[1] * out[1] + (int64_t)r[2] * out[2];
-            if (dot < (INT64_C(1) << 59)) {
-                return CT_ERR_UNPROJECT;
+     * 1/2: dot >= 2^59 in Q60; products < 2^61, sums < 2^63), which also
+     * refuses a node without a ray (dot 0); on a smooth grid it does
+     * (grid_is_smooth).  bound: 4 x 4 nodes */
+    if (!c->grid_smooth) {
+        for (b = 0u; b < 4u; ++b) {
+            for (a = 0u; a < 4u; ++a) {
+                const int32_t *r = g->rays_q30 + 3u * ((j + b - 1u) * g->nu + (i - 1u + a));
+                int64_t dot = (int64_t)r[0] * out[0] + (int64_t)r[1] * out[1] + (int64_t)r[2] * out[2];
+                if (dot < (INT64_C(1) << 59)) {
+                    return CT_ERR_UNPROJECT;
+                }
             }
         }
     }

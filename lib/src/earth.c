@@ -338,11 +338,10 @@ CT_NOINLINE static void fit_eval(const ct_earth_map *mp, const int64_t D[3], int
     /* V[a][b] = round(U_a(s_x) U_b(s_y) / 2^30) for a + b <= deg (|U| <=
      * 2^30 + 2^8: products < 2^61, |V| <= 2^30 + 2^9).  U, V, the terms
      * (<= 2^30 + 2^10) and cf' (<= 2^27) all fit 32 bits: their products
-     * are written as 32 x 32 -> 64-bit ones (one SMULL or SMLAL on
-     * Cortex-M4, where a 64-bit product is three multiplies) */
+     * are 32 x 32 -> 64-bit ones (ct_smul32) */
     for (t = 0; t <= deg; ++t) {         /* bound: CT_EARTH_MAP_DEG + 1 */
         for (k = 0; t + k <= deg; ++k) { /* bound: CT_EARTH_MAP_DEG + 1 */
-            V[t][k] = rshr64((int64_t)(int32_t)U[0][t] * (int32_t)U[1][k], 30u);
+            V[t][k] = rshr64(ct_smul32(U[0][t], U[1][k]), 30u);
         }
     }
     for (k = 3; k <= deg; ++k) { /* bound: CT_EARTH_MAP_DEG - 2 */
@@ -352,10 +351,10 @@ CT_NOINLINE static void fit_eval(const ct_earth_map *mp, const int64_t D[3], int
         /* term_abc's order within a degree: a, then b (c = k - a - b) */
         for (ea = 0; ea <= k; ++ea) {          /* bound: CT_EARTH_MAP_DEG + 1 */
             for (eb = 0; ea + eb <= k; ++eb) { /* bound: CT_EARTH_MAP_DEG + 1 */
-                int32_t ttt = (int32_t)rshr64((int64_t)(int32_t)V[ea][eb] * (int32_t)U[2][k - ea - eb], 30u);
-                s0 += (int64_t)(int32_t)cf[0][0] * ttt;
-                s1 += (int64_t)(int32_t)cf[0][1] * ttt;
-                s2 += (int64_t)(int32_t)cf[0][2] * ttt;
+                int64_t ttt = rshr64(ct_smul32(V[ea][eb], U[2][k - ea - eb]), 30u);
+                s0 += ct_smul32(cf[0][0], ttt);
+                s1 += ct_smul32(cf[0][1], ttt);
+                s2 += ct_smul32(cf[0][2], ttt);
                 cf++;
             }
         }
@@ -805,8 +804,8 @@ static const uint8_t cub_less[10][3] = {{0, 0, 4}, {0, 4, 5}, {0, 5, 6}, {0, 6, 
  * in am (Q62) and a in Q30 (aq): |.| <= 2^30 + 2. */
 CT_OPT_INLINE static inline int64_t quart_mono(const int64_t am[20], const int64_t aq[3], int t)
 {
-    /* both factors <= 2^30 + 2: a 32 x 32 -> 64-bit product (fit_eval) */
-    return rshr64((int64_t)(int32_t)rshr64(am[quart_parent[t]], 32u) * (int32_t)aq[quart_axis[t]], 30u);
+    /* both factors <= 2^30 + 2: ct_smul32 */
+    return rshr64(ct_smul32(rshr64(am[quart_parent[t]], 32u), aq[quart_axis[t]]), 30u);
 }
 
 /* The quartic Taylor term of a degree-4 fit along x(tau) = tau a - tau^2 b
@@ -865,14 +864,14 @@ CT_NOINLINE static int taylor_alone(const ct_package *pk, const ct_earth_map *mp
         d1[t] = 0;
         for (i = 0; i < 3; ++i) { /* bound: 3 axes */
             if (e[i] > 0) {
-                d1[t] += (int64_t)e[i] * rshr64((int64_t)(int32_t)bq[i] * (int32_t)rshr64(am[cub_less[t][i]], 32u), 30u);
+                d1[t] += (int64_t)e[i] * rshr64(ct_smul32(bq[i], rshr64(am[cub_less[t][i]], 32u)), 30u);
             }
         }
     }
     for (o = 0; o < 3; ++o) { /* bound: 3 coordinates */
         int64_t u = 0;
         for (t = 0; t < 15; ++t) { /* bound: 15 terms: G_4(a) */
-            u += (int64_t)(int32_t)mp->cf[tay_row(20 + t)][o] * (int32_t)a4[t]; /* < 2^27, <= 2^30 + 2 */
+            u += ct_smul32(mp->cf[tay_row(20 + t)][o], a4[t]); /* < 2^27, <= 2^30 + 2 */
         }
         for (t = 0; bent && t < 10; ++t) { /* bound: 10 terms: - E_31 */
             u -= mp->cf[tay_row(10 + t)][o] * d1[t];

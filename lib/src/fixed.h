@@ -274,6 +274,11 @@ CT_MUL_INLINE static inline ct_i128 ct_umul64(uint64_t a, uint64_t b)
     return r;
 }
 
+/* a b for |a|, |b| < 2^31 (the caller's bound): a 32 x 32 -> 64-bit
+ * product, one SMULL or SMLAL on Cortex-M4, where a 64-bit one is three
+ * multiplies. */
+static inline int64_t ct_smul32(int64_t a, int64_t b) { return (int64_t)(int32_t)a * (int32_t)b; }
+
 static inline uint64_t ct_uabs64(int64_t a) { return a < 0 ? (uint64_t)0 - (uint64_t)a : (uint64_t)a; }
 
 /* a b, 64 x 64 -> 128 bits, always inlined when optimising, except on

@@ -90,7 +90,7 @@ CT_ALWAYS_INLINE static inline void rect_exit(const ctx *c, int32_t xf, int32_t 
     } else if (c->sx == 0) {
         *face = FACE_Y;
     } else {
-        int64_t lx = (int64_t)(int32_t)nx * (int32_t)c->ady, ly = (int64_t)(int32_t)ny * (int32_t)c->adx;
+        int64_t lx = ct_smul32(nx, c->ady), ly = ct_smul32(ny, c->adx);
         *face = lx < ly ? FACE_X : (ly < lx ? FACE_Y : FACE_XY);
     }
     if (*face == FACE_Y) {
