@@ -29,7 +29,7 @@ command -v "$CC" >/dev/null 2>&1 || { echo "fuzz: $CC not found (scripts/deps.sh
 mkdir -p "$OUT"
 . "$ROOT/tests/fuzz/common.sh"
 fuzz_corpus "$ROOT"/tests/fuzz/corpus ct_fuzz
-FLAGS="-g -O1 -std=c99 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all -fno-sanitize-coverage=trace-cmp"
+FLAGS="-g1 -O1 -std=c99 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all -fno-sanitize-coverage=trace-cmp"
 if ! "$CC" $FLAGS -I"$ROOT/lib/include" -I"$ROOT/lib/src" -I"$ROOT/tests/mcu" \
         "$ROOT/tests/fuzz/fuzz_lib.c" "$VEC" "$ROOT"/lib/src/*.c -o "$OUT/fuzz_lib" 2>"$OUT/build.log"; then
     if grep -q "fuzzer" "$OUT/build.log" && ! grep -q "error:" "$OUT/build.log"; then

@@ -7,7 +7,7 @@
 # The readers' sources (host_tools/) and lib/ are compiled here with the
 # sanitizers; OpenImageIO, libtiff, libgeotiff and libmrcal are the system's
 # (not instrumented for coverage; ASan still sees their heap).  Seeds:
-# tests/fuzz/corpus_host/.  `make test` runs 100,000 inputs or 120 s from the
+# tests/fuzz/corpus_host/.  `make test` runs 100,000 inputs or 60 s from the
 # seeds with a fixed seed (one process; the DEM reader makes it ~2,000 inputs
 # per second); `make fuzz` runs 10^7 inputs (or FUZZ_HOST_SECONDS, default
 # 3600) in fork mode with one worker per core (FUZZ_JOBS) and keeps its corpus in
@@ -30,7 +30,7 @@ mkdir -p "$OUT/obj"
 . "$ROOT/tests/fuzz/common.sh"
 fuzz_corpus "$ROOT"/tests/fuzz/corpus_host ct_fuzz_host
 
-SAN="-g -O1 -fsanitize=address,undefined -fno-sanitize-recover=all"
+SAN="-g1 -O1 -fsanitize=address,undefined -fno-sanitize-recover=all"
 H="$ROOT/host_tools"
 INC="-I$ROOT/lib/include -I$H/core -I$H/io -I$H/dem_io -I$H/camera -I$ROOT/tests/kit -isystem /usr/include/geotiff"
 # a libFuzzer check first (a missing runtime is a skip, not a failure)
