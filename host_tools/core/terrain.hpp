@@ -148,6 +148,8 @@ public:
     virtual ~PackageSink() = default;
     virtual void write(const uint8_t *p, size_t n) = 0;
     virtual void patch(size_t offset, const uint8_t *p, size_t n) = 0;
+    // the package's size, told before the first write (a buffer reserves it)
+    virtual void size_hint(size_t) {}
 };
 
 // The package (header, heights, mipmap, apex, angles, voids, CRC), streamed

