@@ -542,6 +542,56 @@ static void test_png16(void)
 }
 
 // ---------------------------------------------------------------------------
+// DemRows (a mosaic's reader) over tiled TIFFs: rows read tile by tile,
+// partial tiles at the right and bottom edges, starts within a tile row
+
+static void test_rows_tiled(void)
+{
+    const uint32_t W = 100, H = 75, T = 32;  // 4 x 3 tiles, the last column and row partial
+    for (int deflate = 0; deflate < 2; ++deflate) {
+        const std::string path = tmp_path(deflate ? "rows_tiled_z.tif" : "rows_tiled.tif");
+        TIFF *t = XTIFFOpen(path.c_str(), "w");
+        TEST_ASSERT(t != nullptr);
+        TEST_ASSERT(TIFFSetField(t, TIFFTAG_IMAGEWIDTH, W) && TIFFSetField(t, TIFFTAG_IMAGELENGTH, H) &&
+                    TIFFSetField(t, TIFFTAG_SAMPLESPERPIXEL, (uint16_t)1) &&
+                    TIFFSetField(t, TIFFTAG_BITSPERSAMPLE, (uint16_t)16) &&
+                    TIFFSetField(t, TIFFTAG_SAMPLEFORMAT, (uint16_t)SAMPLEFORMAT_INT) &&
+                    TIFFSetField(t, TIFFTAG_PHOTOMETRIC, (uint16_t)PHOTOMETRIC_MINISBLACK) &&
+                    TIFFSetField(t, TIFFTAG_PLANARCONFIG, (uint16_t)PLANARCONFIG_CONTIG) &&
+                    TIFFSetField(t, TIFFTAG_COMPRESSION,
+                                 (uint16_t)(deflate ? COMPRESSION_ADOBE_DEFLATE : COMPRESSION_NONE)) &&
+                    TIFFSetField(t, TIFFTAG_TILEWIDTH, T) && TIFFSetField(t, TIFFTAG_TILELENGTH, T));
+        // post (i, j) = (37 i + 101 j) % 4001 - 2000; a tile's posts past the
+        // image's edge hold 30000, which must never be read
+        for (uint32_t ty = 0; ty < H; ty += T)
+            for (uint32_t tx = 0; tx < W; tx += T) {
+                std::vector<int16_t> px((size_t)T * T, (int16_t)30000);
+                for (uint32_t v = 0; v < T && ty + v < H; ++v)
+                    for (uint32_t u = 0; u < T && tx + u < W; ++u)
+                        px[(size_t)v * T + u] = (int16_t)((37 * (tx + u) + 101 * (ty + v)) % 4001 - 2000);
+                TEST_ASSERT(TIFFWriteTile(t, px.data(), tx, ty, 0, 0) > 0);
+            }
+        XTIFFClose(t);
+        ct_host::DemRows rows(path);
+        TEST_ASSERT_EQUAL_INT((int)W, rows.header().width);
+        TEST_ASSERT_EQUAL_INT((int)H, rows.header().height);
+        const int spans[][2] = {{0, 75}, {0, 1}, {31, 2}, {32, 32}, {33, 40}, {74, 1}, {10, 65}, {64, 11}};
+        std::vector<double> h;
+        std::vector<uint8_t> valid;
+        for (const auto &sp : spans) {
+            rows.read(sp[0], sp[1], h, valid);
+            TEST_ASSERT_EQUAL_INT(sp[1] * (int)W, (int)h.size());
+            for (int j = 0; j < sp[1]; ++j)
+                for (int i = 0; i < (int)W; ++i) {
+                    const double want = (double)((37 * i + 101 * (sp[0] + j)) % 4001 - 2000);
+                    TEST_ASSERT_MSG(h[(size_t)j * W + i] == want, "%s rows %d+%d: post (%d, %d) = %g, expected %g",
+                                    path.c_str(), sp[0], sp[1], i, sp[0] + j, h[(size_t)j * W + i], want);
+                }
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------
 // errors
 
 // A TIFF of w x h float32 posts, deflated, in tiles of tw x th posts (one
@@ -817,6 +867,7 @@ int main(void)
     RUN_TEST(test_georef_variants);
     RUN_TEST(test_native_sample_types);
     RUN_TEST(test_png16);
+    RUN_TEST(test_rows_tiled);
     RUN_TEST(test_read_errors);
     RUN_TEST(test_write_errors);
     RUN_TEST(test_fixture_jacksboro);

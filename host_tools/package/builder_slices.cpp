@@ -218,10 +218,11 @@ constexpr int RING_SIDE = 2 * FINE_RING + 1, RING_GROUPS = RING_SIDE * RING_SIDE
 
 // Consecutive fine-ring offsets (in mfine's order) in one coarse cell of the
 // ring and one row: a cell skips a run whose coarse cell does not rise above
-// its apex with one test (per offset, that test was the near and window
-// terms' most mispredicted branch), and tests the tile's edges per run when
-// the whole run lies inside.  The offsets keep their order: the same terms
-// in the same sequence, the same codes.
+// its apex with one test instead of one per offset, and tests the tile's
+// edges once per run when the whole run lies inside (near and window terms
+// of a 4097^2 tile at r = 8: 0.68 -> 0.46 s; at r = 3, runs of 3, no
+// change).  The offsets keep their order: the same terms in the same
+// sequence, the same codes.
 struct FineRun {
     size_t first, last;  // offsets [first, last) of mfine.offs
     int group;           // the coarse cell, an index into alive[]
