@@ -2,7 +2,7 @@
 # Install the Debian packages conetrace needs, if any is missing.
 # Runs apt-get as root, or through sudo.  Idempotent and quiet when all present.
 set -e
-PKGS="cmake make g++ gcc clang libclang-rt-14-dev valgrind
+PKGS="cmake make ninja-build g++ gcc clang libclang-rt-14-dev valgrind
       libopenimageio-dev libgeotiff-dev libtiff-dev libpng-dev
       gcc-arm-none-eabi libnewlib-arm-none-eabi qemu-system-arm
       libembree-dev python3-numpy python3-mpmath python-matplotlib-data python3-matplotlib
