@@ -366,6 +366,19 @@ static void test_sector_boundaries(void)
     }
 }
 
+/* CRC-32 (IEEE) one bit at a time from the reflected polynomial: no tables */
+static uint32_t crc32_bitwise(uint32_t crc, const uint8_t *p, size_t n)
+{
+    uint32_t c = ~crc;
+    size_t i;
+    int b;
+    for (i = 0; i < n; ++i) {
+        c ^= p[i];
+        for (b = 0; b < 8; ++b) c = (c >> 1) ^ (0xEDB88320u & (0u - (c & 1u)));
+    }
+    return ~c;
+}
+
 static void test_crc32(void)
 {
     uint32_t c;
@@ -377,6 +390,28 @@ static void test_crc32(void)
     TEST_ASSERT_EQUAL_INT(CT_OK, ct_crc32(c, msg + 4, 5, &c));
     TEST_ASSERT_EQUAL_UINT64(0xCBF43926u, c);
     TEST_ASSERT_EQUAL_INT(CT_ERR_ARG, ct_crc32(0, NULL, 3, &c));
+    {
+        /* the sliced tables and word loads against the polynomial bit by bit:
+         * every length 0..70 at every start modulo 8 (unaligned words, the
+         * tail of 0..3 bytes), chained at every split, and 100,003 bytes */
+        static uint8_t buf[100011];
+        size_t k, off, len, cut;
+        ct_rng_seed(&rng, ct_test_seed() + 5u);
+        for (k = 0; k < sizeof buf; ++k) buf[k] = (uint8_t)ct_rng_u64(&rng);
+        for (off = 0; off < 8u; ++off)
+            for (len = 0; len <= 70u; ++len) {
+                uint32_t want = crc32_bitwise(0u, buf + off, len), got = 0u;
+                TEST_ASSERT_EQUAL_INT(CT_OK, ct_crc32(0u, buf + off, len, &got));
+                TEST_ASSERT_EQUAL_UINT64(want, got);
+                for (cut = 0; cut <= len; ++cut) {
+                    TEST_ASSERT_EQUAL_INT(CT_OK, ct_crc32(0u, buf + off, cut, &got));
+                    TEST_ASSERT_EQUAL_INT(CT_OK, ct_crc32(got, buf + off + cut, len - cut, &got));
+                    TEST_ASSERT_EQUAL_UINT64(want, got);
+                }
+            }
+        TEST_ASSERT_EQUAL_INT(CT_OK, ct_crc32(0u, buf + 3, 100003u, &c));
+        TEST_ASSERT_EQUAL_UINT64(crc32_bitwise(0u, buf + 3, 100003u), c);
+    }
 }
 
 /* ct_sector_of picks a sector whose closed wedge holds the direction, and

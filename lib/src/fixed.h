@@ -69,7 +69,7 @@ typedef struct {
 } ct_i128;
 
 extern const int64_t ct_cot_q32[256];
-extern const uint32_t ct_crc32_table[256];
+extern const uint32_t ct_crc32_table[4][256];
 extern const uint32_t ct_isqrt_top8[192];
 
 /* floor(a / b) for b > 0. */
