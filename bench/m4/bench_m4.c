@@ -253,7 +253,7 @@ int main(void)
 {
     static const char *const mname[4] = {"incremental", "hierarchical", "cone", "directional"};
     ct_package p;
-    uint32_t f, m, k, t0, cal_ticks, empty;
+    uint32_t f, m, k, t0, cal_ticks, empty, open_ticks;
     uint64_t ipt_q16; /* instructions per tick, Q16 */
     int ok = 1;
     SYST_RVR = 0xFFFFFFu;
@@ -274,7 +274,7 @@ int main(void)
         ct_plat_puts("bench_m4: FAIL: the package does not open\n");
         ct_plat_exit(0);
     }
-    k = ticks_since(t0) - empty;
+    open_ticks = ticks_since(t0) - empty;
     put("cortex-m4 (qemu -icount): fixture N=24 r=3, ");
     put_u(m4_pkg_size, 0u);
     put(" bytes; instructions per tick ");
@@ -284,10 +284,10 @@ int main(void)
     flush();
     /* the open verifies the CRC of every byte: most of its time */
     put("ct_package_open: ");
-    put_u((uint32_t)(((uint64_t)k * ipt_q16) >> 16), 0u);
+    put_u((uint32_t)(((uint64_t)open_ticks * ipt_q16) >> 16), 0u);
     put(" instructions, ");
     {
-        const uint64_t c100 = (((uint64_t)k * ipt_q16) >> 16) * 100u / m4_pkg_size;
+        const uint64_t c100 = (((uint64_t)open_ticks * ipt_q16) >> 16) * 100u / m4_pkg_size;
         put_u(c100 / 100u, 0u);
         put(c100 % 100u < 10u ? ".0" : ".");
         put_u(c100 % 100u, 0u);
