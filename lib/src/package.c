@@ -94,18 +94,6 @@ ct_status ct_package_size(uint32_t width, uint32_t height, uint32_t reduce,
                              &lv, out_size);
 }
 
-/* CT_LD32_ANY(w, p): w = the little-endian word at p, any alignment: one
- * load where the core reads unaligned words in little-endian order (x86,
- * Cortex-M3/M4; gcc and clang), four byte loads elsewhere (Cortex-M0
- * faults on an unaligned word). */
-#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__ &&                               \
-    (defined(__x86_64__) || defined(__i386__) || defined(__ARM_FEATURE_UNALIGNED))
-#define CT_LD32_ANY(w, p) __builtin_memcpy(&(w), (p), 4u)
-#else
-#define CT_LD32_ANY(w, p)                                                                                      \
-    ((w) = (uint32_t)(p)[0] | ((uint32_t)(p)[1] << 8) | ((uint32_t)(p)[2] << 16) | ((uint32_t)(p)[3] << 24))
-#endif
-
 ct_status ct_crc32(uint32_t crc, const uint8_t *data, size_t len, uint32_t *out_crc)
 {
     const uint32_t *t0 = ct_crc32_table[0], *t1 = ct_crc32_table[1], *t2 = ct_crc32_table[2],
@@ -120,9 +108,7 @@ ct_status ct_crc32(uint32_t crc, const uint8_t *data, size_t len, uint32_t *out_
      * into the register, then each of its bytes advanced by the table for
      * the bytes still to come after it.  bound: len / 4 words */
     for (i = 0u; len - i >= 4u; i += 4u) {
-        uint32_t w;
-        CT_LD32_ANY(w, data + i);
-        c ^= w;
+        c ^= ct_ld32(data + i);
         c = t3[c & 0xffu] ^ t2[(c >> 8) & 0xffu] ^ t1[(c >> 16) & 0xffu] ^ t0[c >> 24];
     }
     /* bound: the last len % 4 bytes */
