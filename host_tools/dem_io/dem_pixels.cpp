@@ -141,27 +141,22 @@ void read_dem_pixel_rows(void *handle, int y0, int n, std::vector<double> &h)
         // tiled files in OpenImageIO 2.4), the rows wanted copied out
         const int th = spec.tile_height, t0 = y0 / th * th, t1 = std::min(spec.height, (y0 + n + th - 1) / th * th);
         ri.buf.resize((size_t)spec.width * (size_t)(t1 - t0) * px);
-        if (spec.depth <= 1) {
-            // tile by tile through one buffer of our own: the samples are
-            // already in the format asked for, and read_tiles zeroes and pages
-            // in a fresh buffer of the whole request on every call
-            // (OpenImageIO 2.4; a third of a mosaic's reading)
-            const int tw = spec.tile_width;
-            const size_t tile_row = (size_t)tw * px;
-            ri.tile.resize(tile_row * (size_t)th);
-            ok = true;
-            for (int ty = t0; ty < t1 && ok; ty += th)
-                for (int tx = 0; tx < spec.width && ok; tx += tw) {
-                    ok = ri.in->read_native_tile(0, 0, spec.x + tx, spec.y + ty, spec.z, ri.tile.data());
-                    const size_t w = (size_t)std::min(tw, spec.width - tx) * px;
-                    for (int r = 0; ok && r < std::min(th, spec.height - ty); ++r)
-                        std::memcpy(ri.buf.data() + ((size_t)(ty - t0 + r) * spec.width + tx) * px,
-                                    ri.tile.data() + (size_t)r * tile_row, w);
-                }
-        } else {
-            ok = ri.in->read_tiles(0, 0, spec.x, spec.x + spec.width, spec.y + t0, spec.y + t1, spec.z,
-                                   spec.z + std::max(1, spec.depth), 0, 1, spec.format, ri.buf.data());
-        }
+        // tile by tile through one buffer of our own (volumes are refused
+        // at open): the samples are already in the format asked for, and
+        // read_tiles zeroes and pages in a fresh buffer of the whole request
+        // on every call (OpenImageIO 2.4; a third of a mosaic's reading)
+        const int tw = spec.tile_width;
+        const size_t tile_row = (size_t)tw * px;
+        ri.tile.resize(tile_row * (size_t)th);
+        ok = true;
+        for (int ty = t0; ty < t1 && ok; ty += th)
+            for (int tx = 0; tx < spec.width && ok; tx += tw) {
+                ok = ri.in->read_native_tile(0, 0, spec.x + tx, spec.y + ty, spec.z, ri.tile.data());
+                const size_t w = (size_t)std::min(tw, spec.width - tx) * px;
+                for (int r = 0; ok && r < std::min(th, spec.height - ty); ++r)
+                    std::memcpy(ri.buf.data() + ((size_t)(ty - t0 + r) * spec.width + tx) * px,
+                                ri.tile.data() + (size_t)r * tile_row, w);
+            }
         if (t0 != y0)
             std::memmove(ri.buf.data(), ri.buf.data() + (size_t)(y0 - t0) * spec.width * px, count * px);
     } else {
