@@ -442,6 +442,59 @@ void test_batch_vertical_pixel()
     }
 }
 
+// A grid camera's pixels in a batch, which keeps the grid's column sums
+// for consecutive pixels of one row in one node column: rows crossing node
+// columns both ways, rows a Q16 unit apart (the same node row, another
+// fraction), a row across a node row's boundary, a pixel repeated, and a
+// pixel outside the grid between pixels of one row.  Every method, straight
+// and sphere-bent: every record as ct_geolocate's (the steps aside: the
+// batch's runs).
+void test_batch_grid_rows()
+{
+    World *wd = world();
+    TEST_ASSERT(wd != nullptr);
+    std::vector<Cam> cams = cameras(*wd);
+    const Cam &gc = cams[3];
+    TEST_ASSERT(gc.lib.cam.lens.model == CT_LENS_GRID);
+    std::vector<int64_t> uv;
+    auto px = [&](double u, int64_t vq) {
+        uv.push_back(std::llround(u * 65536));
+        uv.push_back(vq);
+    };
+    const int64_t v0 = std::llround(700.3 * 65536);
+    for (double u = 900; u <= 1000; u += 3.7) px(u, v0);         // across node columns
+    for (double u = 1000; u >= 900; u -= 5.3) px(u, v0);         // and back
+    for (double u = 900; u <= 1000; u += 3.7) px(u, v0 + 1);     // a Q16 unit down
+    px(950, v0 + 1);
+    px(950, v0 + 1);                                             // repeated
+    px(-500, v0 + 1);                                            // outside the grid
+    px(951, v0 + 1);
+    for (int k = 0; k < 40; ++k) px(930 + 0.9 * k, std::llround((707 + 0.5 * k) * 65536));  // down across a node row
+    const size_t n = uv.size() / 2;
+    ct_effects sphere = {CT_EFFECT_CURVATURE | CT_EFFECT_REFRACTION, CT_REFRACTION_K_STD_Q16, CT_EARTH_RADIUS_NM, 0,
+                         nullptr};
+    int errors = 0;
+    for (const ct_effects *fx : {(const ct_effects *)nullptr, (const ct_effects *)&sphere}) {
+        for (int m = 0; m < CT_METHOD_COUNT; ++m) {
+            std::vector<ct_geo> batch(n);
+            TEST_ASSERT_EQUAL_INT(CT_OK, ct_geolocate_batch(&wd->p, &gc.lib.cam, &gc.lib.pose, (ct_method)m, fx,
+                                                            uv.data(), n, batch.data(), n));
+            for (size_t k = 0; k < n; ++k) {
+                ct_geo g;
+                ct_geolocate(&wd->p, &gc.lib.cam, &gc.lib.pose, (ct_method)m, fx, uv[2 * k], uv[2 * k + 1], &g);
+                ct_hit a = g.hit, b = batch[k].hit;
+                a.steps = b.steps = a.iters = b.iters = 0;
+                TEST_ASSERT_MSG(g.status == batch[k].status && std::memcmp(&a, &b, sizeof a) == 0 &&
+                                    std::memcmp(g.ray_cam_q30, batch[k].ray_cam_q30, sizeof g.ray_cam_q30) == 0 &&
+                                    std::memcmp(g.dir_map_q39, batch[k].dir_map_q39, sizeof g.dir_map_q39) == 0,
+                                "%s, method %d, pixel %zu: the batch's record differs", fx ? "sphere" : "straight", m, k);
+                errors += g.status == CT_ERR_UNPROJECT ? 1 : 0;
+            }
+        }
+    }
+    TEST_ASSERT_EQUAL_INT(2 * CT_METHOD_COUNT, errors);  // the one pixel outside the grid, every time
+}
+
 void test_statuses_and_errors()
 {
     World *wd = world();
@@ -673,6 +726,7 @@ int main()
     RUN_TEST(test_occluded_by_wall);
     RUN_TEST(test_statuses_and_errors);
     RUN_TEST(test_batch_vertical_pixel);
+    RUN_TEST(test_batch_grid_rows);
     RUN_TEST(test_effects_choice);
     return TEST_END();
 }

@@ -193,6 +193,22 @@ typedef struct {
  * The pose and the ray are the caller's, checked.                          */
 void ct_pose_rotate_grid(const ct_pose *pose, const int32_t ray_q30[3], int64_t out_q39[3]);
 
+/* A batch's memo of an unprojection grid's column sums (camera.c): the
+ * four columns' Catmull-Rom interpolation along v (Q30, |.| < 2^31.4) for
+ * one pixel row v (Q16) and one node column i.  Consecutive pixels of a row
+ * in one grid cell share them, so they are formed once; the result is the
+ * same integer as without the memo.  valid = 0 before the first pixel.     */
+typedef struct {
+    int64_t v;
+    uint32_t i, valid;
+    int64_t col[4][3];
+} ct_unproject_memo;
+
+/* ct_camera_unproject with a memo (NULL: none); for other lenses than the
+ * grid the memo is not used.                                               */
+ct_status ct_camera_unproject_memo(const ct_camera *cam, int64_t u, int64_t v, int32_t ray[3], uint32_t *iters,
+                                   ct_unproject_memo *memo);
+
 /* A geoid grid's ranges (conetrace.h, the datum section): CT_OK,
  * CT_ERR_DIMS (nodes) or CT_ERR_GEOREF (step, extent, corner); the values
  * pointer is not looked at (geodesy.c).                                     */

@@ -50,7 +50,7 @@ typedef struct {
     int64_t jxx, jxy, jyy;      /* Jacobian (symmetric off-diagonal)       */
 } lens_eval;
 
-static ct_status grid_unproject(const ct_camera *c, int64_t u, int64_t v, int32_t out[3]);
+static ct_status grid_unproject(const ct_camera *c, int64_t u, int64_t v, int32_t out[3], ct_unproject_memo *memo);
 
 static int has_distortion(const ct_lens *l) { return l->model != CT_LENS_PINHOLE; }
 
@@ -356,6 +356,13 @@ ct_status ct_camera_init(ct_camera *cam, const ct_lens *lens)
 
 ct_status ct_camera_unproject(const ct_camera *cam, int64_t u, int64_t v, int32_t ray[3], uint32_t *iters)
 {
+    return ct_camera_unproject_memo(cam, u, v, ray, iters, NULL);
+}
+
+/* Declared in bend.h (geoloc.c's batches pass a memo). */
+ct_status ct_camera_unproject_memo(const ct_camera *cam, int64_t u, int64_t v, int32_t ray[3], uint32_t *iters,
+                                   ct_unproject_memo *memo)
+{
     const ct_lens *l;
     int64_t xt = 0, yt = 0, x, y;
     uint32_t it = 0u;
@@ -372,7 +379,7 @@ ct_status ct_camera_unproject(const ct_camera *cam, int64_t u, int64_t v, int32_
         return CT_ERR_UNPROJECT;
     }
     if (l->model == CT_LENS_GRID) {
-        return grid_unproject(cam, u, v, ray);
+        return grid_unproject(cam, u, v, ray, memo);
     }
     /* x_d = (u 2^16 - cx) 2^32 / fx (all Q32): |u 2^16 - cx| <= 2^53, so
      * the numerator < 2^85; fx <= 2^52 */
@@ -565,44 +572,59 @@ static int grid_axis(int64_t p, int64_t p0, int64_t step, uint32_t n, uint32_t *
 /* Bicubic (Catmull-Rom) interpolation of the 4 x 4 nodes around the pixel,
  * then normalised; all in 64 bits.  Scaling and overflow: nodes |r| <=
  * 2^30 + 2^12 (checked at init), weights Q30 with sum |w| < 2.6 * 2^30, so
- * a row's sum sum_a w_a r_a < 2.6 * 2^60.01 < 2^62 (Q60, doubled), rounded
- * to Q30 (< 2^31.4); the column's sum_b w_b row_b < 2.6 * 2^31.4 * 2^30 <
- * 2^62.8 (Q60, four times the interpolated vector: coherent unit rays give
- * |V| ~ 2^62).  V >> 32 (rounded) leaves |V'_k| < 2^30.8 and |V'|^2 < 3 *
- * 2^61.6 < 2^64 (unsigned).  |V'| shorter than 2^29 means the 16 rays
- * disagree.  The unit result is |V'_k| f / 2^32 with f = floor(2^62 / L),
- * L = |V'| rounded, >= 2^29: f <= 2^33, products < 2^63.8 (unsigned). */
-static ct_status grid_unproject(const ct_camera *c, int64_t u, int64_t v, int32_t out[3])
+ * a column's sum sum_b w_b r_b < 2.6 * 2^60.01 < 2^62 (Q60, doubled),
+ * rounded to Q30 (< 2^31.4); the row's sum sum_a w_a col_a < 2.6 * 2^31.4 *
+ * 2^30 < 2^62.8 (Q60, four times the interpolated vector: coherent unit
+ * rays give |V| ~ 2^62).  V >> 32 (rounded) leaves |V'_k| < 2^30.8 and
+ * |V'|^2 < 3 * 2^61.6 < 2^64 (unsigned).  |V'| shorter than 2^29 means the
+ * 16 rays disagree.  The unit result is |V'_k| f / 2^32 with f = floor(2^62
+ * / L), L = |V'| rounded, >= 2^29: f <= 2^33, products < 2^63.8
+ * (unsigned).  The columns (along v) depend on v and i only: with a memo
+ * for this row and node column they are taken from it. */
+static ct_status grid_unproject(const ct_camera *c, int64_t u, int64_t v, int32_t out[3], ct_unproject_memo *memo)
 {
     const ct_unproject_grid *g = &c->grid;
     uint32_t i, j, a, b, k;
-    int64_t tu, tv, wu[4], wv[4], row[4][3], V[3];
+    int64_t tu, tv, wu[4], V[3];
+    int64_t own[4][3];
+    int64_t (*col)[3] = memo != NULL ? memo->col : own;
     uint64_t l2 = 0u, L, f;
     if (!grid_axis(u, g->u0_q16, g->step_q16, g->nu, &i, &tu) ||
         !grid_axis(v, g->v0_q16, g->step_q16, g->nv, &j, &tv)) {
         return CT_ERR_UNPROJECT;
     }
     cr_weights(tu, wu);
-    cr_weights(tv, wv);
-    /* along u for rows j-1 .. j+2.  bound: 4 x 4 x 3 */
-    for (b = 0u; b < 4u; ++b) {
-        const int32_t *rowp = g->rays_q30 + 3u * ((j + b - 1u) * g->nu + (i - 1u));
-        int64_t acc[3] = {0, 0, 0};
-        for (a = 0u; a < 4u; ++a) {
-            const int32_t *r = rowp + 3u * a;
-            acc[0] += wu[a] * r[0];
-            acc[1] += wu[a] * r[1];
-            acc[2] += wu[a] * r[2];
+    if (memo == NULL || memo->valid == 0u || memo->v != v || memo->i != i) {
+        int64_t wv[4], acc[4][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
+        cr_weights(tv, wv);
+        /* along v for columns i-1 .. i+2, a row of 4 nodes at a time.
+         * bound: 4 x 4 x 3 */
+        for (b = 0u; b < 4u; ++b) {
+            const int32_t *rowp = g->rays_q30 + 3u * ((j + b - 1u) * g->nu + (i - 1u));
+            for (a = 0u; a < 4u; ++a) {
+                const int32_t *r = rowp + 3u * a;
+                acc[a][0] += wv[b] * r[0];
+                acc[a][1] += wv[b] * r[1];
+                acc[a][2] += wv[b] * r[2];
+            }
         }
-        for (k = 0u; k < 3u; ++k) { /* bound: 3 components */
-            row[b][k] = ct_floor_shr(acc[k] + (INT64_C(1) << 29), 30u);
+        /* bound: 4 x 3 */
+        for (a = 0u; a < 4u; ++a) {
+            for (k = 0u; k < 3u; ++k) {
+                col[a][k] = ct_floor_shr(acc[a][k] + (INT64_C(1) << 29), 30u);
+            }
+        }
+        if (memo != NULL) {
+            memo->v = v;
+            memo->i = i;
+            memo->valid = 1u;
         }
     }
-    /* along v, then V' = V / 2^32 rounded.  bound: 3 x 4 */
+    /* along u, then V' = V / 2^32 rounded.  bound: 3 x 4 */
     for (k = 0u; k < 3u; ++k) {
         int64_t acc = 0;
-        for (b = 0u; b < 4u; ++b) {
-            acc += wv[b] * row[b][k];
+        for (a = 0u; a < 4u; ++a) {
+            acc += wu[a] * col[a][k];
         }
         V[k] = ct_floor_shr(acc + (INT64_C(1) << 31), 32u);
         l2 += (uint64_t)(V[k] * V[k]);

@@ -117,8 +117,10 @@ static ct_status setup(const ct_package *p, const ct_camera *cam, const ct_pose 
 }
 
 /* The pixel's record cleared, its ray unprojected and rotated into the
- * map frame (out->ray_cam_q30, out->dir_map_q39). */
-static ct_status pixel_dir(const ct_camera *cam, const ct_pose *pose, int64_t u, int64_t v, ct_geo *out)
+ * map frame (out->ray_cam_q30, out->dir_map_q39); memo: a batch's (NULL
+ * for one pixel). */
+static ct_status pixel_dir(const ct_camera *cam, const ct_pose *pose, int64_t u, int64_t v, ct_unproject_memo *memo,
+                           ct_geo *out)
 {
     ct_status st;
     uint32_t k;
@@ -132,7 +134,7 @@ static ct_status pixel_dir(const ct_camera *cam, const ct_pose *pose, int64_t u,
     out->hit.t_q26 = 0;
     out->hit.cell_x = out->hit.cell_y = -1;
     out->hit.steps = out->hit.iters = 0u;
-    st = ct_camera_unproject(cam, u, v, out->ray_cam_q30, &out->unproject_iters);
+    st = ct_camera_unproject_memo(cam, u, v, out->ray_cam_q30, &out->unproject_iters, memo);
     if (st == CT_OK) {
         st = ct_pose_rotate(pose, out->ray_cam_q30, out->dir_map_q39);
     }
@@ -155,10 +157,10 @@ static void pixel_ray(const ct_package *p, const geo_setup *s, const ct_geo *g, 
 
 /* ts != NULL: trace over the tile set (p is its frame). */
 static ct_status one_pixel(const ct_package *p, ct_tileset *ts, const ct_camera *cam, const ct_pose *pose, ct_method m,
-                           const geo_setup *s, int64_t u, int64_t v, ct_geo *out)
+                           const geo_setup *s, int64_t u, int64_t v, ct_unproject_memo *memo, ct_geo *out)
 {
     ct_ray ray;
-    ct_status st = pixel_dir(cam, pose, u, v, out);
+    ct_status st = pixel_dir(cam, pose, u, v, memo, out);
     if (st == CT_OK && s->earth) {
         /* the map-frame direction without the pose's horizontal scale */
         int64_t dg[3];
@@ -196,15 +198,17 @@ CT_NOINLINE static void run_pixels(const ct_package *p, ct_tileset *ts, const ct
     ct_status st[CT_RUN_MAX];
     size_t idx[CT_RUN_MAX];
     const ct_lower *lw = s->bend.coeff_q16 != 0 ? &s->bent.lw : NULL;
+    ct_unproject_memo memo;
     size_t k = 0u;
     uint32_t n, i;
+    memo.valid = 0u;
     /* bound: count pixels, at least one per pass */
     while (k < count) {
         /* bound: CT_RUN_MAX pixels per run */
         for (n = 0u; k < count && n < CT_RUN_MAX; ++k) {
             ct_geo *g = &out[k];
             ct_ray ray;
-            ct_status sp = pixel_dir(cam, pose, uv_q16[2u * k], uv_q16[2u * k + 1u], g);
+            ct_status sp = pixel_dir(cam, pose, uv_q16[2u * k], uv_q16[2u * k + 1u], &memo, g);
             g->status = sp;
             if (sp != CT_OK) {
                 continue;
@@ -257,7 +261,7 @@ static ct_status geolocate_one(const ct_package *pkg, ct_tileset *ts, const ct_c
         out->status = st;
         return st;
     }
-    return one_pixel(pkg, ts, cam, pose, method, &s, u_q16, v_q16, out);
+    return one_pixel(pkg, ts, cam, pose, method, &s, u_q16, v_q16, NULL, out);
 }
 
 /* ct_geolocate_batch likewise. */
@@ -266,8 +270,10 @@ static ct_status geolocate_many(const ct_package *pkg, ct_tileset *ts, const ct_
                                 ct_geo *out, size_t out_len)
 {
     geo_setup s;
+    ct_unproject_memo memo;
     ct_status st;
     size_t k;
+    memo.valid = 0u;
     if (count > 0u && (uv_q16 == NULL || out == NULL || out_len < count)) {
         return CT_ERR_ARG;
     }
@@ -283,7 +289,7 @@ static ct_status geolocate_many(const ct_package *pkg, ct_tileset *ts, const ct_
     }
     /* bound: count pixels (caller's buffers) */
     for (k = 0u; k < count; ++k) {
-        (void)one_pixel(pkg, ts, cam, pose, method, &s, uv_q16[2u * k], uv_q16[2u * k + 1u], &out[k]);
+        (void)one_pixel(pkg, ts, cam, pose, method, &s, uv_q16[2u * k], uv_q16[2u * k + 1u], &memo, &out[k]);
     }
     return CT_OK;
 }
