@@ -10,7 +10,8 @@
  * the sphere and on the true Earth; each pixel's status, steps and hit must
  * equal the host's, and ct_geolocate_batch over the same pixels gives the
  * per-call set-up; last, straight again with the lens baked into an 8 px
- * unprojection grid (the last row, pixel_row as the others).
+ * unprojection grid (pixel_row as the others), then runs of 8 neighbouring
+ * pixels of a row with the lens, on the sphere and through the grid.
  * Flight software budgets in cycles: on a Cortex-M4 most instructions take
  * one cycle (loads two, taken branches 1-3, divisions 2-12), so cycles are
  * roughly 1.2-1.5x these counts at zero-wait-state memory.
@@ -246,6 +247,13 @@ static int geo_bench(const ct_package *p, uint32_t empty, uint64_t ipt_q16)
         ok = pixel_row(e == 0 ? "straight, rows of 8 px" : "sphere c+r, rows of 8 px", p, &cam, &pose, fx,
                        m4_geo_rows_uv, 64u, 0, empty, ipt_q16) && ok;
     }
+    /* the same runs through the 8 px grid (a batch keeps a row's column
+     * sums within a node column).  bound: 64 pixels */
+    for (k = 0u; k < 64u; ++k) {
+        g_want[k] = m4_geo_grid_rows_px[k];
+    }
+    ok = pixel_row("straight, 8 px grid, rows", p, &gcam, &pose, (const ct_effects *)0, m4_geo_rows_uv, 64u, 0, empty,
+                   ipt_q16) && ok;
     return ok;
 }
 

@@ -78,4 +78,6 @@ extern const m4_grid_pixel m4_geo_grid_px[];
  * ([0]) and on the sphere ([1], m4_geo_effects(1)). */
 extern const int64_t m4_geo_rows_uv[128];
 extern const m4_grid_pixel m4_geo_rows_px[2][64];
+/* The same 64 pixels through the 8 px grid, straight. */
+extern const m4_grid_pixel m4_geo_grid_rows_px[64];
 #endif

@@ -173,6 +173,10 @@ bool geo_data(FILE *f, const ct_package &p)
         std::fprintf(f, " },\n");
     }
     std::fprintf(f, "};\n");
+    // the same rows through the 8 px grid, straight
+    std::fprintf(f, "const m4_grid_pixel m4_geo_grid_rows_px[64] = {\n");
+    for (size_t k = 0; k < 64; ++k) put_grid_pixel(f, p, gcam, pose, nullptr, ruv[2 * k], ruv[2 * k + 1]);
+    std::fprintf(f, "};\n");
     return true;
 }
 

@@ -103,29 +103,27 @@ int64_t ct_i128_floor_div_sat(ct_i128 n, int64_t d)
 }
 
 /* Integer square roots without a 64-bit division (a library call on
- * Cortex-M0/M4, about 50 instructions on M4): floor(sqrt(a)) of a 32-bit a by Newton's
- * iteration with 32-bit divisions, then each doubling of the width by one
- * Newton step from below, whose error is at most one unit.
+ * Cortex-M0/M4, about 50 instructions on M4): floor(sqrt(a)) of a 32-bit a by one
+ * Newton step from a table with a 32-bit division, then each doubling of
+ * the width by one Newton step from below; each step's error is at most
+ * one unit.
  *
  * isqrt32_norm: floor(sqrt(a)) for a in [2^30, 2^32).  The start is the
  * table's T (ct_isqrt_top8, by a's top eight bits: T >= floor(sqrt(m)) for
- * every 64-bit m with those top bits, so ceil(T / 2^16) >= floor(sqrt(a)),
- * and within 0.8 % of it, <= 2^16).  Newton from above, x <- (x + a / x) /
- * 2 floored, decreases monotonically to floor(sqrt(a)) and never passes
- * below it, so the first x with x^2 <= a is the answer: from 0.8 % the
- * error is below 2^-14 after one step and 2^-28 after two (under a unit),
- * plus the floors: at most two steps for every a in [2^30, 2^32) (a
- * throwaway exhaustive run; test_fixed checks each table segment's ends at
- * every scale).  bound: 8 steps. */
+ * every 64-bit m with those top bits, so x0 = ceil(T / 2^16) >=
+ * floor(sqrt(a)), and within 0.8 % of it, <= 2^16).  One Newton step from
+ * above, x1 = (x0 + a / x0) / 2 floored, never goes below floor(sqrt(a))
+ * and exceeds sqrt(a) by at most (x0 - sqrt(a))^2 / (2 x0) <= 256^2 /
+ * (2 * 33024) < 1 (the first segment's, the widest): so x1 is the
+ * root or one more, decided by its square (a throwaway exhaustive run over
+ * every a: 11 % take the decrement; test_fixed checks each table segment's
+ * ends at every scale). */
 static uint32_t isqrt32_norm(uint32_t a)
 {
     uint32_t t = ct_isqrt_top8[(a >> 24) - 64u];
     uint32_t x = (t >> 16) + ((t & 0xffffu) != 0u ? 1u : 0u); /* <= 2^16 */
-    unsigned k;
-    for (k = 0u; k < 8u && (uint64_t)x * x > a; ++k) { /* bound: 8 steps (at most 2 taken) */
-        x = (x + a / x) >> 1; /* x >= 2^15: a / x < 2^17 */
-    }
-    return x;
+    x = (x + a / x) >> 1; /* x >= 2^15: a / x < 2^17 */
+    return (uint64_t)x * x > a ? x - 1u : x;
 }
 
 /* floor(sqrt(m)) for m in [2^62, 2^64).  s1 = floor(sqrt(m_hi)) (m_hi = m /
