@@ -4,7 +4,8 @@
 # log, -Os as the flight builds, or CT_M4_OPT; toolchain and flags from
 # scripts/m4_common.sh, as bench_m4.sh): the baked scene of bench_m4.sh, the
 # effects FX (0 straight, 1 sphere, 2 the true Earth exact, 3 fitted per
-# call, 4 a kept map), N pixels one by one or in one batch (B = 1).  Prints
+# call, 4 a kept map; 5 straight through the 8 px unprojection grid over
+# bench_m4's rows of 8 px), N pixels one by one or in one batch (B = 1).  Prints
 # the functions with the most executed instructions between the two calls
 # of profile_begin, and their total.  Needs the build's ct_gen_m4_data (the
 # data bench_m4.sh bakes).
