@@ -96,6 +96,14 @@ static const int64_t c_cos[NS] = {INT64_C(576460752303423488), -INT64_C(28823037
                                   -INT64_C(800639933754755),   INT64_C(14297141674192),      -INT64_C(158857129713),
                                   INT64_C(1203463104),         -INT64_C(6612437),            INT64_C(27552),
                                   -INT64_C(90)};
+static const int64_t c_sinh[NS] = {INT64_C(576460752303423488), INT64_C(96076792050570581), INT64_C(4803839602528529),
+                                   INT64_C(114377133393536),    INT64_C(1588571297132),     INT64_C(14441557247),
+                                   INT64_C(92574085),           INT64_C(440829),            INT64_C(1621),
+                                   INT64_C(5)};
+static const int64_t c_cosh[NS] = {INT64_C(576460752303423488), INT64_C(288230376151711744), INT64_C(24019198012642645),
+                                   INT64_C(800639933754755),    INT64_C(14297141674192),     INT64_C(158857129713),
+                                   INT64_C(1203463104),         INT64_C(6612437),            INT64_C(27552),
+                                   INT64_C(90)};
 
 /* sin and cos of |r| <= pi/4 (Q59): Taylor to r^19 / r^18, error < 2^-60 */
 static void sincos_small(int64_t r, int64_t *s, int64_t *c)
@@ -192,19 +200,12 @@ static int64_t asinh_small(int64_t x)
     return odd_series(x, asinh_c, 14); /* t_k ~ (2k)! / (4^k k!^2) */
 }
 
-/* sinh and cosh of |x| <= 0.2: 10 terms each, sin's and cos's without
- * their signs (atanh_c is atan_c's magnitudes the same way, kept as its own
- * table: a sign per term in the series' loop costs more than these) */
+/* sinh and cosh of |x| <= 0.2: 10 terms each (c_sinh, c_cosh: sin's and
+ * cos's coefficients without their signs, as atanh_c is atan_c's) */
 static void sinhcosh_small(int64_t x, int64_t *sh, int64_t *ch)
 {
-    int64_t cs[NS], cc[NS];
-    int k;
-    for (k = 0; k < NS; ++k) { /* bound: NS */
-        cs[k] = ct_abs64(c_sin[k]);
-        cc[k] = ct_abs64(c_cos[k]);
-    }
-    *sh = odd_series(x, cs, NS);
-    *ch = even_series(x, cc, NS);
+    *sh = odd_series(x, c_sinh, NS);
+    *ch = even_series(x, c_cosh, NS);
 }
 
 /* tau' from tau = sin / cos of the latitude (Karney's taupf):
@@ -377,19 +378,22 @@ static ct_status forward(const ct_utm *z, int64_t lat_q61, int64_t lon_q61, int6
  * the step is (tau'(tau) - target) w / ((1 - e^2) sqrt(1 + tau'^2)), w =
  * (1 + (1 - e^2) tau^2) / sqrt(1 + tau^2) (<= sqrt(1 + tau^2) < 10; its
  * numerator formed in Q118, < 2^126).  Start tau' / (1 - e^2); the error
- * squares each step: 5 steps reach the Q59 resolution. */
+ * squares each step: 5 steps reach the Q59 resolution.  A step of 0 ends
+ * it (tau unchanged, every later step would be 0 too: the same result);
+ * over the zone, 2 or 3 steps (0.05 % take 4). */
 static int64_t tau_of_taup(int64_t target)
 {
-    int64_t tau = qdiv(target, TM_1ME2);
+    int64_t tau = qdiv(target, TM_1ME2), step = 1;
     int k;
-    for (k = 0; k < 5; ++k) { /* bound: 5 Newton steps */
+    for (k = 0; k < 5 && step != 0; ++k) { /* bound: 5 Newton steps */
         int64_t sec = qhypot(ONE, tau); /* sqrt(1 + tau^2) = 1 / cos(phi) */
         int64_t cphi = qdiv(ONE, sec), sphi = qdiv(tau, sec);
         int64_t tp = taup(sphi, cphi, tau);
         ct_i128 w2 = ct_i128_add(ct_i128_shl(ct_i128_from64(ONE), QB), ct_i128_mul(qmul(TM_1ME2, tau), tau));
         int64_t w = ct_i128_floor_div(w2, sec);
         int64_t d = qmul(TM_1ME2, qhypot(ONE, tp));
-        tau -= qdiv(qmul(tp - target, w), d);
+        step = qdiv(qmul(tp - target, w), d);
+        tau -= step;
     }
     return tau;
 }
