@@ -292,9 +292,22 @@ void test_geoloc_end_to_end()
         TEST_ASSERT(a[k] == b[k]);
         TEST_ASSERT(c2[k] == d[k]);
     }
+    // the same pixels with CRLF line ends, blank lines of blanks, a column
+    // before them and no newline after the last: the same file, byte for byte
+    std::string crlf = "id,u,v\r\n";
+    for (size_t k = 1; k < 10; ++k) {
+        crlf += "x," + rows[k].substr(0, rows[k].find(',', rows[k].find(',') + 1));
+        crlf += k == 3 ? "\r\n \t\r\n" : (k < 9 ? "\r\n" : "");  // a blank line; nothing after the last
+    }
+    spit(g_dir + "/px3.csv", crlf);
+    r = run({"geoloc", "t.ctp", "--camera", "cam.cameramodel", "--pixels", "px3.csv", "-o", "g3.csv"});
+    TEST_ASSERT_MSG(r.code == 0, "exit %d: %s", r.code, r.err.c_str());
+    TEST_ASSERT_MSG(slurp(g_dir + "/g3.csv") == slurp(g_dir + "/g.csv"), "CRLF pixels: another output");
     fs::remove(g_dir + "/g.csv");
     fs::remove(g_dir + "/g2.csv");
+    fs::remove(g_dir + "/g3.csv");
     fs::remove(g_dir + "/px2.csv");
+    fs::remove(g_dir + "/px3.csv");
 }
 
 // --threads: 5,000 pixels (five chunks) give the same file, byte for byte,

@@ -329,9 +329,12 @@ LibCamera lib_camera(const CameraModel &m, const std::string &path, double grid_
 std::vector<PixelRow> read_pixels_csv(const std::string &path)
 {
     std::vector<PixelRow> rows;
-    read_number_csv(path, {"u", "v"}, [&](const double *v, const std::vector<std::string> &text) {
-        rows.push_back(PixelRow{v[0], v[1], text[0], text[1]});
-    });
+    read_number_csv(
+        path, {"u", "v"},
+        [&](const double *v, const std::vector<std::string> &text) {
+            rows.push_back(PixelRow{v[0], v[1], text[0], text[1]});
+        },
+        [&](size_t n) { rows.reserve(n); });
     return rows;
 }
 
@@ -347,17 +350,19 @@ bool pixel_to_q16(double u, double v, int64_t *uq, int64_t *vq)
 void append_nm_decimal(std::string &out, int64_t nm)
 {
     // metres with nine decimals, exact: the digits of |nm| with a point
-    // before the last nine (no printf: this runs once per output value)
+    // before the last nine (no printf: this runs once per output value),
+    // written backwards into buf and appended at once
     uint64_t a = nm < 0 ? (uint64_t)0 - (uint64_t)nm : (uint64_t)nm;
     char buf[32];
-    int n = 0;
-    while (n < 10 || a != 0) {  // at least "0.000000000"
-        if (n == 9) buf[n++] = '.';
-        buf[n++] = (char)('0' + (int)(a % 10u));
+    int n = 32, d = 0;
+    while (d < 10 || a != 0) {  // at least "0.000000000"
+        if (d == 9) buf[--n] = '.';
+        buf[--n] = (char)('0' + (int)(a % 10u));
         a /= 10u;
+        ++d;
     }
-    if (nm < 0) out.push_back('-');
-    while (n > 0) out.push_back(buf[--n]);
+    if (nm < 0) buf[--n] = '-';
+    out.append(buf + n, (size_t)(32 - n));
 }
 
 std::string nm_to_decimal(int64_t nm)

@@ -235,68 +235,65 @@ void choose_effects(Opts &opt, const ct_package &p, const LibCamera &cam, ct_eff
                  ch.chord_nm * 1e-9, names[ch.flags & 3u]);
 }
 
-// The output rows (header first), formatted in chunks on `threads` threads
-// and joined in input order.
-std::string format_rows(const std::vector<PixelRow> &px, const std::vector<uint8_t> &in_range,
-                        const std::vector<ct_geo> &g, const ct_package &p, const ct_package &gp, int threads)
+// Degrees with nine decimals of an angle in Q61 radians (as %.9f would
+// print it, rounded to the nearest 1e-9 degree in long double: no printf
+// per value).
+void append_deg9(std::string &o, int64_t q61)
 {
-    ct_utm zone = {0, 0};
-    const bool utm = ct_utm_zone_of_epsg((int32_t)p.epsg, &zone) == CT_OK;
-    // rows formatted in chunks on the same threads, joined in input order
-    const size_t CH = 1024;
-    std::vector<std::string> parts((px.size() + CH - 1) / CH);
-    parallel_chunks(px.size(), threads, CH, [&](size_t b, size_t e) {
-        std::string &o = parts[b / CH];
-        o.reserve((e - b) * 64);
-        for (size_t k = b; k < e; ++k) {
-            ct_status s = in_range[k] ? g[k].status : CT_ERR_UNPROJECT;
-            o += px[k].u_text;
+    static const long double k = 180e9L / M_PIl / 2305843009213693952.0L;
+    append_nm_decimal(o, std::llroundl((long double)q61 * k));  // an integer of 1e-9 units
+}
+
+// The rows of pixels px[0..n) with their records g[0..n), appended to o.
+void append_rows(std::string &o, const PixelRow *px, const uint8_t *in_range, const ct_geo *g, size_t n,
+                 const ct_package &p, const ct_package &gp, const ct_utm *zone)
+{
+    o.reserve(o.size() + n * 96);
+    for (size_t k = 0; k < n; ++k) {
+        ct_status s = in_range[k] ? g[k].status : CT_ERR_UNPROJECT;
+        o += px[k].u_text;
+        o += ',';
+        o += px[k].v_text;
+        o += ',';
+        o += status_name(s);
+        o += ',';
+        if (s == CT_HIT || s == CT_HIT_VOID) {
+            append_nm_decimal(o, g[k].hit.e_nm);
             o += ',';
-            o += px[k].v_text;
+            append_nm_decimal(o, g[k].hit.n_nm);
             o += ',';
-            o += status_name(s);
+            // h in the DEM's own datum: the package's (ellipsoidal when
+            // the datum is known) less the geoid for EGM96 DEMs
+            int64_t und = 0;
+            const bool geoid_ok = p.vdatum == CT_VDATUM_EGM96 &&
+                                  ct_package_geoid(&gp, g[k].hit.e_nm, g[k].hit.n_nm, &und) == CT_OK;
+            if (p.vdatum == CT_VDATUM_EGM96 && !geoid_ok)
+                o += "nan";
+            else
+                append_nm_decimal(o, g[k].hit.h_nm - und);
             o += ',';
-            if (s == CT_HIT || s == CT_HIT_VOID) {
-                append_nm_decimal(o, g[k].hit.e_nm);
+            o += std::to_string(g[k].hit.steps);
+            int64_t la, lo;
+            if (zone != nullptr && ct_utm_inverse(zone, g[k].hit.e_nm, g[k].hit.n_nm, &la, &lo) == CT_OK) {
                 o += ',';
-                append_nm_decimal(o, g[k].hit.n_nm);
+                append_deg9(o, la);
                 o += ',';
-                // h in the DEM's own datum: the package's (ellipsoidal when
-                // the datum is known) less the geoid for EGM96 DEMs
-                int64_t und = 0;
-                const bool geoid_ok = p.vdatum == CT_VDATUM_EGM96 &&
-                                      ct_package_geoid(&gp, g[k].hit.e_nm, g[k].hit.n_nm, &und) == CT_OK;
-                if (p.vdatum == CT_VDATUM_EGM96 && !geoid_ok)
-                    o += "nan";
-                else
-                    append_nm_decimal(o, g[k].hit.h_nm - und);
-                o += ',';
-                o += std::to_string(g[k].hit.steps);
-                int64_t la, lo;
-                if (utm && ct_utm_inverse(&zone, g[k].hit.e_nm, g[k].hit.n_nm, &la, &lo) == CT_OK) {
-                    char ll[64];
-                    std::snprintf(ll, sizeof ll, ",%.9Lf,%.9Lf", (long double)la * 180 / M_PIl / 2305843009213693952.0L,
-                                  (long double)lo * 180 / M_PIl / 2305843009213693952.0L);
-                    o += ll;
-                } else {
-                    o += ",nan,nan";
-                }
-                o += ',';
-                if (p.vdatum != CT_VDATUM_UNKNOWN)
-                    append_nm_decimal(o, g[k].hit.h_nm);
-                else
-                    o += "nan";
+                append_deg9(o, lo);
             } else {
-                o += "nan,nan,nan,";
-                o += std::to_string(s >= 0 ? g[k].hit.steps : 0u);
-                o += ",nan,nan,nan";
+                o += ",nan,nan";
             }
-            o += '\n';
+            o += ',';
+            if (p.vdatum != CT_VDATUM_UNKNOWN)
+                append_nm_decimal(o, g[k].hit.h_nm);
+            else
+                o += "nan";
+        } else {
+            o += "nan,nan,nan,";
+            o += std::to_string(s >= 0 ? g[k].hit.steps : 0u);
+            o += ",nan,nan,nan";
         }
-    });
-    std::string txt = "u,v,status,E,N,h,steps,lat,lon,h_ell\n";
-    for (const std::string &part : parts) txt += part;
-    return txt;
+        o += '\n';
+    }
 }
 
 }  // namespace
@@ -350,37 +347,48 @@ int cmd_geoloc(int argc, char **argv)
     // a fitted map is set up once per chunk: few large chunks then
     const size_t chunk =
         (fx.flags & CT_EFFECT_EARTH_FIT) != 0u ? std::max<size_t>(1024, px.size() / 8 + 1) : (size_t)1024;
-    std::vector<ct_geo> g(px.size());
     // the set-up's status (the same for every chunk; an empty input still
     // checks the camera and the effects)
     std::atomic<uint64_t> loads{0}, nodata{0};
     std::atomic<size_t> caches{0};
     ct_status st;
+    ct_geo none;
     if (tiles) {
         TileCache probe(*tiles, 1);
-        st = ct_geolocate_batch_tiles(probe.set(), &cam.cam, &cam.pose, m, &fx, uv.data(), 0, g.data(), 0);
+        st = ct_geolocate_batch_tiles(probe.set(), &cam.cam, &cam.pose, m, &fx, uv.data(), 0, &none, 0);
     } else {
-        st = ct_geolocate_batch(&p, &cam.cam, &cam.pose, m, &fx, uv.data(), 0, g.data(), 0);
+        st = ct_geolocate_batch(&p, &cam.cam, &cam.pose, m, &fx, uv.data(), 0, &none, 0);
     }
+    // each chunk geolocated into its own records and formatted at once into
+    // its part of the output (input order: part b / chunk)
+    ct_utm zone = {0, 0};
+    const bool utm = ct_utm_zone_of_epsg((int32_t)p.epsg, &zone) == CT_OK;
+    std::vector<std::string> parts((px.size() + chunk - 1) / chunk);
     if (st == CT_OK)
         parallel_chunks(px.size(), threads, chunk, [&](size_t b, size_t e) {
+            std::vector<ct_geo> g(e - b);
             if (!tiles) {
-                (void)ct_geolocate_batch(&p, &cam.cam, &cam.pose, m, &fx, uv.data() + 2 * b, e - b, g.data() + b, e - b);
-                return;
+                (void)ct_geolocate_batch(&p, &cam.cam, &cam.pose, m, &fx, uv.data() + 2 * b, e - b, g.data(), e - b);
+            } else {
+                TileCache cache(*tiles, cache_tiles);
+                caches++;
+                (void)ct_geolocate_batch_tiles(cache.set(), &cam.cam, &cam.pose, m, &fx, uv.data() + 2 * b, e - b,
+                                               g.data(), e - b);
+                loads += cache.set()->loads;
+                for (const ct_geo &x : g) nodata += x.status == CT_NO_DATA;
             }
-            TileCache cache(*tiles, cache_tiles);
-            caches++;
-            (void)ct_geolocate_batch_tiles(cache.set(), &cam.cam, &cam.pose, m, &fx, uv.data() + 2 * b, e - b,
-                                           g.data() + b, e - b);
-            loads += cache.set()->loads;
-            for (size_t k = b; k < e; ++k) nodata += g[k].status == CT_NO_DATA;
+            append_rows(parts[b / chunk], px.data() + b, in_range.data() + b, g.data(), e - b, p, tg.gp,
+                        utm ? &zone : nullptr);
         });
     if (st == CT_ERR_EFFECTS)
         throw Error("--effects: the effect parameters are out of range for this package (" + status_name(st) + ")");
     if (st != CT_OK) throw Error(cpath + ": cannot geolocate from this camera (" + status_name(st) + ")");
 
-    const std::string txt = format_rows(px, in_range, g, p, tg.gp, threads);
-    write_file_atomic(opt["-o"], std::vector<uint8_t>(txt.begin(), txt.end()));
+    AtomicFile out(opt["-o"]);
+    const std::string header = "u,v,status,E,N,h,steps,lat,lon,h_ell\n";
+    out.write(header.data(), header.size());
+    for (const std::string &part : parts) out.write(part.data(), part.size());
+    out.commit();
     if (tiles)
         std::fprintf(stderr,
                      "geoloc: %zu pixels over %u x %u tiles: %llu tile loads (%zu caches of %d slots, one per chunk), "

@@ -1,6 +1,7 @@
 // host_io.cpp -- see host_io.hpp.
 #include "host_io.hpp"
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -141,30 +142,50 @@ std::string printable(const std::string &s)
 }  // namespace
 
 void read_number_csv(const std::string &path, const std::vector<std::string> &names,
-                     const std::function<void(const double *v, const std::vector<std::string> &text)> &row)
+                     const std::function<void(const double *v, const std::vector<std::string> &text)> &row,
+                     const std::function<void(size_t rows)> &expect)
 {
     std::string need;
     for (const std::string &n : names) need += (need.empty() ? "" : ",") + n;
-    std::ifstream in(path);
+    std::ifstream in(path, std::ios::binary);
     if (!in) throw Error(path + ": " + std::strerror(errno));
-    std::string line;
-    if (!std::getline(in, line)) throw Error(path + ": empty file (expected a header " + need + ")");
-    auto split = [](const std::string &s) {
-        std::vector<std::string> v;
-        std::string cur;
-        for (char ch : s) {
+    // the whole file, then its lines ('\n'; the last one may lack it)
+    std::string buf;
+    {
+        std::vector<char> tmp((size_t)1 << 16);
+        while (in.read(tmp.data(), (std::streamsize)tmp.size()) || in.gcount() > 0)
+            buf.append(tmp.data(), (size_t)in.gcount());
+    }
+    if (buf.empty()) throw Error(path + ": empty file (expected a header " + need + ")");
+    const char *p = buf.data(), *const end = buf.data() + buf.size();
+    auto next_line = [&](const char **b, const char **e) {
+        const char *nl = static_cast<const char *>(std::memchr(p, '\n', (size_t)(end - p)));
+        *b = p;
+        *e = nl != nullptr ? nl : end;
+        p = nl != nullptr ? nl + 1 : end;
+    };
+    // fields into v (reused from line to line): blanks of every kind
+    // dropped (strtod would skip them, the text keep them)
+    auto split = [](const char *b, const char *e, std::vector<std::string> &v) {
+        size_t k = 0;
+        if (v.empty()) v.emplace_back();
+        v[0].clear();
+        for (; b < e; ++b) {
+            const char ch = *b;
             if (ch == ',') {
-                v.push_back(cur);
-                cur.clear();
+                if (++k == v.size()) v.emplace_back();
+                v[k].clear();
             } else if (ch != '\r' && ch != ' ' && ch != '\t' && ch != '\f' && ch != '\v') {
-                cur += ch;  // blanks of every kind dropped (strtod would skip them, the text keep them)
+                v[k] += ch;
             }
         }
-        v.push_back(cur);
-        return v;
+        v.resize(k + 1);
     };
     const size_t n = names.size();
-    std::vector<std::string> hdr = split(line);
+    const char *lb, *le;
+    next_line(&lb, &le);
+    std::vector<std::string> hdr;
+    split(lb, le, hdr);
     std::vector<int> col(n);
     for (size_t k = 0; k < n; ++k) {
         col[k] = -1;
@@ -175,23 +196,32 @@ void read_number_csv(const std::string &path, const std::vector<std::string> &na
         }
         if (col[k] < 0) throw Error(path + ":1: header lacks column '" + names[k] + "' (need " + need + ")");
     }
+    if (expect) {
+        // at most one row per remaining line
+        size_t lines = (size_t)std::count(p, end, '\n') + (end > p && end[-1] != '\n' ? 1u : 0u);
+        expect(lines);
+    }
     std::vector<double> v(n);
-    std::vector<std::string> text(n);
+    std::vector<std::string> text(n), f;
     int lineno = 1;
-    while (std::getline(in, line)) {
+    while (p < end) {
+        next_line(&lb, &le);
         ++lineno;
-        if (line.find_first_not_of(" \t\r\f\v") == std::string::npos) continue;
-        std::vector<std::string> f = split(line);
+        bool blank = true;
+        for (const char *q = lb; q < le && blank; ++q)
+            blank = *q == ' ' || *q == '\t' || *q == '\r' || *q == '\f' || *q == '\v';
+        if (blank) continue;
+        split(lb, le, f);
         for (size_t k = 0; k < n; ++k) {
             if ((size_t)col[k] >= f.size()) throw Error(path + ":" + std::to_string(lineno) + ": too few columns");
-            char *end = nullptr;
+            char *endp = nullptr;
             const std::string &t = f[col[k]];
-            v[k] = std::strtod(t.c_str(), &end);
+            v[k] = std::strtod(t.c_str(), &endp);
             // the whole field a number (a NUL in it would end strtod's text)
-            if (t.empty() || end != t.c_str() + t.size() || !std::isfinite(v[k]))
+            if (t.empty() || endp != t.c_str() + t.size() || !std::isfinite(v[k]))
                 throw Error(path + ":" + std::to_string(lineno) + ": bad number '" + printable(f[col[k]]) +
                             "' in column " + names[k]);
-            text[k] = std::move(f[col[k]]);
+            text[k] = f[col[k]];
         }
         row(v.data(), text);
     }

@@ -89,8 +89,11 @@ std::string parse_cmdline(int argc, char **argv, int first, const std::vector<st
 // A,B,..)", "<path>:1: header lacks column 'A' (need A,B,..)" / ": column
 // 'A' appears twice in the header",
 // "<path>:<line>: too few columns" / ": bad number 'x' in column A".
+// expect (if given) hears once, before the first row, how many rows there
+// can be at most (the lines after the header).
 void read_number_csv(const std::string &path, const std::vector<std::string> &names,
-                     const std::function<void(const double *v, const std::vector<std::string> &text)> &row);
+                     const std::function<void(const double *v, const std::vector<std::string> &text)> &row,
+                     const std::function<void(size_t rows)> &expect = nullptr);
 
 // A ray in the map frame (metres): origin (e, n, h), direction (de, dn, dh).
 struct MapRay {
