@@ -539,11 +539,15 @@ int cmd_trace(int argc, char **argv)
         open_package_file(a.pos[0], &bytes, &p);
     }
     std::vector<MapRay> rays = read_rays_csv(a.opt["--rays"]);
-    // rows formatted by the threads into their slots, written in input order
-    std::vector<std::string> rows(rays.size());
+    // rows formatted by the threads into their chunk's part, written in
+    // input order
+    const size_t chunk = tiles ? 8192 : 1024;
+    std::vector<std::string> parts((rays.size() + chunk - 1) / chunk);
     std::atomic<uint64_t> loads{0}, nodata{0};
     std::atomic<size_t> caches{0}, cache_bytes{0};
-    parallel_chunks(rays.size(), threads, tiles ? 8192 : 1024, [&](size_t b, size_t e) {
+    parallel_chunks(rays.size(), threads, chunk, [&](size_t b, size_t e) {
+        std::string &o = parts[b / chunk];
+        o.reserve((e - b) * 64);
         std::unique_ptr<TileCache> cache;
         if (tiles) {
             cache = std::make_unique<TileCache>(*tiles, cache_tiles);
@@ -571,15 +575,15 @@ int cmd_trace(int argc, char **argv)
             } else {
                 std::snprintf(line, sizeof line, "%s,nan,nan,nan,nan,0\n", status_name(s).c_str());
             }
-            rows[k] = line;
+            o += line;
         }
         if (cache) loads += cache->set()->loads;
     });
-    std::ostringstream out;
-    out << "status,E,N,h,t,steps\n";
-    for (const std::string &row : rows) out << row;
-    std::string txt = out.str();
-    write_file_atomic(a.opt["-o"], std::vector<uint8_t>(txt.begin(), txt.end()));
+    AtomicFile out(a.opt["-o"]);
+    const std::string header = "status,E,N,h,t,steps\n";
+    out.write(header.data(), header.size());
+    for (const std::string &part : parts) out.write(part.data(), part.size());
+    out.commit();
     if (tiles)
         std::fprintf(stderr,
                      "trace: %zu rays over %u x %u tiles: %llu tile loads (%zu caches of %d slots, one per chunk of "

@@ -230,9 +230,12 @@ void read_number_csv(const std::string &path, const std::vector<std::string> &na
 std::vector<MapRay> read_rays_csv(const std::string &path)
 {
     std::vector<MapRay> rays;
-    read_number_csv(path, {"E", "N", "h", "dE", "dN", "dh"}, [&](const double *v, const std::vector<std::string> &) {
-        rays.push_back(MapRay{v[0], v[1], v[2], v[3], v[4], v[5]});
-    });
+    read_number_csv(
+        path, {"E", "N", "h", "dE", "dN", "dh"},
+        [&](const double *v, const std::vector<std::string> &) {
+            rays.push_back(MapRay{v[0], v[1], v[2], v[3], v[4], v[5]});
+        },
+        [&](size_t n) { rays.reserve(n); });
     return rays;
 }
 
