@@ -595,19 +595,19 @@ static ct_status grid_unproject(const ct_camera *c, int64_t u, int64_t v, int32_
     }
     cr_weights(tu, wu);
     if (memo == NULL || memo->valid == 0u || memo->v != v || memo->i != i) {
+        const size_t stride = 3u * (size_t)g->nu; /* one node row */
         int64_t wv[4];
         cr_weights(tv, wv);
         /* along v for columns i-1 .. i+2 (nodes j-1 .. j+2 of each).
          * bound: 4 x 4 x 3 */
-        const size_t stride = 3u * (size_t)g->nu; /* one node row */
         for (a = 0u; a < 4u; ++a) {
-            const int32_t *r = g->rays_q30 + 3u * ((j - 1u) * g->nu + (i - 1u + a));
+            const int32_t *top = g->rays_q30 + 3u * ((j - 1u) * g->nu + (i - 1u + a));
             int64_t acc[3] = {0, 0, 0};
             for (b = 0u; b < 4u; ++b) {
+                const int32_t *r = top + b * stride;
                 acc[0] += wv[b] * r[0];
                 acc[1] += wv[b] * r[1];
                 acc[2] += wv[b] * r[2];
-                r += stride;
             }
             for (k = 0u; k < 3u; ++k) {
                 col[a][k] = ct_floor_shr(acc[k] + (INT64_C(1) << 29), 30u);
