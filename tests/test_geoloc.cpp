@@ -401,6 +401,39 @@ void test_occluded_by_wall()
     TEST_ASSERT_MSG(found >= 10, "only %d points hidden by the wall", found);
 }
 
+// ct_geolocate_batch over the pixels uv (Q16 pairs) with every method,
+// straight and on a sphere: every record as ct_geolocate's (status, rays,
+// hit), the steps aside (the batch's runs); check(batch) on each batch.
+// *errors: the number of CT_ERR_UNPROJECT records.
+template <class F>
+void batch_as_single(World *wd, const Cam &c, const std::vector<int64_t> &uv, F check, int *errors)
+{
+    const size_t n = uv.size() / 2;
+    ct_effects sphere = {CT_EFFECT_CURVATURE | CT_EFFECT_REFRACTION, CT_REFRACTION_K_STD_Q16, CT_EARTH_RADIUS_NM, 0,
+                         nullptr};
+    *errors = 0;
+    for (const ct_effects *fx : {(const ct_effects *)nullptr, (const ct_effects *)&sphere}) {
+        for (int m = 0; m < CT_METHOD_COUNT; ++m) {
+            std::vector<ct_geo> batch(n);
+            TEST_ASSERT_EQUAL_INT(CT_OK, ct_geolocate_batch(&wd->p, &c.lib.cam, &c.lib.pose, (ct_method)m, fx,
+                                                            uv.data(), n, batch.data(), n));
+            check(batch);
+            for (size_t k = 0; k < n; ++k) {
+                ct_geo g;
+                ct_geolocate(&wd->p, &c.lib.cam, &c.lib.pose, (ct_method)m, fx, uv[2 * k], uv[2 * k + 1], &g);
+                ct_hit a = g.hit, b = batch[k].hit;
+                a.steps = b.steps = a.iters = b.iters = 0;
+                TEST_ASSERT_MSG(g.status == batch[k].status && std::memcmp(&a, &b, sizeof a) == 0 &&
+                                    std::memcmp(g.ray_cam_q30, batch[k].ray_cam_q30, sizeof g.ray_cam_q30) == 0 &&
+                                    std::memcmp(g.dir_map_q39, batch[k].dir_map_q39, sizeof g.dir_map_q39) == 0,
+                                "%s, %s, method %d, pixel %zu: the batch's record differs", c.name,
+                                fx ? "sphere" : "straight", m, k);
+                *errors += g.status == CT_ERR_UNPROJECT ? 1 : 0;
+            }
+        }
+    }
+}
+
 // The batch's runs around the exact nadir camera's principal point, whose
 // ray is exactly vertical: with a bent trace (the sphere) that pixel takes
 // ct_trace_bent_set's straight vertical trace, its neighbours the runs
@@ -418,28 +451,16 @@ void test_batch_vertical_pixel()
         uv.push_back(cu + k * 65536);
         uv.push_back(cv);
     }
-    const size_t n = uv.size() / 2;
-    ct_effects sphere = {CT_EFFECT_CURVATURE | CT_EFFECT_REFRACTION, CT_REFRACTION_K_STD_Q16, CT_EARTH_RADIUS_NM, 0,
-                         nullptr};
-    for (const ct_effects *fx : {(const ct_effects *)nullptr, (const ct_effects *)&sphere}) {
-        for (int m = 0; m < CT_METHOD_COUNT; ++m) {
-            std::vector<ct_geo> batch(n);
-            TEST_ASSERT_EQUAL_INT(CT_OK, ct_geolocate_batch(&wd->p, &nadir.lib.cam, &nadir.lib.pose, (ct_method)m, fx,
-                                                            uv.data(), n, batch.data(), n));
+    int errors;
+    batch_as_single(
+        wd, nadir, uv,
+        [](const std::vector<ct_geo> &batch) {
             TEST_ASSERT_MSG(batch[5].dir_map_q39[0] == 0 && batch[5].dir_map_q39[1] == 0,
                             "the principal point's ray is not vertical (%lld, %lld)",
                             (long long)batch[5].dir_map_q39[0], (long long)batch[5].dir_map_q39[1]);
-            for (size_t k = 0; k < n; ++k) {
-                ct_geo g;
-                ct_geolocate(&wd->p, &nadir.lib.cam, &nadir.lib.pose, (ct_method)m, fx, uv[2 * k], uv[2 * k + 1], &g);
-                ct_hit a = g.hit, b = batch[k].hit;
-                a.steps = b.steps = a.iters = b.iters = 0;
-                TEST_ASSERT_MSG(g.status == batch[k].status && std::memcmp(&a, &b, sizeof a) == 0 &&
-                                    std::memcmp(g.dir_map_q39, batch[k].dir_map_q39, sizeof g.dir_map_q39) == 0,
-                                "%s, method %d, pixel %zu: the batch's record differs", fx ? "sphere" : "straight", m, k);
-            }
-        }
-    }
+        },
+        &errors);
+    TEST_ASSERT_EQUAL_INT(0, errors);
 }
 
 // A grid camera's pixels in a batch, which keeps the grid's column sums
@@ -470,28 +491,8 @@ void test_batch_grid_rows()
     px(-500, v0 + 1);                                            // outside the grid
     px(951, v0 + 1);
     for (int k = 0; k < 40; ++k) px(930 + 0.9 * k, std::llround((707 + 0.5 * k) * 65536));  // down across a node row
-    const size_t n = uv.size() / 2;
-    ct_effects sphere = {CT_EFFECT_CURVATURE | CT_EFFECT_REFRACTION, CT_REFRACTION_K_STD_Q16, CT_EARTH_RADIUS_NM, 0,
-                         nullptr};
-    int errors = 0;
-    for (const ct_effects *fx : {(const ct_effects *)nullptr, (const ct_effects *)&sphere}) {
-        for (int m = 0; m < CT_METHOD_COUNT; ++m) {
-            std::vector<ct_geo> batch(n);
-            TEST_ASSERT_EQUAL_INT(CT_OK, ct_geolocate_batch(&wd->p, &gc.lib.cam, &gc.lib.pose, (ct_method)m, fx,
-                                                            uv.data(), n, batch.data(), n));
-            for (size_t k = 0; k < n; ++k) {
-                ct_geo g;
-                ct_geolocate(&wd->p, &gc.lib.cam, &gc.lib.pose, (ct_method)m, fx, uv[2 * k], uv[2 * k + 1], &g);
-                ct_hit a = g.hit, b = batch[k].hit;
-                a.steps = b.steps = a.iters = b.iters = 0;
-                TEST_ASSERT_MSG(g.status == batch[k].status && std::memcmp(&a, &b, sizeof a) == 0 &&
-                                    std::memcmp(g.ray_cam_q30, batch[k].ray_cam_q30, sizeof g.ray_cam_q30) == 0 &&
-                                    std::memcmp(g.dir_map_q39, batch[k].dir_map_q39, sizeof g.dir_map_q39) == 0,
-                                "%s, method %d, pixel %zu: the batch's record differs", fx ? "sphere" : "straight", m, k);
-                errors += g.status == CT_ERR_UNPROJECT ? 1 : 0;
-            }
-        }
-    }
+    int errors;
+    batch_as_single(wd, gc, uv, [](const std::vector<ct_geo> &) {}, &errors);
     TEST_ASSERT_EQUAL_INT(2 * CT_METHOD_COUNT, errors);  // the one pixel outside the grid, every time
 }
 
