@@ -181,14 +181,16 @@ static ct_status one_pixel(const ct_package *p, ct_tileset *ts, const ct_camera 
 }
 
 /* A batch with straight rays or the lowered model on one package (ts
- * NULL) or over a tile set (p its frame), in runs of up to CT_RUN_MAX
+ * NULL) or over a tile set (p its frame; memo: the batch's, cleared), in
+ * runs of up to CT_RUN_MAX
  * consecutive pixels traced together (ct_trace_run, ct_tileset_trace_run):
  * each record as one_pixel's but for hit.steps and hit.iters (the pixel's
  * own walk).  A pixel whose ray does not take that walk (an unprojection
  * or preparation error, a vertical ray of a bent trace) is done as
  * one_pixel does it. */
 CT_NOINLINE static void run_pixels(const ct_package *p, ct_tileset *ts, const ct_camera *cam, const ct_pose *pose,
-                                   ct_method m, const geo_setup *s, const int64_t *uv_q16, size_t count, ct_geo *out)
+                                   ct_method m, const geo_setup *s, const int64_t *uv_q16, size_t count,
+                                   ct_unproject_memo *memo, ct_geo *out)
 {
     union {
         ct_prepared r[CT_RUN_MAX]; /* one package: the prepared rays */
@@ -198,17 +200,15 @@ CT_NOINLINE static void run_pixels(const ct_package *p, ct_tileset *ts, const ct
     ct_status st[CT_RUN_MAX];
     size_t idx[CT_RUN_MAX];
     const ct_lower *lw = s->bend.coeff_q16 != 0 ? &s->bent.lw : NULL;
-    ct_unproject_memo memo;
     size_t k = 0u;
     uint32_t n, i;
-    memo.valid = 0u;
     /* bound: count pixels, at least one per pass */
     while (k < count) {
         /* bound: CT_RUN_MAX pixels per run */
         for (n = 0u; k < count && n < CT_RUN_MAX; ++k) {
             ct_geo *g = &out[k];
             ct_ray ray;
-            ct_status sp = pixel_dir(cam, pose, uv_q16[2u * k], uv_q16[2u * k + 1u], &memo, g);
+            ct_status sp = pixel_dir(cam, pose, uv_q16[2u * k], uv_q16[2u * k + 1u], memo, g);
             g->status = sp;
             if (sp != CT_OK) {
                 continue;
@@ -284,7 +284,7 @@ static ct_status geolocate_many(const ct_package *pkg, ct_tileset *ts, const ct_
     if (!s.earth && (s.bend.coeff_q16 == 0 || s.bent.lowered) && method != CT_METHOD_INCREMENTAL) {
         /* runs (the incremental method stays the plain cell-by-cell walk,
          * the reference, in a batch too) */
-        run_pixels(pkg, ts, cam, pose, method, &s, uv_q16, count, out);
+        run_pixels(pkg, ts, cam, pose, method, &s, uv_q16, count, &memo, out);
         return CT_OK;
     }
     /* bound: count pixels (caller's buffers) */
