@@ -380,7 +380,8 @@ static ct_status forward(const ct_utm *z, int64_t lat_q61, int64_t lon_q61, int6
  * numerator formed in Q118, < 2^126).  Start tau' / (1 - e^2); the error
  * squares each step: 5 steps reach the Q59 resolution.  A step of 0 ends
  * it (tau unchanged, every later step would be 0 too: the same result);
- * over the zone, 2 or 3 steps (0.05 % take 4). */
+ * over the zone 2 or 3 steps (0.05 % take 4; a few points near the
+ * domain's limits, in the tests, all 5). */
 static int64_t tau_of_taup(int64_t target)
 {
     int64_t tau = qdiv(target, TM_1ME2), step = 1;
