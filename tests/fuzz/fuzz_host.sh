@@ -46,13 +46,25 @@ build_one() {  # source object compiler flags...
     fi
 }
 fail=0
+pids=""
+# build_one in the background, waiting for the pair once two run
+build_bg() {
+    build_one "$@" &
+    pids="$pids $!"
+    set -- $pids
+    if [ $# -ge 2 ]; then
+        for p in $pids; do wait "$p" || fail=1; done
+        pids=""
+    fi
+}
 for s in "$ROOT"/lib/src/*.c; do
-    build_one "$s" "$OUT/obj/lib_$(basename "$s" .c).o" "$CC" $SAN -fsanitize=fuzzer-no-link -std=c99 $INC || fail=1
+    build_bg "$s" "$OUT/obj/lib_$(basename "$s" .c).o" "$CC" $SAN -fsanitize=fuzzer-no-link -std=c99 $INC
 done
 for s in core/terrain.cpp io/host_io.cpp dem_io/dem_io.cpp dem_io/dem_pixels.cpp dem_io/temp_output.cpp \
          camera/camera_host.cpp; do
-    build_one "$H/$s" "$OUT/obj/host_$(basename "$s" .cpp).o" "$CXX" $SAN -fsanitize=fuzzer-no-link -std=c++17 $INC || fail=1
+    build_bg "$H/$s" "$OUT/obj/host_$(basename "$s" .cpp).o" "$CXX" $SAN -fsanitize=fuzzer-no-link -std=c++17 $INC
 done
+for p in $pids; do wait "$p" || fail=1; done
 if [ $fail -ne 0 ] || ! "$CXX" $SAN -fsanitize=fuzzer -std=c++17 $INC "$ROOT/tests/fuzz/fuzz_host.cpp" "$OUT"/obj/*.o \
         -lOpenImageIO -lOpenImageIO_Util -lgeotiff -ltiff -lmrcal -lpthread -o "$OUT/fuzz_host" >>"$OUT/build.log" 2>&1; then
     cat "$OUT/build.log"; echo "fuzz_host: build failed"; exit 1
