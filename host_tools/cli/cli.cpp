@@ -579,11 +579,7 @@ int cmd_trace(int argc, char **argv)
         }
         if (cache) loads += cache->set()->loads;
     });
-    AtomicFile out(a.opt["-o"]);
-    const std::string header = "status,E,N,h,t,steps\n";
-    out.write(header.data(), header.size());
-    for (const std::string &part : parts) out.write(part.data(), part.size());
-    out.commit();
+    write_file_atomic(a.opt["-o"], "status,E,N,h,t,steps\n", parts);
     if (tiles)
         std::fprintf(stderr,
                      "trace: %zu rays over %u x %u tiles: %llu tile loads (%zu caches of %d slots, one per chunk of "

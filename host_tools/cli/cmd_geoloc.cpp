@@ -384,11 +384,7 @@ int cmd_geoloc(int argc, char **argv)
         throw Error("--effects: the effect parameters are out of range for this package (" + status_name(st) + ")");
     if (st != CT_OK) throw Error(cpath + ": cannot geolocate from this camera (" + status_name(st) + ")");
 
-    AtomicFile out(opt["-o"]);
-    const std::string header = "u,v,status,E,N,h,steps,lat,lon,h_ell\n";
-    out.write(header.data(), header.size());
-    for (const std::string &part : parts) out.write(part.data(), part.size());
-    out.commit();
+    write_file_atomic(opt["-o"], "u,v,status,E,N,h,steps,lat,lon,h_ell\n", parts);
     if (tiles)
         std::fprintf(stderr,
                      "geoloc: %zu pixels over %u x %u tiles: %llu tile loads (%zu caches of %d slots, one per chunk), "

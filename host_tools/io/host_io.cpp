@@ -82,6 +82,14 @@ void write_file_atomic(const std::string &path, const std::vector<uint8_t> &byte
     f.commit();
 }
 
+void write_file_atomic(const std::string &path, const std::string &head, const std::vector<std::string> &parts)
+{
+    AtomicFile f(path);
+    f.write(head.data(), head.size());
+    for (const std::string &part : parts) f.write(part.data(), part.size());
+    f.commit();
+}
+
 double proc_status_kib(const char *key)
 {
     std::ifstream f("/proc/self/status");

@@ -45,6 +45,9 @@ private:
 };
 // The whole file at once, through AtomicFile.
 void write_file_atomic(const std::string &path, const std::vector<uint8_t> &bytes);
+// The same from a head and parts written one after another (text made in
+// chunks, never joined in memory).
+void write_file_atomic(const std::string &path, const std::string &head, const std::vector<std::string> &parts);
 
 // A field of /proc/self/status in KiB (0 when unavailable), e.g. "VmHWM".
 double proc_status_kib(const char *key);
