@@ -582,6 +582,21 @@ void run_frame(const Prepared &bm, const Frame &f, const D &dist, typename D::va
             stats->add(*s);
 }
 
+// The kernel for frame f: a transposed one only when D is not symmetric
+// (a symmetric D's transposed frame computes the same values untransposed).
+template <class D, bool kCount>
+void run_frame_for(const Prepared &bm, const Frame &f, const D &dist, typename D::value_type *dt, Point *ft,
+                     const Options &opt, bool first, Stats *stats)
+{
+    if constexpr (!D::symmetric) {
+        if (f.transpose) {
+            run_frame<D, true, kCount>(bm, f, dist, dt, ft, opt, first, stats);
+            return;
+        }
+    }
+    run_frame<D, false, kCount>(bm, f, dist, dt, ft, opt, first, stats);
+}
+
 template <class D>
 void run_pieces(const Prepared &bm, const std::vector<Piece> &pieces, const D &dist,
                 std::vector<typename D::value_type> &dt, std::vector<Point> &ft, const Options &opt,
@@ -601,14 +616,10 @@ void run_pieces(const Prepared &bm, const std::vector<Piece> &pieces, const D &d
     bool first = true;
     for (const Piece &p : pieces) {
         const Frame f = make_frame(bm.width(), bm.height(), p, opt.frame);
-        if (f.transpose && stats)
-            run_frame<D, true, true>(bm, f, dist, dt.data(), ftp, opt, first, stats);
-        else if (f.transpose)
-            run_frame<D, true, false>(bm, f, dist, dt.data(), ftp, opt, first, stats);
-        else if (stats)
-            run_frame<D, false, true>(bm, f, dist, dt.data(), ftp, opt, first, stats);
+        if (stats)
+            run_frame_for<D, true>(bm, f, dist, dt.data(), ftp, opt, first, stats);
         else
-            run_frame<D, false, false>(bm, f, dist, dt.data(), ftp, opt, first, stats);
+            run_frame_for<D, false>(bm, f, dist, dt.data(), ftp, opt, first, stats);
         first = false;
     }
 }

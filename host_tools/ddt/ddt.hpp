@@ -206,21 +206,27 @@ struct Point {
 };
 
 // ---------------------------------------------------------------- distances
-// Each takes |dx|, |dy| (pixels, >= 0, < 2^31).
+// Each takes |dx|, |dy| (pixels, >= 0, < 2^31).  symmetric: D(a, b) ==
+// D(b, a) for all arguments, so a transposed frame runs the plain kernel
+// (the same values; half the kernels to compile).
 struct EuclideanSq {
     using value_type = int64_t;
+    static constexpr bool symmetric = true;
     int64_t operator()(int64_t ax, int64_t ay) const { return ax * ax + ay * ay; }
 };
 struct CityBlock {
     using value_type = int64_t;
+    static constexpr bool symmetric = true;
     int64_t operator()(int64_t ax, int64_t ay) const { return ax + ay; }
 };
 struct Chessboard {
     using value_type = int64_t;
+    static constexpr bool symmetric = true;
     int64_t operator()(int64_t ax, int64_t ay) const { return ax > ay ? ax : ay; }
 };
 struct ChamferInt {  // w_max * max + w_min * min, weights in [0, 2^40]
     using value_type = int64_t;
+    static constexpr bool symmetric = true;
     int64_t w_max = 1, w_min = 0;
     int64_t operator()(int64_t ax, int64_t ay) const
     {
@@ -229,6 +235,7 @@ struct ChamferInt {  // w_max * max + w_min * min, weights in [0, 2^40]
 };
 struct ChamferReal {  // same, double weights >= 0
     using value_type = double;
+    static constexpr bool symmetric = true;
     double w_max = 1.0, w_min = 0.0;
     double operator()(int64_t ax, int64_t ay) const
     {
@@ -243,6 +250,7 @@ inline ChamferReal chamfer_from_steps(double a, double b) { return ChamferReal{a
 // nondecreasing table covering |dx| < cols, |dy| < rows (not copied).
 struct TableDistance {
     using value_type = int64_t;
+    static constexpr bool symmetric = false;  // any nondecreasing table
     const int64_t *table = nullptr;
     int64_t cols = 0, rows = 0;
     int64_t operator()(int64_t ax, int64_t ay) const { return table[ay * cols + ax]; }
