@@ -48,6 +48,8 @@ void check_case(const dem_cases::Case &cs, long nrays, Stats *st, std::map<std::
     ct_rng rng;
     ct_rng_seed(&rng, ct_test_seed() * 7919u + (uint64_t)cs.name.size() * 131u + cs.t.width);
     int reported = 0;
+    double lo, hi;  // the families' heights, once (not per ray: O(posts) each)
+    dem_cases::minmax(cs.t, &lo, &hi);
     for (long k = 0; k < nrays; ++k) {
         const char *fname;
         ct_ray ray;
@@ -55,7 +57,7 @@ void check_case(const dem_cases::Case &cs, long nrays, Stats *st, std::map<std::
             ray = gen(k, &rng, &fname);
         } else {
             dem_cases::Family f = (dem_cases::Family)(k % dem_cases::FAMILY_COUNT);
-            ray = dem_cases::make_ray(cs.t, f, &rng);
+            ray = dem_cases::make_ray(cs.t, f, &rng, lo, hi);
             fname = dem_cases::family_name(f);
         }
         ct_prepared pr;
