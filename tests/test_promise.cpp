@@ -146,7 +146,8 @@ struct Checker {
     const ct_host::Terrain *t;
     const ct_package *p;
     Wedge w;
-    long violations = 0, undecided = 0, regions = 0;
+    long violations = 0, undecided = 0, regions = 0, cones = 0, degenerate = 0;
+    bool quiet = false;  // no VIOLATION lines (the checker's own test)
     ld worst = -INFINITY;
 
     ld S(ld x, ld y) const
@@ -239,6 +240,21 @@ struct Checker {
         return std::fabs(A) / 2;
     }
 
+    // max of the bilinear patch of cell (i, j) over [x0, x1] x [y0, y1]
+    // inside it: at a corner (the patch is linear along each axis)
+    ld s_max_rect(int i, int j, ld x0, ld x1, ld y0, ld y1) const
+    {
+        ld h00 = t->at(i, j), h10 = t->at(i + 1, j), h01 = t->at(i, j + 1), h11 = t->at(i + 1, j + 1);
+        ld a = h10 - h00, b = h01 - h00, c = h11 - h10 - h01 + h00;
+        ld m = -INFINITY;
+        for (ld x : {x0, x1})
+            for (ld y : {y0, y1}) {
+                ld u = x - i, v = y - j;
+                m = std::max(m, h00 + a * u + b * v + c * u * v);
+            }
+        return m;
+    }
+
     // max of the bilinear patch of cell (i, j) over a convex polygon inside
     // it: on the boundary (no interior maximum), at a vertex or where an
     // edge's quadratic peaks
@@ -307,13 +323,17 @@ struct Checker {
     void check(int s, ld a, ld cot, ld fx0, ld fx1, ld fy0, ld fy1, const Poly &reach, int i, int j, ld x0, ld x1,
                ld y0, ld y1, int depth)
     {
-        Poly pr = clip_to(Poly{{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}}, reach);
-        if (pr.empty()) return;
         Poly d = rect_in_wedge(w, s, x0 - fx1, x1 - fx0, y0 - fy1, y1 - fy0);
         if (d.empty()) return;
+        ld rho = cot >= 0 ? poly_min(d) : poly_max(d);
+        // first the whole of R: the bilinear patch's max over R (at its
+        // corners) bounds its max over R's reachable part, so R is safe
+        // when even that is under the cone -- before R is cut to the reach
+        if (s_max_rect(i, j, x0, x1, y0, y1) - a - cot * rho <= 0) return;
+        Poly pr = clip_to(Poly{{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}}, reach);
+        if (pr.empty()) return;
         regions++;
         ld smax = s_max_poly(pr, i, j);
-        ld rho = cot >= 0 ? poly_min(d) : poly_max(d);
         ld ub = smax - a - cot * rho;
         if (ub <= 0) return;
         // Mean value bound: with p* in F the nearest wedge point of q,
@@ -343,7 +363,7 @@ struct Checker {
             ld v = S(q.x, q.y) - a - cot * rq;
             worst = std::max(worst, v);
             if (v > TOL) {
-                if (violations++ < 5)
+                if (violations++ < 5 && !quiet)
                     std::printf("    VIOLATION sector %d F=[%Lg,%Lg]x[%Lg,%Lg] q=(%.9Lf, %.9Lf): S=%.6Lf a=%.0Lf "
                                 "cot=%.6Lf rho=%.9Lf excess %.3Lg LSB\n",
                                 s, fx0, fx1, fy0, fy1, q.x, q.y, S(q.x, q.y), a, cot, rq, v);
@@ -367,6 +387,53 @@ struct Checker {
     }
 };
 
+// Every cone of package p (built from t with n sectors at reduction r)
+// against the terrain; wider: each cone's cot taken down by that fraction
+// of its size (0: the package's cones; > 0: wider cones than built, which
+// must fail).
+Checker check_promise(const ct_host::Terrain &t, const ct_package &p, int n, int r, ld wider = 0)
+{
+    Checker c;
+    c.quiet = wider > 0;
+    c.t = &t;
+    c.p = &p;
+    c.w.n = n;
+    for (int k = 0; k <= n; ++k) {
+        c.w.bx.push_back(p.bound_x[k]);
+        c.w.by.push_back(p.bound_y[k]);
+    }
+    int cx = t.width - 1, cy = t.height - 1;
+    for (uint32_t cj = 0; cj < p.coarse_y; ++cj)
+        for (uint32_t ci = 0; ci < p.coarse_x; ++ci) {
+            size_t k = (size_t)cj * p.coarse_x + ci;
+            ld a = (ld)(p.apex[2 * k] | (p.apex[2 * k + 1] << 8));
+            ld fx0 = ci * r, fy0 = cj * r, fx1 = std::min<int>((ci + 1) * r, cx), fy1 = std::min<int>((cj + 1) * r, cy);
+            for (uint32_t s = 0; s < p.planes; ++s) {
+                uint8_t code = p.angles[(size_t)s * p.coarse_x * p.coarse_y + k];
+                c.cones++;
+                if (!p.cot_ok[code]) {
+                    c.degenerate++;
+                    continue;  // no promise for a degenerate cone
+                }
+                ld cot = (ld)p.cot_q16[code] / 65536.0L;
+                cot -= wider * std::fabs(cot);
+                // the omni plane (s == N) must hold for every sector's wedge
+                int s0 = (int)s, s1 = (int)s;
+                if (s == (uint32_t)n) {
+                    s0 = 0;
+                    s1 = n - 1;
+                }
+                for (int ss = s0; ss <= s1; ++ss) {
+                    Poly reach = c.shadow_hull(ss, fx0, fx1, fy0, fy1);
+                    for (int j = 0; j < cy; ++j)
+                        for (int i = 0; i < cx; ++i)
+                            c.check(ss, a, cot, fx0, fx1, fy0, fy1, reach, i, j, i, i + 1, j, j + 1, 0);
+                }
+            }
+        }
+    return c;
+}
+
 // builder: the default (the slice builder), or the one given; window: the
 // slice builder's near window Rw (small windows send most terrain through
 // the slice DTs).  *stats_out: the build's stats.
@@ -387,46 +454,10 @@ void check_package(const char *name, const ct_host::Terrain &t, int n, int r, in
     ct_package p;
     TEST_ASSERT_EQUAL_INT(CT_OK, ct_package_open(&p, b.data(), b.size()));
     if (ct_harness_g.current_failed) return;
-    Checker c;
-    c.t = &t;
-    c.p = &p;
-    c.w.n = n;
-    for (int k = 0; k <= n; ++k) {
-        c.w.bx.push_back(p.bound_x[k]);
-        c.w.by.push_back(p.bound_y[k]);
-    }
-    long cones = 0, degenerate = 0;
-    int cx = t.width - 1, cy = t.height - 1;
-    for (uint32_t cj = 0; cj < p.coarse_y; ++cj)
-        for (uint32_t ci = 0; ci < p.coarse_x; ++ci) {
-            size_t k = (size_t)cj * p.coarse_x + ci;
-            ld a = (ld)(p.apex[2 * k] | (p.apex[2 * k + 1] << 8));
-            ld fx0 = ci * r, fy0 = cj * r, fx1 = std::min<int>((ci + 1) * r, cx), fy1 = std::min<int>((cj + 1) * r, cy);
-            for (uint32_t s = 0; s < p.planes; ++s) {
-                uint8_t code = p.angles[(size_t)s * p.coarse_x * p.coarse_y + k];
-                cones++;
-                if (!p.cot_ok[code]) {
-                    degenerate++;
-                    continue;  // no promise for a degenerate cone
-                }
-                ld cot = (ld)p.cot_q16[code] / 65536.0L;
-                // the omni plane (s == N) must hold for every sector's wedge
-                int s0 = (int)s, s1 = (int)s;
-                if (s == (uint32_t)n) {
-                    s0 = 0;
-                    s1 = n - 1;
-                }
-                for (int ss = s0; ss <= s1; ++ss) {
-                    Poly reach = c.shadow_hull(ss, fx0, fx1, fy0, fy1);
-                    for (int j = 0; j < cy; ++j)
-                        for (int i = 0; i < cx; ++i)
-                            c.check(ss, a, cot, fx0, fx1, fy0, fy1, reach, i, j, i, i + 1, j, j + 1, 0);
-                }
-            }
-        }
+    const Checker c = check_promise(t, p, n, r);
     std::printf("  %-5s %-16s N=%-2d r=%d K=%-2d W=%-2d: %ld cones (%ld degenerate), %ld regions; worst excess %.3Lg LSB; "
                 "violations %ld, undecided %ld\n",
-                builder == ct_host::PptBuilder::Brute ? "brute" : "slice", name, n, r, slices, window, cones, degenerate, c.regions, c.worst, c.violations, c.undecided);
+                builder == ct_host::PptBuilder::Brute ? "brute" : "slice", name, n, r, slices, window, c.cones, c.degenerate, c.regions, c.worst, c.violations, c.undecided);
     TEST_ASSERT_MSG(c.violations == 0, "%s N=%d r=%d: %ld promise violations", name, n, r, c.violations);
     TEST_ASSERT_MSG(c.undecided == 0, "%s N=%d r=%d: %ld undecided regions", name, n, r, c.undecided);
 }
@@ -514,6 +545,30 @@ void test_promise_slice_builder()
     }
 }
 
+// The checker itself: cones wider than built (each cot taken down by a
+// tenth of its size) break the promise on rough DEMs (noise, spikes and a
+// wall: the cones nearly touch them; a smooth DEM's have slack), and it
+// must say so; the same packages as built hold.
+void test_checker_finds_wider_cones()
+{
+    const ct_host::Terrain ts[2] = {small(1, 13, 11), small(2, 12, 12)};
+    for (int k = 0; k < 2; ++k)
+        for (int r = 1; r <= 2; ++r) {
+            ct_host::BuildOptions o;
+            o.sectors = 8;
+            o.reduce = r;
+            std::vector<uint8_t> b = ct_host::build_package(ts[k], o);
+            ct_package p;
+            TEST_ASSERT_EQUAL_INT(CT_OK, ct_package_open(&p, b.data(), b.size()));
+            const Checker as_built = check_promise(ts[k], p, 8, r), wider = check_promise(ts[k], p, 8, r, 0.1L);
+            std::printf("  DEM %d r=%d: as built %ld violations, cot 10 %% less %ld\n", k, r,
+                        as_built.violations, wider.violations);
+            TEST_ASSERT_MSG(as_built.violations == 0 && as_built.undecided == 0, "DEM %d r=%d as built: %ld violations",
+                            k, r, as_built.violations);
+            TEST_ASSERT_MSG(wider.violations > 0, "DEM %d r=%d: wider cones not found", k, r);
+        }
+}
+
 // Tile sets (conetrace.h, "Tile sets"): each tile's cones are built from the
 // tile alone and promise empty space only inside the tile's box -- all a walk
 // over the set uses (a tile's walk ends at its seam; the next tile's starts
@@ -584,6 +639,7 @@ void test_slice_dt_paths_agree()
 int main()
 {
     TEST_BEGIN("test_promise");
+    RUN_TEST(test_checker_finds_wider_cones);
     RUN_TEST(test_promise_sectors);
     RUN_TEST(test_promise_reduce_and_slices);
     RUN_TEST(test_promise_slice_builder);
