@@ -26,7 +26,11 @@
 #include <string>
 #include <vector>
 
+#include <malloc.h>
 #include <unistd.h>
+
+#include <atomic>
+#include <new>
 
 #include "bend.h"
 #include "conetrace.h"
@@ -1473,6 +1477,66 @@ static std::vector<uint8_t> file_bytes(const std::string &p)
     return b;
 }
 
+// The heap this process holds, and its peak since reset (the global
+// operator new and delete below count every C++ allocation by its usable
+// size): a build's working memory, whatever the allocator keeps resident.
+static std::atomic<size_t> g_heap_now{0}, g_heap_peak{0};
+
+void *operator new(size_t n)
+{
+    void *p = std::malloc(n ? n : 1);
+    if (p == nullptr) throw std::bad_alloc();
+    const size_t now = g_heap_now += malloc_usable_size(p);
+    size_t peak = g_heap_peak.load();
+    while (now > peak && !g_heap_peak.compare_exchange_weak(peak, now)) {
+    }
+    return p;
+}
+void operator delete(void *p) noexcept
+{
+    if (p == nullptr) return;
+    g_heap_now -= malloc_usable_size(p);
+    std::free(p);
+}
+void operator delete(void *p, size_t) noexcept { operator delete(p); }
+
+// A mosaic's memory check (streamed_memory_estimate) counts, per tile being
+// built, tile_build_memory: a tile's build streamed to a sink (as a mosaic's
+// tiles are to their files) must stay within it, its terrain included, on
+// one thread, at r = 1 (the builder's DT arrays per cell dominate: on this
+// terrain, whose slices take full DTs, an estimate without them was 35-50 %
+// of the heap) and r = 3.
+static void test_tile_build_memory(void)
+{
+    struct Discard : ct_host::PackageSink {
+        size_t n = 0;
+        void write(const uint8_t *, size_t k) override { n += k; }
+        void patch(size_t, const uint8_t *, size_t) override {}
+    };
+    const int P = 257;
+    std::vector<uint16_t> z((size_t)P * P);
+    for (int j = 0; j < P; ++j)
+        for (int i = 0; i < P; ++i)
+            z[(size_t)j * P + i] = (uint16_t)(std::lround(100 + 50 * std::sin(i / 37.0) * std::cos(j / 23.0) + 20 * std::sin((i + 2 * j) / 11.0)) - 30);
+    const ct_host::Terrain t = dem_cases::make_terrain(P, P, z, 1.0);
+    for (const auto rn : {std::array<int, 2>{1, 24}, std::array<int, 2>{1, 8}, std::array<int, 2>{3, 24}}) {
+        ct_host::BuildOptions o;
+        o.reduce = rn[0];
+        o.sectors = rn[1];
+        o.threads = 1;
+        Discard sink;
+        const size_t before = g_heap_now.load();
+        g_heap_peak = before;
+        ct_host::build_package_to(t, o, sink);
+        const double work = (double)(g_heap_peak.load() - before) + 3.0 * P * P;
+        const double est = (double)ct_host::tile_build_memory(P, o.reduce, o.sectors);
+        std::printf("  P=%d r=%d N=%d: package %zu B, heap at most %.2f MB with the tile, estimate %.2f MB\n", P,
+                    o.reduce, o.sectors, sink.n, work / 1e6, est / 1e6);
+        TEST_ASSERT_MSG(work <= est, "r=%d N=%d: %.2f MB of heap above the estimate %.2f MB", o.reduce, o.sectors,
+                        work / 1e6, est / 1e6);
+    }
+}
+
 static void test_streamed_build(void)
 {
     const int W = 203, H = 150;
@@ -1555,5 +1619,6 @@ int main()
     RUN_TEST(test_bent_start_below_after_entered);
     RUN_TEST(test_frame_refused);
     RUN_TEST(test_streamed_build);
+    RUN_TEST(test_tile_build_memory);
     return TEST_END();
 }

@@ -348,20 +348,27 @@ int mosaic_set_tiles(int P)
     return std::min(64, (CT_MAX_POSTS - 1) / (P - 1));  // K^2 <= CT_SET_MAX_TILES, K (P - 1) + 1 <= CT_MAX_POSTS
 }
 
-size_t streamed_memory_estimate(int width, int height, int P, int chunk_rows, int threads, int reduce, int sectors)
+size_t tile_build_memory(int P, int reduce, int sectors)
 {
-    (void)height;
     uint32_t pkg = 0;
     if (ct_package_size((uint32_t)P, (uint32_t)P, (uint32_t)reduce, (uint32_t)sectors, 0u, &pkg) != CT_OK)
         pkg = (uint32_t)((size_t)P * P * 4);
+    const size_t r = (size_t)std::max(1, reduce), cells = ((size_t)P - 1 + r - 1) / r;
+    // the tile's codes and voids (3 B/post) and small arrays per post (4 B);
+    // as much again as the package (the package is streamed into its file,
+    // but its angle planes and apexes are held while they are made); and
+    // the slice builder's arrays per coarse cell, its DTs above all (full
+    // DTs' distances, minima and line tables): 23-29 B measured at r = 1
+    // (257 to 1025 posts, N = 8 and 24), 40 B counted (test_tiles)
+    return (size_t)P * P * 7 + pkg + cells * cells * 40;
+}
+
+size_t streamed_memory_estimate(int width, int height, int P, int chunk_rows, int threads, int reduce, int sectors)
+{
+    (void)height;
     const size_t band = (size_t)width * (size_t)P * 3;                     // codes and void flags
     const size_t chunk = (size_t)width * (size_t)chunk_rows * (8 + 1 + 8);  // doubles, flags, raw samples
-    // per tile being built: its codes and voids (3 B/post), the builder's
-    // working memory (~3.3 B/post at r = 3: 1.62x the 16-bit DEM) and as
-    // much again as the package (the package is streamed into its file, but
-    // its angle planes and apexes are held while they are made)
-    const size_t tile = (size_t)P * P * 7 + pkg;
-    return band + chunk + (size_t)std::max(1, threads) * tile + (64u << 20);
+    return band + chunk + (size_t)std::max(1, threads) * tile_build_memory(P, reduce, sectors) + (64u << 20);
 }
 
 namespace {

@@ -96,6 +96,10 @@ struct StreamedSetSummary {
 // once (a band of P rows of codes and voids, a chunk of read rows, and
 // `threads` tiles being built), by the estimate checked before it starts.
 size_t streamed_memory_estimate(int width, int height, int P, int chunk_rows, int threads, int reduce, int sectors);
+// Its part per tile being built: a P x P tile's terrain, package and the
+// builder's working memory at reduction r with N sectors (test_tiles
+// checks it against a build's measured peak).
+size_t tile_build_memory(int P, int reduce, int sectors);
 
 // Build a W x H DEM (W or H beyond kMaxPackagePosts, at most
 // kMaxTileSetDemPosts; vdatum and geoid as the whole DEM's Terrain has
