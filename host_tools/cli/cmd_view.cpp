@@ -12,6 +12,7 @@
 // from the camera centre to each pixel's hit in metres, a single-channel
 // float32 TIFF of the image's size (NaN where nothing is hit).
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -50,20 +51,12 @@ int cmd_view(int argc, char **argv)
     ct_effects fx = {0u, CT_REFRACTION_K_STD_Q16, 0, 0, nullptr};
     if (opt.count("--effects")) fx.flags = effects_from_list(opt["--effects"]);
     fx.flags |= CT_EFFECT_EARTH_FIT;
-    std::vector<int64_t> uv(2 * (size_t)W * H);
-    for (int v = 0; v < H; ++v)
-        for (int u = 0; u < W; ++u) {
-            uv[2 * ((size_t)v * W + u)] = (int64_t)u << 16;
-            uv[2 * ((size_t)v * W + u) + 1] = (int64_t)v << 16;
-        }
-    std::vector<ct_geo> g((size_t)W * H);
-    const ct_status st = ct_geolocate_batch(&p, &cam.cam, &cam.pose, CT_METHOD_DIRECTIONAL, &fx, uv.data(), 0, g.data(), 0);
+    // the camera against the package first (its status, as one call's)
+    const int64_t uv0[2] = {0, 0};
+    ct_geo none;
+    const ct_status st = ct_geolocate_batch(&p, &cam.cam, &cam.pose, CT_METHOD_DIRECTIONAL, &fx, uv0, 0, &none, 0);
     if (st != CT_OK) throw Error(cpath + ": cannot geolocate from this camera (" + status_name(st) + ")");
     const size_t n = (size_t)W * H;
-    parallel_chunks(n, threads, std::max<size_t>(4096, n / 16 + 1), [&](size_t b, size_t e) {
-        (void)ct_geolocate_batch(&p, &cam.cam, &cam.pose, CT_METHOD_DIRECTIONAL, &fx, uv.data() + 2 * b, e - b,
-                                 g.data() + b, e - b);
-    });
     // shading from the bilinear surface's normal at each hit
     const double post = std::fabs(p.posting_e_nm * 1e-9), hs = p.height_scale_nm * 1e-9;
     const Terrain t = terrain_from_package(p);
@@ -73,40 +66,55 @@ int cmd_view(int argc, char **argv)
     // light from the north-west, 45 degrees up, in (east, south, up) like the hillshade
     const double lx = -0.5, ly = -0.5, lz = std::sqrt(0.5);
     Image im(W, H);
-    std::vector<float> range(n, NAN);
-    long hits = 0;
-    for (size_t k = 0; k < n; ++k) {
-        const ct_geo &q = g[k];
-        const int u = (int)(k % (size_t)W), v = (int)(k / (size_t)W);
-        if (q.status != CT_HIT && q.status != CT_HIT_VOID) {
-            im.set(u, v, Rgb{200, 222, 245});
-            continue;
+    const bool want_range = opt.count("--range") != 0;
+    std::vector<float> range(want_range ? n : 0, NAN);
+    std::atomic<long> hits{0};
+    // chunks of pixels geolocated and shaded where they are (the image and
+    // the range are all that is kept: 3 and 4 bytes a pixel)
+    parallel_chunks(n, threads, 16384, [&](size_t b, size_t e) {
+        std::vector<int64_t> uv(2 * (e - b));
+        for (size_t k = b; k < e; ++k) {
+            uv[2 * (k - b)] = (int64_t)(k % (size_t)W) << 16;
+            uv[2 * (k - b) + 1] = (int64_t)(k / (size_t)W) << 16;
         }
-        hits++;
-        const double x = q.hit.x_q16 / 65536.0, y = q.hit.y_q16 / 65536.0;
-        const int i = std::min((int)p.width - 2, std::max(0, (int)std::floor(x)));
-        const int j = std::min((int)p.height - 2, std::max(0, (int)std::floor(y)));
-        const double fu = x - i, fv = y - j;
-        const double h00 = code(i, j), h10 = code(i + 1, j), h01 = code(i, j + 1), h11 = code(i + 1, j + 1);
-        const double gx = ((h10 - h00) * (1 - fv) + (h11 - h01) * fv) * hs / post;
-        const double gy = ((h01 - h00) * (1 - fu) + (h11 - h10) * fu) * hs / post;  // towards the south (grid y)
-        const double nn = std::sqrt(gx * gx + gy * gy + 1);
-        const double sh = std::max(0.0, (-gx * lx - gy * ly + lz) / nn);
-        const double de = (q.hit.e_nm - cam.pose.e_nm) * 1e-9, dn = (q.hit.n_nm - cam.pose.n_nm) * 1e-9,
-                     dh = (q.hit.h_nm - cam.pose.h_nm) * 1e-9;
-        const double r = std::sqrt(de * de + dn * dn + dh * dh);
-        range[k] = (float)r;
-        // a little atmospheric fade with range (5 % per 10 km)
-        const double fade = std::min(0.5, r / 200000.0);
-        const double val = (0.2 + 0.75 * sh) * (1 - fade) + 0.85 * fade;
-        im.set(u, v, Rgb{(uint8_t)std::lround(255 * val * 0.92), (uint8_t)std::lround(255 * val * 0.95),
-                         (uint8_t)std::lround(255 * val * 0.85)});
-    }
+        std::vector<ct_geo> g(e - b);
+        (void)ct_geolocate_batch(&p, &cam.cam, &cam.pose, CT_METHOD_DIRECTIONAL, &fx, uv.data(), e - b, g.data(),
+                                 e - b);
+        long h = 0;
+        for (size_t k = b; k < e; ++k) {
+            const ct_geo &q = g[k - b];
+            const int u = (int)(k % (size_t)W), v = (int)(k / (size_t)W);
+            if (q.status != CT_HIT && q.status != CT_HIT_VOID) {
+                im.set(u, v, Rgb{200, 222, 245});
+                continue;
+            }
+            h++;
+            const double x = q.hit.x_q16 / 65536.0, y = q.hit.y_q16 / 65536.0;
+            const int i = std::min((int)p.width - 2, std::max(0, (int)std::floor(x)));
+            const int j = std::min((int)p.height - 2, std::max(0, (int)std::floor(y)));
+            const double fu = x - i, fv = y - j;
+            const double h00 = code(i, j), h10 = code(i + 1, j), h01 = code(i, j + 1), h11 = code(i + 1, j + 1);
+            const double gx = ((h10 - h00) * (1 - fv) + (h11 - h01) * fv) * hs / post;
+            const double gy = ((h01 - h00) * (1 - fu) + (h11 - h10) * fu) * hs / post;  // towards the south (grid y)
+            const double nn = std::sqrt(gx * gx + gy * gy + 1);
+            const double sh = std::max(0.0, (-gx * lx - gy * ly + lz) / nn);
+            const double de = (q.hit.e_nm - cam.pose.e_nm) * 1e-9, dn = (q.hit.n_nm - cam.pose.n_nm) * 1e-9,
+                         dh = (q.hit.h_nm - cam.pose.h_nm) * 1e-9;
+            const double r = std::sqrt(de * de + dn * dn + dh * dh);
+            if (want_range) range[k] = (float)r;
+            // a little atmospheric fade with range (5 % per 10 km)
+            const double fade = std::min(0.5, r / 200000.0);
+            const double val = (0.2 + 0.75 * sh) * (1 - fade) + 0.85 * fade;
+            im.set(u, v, Rgb{(uint8_t)std::lround(255 * val * 0.92), (uint8_t)std::lround(255 * val * 0.95),
+                             (uint8_t)std::lround(255 * val * 0.85)});
+        }
+        hits += h;
+    });
     write_png_atomic(opt["-o"], im, "conetrace view: " + cpath, "conetrace view");
-    if (opt.count("--range")) {
+    if (want_range) {
         write_float_tiff(opt["--range"], W, H, range,
                          "conetrace view: range from the camera centre, metres (NaN: no hit)");
     }
-    std::fprintf(stderr, "view: %dx%d pixels, %ld hit the terrain\n", W, H, hits);
+    std::fprintf(stderr, "view: %dx%d pixels, %ld hit the terrain\n", W, H, hits.load());
     return 0;
 }
