@@ -455,7 +455,20 @@ void build_mosaic_dir(int width, int height, const Georef &geo, double scale_m, 
     for (int y = 0; y < height; y += chunk_rows) {
         const int n = std::min(chunk_rows, height - y);
         read(y, n, h, valid);
-        for (size_t k = 0; k < h.size(); ++k) range.add(h[k], valid[k] != 0);
+        // the chunk's range in one part per thread, then merged (min, max
+        // and count: the same in any order)
+        const size_t per = (h.size() + (size_t)nthreads - 1) / (size_t)nthreads;
+        std::vector<HeightRange> parts((size_t)nthreads);
+        parallel_chunks(h.size(), nthreads, per, [&](size_t b, size_t e) {
+            HeightRange part;  // a local (the parts share cache lines)
+            for (size_t k = b; k < e; ++k) part.add(h[k], valid[k] != 0);
+            parts[b / per] = part;
+        });
+        for (const HeightRange &part : parts) {
+            range.lo = std::min(range.lo, part.lo);
+            range.hi = std::max(range.hi, part.hi);
+            range.nvalid += part.nvalid;
+        }
         if (progress) progress("scanning heights", (size_t)(y + n), (size_t)height);
     }
     if (range.nvalid == 0) throw Error("every sample is nodata");
@@ -502,7 +515,7 @@ void build_mosaic_dir(int width, int height, const Georef &geo, double scale_m, 
         for (int row = 0; row < g.tiles_y; ++row) {
             const int y0 = g.first_row(row), rows = std::min(P, height - y0);
             // the band's rows: the previous band's last row is this one's first
-            for (int j = have; j < rows; ++j) {
+            for (int j = have; j < rows;) {
                 const int y = y0 + j;
                 if (y >= chunk_y + chunk_n) {
                     chunk_y = next_row;
@@ -510,13 +523,24 @@ void build_mosaic_dir(int width, int height, const Georef &geo, double scale_m, 
                     read(chunk_y, chunk_n, h, valid);
                     next_row = chunk_y + chunk_n;
                 }
-                const size_t src = (size_t)(y - chunk_y) * width, dst = (size_t)j * width;
-                for (int i = 0; i < width; ++i) {
-                    const double v = h[src + i];
-                    const bool ok = valid[src + i] && std::isfinite(v);
-                    band.codes[dst + i] = ok ? height_code(v, lo, scale_m) : 0;  // voids: the lowest height
-                    band.void_post[dst + i] = ok ? 0 : 1;
-                }
+                // the band's rows j .. jend - 1 held by this chunk, quantised
+                // on the threads (each row alone)
+                const int jend = std::min(rows, chunk_y + chunk_n - y0), nrows = jend - j;
+                parallel_chunks((size_t)nrows, nthreads, ((size_t)nrows + (size_t)nthreads - 1) / (size_t)nthreads,
+                                [&](size_t rb, size_t re) {
+                                    for (size_t q = rb; q < re; ++q) {
+                                        const size_t src = (size_t)(y + (int)q - chunk_y) * width,
+                                                     dst = (size_t)(j + (int)q) * width;
+                                        for (int i = 0; i < width; ++i) {
+                                            const double v = h[src + i];
+                                            const bool ok = valid[src + i] && std::isfinite(v);
+                                            // voids: the lowest height
+                                            band.codes[dst + i] = ok ? height_code(v, lo, scale_m) : 0;
+                                            band.void_post[dst + i] = ok ? 0 : 1;
+                                        }
+                                    }
+                                });
+                j = jend;
             }
             band.height = rows;
             band.geo = shifted_georef(geo, 0, y0);
