@@ -586,7 +586,7 @@ void run_frame(const Prepared &bm, const Frame &f, const D &dist, typename D::va
 // (a symmetric D's transposed frame computes the same values untransposed).
 template <class D, bool kCount>
 void run_frame_for(const Prepared &bm, const Frame &f, const D &dist, typename D::value_type *dt, Point *ft,
-                     const Options &opt, bool first, Stats *stats)
+                   const Options &opt, bool first, Stats *stats)
 {
     if constexpr (!D::symmetric) {
         if (f.transpose) {
