@@ -224,15 +224,18 @@ constexpr int RING_SIDE = 2 * FINE_RING + 1, RING_GROUPS = RING_SIDE * RING_SIDE
 // change).  The offsets keep their order: the same terms in the same
 // sequence, the same codes.
 struct FineRun {
-    size_t first, last;  // offsets [first, last) of mfine.offs
-    int group;           // the coarse cell, an index into alive[]
-    int dy, dx0, dx1;    // their row, first and last column (increasing)
+    size_t first, last;    // offsets [first, last) of mfine.offs
+    int group;             // the coarse cell, an index into alive[]
+    int dy, dx0, dx1;      // their row, first and last column (increasing)
+    double min_rho;        // the least rho of their terms
+    size_t sfirst, scount;  // the sectors of their terms: run_secs[sfirst, sfirst + scount)
 };
 
 // What the near and window terms read, shared by the workers.
 struct LocalTables {
     MergedList mnear, mfine, mcoarse;
     std::vector<FineRun> fine_runs;                 // mfine.offs cut where the coarse cell or the row changes
+    std::vector<int> run_secs;                      // each run's sectors, once each
     std::vector<std::vector<SecOffset>> by_sector;  // the coarse window per sector, by increasing rho
 };
 
@@ -256,8 +259,22 @@ LocalTables local_tables(const Ctx &c, int rw)
             b->last = m + 1;
             b->dx1 = o.dx;
         } else {
-            t.fine_runs.push_back(FineRun{m, m + 1, g, o.dy, o.dx, o.dx});
+            t.fine_runs.push_back(FineRun{m, m + 1, g, o.dy, o.dx, o.dx, 0.0, 0, 0});
         }
+    }
+    for (FineRun &run : t.fine_runs) {
+        run.min_rho = INF;
+        run.sfirst = t.run_secs.size();
+        for (size_t m = run.first; m < run.last; ++m) {
+            const Merged &o = t.mfine.offs[m];
+            for (size_t e = o.first; e < o.first + o.count; ++e) {
+                run.min_rho = std::min(run.min_rho, t.mfine.rhos[e]);
+                const int s = t.mfine.secs[e];
+                if (std::find(t.run_secs.begin() + (long)run.sfirst, t.run_secs.end(), s) == t.run_secs.end())
+                    t.run_secs.push_back(s);
+            }
+        }
+        run.scount = t.run_secs.size() - run.sfirst;
     }
     t.by_sector.assign((size_t)c.n, {});
     for (const Merged &o : t.mcoarse.offs)
@@ -317,6 +334,7 @@ double refined_need(const Ctx &c, int s, double a, Top &tp, double other, int fx
 struct LocalScratch {
     std::vector<uint16_t> colmax, winmax;  // per coarse column of the row: the window's max height
     bool alive[RING_GROUPS];               // the fine ring's coarse cells that rise above the apex
+    double rise[RING_GROUPS];              // and by how much (when alive)
     std::vector<double> need;              // per sector
     std::vector<Top> top;                  // per sector
     std::vector<Sub> stack;
@@ -361,6 +379,7 @@ void local_row(const LocalInput &L, int cj, LocalScratch &sc, uint8_t *codes)
         for (int g = 0; g < RING_GROUPS; ++g) {
             int gi = ci + g % RING_SIDE - FINE_RING, gj = cj + g / RING_SIDE - FINE_RING;
             sc.alive[g] = gi >= 0 && gj >= 0 && gi < wc && gj < hc && hcm[(size_t)gj * wc + gi] > a;
+            if (sc.alive[g]) sc.rise[g] = hcm[(size_t)gj * wc + gi] - a;
         }
         std::fill(sc.need.begin(), sc.need.end(), 0.0);
         for (Top &tp : sc.top) tp.reset();
@@ -375,6 +394,20 @@ void local_row(const LocalInput &L, int cj, LocalScratch &sc, uint8_t *codes)
         }
         for (const FineRun &run : T.fine_runs) {
             if (!sc.alive[run.group]) continue;  // its coarse cell is not above a
+            {
+                // no term of the run exceeds its coarse cell's rise over its
+                // least rho (a fine cell is no taller than its coarse cell,
+                // and a quotient of doubles is monotone in both): when that
+                // bound neither enters a sector's top three nor raises its
+                // rest, the run's terms change nothing (the same codes)
+                const double bound = sc.rise[run.group] / run.min_rho;
+                bool passed = true;
+                for (size_t q = run.sfirst; q < run.sfirst + run.scount && passed; ++q) {
+                    const Top &tp = sc.top[(size_t)T.run_secs[q]];
+                    passed = bound <= tp.v[2] && bound <= tp.rest;
+                }
+                if (passed) continue;
+            }
             const int qj = fy0 + run.dy;
             if (qj < 0 || qj >= c.cy) continue;
             const bool inside = fx0 + run.dx0 >= 0 && fx0 + run.dx1 < c.cx;
