@@ -10,6 +10,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <condition_variable>
 #include <functional>
 #include <mutex>
 #include <thread>
@@ -509,87 +510,132 @@ void build_mosaic_dir(int width, int height, const Georef &geo, double scale_m, 
         int chunk_n = 0;
         const size_t ntiles = entries.size();
         std::atomic<size_t> done{0};
+        // The workers take the tiles in order over the whole grid.  A tile's
+        // terrain is copied out of the band before it is built, so the band
+        // is free once every tile of its row has been copied: the next band
+        // is read and quantised while this row's last tiles are still being
+        // built (no core waits for the reading, nor for a row's last tile).
+        std::mutex mu;
+        std::condition_variable cv;
+        int band_row = -1;  // the row of tiles the band holds (under mu)
+        int copied = 0;     // tiles of band_row copied out of it (under mu)
+        bool failed = false;
+        std::string err;
+        std::atomic<size_t> next_tile{0};
+        auto fail = [&](const std::string &what) {
+            std::lock_guard<std::mutex> lk(mu);
+            if (err.empty()) err = what;
+            failed = true;
+            next_tile = ntiles;  // stop the others
+            cv.notify_all();
+        };
+        auto is_failed = [&] {
+            std::lock_guard<std::mutex> lk(mu);
+            return failed;
+        };
+        auto work = [&](Terrain &tile) {
+            for (;;) {
+                const size_t k = next_tile++;
+                if (k >= ntiles) return;
+                const int row = (int)(k / (size_t)g.tiles_x), col = (int)(k % (size_t)g.tiles_x);
+                try {
+                    {
+                        std::unique_lock<std::mutex> lk(mu);
+                        cv.wait(lk, [&] { return failed || band_row == row; });
+                        if (failed) return;
+                    }
+                    tile_terrain(band, g, col, 0, tile);
+                    {
+                        std::lock_guard<std::mutex> lk(mu);
+                        if (++copied == g.tiles_x) cv.notify_all();
+                    }
+                    const int bx = col / K, by = row / K;
+                    AtomicFile f((fs::path(tmp) / mosaic_set_name(bx, by) / tile_file_name(col - bx * K, row - by * K))
+                                     .string());
+                    TileFileSink sink(f);
+                    build_package_to(tile, o, sink);
+                    f.commit();
+                    entries[k] = sink.entry();
+                } catch (const std::exception &e) {
+                    fail("tile " + std::to_string(col) + "," + std::to_string(row) + ": " + e.what());
+                    return;
+                }
+                done++;
+            }
+        };
         // each worker's tile, its buffers reused from tile to tile (fresh
         // ones per tile were page faults and memsets: ~7% of the build)
-        std::vector<Terrain> tiles((size_t)std::max(1, std::min(nthreads, g.tiles_x)));
-        for (int row = 0; row < g.tiles_y; ++row) {
-            const int y0 = g.first_row(row), rows = std::min(P, height - y0);
-            // the band's rows: the previous band's last row is this one's first
-            for (int j = have; j < rows;) {
-                const int y = y0 + j;
-                if (y >= chunk_y + chunk_n) {
-                    chunk_y = next_row;
-                    chunk_n = std::min(chunk_rows, height - chunk_y);
-                    read(chunk_y, chunk_n, h, valid);
-                    next_row = chunk_y + chunk_n;
-                }
-                // the band's rows j .. jend - 1 held by this chunk, quantised
-                // on the threads (each row alone)
-                const int jend = std::min(rows, chunk_y + chunk_n - y0), nrows = jend - j;
-                parallel_chunks((size_t)nrows, nthreads, ((size_t)nrows + (size_t)nthreads - 1) / (size_t)nthreads,
-                                [&](size_t rb, size_t re) {
-                                    for (size_t q = rb; q < re; ++q) {
-                                        const size_t src = (size_t)(y + (int)q - chunk_y) * width,
-                                                     dst = (size_t)(j + (int)q) * width;
-                                        for (int i = 0; i < width; ++i) {
-                                            const double v = h[src + i];
-                                            const bool ok = valid[src + i] && std::isfinite(v);
-                                            // voids: the lowest height
-                                            band.codes[dst + i] = ok ? height_code(v, lo, scale_m) : 0;
-                                            band.void_post[dst + i] = ok ? 0 : 1;
-                                        }
-                                    }
-                                });
-                j = jend;
-            }
-            band.height = rows;
-            band.geo = shifted_georef(geo, 0, y0);
-            // this band's tiles, `nthreads` at a time
-            std::atomic<int> next_col{0};
-            std::mutex err_mu;
-            std::string err;
-            std::atomic<bool> failed{false};
-            auto work = [&](Terrain &tile) {
-                for (;;) {
-                    const int col = next_col++;
-                    if (col >= g.tiles_x) return;
-                    try {
-                        tile_terrain(band, g, col, 0, tile);
-                        const int bx = col / K, by = row / K;
-                        AtomicFile f((fs::path(tmp) / mosaic_set_name(bx, by) /
-                                      tile_file_name(col - bx * K, row - by * K))
-                                         .string());
-                        TileFileSink sink(f);
-                        build_package_to(tile, o, sink);
-                        f.commit();
-                        entries[(size_t)row * g.tiles_x + col] = sink.entry();
-                    } catch (const std::exception &e) {
-                        std::lock_guard<std::mutex> lk(err_mu);
-                        if (err.empty()) err = "tile " + std::to_string(col) + "," + std::to_string(row) + ": " + e.what();
-                        failed = true;
-                        next_col = g.tiles_x;  // stop the others
+        const int nw = (int)std::max<size_t>(1, std::min<size_t>((size_t)nthreads, ntiles));
+        std::vector<Terrain> tiles((size_t)nw);
+        std::vector<std::thread> pool;
+        for (int k = 0; k < nw; ++k) pool.emplace_back(work, std::ref(tiles[(size_t)k]));
+        try {
+            for (int row = 0; row < g.tiles_y; ++row) {
+                const int y0 = g.first_row(row), rows = std::min(P, height - y0);
+                // the band's rows: the previous band's last row is this one's first
+                for (int j = have; j < rows;) {
+                    const int y = y0 + j;
+                    if (y >= chunk_y + chunk_n) {
+                        chunk_y = next_row;
+                        chunk_n = std::min(chunk_rows, height - chunk_y);
+                        read(chunk_y, chunk_n, h, valid);
+                        next_row = chunk_y + chunk_n;
                     }
-                    done++;
+                    // the band's rows j .. jend - 1 held by this chunk,
+                    // quantised on the threads (each row alone)
+                    const int jend = std::min(rows, chunk_y + chunk_n - y0), nrows = jend - j;
+                    parallel_chunks((size_t)nrows, nthreads, ((size_t)nrows + (size_t)nthreads - 1) / (size_t)nthreads,
+                                    [&](size_t rb, size_t re) {
+                                        for (size_t q = rb; q < re; ++q) {
+                                            const size_t src = (size_t)(y + (int)q - chunk_y) * width,
+                                                         dst = (size_t)(j + (int)q) * width;
+                                            for (int i = 0; i < width; ++i) {
+                                                const double v = h[src + i];
+                                                const bool ok = valid[src + i] && std::isfinite(v);
+                                                // voids: the lowest height
+                                                band.codes[dst + i] = ok ? height_code(v, lo, scale_m) : 0;
+                                                band.void_post[dst + i] = ok ? 0 : 1;
+                                            }
+                                        }
+                                    });
+                    j = jend;
                 }
-            };
-            std::vector<std::thread> pool;
-            const int nw = std::max(1, std::min(nthreads, g.tiles_x));
-            for (int k = 0; k < nw; ++k) pool.emplace_back(work, std::ref(tiles[(size_t)k]));
-            const size_t target = (size_t)(row + 1) * g.tiles_x;
-            while (progress && done.load() < target && !failed.load()) {
+                band.height = rows;
+                band.geo = shifted_georef(geo, 0, y0);
+                // the band to the workers; back once its tiles are copied out
+                std::unique_lock<std::mutex> lk(mu);
+                band_row = row;
+                copied = 0;
+                cv.notify_all();
+                while (!failed && copied < g.tiles_x) {
+                    cv.wait_for(lk, std::chrono::milliseconds(100));
+                    if (progress) {
+                        lk.unlock();
+                        progress("building tiles", done.load(), ntiles);
+                        lk.lock();
+                    }
+                }
+                if (failed) break;
+                lk.unlock();
+                // the band's last row is the next band's first
+                if (row + 1 < g.tiles_y) {
+                    std::copy_n(&band.codes[(size_t)(rows - 1) * width], width, &band.codes[0]);
+                    std::copy_n(&band.void_post[(size_t)(rows - 1) * width], width, &band.void_post[0]);
+                    have = 1;
+                }
+            }
+            while (progress && done.load() < ntiles && !is_failed()) {
                 progress("building tiles", done.load(), ntiles);
                 std::this_thread::sleep_for(std::chrono::milliseconds(100));
             }
+        } catch (...) {
+            fail("the DEM's reading failed");  // the workers stop; the reader's error is thrown again
             for (std::thread &th : pool) th.join();
-            if (!err.empty()) throw Error(err);
-            if (progress) progress("building tiles", done.load(), ntiles);
-            // the band's last row is the next band's first
-            if (row + 1 < g.tiles_y) {
-                std::copy_n(&band.codes[(size_t)(rows - 1) * width], width, &band.codes[0]);
-                std::copy_n(&band.void_post[(size_t)(rows - 1) * width], width, &band.void_post[0]);
-                have = 1;
-            }
+            throw;
         }
+        for (std::thread &th : pool) th.join();
+        if (!err.empty()) throw Error(err);
+        if (progress) progress("building tiles", done.load(), ntiles);
         // each set's manifest: its grid, origin and codes' range
         for (int by = 0; by < sets_y; ++by)
             for (int bx = 0; bx < sets_x; ++bx) {
