@@ -108,7 +108,9 @@ size_t tile_build_memory(int P, int reduce, int sectors);
 // mosaic of tile sets at `dir`, holding one band of tiles (P rows) at a
 // time: a first pass finds the heights' range (the height coding,
 // choose_height_scale(lo, hi, scale_m)), the second reads each band,
-// quantises it and builds its tiles `threads` at a time, writing each to
+// quantises it and builds its tiles `threads` at a time (each tile copied
+// out of the band first, so the next band is read while a band's last
+// tiles are built), writing each to
 // "<dir>.tmp.<pid>" as it is made; renamed into place on success (an
 // existing tile set or mosaic at dir replaced, anything else refused).
 // Refuses with Error when the memory estimate exceeds what the machine has
