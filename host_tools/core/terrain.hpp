@@ -126,6 +126,13 @@ struct HeightRange {
         nvalid++;
         return true;
     }
+    // another part's heights counted too (min, max and count: any order)
+    void merge(const HeightRange &o)
+    {
+        lo = std::min(lo, o.lo);
+        hi = std::max(hi, o.hi);
+        nvalid += o.nvalid;
+    }
 };
 
 // A height's code: lround((h - lo) / scale) clamped to 0..65535.

@@ -172,9 +172,10 @@ void read_number_csv(const std::string &path, const std::vector<std::string> &na
         *e = nl != nullptr ? nl : end;
         p = nl != nullptr ? nl + 1 : end;
     };
+    auto blank = [](char ch) { return ch == ' ' || ch == '\t' || ch == '\r' || ch == '\f' || ch == '\v'; };
     // fields into v (reused from line to line): blanks of every kind
     // dropped (strtod would skip them, the text keep them)
-    auto split = [](const char *b, const char *e, std::vector<std::string> &v) {
+    auto split = [&blank](const char *b, const char *e, std::vector<std::string> &v) {
         size_t k = 0;
         if (v.empty()) v.emplace_back();
         v[0].clear();
@@ -183,7 +184,7 @@ void read_number_csv(const std::string &path, const std::vector<std::string> &na
             if (ch == ',') {
                 if (++k == v.size()) v.emplace_back();
                 v[k].clear();
-            } else if (ch != '\r' && ch != ' ' && ch != '\t' && ch != '\f' && ch != '\v') {
+            } else if (!blank(ch)) {
                 v[k] += ch;
             }
         }
@@ -215,10 +216,7 @@ void read_number_csv(const std::string &path, const std::vector<std::string> &na
     while (p < end) {
         next_line(&lb, &le);
         ++lineno;
-        bool blank = true;
-        for (const char *q = lb; q < le && blank; ++q)
-            blank = *q == ' ' || *q == '\t' || *q == '\r' || *q == '\f' || *q == '\v';
-        if (blank) continue;
+        if (std::all_of(lb, le, blank)) continue;
         split(lb, le, f);
         for (size_t k = 0; k < n; ++k) {
             if ((size_t)col[k] >= f.size()) throw Error(path + ":" + std::to_string(lineno) + ": too few columns");

@@ -395,6 +395,29 @@ std::string gib(size_t b)
     return buf;
 }
 
+// n items in one share per thread: the chunk for parallel_chunks.
+size_t share(size_t n, int threads) { return (n + (size_t)threads - 1) / (size_t)threads; }
+
+// Rows src .. src + n - 1 of a read chunk (h, valid: whole rows of
+// band.width) quantised into the band's rows dst .. dst + n - 1, each row
+// alone on one of `threads` threads; voids get the lowest height.
+void quantise_rows(const std::vector<double> &h, const std::vector<uint8_t> &valid, int src, int dst, int n, double lo,
+                   double scale_m, int threads, Terrain &band)
+{
+    const size_t w = (size_t)band.width;
+    parallel_chunks((size_t)n, threads, share((size_t)n, threads), [&](size_t rb, size_t re) {
+        for (size_t q = rb; q < re; ++q) {
+            const size_t from = ((size_t)src + q) * w, to = ((size_t)dst + q) * w;
+            for (size_t i = 0; i < w; ++i) {
+                const double v = h[from + i];
+                const bool ok = valid[from + i] && std::isfinite(v);
+                band.codes[to + i] = ok ? height_code(v, lo, scale_m) : 0;
+                band.void_post[to + i] = ok ? 0 : 1;
+            }
+        }
+    });
+}
+
 }  // namespace
 
 void build_mosaic_dir(int width, int height, const Georef &geo, double scale_m, int vdatum, const GeoidGrid &geoid,
@@ -456,20 +479,15 @@ void build_mosaic_dir(int width, int height, const Georef &geo, double scale_m, 
     for (int y = 0; y < height; y += chunk_rows) {
         const int n = std::min(chunk_rows, height - y);
         read(y, n, h, valid);
-        // the chunk's range in one part per thread, then merged (min, max
-        // and count: the same in any order)
-        const size_t per = (h.size() + (size_t)nthreads - 1) / (size_t)nthreads;
+        // the chunk's range in one part per thread, then merged
+        const size_t per = share(h.size(), nthreads);
         std::vector<HeightRange> parts((size_t)nthreads);
         parallel_chunks(h.size(), nthreads, per, [&](size_t b, size_t e) {
             HeightRange part;  // a local (the parts share cache lines)
             for (size_t k = b; k < e; ++k) part.add(h[k], valid[k] != 0);
             parts[b / per] = part;
         });
-        for (const HeightRange &part : parts) {
-            range.lo = std::min(range.lo, part.lo);
-            range.hi = std::max(range.hi, part.hi);
-            range.nvalid += part.nvalid;
-        }
+        for (const HeightRange &part : parts) range.merge(part);
         if (progress) progress("scanning heights", (size_t)(y + n), (size_t)height);
     }
     if (range.nvalid == 0) throw Error("every sample is nodata");
@@ -581,23 +599,9 @@ void build_mosaic_dir(int width, int height, const Georef &geo, double scale_m, 
                         read(chunk_y, chunk_n, h, valid);
                         next_row = chunk_y + chunk_n;
                     }
-                    // the band's rows j .. jend - 1 held by this chunk,
-                    // quantised on the threads (each row alone)
-                    const int jend = std::min(rows, chunk_y + chunk_n - y0), nrows = jend - j;
-                    parallel_chunks((size_t)nrows, nthreads, ((size_t)nrows + (size_t)nthreads - 1) / (size_t)nthreads,
-                                    [&](size_t rb, size_t re) {
-                                        for (size_t q = rb; q < re; ++q) {
-                                            const size_t src = (size_t)(y + (int)q - chunk_y) * width,
-                                                         dst = (size_t)(j + (int)q) * width;
-                                            for (int i = 0; i < width; ++i) {
-                                                const double v = h[src + i];
-                                                const bool ok = valid[src + i] && std::isfinite(v);
-                                                // voids: the lowest height
-                                                band.codes[dst + i] = ok ? height_code(v, lo, scale_m) : 0;
-                                                band.void_post[dst + i] = ok ? 0 : 1;
-                                            }
-                                        }
-                                    });
+                    // the band's rows j .. jend - 1 held by this chunk
+                    const int jend = std::min(rows, chunk_y + chunk_n - y0);
+                    quantise_rows(h, valid, y - chunk_y, j, jend - j, lo, scale_m, nthreads, band);
                     j = jend;
                 }
                 band.height = rows;
